@@ -1,0 +1,42 @@
+"""Exception classes.
+
+Every error imgmtf raises on purpose derives from :class:`ImgmtfError`, so a
+caller (and the CLI) can tell a problem with the input from a bug.  Messages
+are one line and name the offending value or file.
+"""
+
+
+class ImgmtfError(Exception):
+    """Base class of all deliberate imgmtf errors."""
+
+
+class ParameterError(ImgmtfError, ValueError):
+    """A parameter is out of its valid range or of the wrong kind."""
+
+
+class ConfigError(ImgmtfError):
+    """A configuration file (sensor TOML) cannot be read or is malformed."""
+
+
+class FileWriteError(ImgmtfError):
+    """An output file cannot be written."""
+
+
+class ImageReadError(ImgmtfError):
+    """An image file cannot be opened or decoded."""
+
+
+class ImageContentError(ImgmtfError):
+    """An image was read but cannot be measured (NaN, flat, too small...)."""
+
+
+class TargetNotFoundError(ImageContentError):
+    """No usable edge or bar was found in the image."""
+
+
+class MultipleTargetsError(ImageContentError):
+    """More than one edge or bar was found where one was expected."""
+
+
+class UnsuitableTargetError(ImageContentError):
+    """A target was found but cannot give a trustworthy MTF (angle, saturation...)."""

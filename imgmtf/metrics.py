@@ -1,0 +1,40 @@
+"""Scalar figures read off sampled curves: half-maximum widths and level
+crossings.  Shared by the sensor model and the estimators so that the truth
+and the estimate are read off in the same way."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def fwhm(x: np.ndarray, y: np.ndarray) -> float:
+    """Full width at half maximum of a single-peaked curve ``y(x)``.
+
+    The half-maximum crossings nearest the peak on each side are found by
+    linear interpolation.  Returns NaN when a side never falls below half
+    the peak.  The result is in the units of ``x``.
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    peak = int(np.argmax(y))
+    half = y[peak] / 2.0
+    below_right = np.nonzero(y[peak:] < half)[0]
+    below_left = np.nonzero(y[: peak + 1] < half)[0]
+    if below_right.size == 0 or below_left.size == 0:
+        return float("nan")
+    r = peak + below_right[0]
+    left = below_left[-1]
+    x_right = x[r - 1] + (y[r - 1] - half) / (y[r - 1] - y[r]) * (x[r] - x[r - 1])
+    x_left = x[left] + (half - y[left]) / (y[left + 1] - y[left]) * (x[left + 1] - x[left])
+    return float(x_right - x_left)
+
+
+def first_crossing(x: np.ndarray, y: np.ndarray, level: float) -> float:
+    """First ``x`` at which a curve starting above ``level`` falls below it
+    (linear interpolation between samples); NaN if it never does."""
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    below = np.nonzero(y < level)[0]
+    if below.size == 0 or below[0] == 0:
+        return float("nan")
+    i = below[0]
+    return float(x[i - 1] + (y[i - 1] - level) / (y[i - 1] - y[i]) * (x[i] - x[i - 1]))
