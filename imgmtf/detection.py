@@ -1,0 +1,110 @@
+"""Find straight edges in an image chip: the seed for the sub-pixel fits.
+
+Canny edge pixels (scikit-image) vote in a Hough transform for lines; the
+strongest line is the edge.  A second line with comparable support, away
+from the first, means the chip holds two edges (or a bar).
+
+Angles follow :mod:`imgmtf.targets`: a line is x cos(theta) + y sin(theta)
+= rho, with theta the angle of its normal from the x (column) axis, which
+is also the tilt of the line from the column axis.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from skimage.feature import canny
+from skimage.transform import hough_line
+
+from .errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
+
+_THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
+_THETAS = np.deg2rad(np.arange(-90.0, 90.0, _THETA_STEP_DEG))
+
+
+@dataclass(frozen=True)
+class Line:
+    """A straight line x cos(theta) + y sin(theta) = rho (pixels), with the
+    number of edge pixels that voted for it."""
+
+    theta_deg: float
+    rho_px: float
+    votes: int
+
+
+def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> list[Line]:
+    """Straight lines of strong gradient, strongest first.
+
+    Canny thresholds are set relative to the image's strongest gradients,
+    so the result does not depend on the DN scale.
+    """
+    lo, hi = np.percentile(image, [1, 99])
+    if not hi > lo:
+        raise ImageContentError("the image is flat: no contrast to measure")
+    norm = (image - lo) / (hi - lo)
+    edges = canny(norm, sigma=sigma, low_threshold=0.1, high_threshold=0.2)
+    if edges.sum() < 5:
+        edges = canny(norm, sigma=sigma, low_threshold=0.5, high_threshold=0.8,
+                      use_quantiles=True)
+    if edges.sum() < 5:
+        return []
+    acc, thetas, rhos = hough_line(edges, theta=_THETAS)
+    return _peaks(acc.astype(float), thetas, rhos, max_lines)
+
+
+def _peaks(acc, thetas, rhos, max_lines, min_distance_px=5, min_angle_deg=8.0) -> list[Line]:
+    """Strongest accumulator cells, each suppressing its neighbourhood
+    (``min_distance_px`` in rho, ``min_angle_deg`` in theta) before the
+    next is taken; cells below a quarter of the strongest are ignored."""
+    threshold = 0.25 * acc.max()
+    dr = min_distance_px
+    dt = int(round(min_angle_deg / _THETA_STEP_DEG))
+    lines = []
+    for _ in range(max_lines):
+        i, j = np.unravel_index(int(np.argmax(acc)), acc.shape)
+        if acc[i, j] < threshold or acc[i, j] == 0:
+            break
+        lines.append(Line(float(np.rad2deg(thetas[j])), float(rhos[i]), int(acc[i, j])))
+        acc[max(i - dr, 0): i + dr + 1, max(j - dt, 0): j + dt + 1] = 0
+    return lines
+
+
+def find_edge(image: np.ndarray, min_votes: int = 10) -> Line:
+    """The single straight edge of a chip.
+
+    Raises
+    ------
+    TargetNotFoundError : no line of at least ``min_votes`` edge pixels.
+    MultipleTargetsError : a second line with at least half the support of
+        the first lies more than 3 px away from it inside the chip.
+    """
+    lines = [ln for ln in find_lines(image) if ln.votes >= min_votes]
+    if not lines:
+        raise TargetNotFoundError("no straight edge found")
+    best = lines[0]
+    for other in lines[1:]:
+        if other.votes >= 0.5 * best.votes and _separation(best, other, image.shape) > 3.0:
+            raise MultipleTargetsError(
+                f"two edges found (at {_describe(best)} and {_describe(other)}); "
+                "crop the image to one edge with --roi")
+    return best
+
+
+def _separation(a: Line, b: Line, shape) -> float:
+    """Largest distance from line a to line b over the chip's rows/columns
+    crossed by a (px)."""
+    rows, cols = shape
+    ta, tb = math.radians(a.theta_deg), math.radians(b.theta_deg)
+    ts = np.linspace(0, 1, 11)
+    if abs(math.cos(ta)) >= abs(math.sin(ta)):
+        y = ts * (rows - 1)
+        x = (a.rho_px - y * math.sin(ta)) / math.cos(ta)
+    else:
+        x = ts * (cols - 1)
+        y = (a.rho_px - x * math.cos(ta)) / math.sin(ta)
+    return float(np.max(np.abs(x * math.cos(tb) + y * math.sin(tb) - b.rho_px)))
+
+
+def _describe(line: Line) -> str:
+    return f"{line.theta_deg:.1f} deg, rho {line.rho_px:.1f} px"

@@ -1,0 +1,53 @@
+"""Checks and crops shared by the estimators: what makes an array a chip
+that can be measured."""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import ImageContentError, ParameterError
+
+MIN_SIZE_PX = 16
+
+
+def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
+    """Validate a 2-D image and crop it to ``roi`` = (x, y, width, height).
+
+    Returns the float64 crop and the (x, y) of its top-left pixel in the
+    image.  Raises :class:`ParameterError` for a bad ROI and
+    :class:`ImageContentError` for an image that cannot be measured.
+    """
+    array = np.asarray(image)
+    if array.ndim != 2:
+        raise ImageContentError(f"expected a 2-D image, got an array of shape {array.shape}")
+    if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):
+        raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
+    x0, y0 = 0, 0
+    if roi is not None:
+        try:
+            x0, y0, w, h = (int(v) for v in roi)
+        except (TypeError, ValueError):
+            raise ParameterError(f"ROI must be four integers x, y, width, height; got {roi!r}") from None
+        rows, cols = array.shape
+        if w <= 0 or h <= 0 or x0 < 0 or y0 < 0 or x0 + w > cols or y0 + h > rows:
+            raise ParameterError(f"ROI x={x0}, y={y0}, width={w}, height={h} is not inside "
+                                 f"the {cols} x {rows} image")
+        array = array[y0:y0 + h, x0:x0 + w]
+    data = array.astype(np.float64)
+    bad = ~np.isfinite(data)
+    if bad.any():
+        raise ImageContentError(f"{int(bad.sum())} pixel(s) are NaN, infinite or nodata")
+    if min(data.shape) < MIN_SIZE_PX:
+        raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
+                                f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
+    if data.max() == data.min():
+        raise ImageContentError("the image is flat: no contrast to measure")
+    return data, (x0, y0)
+
+
+def saturation_levels(dtype) -> tuple[float, float] | None:
+    """(min, max) representable by an integer dtype, None for floats."""
+    dtype = np.dtype(dtype)
+    if np.issubdtype(dtype, np.integer):
+        info = np.iinfo(dtype)
+        return float(info.min), float(info.max)
+    return None
