@@ -1,0 +1,132 @@
+"""Figures.  Each function draws on ``ax`` (a new figure when None) and
+returns the figure; nothing here touches pyplot's global state, so the
+figures render with the Agg canvas whatever the session's backend."""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .mtf import NYQUIST
+
+
+def _axes(ax, size=(5.0, 3.6)):
+    if ax is None:
+        fig = Figure(figsize=size, layout="constrained")
+        return fig, fig.add_subplot()
+    return ax.figure, ax
+
+
+# -- the sensor model --------------------------------------------------------
+def plot_psf(sensor, ax=None, oversampling: int = 20):
+    """The system PSF image (paper Fig. 2a), axes in metres."""
+    fig, ax = _axes(ax)
+    psf = sensor.psf(oversampling)
+    half = psf.data.shape[0] // 2 * psf.step_m
+    ax.imshow(psf.data, extent=(-half, half, half, -half), cmap="magma")
+    ax.set(title="System PSF", xlabel="across track x (m)", ylabel="along track y (m)")
+    return fig
+
+
+def plot_sensor_lsf(sensor, ax=None):
+    """Across- and along-track LSFs with their FWHM (paper Fig. 2b, c)."""
+    fig, ax = _axes(ax)
+    for direction in ("across", "along"):
+        x, lsf = sensor.lsf(direction)
+        ax.plot(x, lsf / lsf.max(), label=f"{direction} track, FWHM {sensor.fwhm_m(direction):.3f} m")
+    ax.axhline(0.5, color="0.6", lw=0.8, ls=":")
+    ax.set(xlim=(-2.5, 2.5), title="Line spread functions", xlabel="distance (m)",
+           ylabel="normalised LSF")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_sensor_mtf(sensor, ax=None):
+    """Across- and along-track MTFs with the Nyquist values (paper Fig. 3)."""
+    fig, ax = _axes(ax)
+    f = np.linspace(0, 1.0, 401)
+    for direction in ("across", "along"):
+        ax.plot(f, sensor.mtf(f, direction),
+                label=f"{direction} track, MTF@Nyquist {sensor.mtf_nyquist(direction):.4f}")
+    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
+    ax.set(title="System MTF", xlabel="frequency (cycles/pixel)", ylabel="MTF", ylim=(0, 1.02))
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_sensor(sensor):
+    """PSF, LSFs and MTFs of the sensor side by side."""
+    fig = Figure(figsize=(14, 4), layout="constrained")
+    axes = fig.subplots(1, 3)
+    plot_psf(sensor, axes[0])
+    plot_sensor_lsf(sensor, axes[1])
+    plot_sensor_mtf(sensor, axes[2])
+    return fig
+
+
+# -- an edge measurement -----------------------------------------------------
+def plot_edge_locations(result, ax=None):
+    """Per-row sub-pixel edge locations and the fitted line (paper Fig. 5a)."""
+    fig, ax = _axes(ax)
+    g = result.geometry
+    ax.plot(g.locations[g.kept], g.rows[g.kept], "o", ms=3, mfc="none", label="row edge location")
+    if (~g.kept).any():
+        ax.plot(g.locations[~g.kept], g.rows[~g.kept], "x", color="C3", label="rejected")
+    ax.plot(g.slope * g.rows + g.intercept, g.rows, "-", color="C1", label="least-squares line")
+    ax.invert_yaxis()
+    frame = "columns" if not g.transposed else "rows"
+    ax.set(title=f"Edge at {result.angle_deg:.2f} deg", xlabel=f"position ({frame}, px)",
+           ylabel="row" if not g.transposed else "column")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_esf(result, ax=None):
+    """Over-sampled ESF samples and the resampled profile (paper Fig. 5b)."""
+    fig, ax = _axes(ax)
+    lo, hi = result.levels_dn
+    ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
+            color="0.6", label="pixels")
+    ax.plot(result.esf_x_px, result.esf, "-", color="C0", label=f"{result.method} profile")
+    ax.set(xlim=(-6, 6), title=f"ESF (SNR {result.snr:.0f})", xlabel="distance from edge (px)",
+           ylabel="normalised DN")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_lsf(result, ax=None):
+    """The windowed LSF with its FWHM."""
+    fig, ax = _axes(ax)
+    ax.plot(result.lsf_x_px, result.lsf, color="C0")
+    ax.set(xlim=(-6, 6), title=f"LSF, FWHM {result.fwhm_px:.3f} px",
+           xlabel="distance from edge (px)", ylabel="LSF (1/px)")
+    return fig
+
+
+def plot_mtf(result, ax=None, truth=None):
+    """The MTF with Nyquist and MTF50 marked; ``truth(f)`` overlays a known
+    MTF (cycles/pixel)."""
+    fig, ax = _axes(ax)
+    f = result.frequencies_cy_px
+    ax.plot(f, result.mtf, color="C0", label="measured")
+    if truth is not None:
+        ax.plot(f, truth(f), "--", color="C2", label="true")
+    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
+    ax.plot([NYQUIST], [result.mtf_nyquist], "o", color="C1",
+            label=f"MTF@Nyquist {result.mtf_nyquist:.4f}")
+    ax.plot([result.mtf50_cy_px], [0.5], "s", color="C3",
+            label=f"MTF50 {result.mtf50_cy_px:.4f} cy/px")
+    ax.set(title="MTF", xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF",
+           ylim=(0, 1.05))
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_edge(result, truth=None):
+    """Edge locations, ESF, LSF and MTF of one measurement."""
+    fig = Figure(figsize=(11, 8), layout="constrained")
+    axes = fig.subplots(2, 2)
+    plot_edge_locations(result, axes[0, 0])
+    plot_esf(result, axes[0, 1])
+    plot_lsf(result, axes[1, 0])
+    plot_mtf(result, axes[1, 1], truth=truth)
+    return fig
