@@ -70,18 +70,25 @@ def _peaks(acc, thetas, rhos, max_lines, min_distance_px=5, min_angle_deg=8.0) -
     return lines
 
 
-def find_edge(image: np.ndarray, min_votes: int = 10) -> Line:
+def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0) -> Line:
     """The single straight edge of a chip.
+
+    A line counts when at least ``min_votes`` Canny pixels lie on it and the
+    mean levels 1-5 px either side of it differ by ``min_contrast`` times
+    the image noise.
 
     Raises
     ------
-    TargetNotFoundError : no line of at least ``min_votes`` edge pixels.
+    TargetNotFoundError : no such line.
     MultipleTargetsError : a second line with at least half the support of
         the first lies more than 3 px away from it inside the chip.
     """
-    lines = [ln for ln in find_lines(image) if ln.votes >= min_votes]
+    noise = robust_noise(image)
+    lines = [ln for ln in find_lines(image)
+             if ln.votes >= min_votes and step_contrast(image, ln) >= min_contrast * noise]
     if not lines:
-        raise TargetNotFoundError("no straight edge found")
+        raise TargetNotFoundError("no straight edge found: no line of strong contrast "
+                                  "stands out of the noise")
     best = lines[0]
     for other in lines[1:]:
         if other.votes >= 0.5 * best.votes and _separation(best, other, image.shape) > 3.0:
@@ -89,6 +96,25 @@ def find_edge(image: np.ndarray, min_votes: int = 10) -> Line:
                 f"two edges found (at {_describe(best)} and {_describe(other)}); "
                 "crop the image to one edge with --roi")
     return best
+
+
+def robust_noise(image: np.ndarray) -> float:
+    """Noise standard deviation (DN) from the median absolute difference of
+    horizontally adjacent pixels, which an edge barely affects."""
+    diff = np.diff(image, axis=1)
+    mad = np.median(np.abs(diff - np.median(diff)))
+    return float(1.4826 * mad / np.sqrt(2.0)) or float(np.std(diff) / np.sqrt(2.0)) or 1e-12
+
+
+def step_contrast(image: np.ndarray, line: Line) -> float:
+    """|mean level 1-5 px on one side of ``line`` - on the other| (DN)."""
+    t = math.radians(line.theta_deg)
+    y, x = np.indices(image.shape)
+    d = x * math.cos(t) + y * math.sin(t) - line.rho_px
+    near, far = (d > 1) & (d < 5), (d < -1) & (d > -5)
+    if not near.any() or not far.any():
+        return 0.0
+    return float(abs(image[near].mean() - image[far].mean()))
 
 
 def _separation(a: Line, b: Line, shape) -> float:

@@ -1,0 +1,28 @@
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.detection import find_edge
+from imgmtf.errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
+
+
+@pytest.mark.parametrize("angle", [2.0, 6.0, -17.0, 38.0, 84.0, -70.0])
+def test_finds_the_edge_within_a_degree(angle):
+    img = im.render(im.Sensor(), im.Target("edge", angle), 80, noise_std_dn=20, seed=1).image
+    line = find_edge(img.astype(float))
+    diff = (line.theta_deg - angle + 90) % 180 - 90
+    assert abs(diff) <= 1.0
+
+
+def test_two_edges_are_refused():
+    img = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, 0, 8.0), 60).image
+    with pytest.raises(MultipleTargetsError, match="two edges"):
+        find_edge(img.astype(float))
+
+
+def test_noise_only_and_flat_images():
+    noise = np.random.default_rng(0).normal(500, 20, (60, 60))
+    with pytest.raises(TargetNotFoundError):
+        find_edge(noise)
+    with pytest.raises(ImageContentError, match="flat"):
+        find_edge(np.full((40, 40), 7.0))

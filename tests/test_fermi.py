@@ -1,0 +1,35 @@
+import numpy as np
+import pytest
+
+from imgmtf.fermi import fermi, fit_fermi
+
+
+def test_recovers_exact_parameters_for_every_row_at_once():
+    rng = np.random.default_rng(0)
+    n = 60
+    x = np.tile(np.arange(-10.0, 11.0), (n, 1)) + rng.integers(-3, 4, (n, 1))
+    truth = np.column_stack([rng.uniform(-900, 900, n), x[:, 10] + rng.uniform(-0.5, 0.5, n),
+                             rng.uniform(0.3, 1.2, n), rng.uniform(100, 300, n)])
+    truth[:, 0] = np.where(np.abs(truth[:, 0]) < 100, 500.0, truth[:, 0])
+    y = fermi(x, truth)
+    fit = fit_fermi(x, y, np.ones_like(y), x[:, 10].astype(float))
+    assert fit.ok.all()
+    np.testing.assert_allclose(fit.location, truth[:, 1], atol=1e-6)
+    np.testing.assert_allclose(fit.width, truth[:, 2], rtol=1e-5)
+    assert fit.rms.max() < 1e-3
+
+
+def test_padding_weights_are_ignored():
+    x = np.tile(np.arange(-8.0, 9.0), (2, 1))
+    y = fermi(x, np.array([[1000.0, 0.3, 0.5, 100.0]] * 2))
+    w = np.ones_like(y)
+    y[1, :3] = 1e6            # garbage where the weight is zero
+    w[1, :3] = 0
+    fit = fit_fermi(x, y, w, np.zeros(2))
+    np.testing.assert_allclose(fit.location, [0.3, 0.3], atol=1e-6)
+
+
+def test_flat_row_fails():
+    x = np.tile(np.arange(-8.0, 9.0), (1, 1))
+    fit = fit_fermi(x, np.full_like(x, 50.0) + np.linspace(0, 1e-9, x.size), np.ones_like(x), np.zeros(1))
+    assert not fit.ok[0] or abs(fit.params[0, 0]) < 1e-3

@@ -1,0 +1,64 @@
+import numpy as np
+import pytest
+from scipy.special import erf
+
+from imgmtf.metrics import first_crossing, fwhm
+from imgmtf.mtf import (central_difference, corrected_mtf, restore_lsf, flat_top_window, mtf50, mtf_area,
+                        relative_edge_response, rise_distance)
+
+
+def gaussian_edge(sigma=0.6, step=0.05, half=15.0):
+    x = np.arange(-half, half + step / 2, step)
+    return x, 0.5 * (1 + erf(x / (sigma * np.sqrt(2))))
+
+
+def test_corrected_mtf_of_gaussian_edge_is_exact():
+    sigma = 0.6
+    x, esf = gaussian_edge(sigma)
+    _, lsf = central_difference(x, esf)
+    mtf = corrected_mtf(lsf, 0.05, None)
+    f = np.array([0.1, 0.25, 0.5, 0.8])
+    np.testing.assert_allclose(mtf(f), np.exp(-2 * np.pi**2 * sigma**2 * f**2), atol=2e-6)
+
+
+def test_uncorrected_central_difference_reads_low_by_its_sinc():
+    x, esf = gaussian_edge(0.6, step=0.25)
+    _, lsf = central_difference(x, esf)
+    corrected = corrected_mtf(lsf, 0.25, None)(np.array([0.5]))[0]
+    raw = corrected * np.sinc(2 * 0.5 * 0.25)
+    assert corrected == pytest.approx(np.exp(-2 * np.pi**2 * 0.36 * 0.25), abs=1e-4)
+    assert raw < corrected
+
+
+def test_mtf50_and_area_of_gaussian():
+    sigma = 0.6
+    x, esf = gaussian_edge(sigma)
+    mtf = corrected_mtf(central_difference(x, esf)[1], 0.05, None)
+    assert mtf50(mtf) == pytest.approx(np.sqrt(np.log(2) / (2 * np.pi**2 * sigma**2)), abs=1e-5)
+    f = np.linspace(0, 0.5, 2001)
+    assert mtf_area(mtf) == pytest.approx(np.trapezoid(np.exp(-2 * np.pi**2 * sigma**2 * f**2), f), abs=1e-5)
+
+
+def test_rise_rer_and_fwhm_of_gaussian():
+    sigma = 0.6
+    x, esf = gaussian_edge(sigma)
+    assert rise_distance(x, esf, 0.0) == pytest.approx(2 * 1.2815516 * sigma, abs=2e-3)
+    assert relative_edge_response(x, esf, 0.0) == pytest.approx(erf(0.5 / (sigma * np.sqrt(2))), abs=1e-6)
+    xl, lsf = central_difference(x, esf)
+    # the central difference widens the LSF by ~0.1 %; deconvolution undoes it
+    assert fwhm(xl, lsf) == pytest.approx(2.3548200 * sigma, rel=2e-3)
+    assert fwhm(xl, restore_lsf(lsf, 0.05, None)) == pytest.approx(2.3548200 * sigma, rel=2e-4)
+
+
+def test_flat_top_window_shape():
+    x = np.linspace(-5, 5, 1001)
+    w = flat_top_window(x, 0.5, 2.0, 1.0)
+    assert w[np.abs(x - 0.5) <= 2.0].min() == 1.0
+    assert w[np.abs(x - 0.5) >= 3.0].max() == 0.0
+    assert w[np.argmin(np.abs(x - 3.0))] == pytest.approx(0.5)
+
+
+def test_first_crossing():
+    f = np.linspace(0, 1, 11)
+    assert first_crossing(f, 1 - f, 0.55) == pytest.approx(0.45)
+    assert np.isnan(first_crossing(f, np.ones(11), 0.5))

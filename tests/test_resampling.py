@@ -1,0 +1,75 @@
+import numpy as np
+import pytest
+from scipy.special import erf
+
+from imgmtf.errors import ParameterError
+from imgmtf.resampling import METHODS, resample_profile, sample_gap
+
+
+def erf_edge(x, sigma=0.6):
+    return 0.5 * (1 + erf(x / (sigma * np.sqrt(2))))
+
+
+@pytest.fixture(scope="module")
+def samples():
+    d = np.random.default_rng(0).uniform(-12, 12, 6000)
+    return d, erf_edge(d)
+
+
+@pytest.mark.parametrize("method, tolerance", [("msg", 1e-4), ("spline", 1e-3), ("iso", None), ("sliding", None)])
+def test_methods_reproduce_a_smooth_edge(samples, method, tolerance):
+    d, v = samples
+    r = resample_profile(d, v, method=method, half_range=11)
+    assert np.allclose(np.diff(r.grid), r.step)
+    assert r.grid[0] == pytest.approx(-r.grid[-1])
+    if tolerance is None:
+        # box-like methods: the result is the edge blurred by their own
+        # kernel; a bin's mean over ~60 random positions scatters by ~0.006
+        width = r.params.get("window_px", r.params.get("bin_px"))
+        x = np.linspace(-width / 2, width / 2, 401)
+        blurred = np.array([np.mean(erf_edge(g + x)) for g in r.grid])
+        assert np.abs(r.values - blurred).max() < (2e-3 if method == "sliding" else 2e-2)
+    else:
+        assert np.nanmax(np.abs(r.values - erf_edge(r.grid))) < tolerance
+
+
+def test_transfer_functions_closed_forms(samples):
+    d, v = samples
+    f = np.array([0.0, 0.25, 0.5, 1.0])
+    sliding = resample_profile(d, v, method="sliding", half_range=10)
+    w = sliding.params["window_px"]
+    np.testing.assert_allclose(sliding.transfer(f), np.sinc(f * w), atol=1e-6)
+    iso = resample_profile(d, v, method="iso", half_range=10)
+    np.testing.assert_allclose(iso.transfer(f), np.sinc(f * 0.25))
+    spline = resample_profile(d, v, method="spline", half_range=10)
+    assert spline.transfer(np.array([2.0]))[0] == pytest.approx(0.5)
+    msg = resample_profile(d, v, method="msg", half_range=10)
+    assert msg.transfer(np.array([0.0]))[0] == pytest.approx(1.0)
+    assert 0.99 < msg.transfer(np.array([0.5]))[0] < 1.0
+
+
+def test_msg_preserves_quartics_exactly():
+    d = np.random.default_rng(1).uniform(-5, 5, 3000)
+    v = 0.3 * d**4 - d**3 + 2 * d + 1
+    r = resample_profile(d, v, method="msg", half_range=4)
+    assert np.abs(r.values - (0.3 * r.grid**4 - r.grid**3 + 2 * r.grid + 1)).max() < 1e-8
+
+
+def test_window_widens_on_a_sample_lattice():
+    d = np.arange(-2000, 2001) * 0.24 / 10
+    d = np.round(d / 0.24) * 0.24                # samples only every 0.24 px
+    assert sample_gap(d) == pytest.approx(0.24)
+    r = resample_profile(d, erf_edge(d), method="msg", half_range=8)
+    assert r.params["window_px"] >= 5.5 * 0.24 - 0.05
+    assert np.isfinite(r.values).all()
+
+
+def test_dispatcher_errors(samples):
+    d, v = samples
+    with pytest.raises(ParameterError, match="unknown method"):
+        resample_profile(d, v, method="lanczos", half_range=5)
+    with pytest.raises(ParameterError, match="takes no option"):
+        resample_profile(d, v, method="iso", half_range=5, order=3)
+    with pytest.raises(ParameterError, match="step"):
+        resample_profile(d, v, method="msg", step=0, half_range=5)
+    assert set(METHODS) == {"msg", "sliding", "spline", "iso"}
