@@ -183,7 +183,7 @@ def measure(paths, kind, method, roi, band, fmt, plot_path, plot_dir):
         if fmt == "json":
             click.echo(json.dumps({"path": path, "band": raster.band, **result.to_dict()}))
         else:
-            click.echo(f"{path:<32} {result.angle_deg:7.2f} {result.direction[:5]:>6} "
+            click.echo(f"{path:<32} {result.angle_deg:7.2f} {result.direction.split('-')[0]:>6} "
                        f"{result.snr:7.0f} {result.mtf_nyquist:8.4f} {result.mtf50_cy_px:7.4f} "
                        f"{result.fwhm_px:6.3f} {result.rer:6.3f}")
             for warning in result.warnings:
@@ -217,3 +217,7 @@ def selftest(method):
         click.echo(f"FAILED: {len(failed)} of {len(rows)} cases out of tolerance (marked !)", err=True)
         sys.exit(1)
     click.echo(f"all {len(rows)} cases within tolerance")
+
+
+if __name__ == "__main__":
+    main()

@@ -229,8 +229,11 @@ class EdgeEstimator:
         if snr < self.snr_threshold:
             warnings.append(f"SNR {snr:.0f} is below {self.snr_threshold:.0f}: the estimate "
                             "is not confident")
-        lsf_c = restore_lsf(lsf_w, esf.step, esf.transfer if self.correct else None)
-        area = np.sum(lsf_c) * esf.step
+        support = np.nonzero(lsf_w)[0]
+        offsets, lsf_c = restore_lsf(lsf_w[support[0]: support[-1] + 1], esf.step,
+                                     esf.transfer if self.correct else None)
+        x_c = x[support[0]] + offsets
+        area = np.sum(lsf_c) * (offsets[1] - offsets[0])
         params = {"method": self.method, **esf.params, "correct": self.correct,
                   "lsf_half_width_px": half_width, "lsf_taper_px": taper}
         return EdgeResult(
@@ -239,10 +242,10 @@ class EdgeEstimator:
             polarity="rising" if right > left else "falling",
             rows_used=int(geometry.kept.sum()), rows_total=int(work.shape[0]), snr=snr,
             mtf_nyquist=float(mtf(NYQUIST)[0]), mtf50_cy_px=mtf50(mtf),
-            fwhm_px=fwhm(x, lsf_c), rer=relative_edge_response(grid, esf01, centre),
+            fwhm_px=fwhm(x_c, lsf_c), rer=relative_edge_response(grid, esf01, centre),
             mtfa=mtf_area(mtf), gsd_m=gsd_m,
             frequencies_cy_px=self.frequencies_cy_px, mtf=mtf(self.frequencies_cy_px),
-            esf_x_px=grid, esf=esf01, lsf_x_px=x, lsf=lsf_c / area,
+            esf_x_px=grid, esf=esf01, lsf_x_px=x_c, lsf=lsf_c / area,
             samples_x_px=d, samples_dn=v, levels_dn=(float(left), float(right)),
             geometry=geometry, roi=roi, window_half_width_px=half_width,
             warnings=tuple(warnings), mtf_function=mtf)

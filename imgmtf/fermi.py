@@ -74,7 +74,8 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
         p = np.where(better[:, None], trial, p)
         cost = np.where(better, trial_cost, cost)
         lam = np.where(better, lam / 3.0, lam * 4.0)
-        if np.all(lam > 1e8) or np.all(np.abs(step[:, 1]) < 1e-7):
+        # converged: no row proposes to move its edge by more than 1e-5 px
+        if np.all((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5)):
             break
     # the model is symmetric under (a, c) -> (-a, -c) with d shifted: keep c > 0
     flip = p[:, 2] < 0

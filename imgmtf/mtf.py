@@ -64,23 +64,32 @@ def estimator_transfer(f: np.ndarray, step: float, transfer: Callable | None) ->
 
 
 def restore_lsf(lsf: np.ndarray, step: float, transfer: Callable | None,
-                band_cy_px: tuple[float, float] = (1.5, 3.0)) -> np.ndarray:
-    """The LSF with the estimator's own blur divided out of its spectrum and
-    its spectrum rolled off (raised cosine) between ``band_cy_px``.
+                band_cy_px: tuple[float, float] = (1.5, 3.0),
+                out_step: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+    """The LSF with the estimator's own blur divided out of its spectrum,
+    rolled off (raised cosine) between ``band_cy_px`` and resampled by
+    band-limited (FFT) interpolation onto a grid no coarser than
+    ``out_step`` px.  Returns ``(offsets, lsf)``, offsets in px from the
+    first input sample.
 
     An imaging LSF sampled at 1 px has almost nothing above 1.5 cy/px (the
-    pixel aperture alone passes < 0.22 there, and optics take the rest), while
-    the resampled profile's noise grows with frequency: the roll-off removes
-    that noise from the FWHM without shifting it (< 0.05 % on the sensors
-    tested).  Where the blur's transfer is below 1/2 the spectrum is only
-    doubled, so noise is never amplified without bound."""
+    pixel aperture alone passes < 0.22 there, and optics take the rest),
+    while the resampled profile's noise grows with frequency: the roll-off
+    removes that noise from the FWHM without shifting it (< 0.05 % on the
+    sensors tested).  Frequencies where the blur's transfer is below
+    ``MIN_TRANSFER`` (the MTF's own limit) cannot be restored and are
+    dropped."""
     n = 2 * lsf.size
+    k = max(int(np.ceil(step / out_step - 1e-9)), 1)
     f = np.fft.rfftfreq(n, d=step)
-    divisor = np.maximum(estimator_transfer(f, step, transfer), 0.5)
     lo, hi = band_cy_px
-    rolloff = np.clip((hi - f) / (hi - lo), 0.0, 1.0)
-    rolloff = 0.5 - 0.5 * np.cos(np.pi * rolloff)
-    return np.fft.irfft(np.fft.rfft(lsf, n=n) * rolloff / divisor, n=n)[: lsf.size]
+    passed = f < hi
+    divisor = estimator_transfer(f[passed], step, transfer)
+    gain = np.zeros_like(f)
+    gain[passed] = np.where(divisor >= MIN_TRANSFER, 1.0 / np.where(divisor > 0, divisor, 1.0), 0.0)
+    rolloff = 0.5 - 0.5 * np.cos(np.pi * np.clip((hi - f) / (hi - lo), 0.0, 1.0))
+    restored = np.fft.irfft(np.fft.rfft(lsf, n=n) * gain * rolloff, n=n * k) * k
+    return np.arange(lsf.size * k) * (step / k), restored[: lsf.size * k]
 
 
 def corrected_mtf(lsf: np.ndarray, step: float,

@@ -26,6 +26,7 @@ from typing import Callable
 
 import numpy as np
 from scipy.interpolate import make_smoothing_spline
+from scipy.ndimage import correlate1d
 
 from .errors import ImageContentError, ParameterError
 
@@ -87,17 +88,17 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     s = np.stack([np.bincount(bins, weights=p, minlength=grid.size) for p in powers])
     t = np.stack([np.bincount(bins, weights=p * v, minlength=grid.size) for p in powers[: order + 1]])
     offsets = np.arange(-half_bins, half_bins + 1) * step / scale
-    # sum over window bins of (u + offset)^k = sum_j C(k, j) offset^(k-j) sum u^j
-    def window_sums(moments, kmax):
-        out = np.zeros((kmax + 1, grid.size))
-        for k in range(kmax + 1):
-            for j in range(k + 1):
-                kernel = math.comb(k, j) * offsets ** (k - j)
-                # correlate: the grid point i collects bins i + offset
-                out[k] += np.convolve(moments[j], kernel[::-1], mode="same")
-        return out
-    m = window_sums(s, 2 * order)
-    rhs = window_sums(t, order)
+
+    def window_sums(moments):
+        """Sum over each grid point's window of (u + offset)^k for every k,
+        from the per-bin sums of u^j: sum_j C(k, j) (offset^(k-j) * S_j),
+        one correlation per power of the offset for all moments at once."""
+        kmax = moments.shape[0] - 1
+        shifted = [correlate1d(moments, offsets ** p, axis=1, mode="constant") for p in range(kmax + 1)]
+        return np.array([sum(math.comb(k, j) * shifted[k - j][j] for j in range(k + 1))
+                         for k in range(kmax + 1)])
+    m = window_sums(s)
+    rhs = window_sums(t)
     idx = np.arange(order + 1)
     normal = m[idx[:, None] + idx[None, :]].transpose(2, 0, 1)
     # a window needs enough samples, spread over it (uniform spread gives

@@ -47,7 +47,13 @@ def test_rise_rer_and_fwhm_of_gaussian():
     xl, lsf = central_difference(x, esf)
     # the central difference widens the LSF by ~0.1 %; deconvolution undoes it
     assert fwhm(xl, lsf) == pytest.approx(2.3548200 * sigma, rel=2e-3)
-    assert fwhm(xl, restore_lsf(lsf, 0.05, None)) == pytest.approx(2.3548200 * sigma, rel=2e-4)
+    offsets, restored = restore_lsf(lsf, 0.05, None)
+    assert fwhm(offsets, restored) == pytest.approx(2.3548200 * sigma, rel=2e-4)
+    # a coarse 1/4-px LSF is interpolated onto a 0.05 px grid
+    xc, esfc = gaussian_edge(sigma, step=0.25)
+    offsets, restored = restore_lsf(central_difference(xc, esfc)[1], 0.25, None)
+    assert offsets[1] == pytest.approx(0.05)
+    assert fwhm(offsets, restored) == pytest.approx(2.3548200 * sigma, rel=1e-3)
 
 
 def test_flat_top_window_shape():

@@ -1,0 +1,116 @@
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from imgmtf.cli import main
+
+
+@pytest.fixture
+def run():
+    def invoke(*args):
+        return CliRunner().invoke(main, [str(a) for a in args])
+    return invoke
+
+
+@pytest.fixture
+def chip(run, tmp_path):
+    path = tmp_path / "edge.tif"
+    result = run("simulate", "--angle", 6, "--size", 64, "--seed", 1, "--out", path)
+    assert result.exit_code == 0, result.output
+    return path
+
+
+def test_simulate_then_measure_json_contract(run, chip, tmp_path):
+    result = run("measure", "--format", "json", chip)
+    assert result.exit_code == 0
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert len(rows) == 1
+    row = rows[0]
+    for key in ("path", "target", "method", "angle_deg", "orientation", "snr", "mtf_nyquist",
+                "mtf50_cy_px", "fwhm_px", "rer", "mtfa", "gsd_m", "frequencies_cy_px", "mtf",
+                "warnings", "imgmtf_version", "params", "band"):
+        assert key in row
+    assert row["path"] == str(chip) and row["target"] == "edge" and row["gsd_m"] == 1.0
+    assert abs(row["angle_deg"] - 6.0) < 0.05
+    assert len(row["frequencies_cy_px"]) == len(row["mtf"]) and row["frequencies_cy_px"][-1] == 1.0
+
+
+def test_batch_keeps_going_past_a_bad_file(run, chip, tmp_path):
+    bad = tmp_path / "bad.tif"
+    bad.write_text("junk")
+    result = run("measure", "--format", "json", bad, chip, tmp_path / "missing.tif")
+    assert result.exit_code == 1
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [("error" in r) for r in rows] == [True, False, True]
+    assert "bad.tif" in rows[0]["error"] and "no such file" in rows[2]["error"]
+
+
+def test_text_output_plots_and_methods(run, chip, tmp_path):
+    png = tmp_path / "edge.png"
+    result = run("measure", "--method", "sliding", "--plot", png, chip)
+    assert result.exit_code == 0 and "MTF@Nyq" in result.stdout
+    assert png.stat().st_size > 10_000
+    out_dir = tmp_path / "plots"
+    assert run("measure", "--plot-dir", out_dir, chip, chip).exit_code == 0
+    assert (out_dir / "edge_mtf.png").exists()
+
+
+def test_roi_and_band(run, chip):
+    assert run("measure", "--roi", "0,0,64,64", "--band", 1, chip).exit_code == 0
+    r = run("measure", "--band", 2, chip)
+    assert r.exit_code == 1 and "band 2 does not exist" in r.stdout
+    r = run("measure", "--roi", "1,2,3", chip)
+    assert r.exit_code == 2
+
+
+@pytest.mark.parametrize("args, message", [
+    (["simulate", "--angle", "120", "--out", "{tmp}/a.tif"], "angle must be in"),
+    (["simulate", "--target", "pulse", "--pulse-width", "-2", "--out", "{tmp}/a.tif"], "pulse width must be > 0"),
+    (["simulate", "--out", "{tmp}/no/such/dir/a.tif"], "cannot write"),
+    (["simulate", "--sensor", "{tmp}/bad.toml", "--out", "{tmp}/a.tif"], "malformed TOML"),
+    (["simulate", "--gsd", "-1", "--out", "{tmp}/a.tif"], "--gsd must be > 0"),
+    (["sensor", "--sensor", "{tmp}/missing.toml"], "cannot read"),
+])
+def test_bad_input_is_one_line_and_exit_1(run, tmp_path, args, message):
+    (tmp_path / "bad.toml").write_text("[sensor\n")
+    result = CliRunner().invoke(main, [a.format(tmp=tmp_path) for a in args])
+    assert result.exit_code == 1
+    assert message in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
+
+
+def test_usage_errors_exit_2(run):
+    assert run("simulate").exit_code == 2                      # --out missing
+    assert run("simulate", "--angle", "abc", "--out", "x.tif").exit_code == 2
+    assert run("measure").exit_code == 2
+    assert run("frobnicate").exit_code == 2
+
+
+def test_sensor_command_prints_and_plots(run, tmp_path):
+    result = run("sensor", "--plot", tmp_path / "s.png", "--save", tmp_path / "s.toml")
+    assert result.exit_code == 0
+    assert "system" in result.stdout and "0.2665" in result.stdout
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+    assert run("sensor", "--sensor", tmp_path / "s.toml").exit_code == 0
+
+
+def test_selftest_passes(run):
+    result = run("selftest")
+    assert result.exit_code == 0, result.output
+    assert "PASS" in result.stdout and "FAIL" not in result.stdout
+
+
+def test_simulated_chip_describes_itself(run, tmp_path):
+    from imgmtf.io import read_raster
+    path = tmp_path / "p.tif"
+    r = run("simulate", "--target", "pulse", "--pulse-width", "2.5", "--gsd", "0.5", "--bits", "8",
+            "--low", "20", "--high", "200", "--ground-noise", "--seed", "3", "--out", path)
+    assert r.exit_code == 0, r.output
+    raster = read_raster(path)
+    assert raster.gsd_m == 0.5 and raster.dtype == "uint8"
+    prov = raster.provenance
+    assert prov["target"]["width_px"] == 5.0 and prov["seed"] == 3
+    assert prov["ground_noise"] == {"layers": 20, "layer_variance_dn2": 100.0}
+    assert np.nanmax(raster.data) <= 255

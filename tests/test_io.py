@@ -1,0 +1,77 @@
+import warnings
+
+import numpy as np
+import pytest
+import rasterio
+from rasterio.errors import NotGeoreferencedWarning
+
+import imgmtf as im
+from imgmtf.errors import FileWriteError, ImageReadError, ParameterError
+from imgmtf.io import read_raster, write_geotiff
+
+
+def test_geotiff_round_trip_with_gsd_and_provenance(tmp_path):
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 32, gsd_m=0.5, seed=3)
+    path = tmp_path / "c.tif"
+    write_geotiff(path, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
+    r = read_raster(path)
+    assert np.array_equal(r.data, chip.image) and r.dtype == "uint16"
+    assert r.gsd_m == 0.5 and r.band == 1
+    assert r.provenance["target"]["angle_deg"] == 6.0
+    assert r.provenance["sensor"] == im.Sensor().to_dict()
+    assert r.tags["TARGET_KIND"] == "edge"
+
+
+def test_multiband_8bit(tmp_path):
+    bands = np.stack([np.full((20, 20), 10 * k, np.uint8) for k in range(1, 4)])
+    path = tmp_path / "m.tif"
+    write_geotiff(path, bands)
+    assert read_raster(path, band=3).data[0, 0] == 30
+    with pytest.raises(ParameterError, match="band 5 does not exist"):
+        read_raster(path, band=5)
+
+
+def test_rgb_png_reads_as_luminance_without_gsd(tmp_path):
+    rgb = np.zeros((3, 20, 20), np.uint8)
+    rgb[0], rgb[1], rgb[2] = 100, 200, 50
+    path = tmp_path / "c.png"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, "w", driver="PNG", width=20, height=20, count=3, dtype="uint8") as dst:
+            dst.write(rgb)
+    r = read_raster(path)
+    assert r.band == "luminance" and r.gsd_m is None
+    assert r.data[0, 0] == pytest.approx(0.2126 * 100 + 0.7152 * 200 + 0.0722 * 50)
+
+
+def test_nodata_becomes_nan(tmp_path):
+    data = np.arange(400, dtype=np.uint16).reshape(20, 20)
+    path = tmp_path / "n.tif"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, "w", driver="GTiff", width=20, height=20, count=1, dtype="uint16",
+                           nodata=5) as dst:
+            dst.write(data, 1)
+    r = read_raster(path)
+    assert np.isnan(r.data[0, 5]) and np.isfinite(r.data).sum() == 399
+
+
+def test_read_errors_name_the_file(tmp_path):
+    with pytest.raises(ImageReadError, match="no such file"):
+        read_raster(tmp_path / "missing.tif")
+    junk = tmp_path / "junk.tif"
+    junk.write_text("not an image")
+    with pytest.raises(ImageReadError, match="junk.tif: not an image"):
+        read_raster(junk)
+    with pytest.raises(FileWriteError, match="cannot write"):
+        write_geotiff(tmp_path / "no" / "dir.tif", np.zeros((4, 4), np.uint8))
+
+
+def test_truncated_tiff(tmp_path):
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 64).image
+    path = tmp_path / "t.tif"
+    write_geotiff(path, chip)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ImageReadError, match="t.tif"):
+        read_raster(path)
