@@ -27,8 +27,8 @@ from .detection import find_edge
 from .errors import ImageContentError, UnsuitableTargetError
 from .inputs import prepare_image, saturation_levels
 from .metrics import fwhm
-from .mtf import (NYQUIST, central_difference, corrected_mtf, restore_lsf, flat_top_window, mtf50,
-                  mtf_area, relative_edge_response, rise_distance)
+from .mtf import (NYQUIST, central_difference, corrected_mtf, flat_top_window, mtf50, mtf_area,
+                  noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
 from .profile import EdgeGeometry, locate_edge
 from .resampling import METHODS, sample_gap, resample_profile
 
@@ -49,7 +49,9 @@ class EdgeResult:
     Distances are in pixels along the edge normal, frequencies in cycles per
     pixel along the normal, the MTF is normalised to 1 at zero frequency.
     ``esf`` is normalised to rise from 0 to 1 whatever the edge's polarity;
-    ``lsf`` integrates to 1 (1/px).
+    ``lsf`` integrates to 1 (1/px).  ``noise_limit_cy_px`` is the frequency
+    above which the MTF is within 3 standard deviations of noise (inf for a
+    noise-free chip): the curve beyond it is not signal.
     """
 
     method: str
@@ -78,6 +80,7 @@ class EdgeResult:
     geometry: EdgeGeometry
     roi: tuple[int, int, int, int]
     window_half_width_px: float
+    noise_limit_cy_px: float
     warnings: tuple[str, ...] = ()
     mtf_function: Callable = field(default=None, repr=False)
 
@@ -108,7 +111,8 @@ class EdgeResult:
             "mtf_nyquist": _finite(self.mtf_nyquist), "mtf50_cy_px": _finite(self.mtf50_cy_px),
             "fwhm_px": _finite(self.fwhm_px), "rer": _finite(self.rer), "mtfa": _finite(self.mtfa),
             "gsd_m": self.gsd_m, "mtf50_cy_m": _finite(self.mtf50_cy_m),
-            "fwhm_m": _finite(self.fwhm_m), "levels_dn": list(self.levels_dn),
+            "fwhm_m": _finite(self.fwhm_m), "noise_limit_cy_px": _finite(self.noise_limit_cy_px),
+            "levels_dn": list(self.levels_dn),
             "roi": list(self.roi), "warnings": list(self.warnings),
             "params": self.params, "imgmtf_version": __version__,
         }
@@ -229,9 +233,12 @@ class EdgeEstimator:
         if snr < self.snr_threshold:
             warnings.append(f"SNR {snr:.0f} is below {self.snr_threshold:.0f}: the estimate "
                             "is not confident")
+        density = d.size / (2.0 * half_range)
+        noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
         support = np.nonzero(lsf_w)[0]
+        band = (min(noise_limit, 1.5), min(2.0 * noise_limit, 3.0))
         offsets, lsf_c = restore_lsf(lsf_w[support[0]: support[-1] + 1], esf.step,
-                                     esf.transfer if self.correct else None)
+                                     esf.transfer if self.correct else None, band_cy_px=band)
         x_c = x[support[0]] + offsets
         area = np.sum(lsf_c) * (offsets[1] - offsets[0])
         params = {"method": self.method, **esf.params, "correct": self.correct,
@@ -248,6 +255,7 @@ class EdgeEstimator:
             esf_x_px=grid, esf=esf01, lsf_x_px=x_c, lsf=lsf_c / area,
             samples_x_px=d, samples_dn=v, levels_dn=(float(left), float(right)),
             geometry=geometry, roi=roi, window_half_width_px=half_width,
+            noise_limit_cy_px=noise_limit,
             warnings=tuple(warnings), mtf_function=mtf)
 
 

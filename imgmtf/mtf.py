@@ -112,6 +112,24 @@ def corrected_mtf(lsf: np.ndarray, step: float,
     return mtf
 
 
+def noise_limited_frequency(mtf: Callable, snr: float, window_px: float, density: float,
+                            f_max: float = 3.0) -> float:
+    """First frequency (cy/px) where the MTF falls below 3 times its own
+    noise, or inf if it never does below ``f_max``.
+
+    White noise of relative level 1/SNR on ESF samples of ``density`` per
+    pixel, differentiated and transformed over a window of ``window_px``,
+    gives the MTF a standard deviation of 2 pi f / SNR * sqrt(window / (2
+    density)) (the in-phase half of the noise's power).
+    """
+    if not (math.isfinite(snr) and snr > 0):
+        return float("inf")
+    f = np.arange(0.02, f_max + 1e-9, 0.02)
+    sigma = 2 * np.pi * f / snr * math.sqrt(window_px / (2 * density))
+    below = np.nonzero(~(mtf(f) >= 3 * sigma))[0]
+    return float(f[below[0]]) if below.size else float("inf")
+
+
 def mtf50(mtf: Callable, f_max: float = 2.0, coarse: float = 0.02) -> float:
     """Frequency (cy/px) where the MTF first falls to 0.5: bracketed on a
     ``coarse`` grid, then interpolated linearly on a 1/50-finer grid inside

@@ -149,3 +149,12 @@ def test_estimator_is_reusable_and_result_serialises():
                 "mtfa", "gsd_m", "frequencies_cy_px", "mtf", "warnings", "params"):
         assert key in d
     assert a.mtf_at([0.5])[0] == pytest.approx(a.mtf_nyquist)
+
+
+def test_noisy_fwhm_and_noise_limit():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    r = measure_edge(exact_edge_chip(h, 6.0, noise_std=10.0, seed=9))      # SNR 100
+    assert r.fwhm_px == pytest.approx(true_fwhm(h), rel=0.04)
+    assert 0.5 < r.noise_limit_cy_px < 1.5
+    clean = measure_edge(exact_edge_chip(h, 6.0))
+    assert clean.noise_limit_cy_px > r.noise_limit_cy_px

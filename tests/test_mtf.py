@@ -68,3 +68,17 @@ def test_first_crossing():
     f = np.linspace(0, 1, 11)
     assert first_crossing(f, 1 - f, 0.55) == pytest.approx(0.45)
     assert np.isnan(first_crossing(f, np.ones(11), 0.5))
+
+
+def test_noise_limited_frequency_closed_form():
+    from scipy.optimize import brentq
+
+    from imgmtf.mtf import noise_limited_frequency
+
+    def mtf(f):
+        return np.exp(-4.0 * np.asarray(f))
+    k = 3 * 2 * np.pi / 100 * np.sqrt(4.0 / 200.0)
+    exact = brentq(lambda f: np.exp(-4 * f) - k * f, 0.01, 3.0)
+    got = noise_limited_frequency(mtf, 100.0, 4.0, 100.0)
+    assert exact <= got < exact + 0.02
+    assert noise_limited_frequency(mtf, float("inf"), 4.0, 100.0) == float("inf")
