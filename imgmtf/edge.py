@@ -29,14 +29,10 @@ from .inputs import prepare_image, saturation_levels
 from .metrics import fwhm
 from .mtf import (NYQUIST, central_difference, corrected_mtf, flat_top_window, mtf50, mtf_area,
                   noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
-from .profile import EdgeGeometry, locate_edge
-from .resampling import METHODS, sample_gap, resample_profile
+from .profile import EdgeGeometry, check_angle, locate_edge, profile_samples, vertical_frame
+from .resampling import METHODS, resample_profile
 
 SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
-MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
-MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
-MAX_PHASE_GAP_PX = 0.25       # at least 4 sample phases per pixel
-MAX_HALF_RANGE_PX = 32.0       # ESF samples kept within this distance
 WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
 WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
 DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
@@ -172,36 +168,14 @@ class EdgeEstimator:
         data, (x0, y0) = prepare_image(image, roi)
         if saturation is None:
             saturation = saturation_levels(np.asarray(image).dtype)
-        seed = find_edge(data)
-        theta = math.radians(seed.theta_deg)
-        transposed = abs(math.sin(theta)) > abs(math.cos(theta))
-        work = data.T if transposed else data
-        if transposed:
-            theta = math.pi / 2 - theta
-        rows = np.arange(work.shape[0])
-        seed_x = ((seed.rho_px - rows * math.sin(theta)) / math.cos(theta)) if not transposed \
-            else ((seed.rho_px - rows * math.cos(math.radians(seed.theta_deg)))
-                  / math.sin(math.radians(seed.theta_deg)))
+        work, seed_x, transposed = vertical_frame(data, find_edge(data))
         geometry = locate_edge(work, seed_x, transposed=transposed)
-        _check_angle(math.degrees(math.atan(geometry.slope)))
+        check_angle(geometry, "edge")
         return self._profile(work, geometry, (x0, y0, data.shape[1], data.shape[0]),
                              gsd_m, saturation)
 
     def _profile(self, work, geometry: EdgeGeometry, roi, gsd_m, saturation) -> EdgeResult:
-        kept_rows = geometry.rows[geometry.kept]
-        cols = np.arange(work.shape[1], dtype=float)
-        d = geometry.distance(cols[None, :], kept_rows[:, None].astype(float))
-        v = work[kept_rows]
-        # most rows (3 in 4) must reach the profile's ends on both sides
-        reach = np.minimum(-d[:, 0], d[:, -1])
-        half_range = min(float(np.quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
-        if half_range < 4.0:
-            raise UnsuitableTargetError(
-                f"the edge is {max(half_range, 0):.1f} px from the image border; "
-                "at least 4 px of flat level are needed on each side")
-        inside = np.abs(d) <= half_range
-        d, v = d[inside], v[inside]
-        _check_phases(d, geometry)
+        d, v, half_range = profile_samples(work, geometry, "edge")
         esf = resample_profile(d, v, method=self.method, step=self.step_px,
                                half_range=half_range - 0.6, **self.method_options)
         grid, values = esf.grid, esf.values
@@ -278,32 +252,6 @@ def measure_edge(image, *, roi=None, method: str = "msg", gsd_m: float | None = 
     EdgeResult
     """
     return EdgeEstimator(method, **options)(image, roi=roi, gsd_m=gsd_m, saturation=saturation)
-
-
-def _check_angle(tilt_deg: float) -> None:
-    a = abs(tilt_deg)
-    if a < MIN_ANGLE_DEG:
-        raise UnsuitableTargetError(
-            f"the edge is {a:.2f} deg from the image axis: too close for sub-pixel sampling "
-            f"(tilt it by {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)")
-    if a > MAX_ANGLE_DEG:
-        raise UnsuitableTargetError(
-            f"the edge is {a:.2f} deg from the image axis, too close to 45 deg for "
-            f"sub-pixel sampling (tilt it by {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)")
-
-
-def _check_phases(d: np.ndarray, geometry: EdgeGeometry) -> None:
-    """Refuse when the samples near the edge leave a sub-pixel gap wider than
-    :data:`MAX_PHASE_GAP_PX`: fewer than 4 phases per pixel cannot resolve
-    the profile (angles with tan a = 1/q, q < 4, or too few rows)."""
-    if np.count_nonzero(np.abs(d) < 2.0) < 20:
-        raise UnsuitableTargetError("too few samples near the edge")
-    gap = sample_gap(d)
-    if gap > MAX_PHASE_GAP_PX:
-        raise UnsuitableTargetError(
-            f"the edge at {geometry.angle_deg:.2f} deg samples sub-pixel phases with a gap of "
-            f"{gap:.2f} px (at most {MAX_PHASE_GAP_PX} allowed): too few rows, or an angle "
-            "whose phases repeat every 1-3 rows (near 45, 26.6, 18.4 deg)")
 
 
 def _check_saturation(v, d, left, right, saturation) -> None:

@@ -13,8 +13,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import TargetNotFoundError
+from .detection import Line
+from .errors import TargetNotFoundError, UnsuitableTargetError
 from .fermi import fit_fermi
+from .resampling import sample_gap
+
+MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
+MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
+MAX_SAMPLE_GAP_PX = 0.25       # at least 4 sample positions per pixel
+MAX_HALF_RANGE_PX = 32.0       # profile samples kept within this distance
+MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,21 +65,22 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
     Rows whose fit fails are dropped; the line is refitted after discarding
     locations more than 4 robust standard deviations (and 0.05 px) off it.
     """
-    rows_n, cols_n = image.shape
-    rows = np.arange(rows_n)
-    centre = np.rint(seed_x).astype(int)
-    cols = centre[:, None] + np.arange(-half_window, half_window + 1)[None, :]
-    inside = (cols >= 0) & (cols < cols_n)
-    values = image[rows[:, None], np.clip(cols, 0, cols_n - 1)]
+    rows = np.arange(image.shape[0])
+    cols, values, inside = row_windows(image, seed_x, half_window)
     usable = inside.sum(axis=1) >= half_window + 4
     if usable.sum() < 5:
         raise TargetNotFoundError("the edge does not cross enough rows of the image")
     fit = fit_fermi(cols[usable].astype(float), values[usable], inside[usable].astype(float),
                     seed_x[usable])
-    y = rows[usable][fit.ok]
-    x = fit.location[fit.ok]
+    return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed)
+
+
+def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> EdgeGeometry:
+    """Robust least-squares line x = m y + k through per-row locations:
+    refitted after discarding locations more than 4 robust standard
+    deviations (and 0.05 px) off it."""
     if y.size < 5:
-        raise TargetNotFoundError("the per-row edge fits failed: no clear edge profile in the rows")
+        raise TargetNotFoundError("the per-row fits failed: no clear target profile in the rows")
     keep = np.ones(y.size, bool)
     for _ in range(4):
         slope, intercept = np.polyfit(y[keep], x[keep], 1)
@@ -83,3 +92,70 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
         keep = new_keep
     slope, intercept = np.polyfit(y[keep], x[keep], 1)
     return EdgeGeometry(float(slope), float(intercept), y, x, keep, transposed)
+
+
+def row_windows(image: np.ndarray, centre_x: np.ndarray, half_window: int):
+    """Each row's pixels within ``half_window`` of ``centre_x``: (cols,
+    values, inside), arrays of n_rows x (2 half_window + 1), ``inside``
+    False where the window leaves the image."""
+    rows_n, cols_n = image.shape
+    cols = np.rint(centre_x).astype(int)[:, None] + np.arange(-half_window, half_window + 1)[None, :]
+    inside = (cols >= 0) & (cols < cols_n)
+    values = image[np.arange(rows_n)[:, None], np.clip(cols, 0, cols_n - 1)]
+    return cols, values, inside
+
+
+def vertical_frame(image: np.ndarray, line: Line) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The image in the vertical frame of ``line`` (transposed when the line
+    is nearer horizontal), the line's column in every row of that frame, and
+    whether it was transposed."""
+    t = math.radians(line.theta_deg)
+    c, s = math.cos(t), math.sin(t)
+    transposed = abs(s) > abs(c)
+    work = image.T if transposed else image
+    a, b = (s, c) if transposed else (c, s)        # the line: a x + b y = rho
+    return work, (line.rho_px - np.arange(work.shape[0]) * b) / a, transposed
+
+
+def check_angle(geometry: EdgeGeometry, name: str) -> None:
+    """Refuse a target too close to an axis or to 45 deg for sub-pixel
+    sampling."""
+    a = abs(math.degrees(math.atan(geometry.slope)))
+    advice = f"(tilt it by {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)"
+    if a < MIN_ANGLE_DEG:
+        raise UnsuitableTargetError(f"the {name} is {a:.2f} deg from the image axis: too close "
+                                    f"for sub-pixel sampling {advice}")
+    if a > MAX_ANGLE_DEG:
+        raise UnsuitableTargetError(f"the {name} is {a:.2f} deg from the image axis, too close "
+                                    f"to 45 deg for sub-pixel sampling {advice}")
+
+
+def profile_samples(work: np.ndarray, geometry: EdgeGeometry, name: str):
+    """Every pixel of the kept rows as a profile sample: ``(d, v,
+    half_range)``, the signed distance (px) to the line, the value, and the
+    distance D within which samples are kept (the distance 3 rows in 4
+    reach on both sides, at most ``MAX_HALF_RANGE_PX``).
+
+    Refuses a target too near the border or whose samples leave a gap wider
+    than ``MAX_SAMPLE_GAP_PX`` within 2 px of the line."""
+    rows = geometry.rows[geometry.kept]
+    cols = np.arange(work.shape[1], dtype=float)
+    d = geometry.distance(cols[None, :], rows[:, None].astype(float))
+    v = work[rows]
+    reach = np.minimum(-d[:, 0], d[:, -1])
+    half_range = min(float(np.quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
+    if half_range < MIN_HALF_RANGE_PX:
+        raise UnsuitableTargetError(
+            f"the {name} is {max(half_range, 0):.1f} px from the image border; at least "
+            f"{MIN_HALF_RANGE_PX:g} px of flat level are needed on each side")
+    inside = np.abs(d) <= half_range
+    d, v = d[inside], v[inside]
+    if np.count_nonzero(np.abs(d) < 2.0) < 20:
+        raise UnsuitableTargetError(f"too few samples near the {name}")
+    gap = sample_gap(d)
+    if gap > MAX_SAMPLE_GAP_PX:
+        raise UnsuitableTargetError(
+            f"the {name} at {geometry.angle_deg:.2f} deg samples sub-pixel phases with a gap of "
+            f"{gap:.2f} px (at most {MAX_SAMPLE_GAP_PX} allowed): too few rows, or an angle "
+            "whose phases repeat every 1-3 rows (near 45, 26.6, 18.4 deg)")
+    return d, v, half_range
