@@ -27,7 +27,7 @@ from .detection import find_edge
 from .errors import ImageContentError, UnsuitableTargetError
 from .inputs import prepare_image, saturation_levels
 from .metrics import fwhm
-from .mtf import (NYQUIST, central_difference, corrected_mtf, flat_top_window, mtf50, mtf_area,
+from .mtf import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
                   noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
 from .profile import EdgeGeometry, check_angle, locate_edge, profile_samples, vertical_frame
 from .resampling import METHODS, resample_profile
@@ -202,19 +202,18 @@ class EdgeEstimator:
         half_width = self.lsf_half_width_px or factor * rise
         taper = 0.5 * half_width
         lsf_w = lsf * flat_top_window(x, centre, half_width, taper)
-        mtf = corrected_mtf(lsf_w, esf.step, esf.transfer if self.correct else None)
+        divisor = edge_divisor(esf.step, esf.transfer if self.correct else None)
+        mtf = corrected_mtf(lsf_w, esf.step, divisor)
         warnings = []
         if snr < self.snr_threshold:
             warnings.append(f"SNR {snr:.0f} is below {self.snr_threshold:.0f}: the estimate "
                             "is not confident")
         density = d.size / (2.0 * half_range)
         noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
-        support = np.nonzero(lsf_w)[0]
+        support = slice(*np.nonzero(lsf_w)[0][[0, -1]] + [0, 1])
         band = (min(noise_limit, 1.5), min(2.0 * noise_limit, 3.0))
-        offsets, lsf_c = restore_lsf(lsf_w[support[0]: support[-1] + 1], esf.step,
-                                     esf.transfer if self.correct else None, band_cy_px=band)
-        x_c = x[support[0]] + offsets
-        area = np.sum(lsf_c) * (offsets[1] - offsets[0])
+        x_c, lsf_c = restore_lsf(lsf_w[support], x[support], divisor, band_cy_px=band)
+        area = np.sum(lsf_c) * (x_c[1] - x_c[0])
         params = {"method": self.method, **esf.params, "correct": self.correct,
                   "lsf_half_width_px": half_width, "lsf_taper_px": taper}
         return EdgeResult(

@@ -56,59 +56,72 @@ def spectrum(lsf: np.ndarray, step: float, resolution: float = 1e-3) -> tuple[np
     return np.fft.rfftfreq(n, d=step), np.abs(np.fft.rfft(lsf, n=n)) * step
 
 
-def estimator_transfer(f: np.ndarray, step: float, transfer: Callable | None) -> np.ndarray:
-    """Transfer of the estimator's own steps at ``f`` cy/px: the central
-    difference with ``step`` times the resampling ``transfer`` (if any)."""
-    divisor = np.sinc(2 * f * step)
-    return divisor * transfer(f) if transfer is not None else divisor
+def edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
+    """Transfer of an edge estimator's own steps: the central difference
+    with ``step`` (sinc(2 f step)) times the resampling ``transfer``."""
+    def divisor(f):
+        f = np.atleast_1d(np.asarray(f, float))
+        central = np.sinc(2 * f * step)
+        return central * transfer(f) if transfer is not None else central
+    return divisor
 
 
-def restore_lsf(lsf: np.ndarray, step: float, transfer: Callable | None,
+def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
                 band_cy_px: tuple[float, float] = (1.5, 3.0),
                 out_step: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
-    """The LSF with the estimator's own blur divided out of its spectrum,
-    rolled off (raised cosine) between ``band_cy_px`` and resampled by
-    band-limited (FFT) interpolation onto a grid no coarser than
-    ``out_step`` px.  Returns ``(offsets, lsf)``, offsets in px from the
-    first input sample.
+    """The LSF behind a profile (an LSF or a pulse response sampled at the
+    uniform positions ``x``, px): its spectrum, referenced to x = 0, divided
+    by ``divisor`` (signed), rolled off (raised cosine) between
+    ``band_cy_px``, and transformed back on a grid no coarser than
+    ``out_step`` px (band-limited interpolation).  Returns ``(x, lsf)``,
+    centred on 0.
 
-    An imaging LSF sampled at 1 px has almost nothing above 1.5 cy/px (the
-    pixel aperture alone passes < 0.22 there, and optics take the rest),
-    while the resampled profile's noise grows with frequency: the roll-off
-    removes that noise from the FWHM without shifting it (< 0.05 % on the
-    sensors tested).  Frequencies where the blur's transfer is below
-    ``MIN_TRANSFER`` (the MTF's own limit) cannot be restored and are
-    dropped."""
-    n = 2 * lsf.size
+    Where |divisor| < ``MIN_TRANSFER`` (near a zero of a pulse's sinc) the
+    spectrum is interpolated linearly from its neighbours instead of being
+    divided.  An imaging LSF sampled at 1 px has almost nothing above
+    1.5 cy/px, while the resampled profile's noise grows with frequency:
+    the roll-off removes that noise from the FWHM without shifting it
+    (< 0.05 % on the sensors tested)."""
+    step = x[1] - x[0]
+    n = 2 * profile.size
     k = max(int(np.ceil(step / out_step - 1e-9)), 1)
     f = np.fft.rfftfreq(n, d=step)
     lo, hi = band_cy_px
+    spec = np.fft.rfft(profile, n=n) * np.exp(-2j * np.pi * f * x[0])
     passed = f < hi
-    divisor = estimator_transfer(f[passed], step, transfer)
-    gain = np.zeros_like(f)
-    gain[passed] = np.where(divisor >= MIN_TRANSFER, 1.0 / np.where(divisor > 0, divisor, 1.0), 0.0)
-    rolloff = 0.5 - 0.5 * np.cos(np.pi * np.clip((hi - f) / (hi - lo), 0.0, 1.0))
-    restored = np.fft.irfft(np.fft.rfft(lsf, n=n) * gain * rolloff, n=n * k) * k
-    return np.arange(lsf.size * k) * (step / k), restored[: lsf.size * k]
+    div = divisor(f[passed])
+    good = np.abs(div) >= MIN_TRANSFER
+    restored = np.zeros_like(spec)
+    fp, sp = f[passed], spec[passed]
+    restored[passed] = np.where(good, sp / np.where(good, div, 1.0), 0.0)
+    if good.any() and not good.all():
+        bad = ~good
+        restored[passed] = np.where(bad, np.interp(fp, fp[good], restored[passed][good].real)
+                                    + 1j * np.interp(fp, fp[good], restored[passed][good].imag),
+                                    restored[passed])
+    restored *= 0.5 - 0.5 * np.cos(np.pi * np.clip((hi - f) / (hi - lo), 0.0, 1.0))
+    out = np.fft.fftshift(np.fft.irfft(restored, n=n * k) * k)
+    return (np.arange(n * k) - n * k // 2) * (step / k), out
 
 
-def corrected_mtf(lsf: np.ndarray, step: float,
-                  transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
-    """MTF(f) of a windowed LSF sampled every ``step`` px, normalised at 0,
-    divided by the transfer of the central difference with that step and
-    by ``transfer`` (the resampling method's) when given.  Between FFT bins
-    the modulus is interpolated linearly (bins 0.001 cy/px apart)."""
-    support = np.nonzero(lsf)[0]
+def corrected_mtf(profile: np.ndarray, step: float,
+                  divisor: Callable) -> Callable[[np.ndarray], np.ndarray]:
+    """MTF(f) of a windowed profile (LSF, or pulse response) sampled every
+    ``step`` px: |FT| normalised at 0, divided by |divisor(f)|, the transfer
+    of everything between the system's LSF and this profile.  NaN where
+    |divisor| < ``MIN_TRANSFER``.  Between FFT bins (0.001 cy/px apart) the
+    modulus is interpolated linearly."""
+    support = np.nonzero(profile)[0]
     if support.size:
-        lsf = lsf[support[0]: support[-1] + 1]
-    freqs, modulus = spectrum(lsf, step)
+        profile = profile[support[0]: support[-1] + 1]
+    freqs, modulus = spectrum(profile, step)
     modulus = modulus / modulus[0]
 
     def mtf(f):
         f = np.atleast_1d(np.asarray(f, float))
-        divisor = estimator_transfer(f, step, transfer)
+        div = np.abs(divisor(f) / divisor(np.zeros(1)))
         value = np.interp(f, freqs, modulus, right=np.nan)
-        return np.where(divisor >= MIN_TRANSFER, value / np.where(divisor > 0, divisor, 1), np.nan)
+        return np.where(div >= MIN_TRANSFER, value / np.where(div > 0, div, 1), np.nan)
     return mtf
 
 

@@ -3,8 +3,8 @@ import pytest
 from scipy.special import erf
 
 from imgmtf.metrics import first_crossing, fwhm
-from imgmtf.mtf import (central_difference, corrected_mtf, restore_lsf, flat_top_window, mtf50, mtf_area,
-                        relative_edge_response, rise_distance)
+from imgmtf.mtf import (central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
+                        relative_edge_response, restore_lsf, rise_distance)
 
 
 def gaussian_edge(sigma=0.6, step=0.05, half=15.0):
@@ -16,7 +16,7 @@ def test_corrected_mtf_of_gaussian_edge_is_exact():
     sigma = 0.6
     x, esf = gaussian_edge(sigma)
     _, lsf = central_difference(x, esf)
-    mtf = corrected_mtf(lsf, 0.05, None)
+    mtf = corrected_mtf(lsf, 0.05, edge_divisor(0.05, None))
     f = np.array([0.1, 0.25, 0.5, 0.8])
     np.testing.assert_allclose(mtf(f), np.exp(-2 * np.pi**2 * sigma**2 * f**2), atol=2e-6)
 
@@ -24,7 +24,7 @@ def test_corrected_mtf_of_gaussian_edge_is_exact():
 def test_uncorrected_central_difference_reads_low_by_its_sinc():
     x, esf = gaussian_edge(0.6, step=0.25)
     _, lsf = central_difference(x, esf)
-    corrected = corrected_mtf(lsf, 0.25, None)(np.array([0.5]))[0]
+    corrected = corrected_mtf(lsf, 0.25, edge_divisor(0.25, None))(np.array([0.5]))[0]
     raw = corrected * np.sinc(2 * 0.5 * 0.25)
     assert corrected == pytest.approx(np.exp(-2 * np.pi**2 * 0.36 * 0.25), abs=1e-4)
     assert raw < corrected
@@ -33,7 +33,7 @@ def test_uncorrected_central_difference_reads_low_by_its_sinc():
 def test_mtf50_and_area_of_gaussian():
     sigma = 0.6
     x, esf = gaussian_edge(sigma)
-    mtf = corrected_mtf(central_difference(x, esf)[1], 0.05, None)
+    mtf = corrected_mtf(central_difference(x, esf)[1], 0.05, edge_divisor(0.05, None))
     assert mtf50(mtf) == pytest.approx(np.sqrt(np.log(2) / (2 * np.pi**2 * sigma**2)), abs=1e-5)
     f = np.linspace(0, 0.5, 2001)
     assert mtf_area(mtf) == pytest.approx(np.trapezoid(np.exp(-2 * np.pi**2 * sigma**2 * f**2), f), abs=1e-5)
@@ -47,13 +47,15 @@ def test_rise_rer_and_fwhm_of_gaussian():
     xl, lsf = central_difference(x, esf)
     # the central difference widens the LSF by ~0.1 %; deconvolution undoes it
     assert fwhm(xl, lsf) == pytest.approx(2.3548200 * sigma, rel=2e-3)
-    offsets, restored = restore_lsf(lsf, 0.05, None)
-    assert fwhm(offsets, restored) == pytest.approx(2.3548200 * sigma, rel=2e-4)
+    xr, restored = restore_lsf(lsf, xl, edge_divisor(0.05, None))
+    assert fwhm(xr, restored) == pytest.approx(2.3548200 * sigma, rel=2e-4)
+    assert xr[np.argmax(restored)] == pytest.approx(0.0, abs=0.03)
     # a coarse 1/4-px LSF is interpolated onto a 0.05 px grid
     xc, esfc = gaussian_edge(sigma, step=0.25)
-    offsets, restored = restore_lsf(central_difference(xc, esfc)[1], 0.25, None)
-    assert offsets[1] == pytest.approx(0.05)
-    assert fwhm(offsets, restored) == pytest.approx(2.3548200 * sigma, rel=1e-3)
+    xl, lsf = central_difference(xc, esfc)
+    xr, restored = restore_lsf(lsf, xl, edge_divisor(0.25, None))
+    assert xr[1] - xr[0] == pytest.approx(0.05)
+    assert fwhm(xr, restored) == pytest.approx(2.3548200 * sigma, rel=1e-3)
 
 
 def test_flat_top_window_shape():
