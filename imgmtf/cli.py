@@ -14,10 +14,11 @@ import click
 
 from . import __version__
 from .edge import EdgeEstimator
-from .errors import ImgmtfError
+from .errors import ImgmtfError, ParameterError
 from .inputs import saturation_levels
 from .io import read_raster, write_geotiff
 from .noise import GroundNoise
+from .pulse import PulseEstimator, check_width
 from .rendering import render
 from .resampling import METHODS
 from .selftest import run_selftest
@@ -51,6 +52,21 @@ def _write_error(path, exc):
     return FileWriteError(f"{path}: cannot write: {exc.strerror or exc}")
 
 
+def _length_option(default_unit: str):
+    """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit)."""
+    def parse(ctx, param, value):
+        if value is None:
+            return None
+        text = value.strip().lower()
+        unit = next((u for u in ("px", "m") if text.endswith(u)), None)
+        number = text[: -len(unit)] if unit else text
+        try:
+            return float(number), unit or default_unit
+        except ValueError:
+            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}")
+    return parse
+
+
 def _parse_roi(ctx, param, value):
     if value is None:
         return None
@@ -77,7 +93,8 @@ def main():
               help="tilt of the edge from the column axis, degrees in (-90, 90]; near 90 for along track")
 @click.option("--low", type=float, default=200.0, show_default=True, help="DN on the dark side (outside a pulse)")
 @click.option("--high", type=float, default=1200.0, show_default=True, help="DN on the bright side (inside a pulse)")
-@click.option("--pulse-width", type=float, help="pulse width in metres (pulse targets)")
+@click.option("--pulse-width", callback=_length_option("m"),
+              help="pulse width: 18.3 or 18.3m (metres), 1.4px (pixels); pulse targets")
 @click.option("--offset", type=float, default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
 @click.option("--size", type=int, default=50, show_default=True, help="chip side, pixels")
@@ -101,7 +118,10 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
             raise ImgmtfError("a pulse target needs --pulse-width (metres)")
         if kind == "edge" and pulse_width is not None:
             raise ImgmtfError("--pulse-width applies to --target pulse only")
-        width_px = pulse_width / gsd_m if kind == "pulse" else 0.0
+        width_px = 0.0
+        if kind == "pulse":
+            value, unit = pulse_width
+            width_px = value if unit == "px" else value / gsd_m
         target = Target(kind, angle, low, high, offset, width_px)
         chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
                       noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
@@ -144,35 +164,48 @@ def sensor_command(sensor_path, plot_path, save_path):
 # -- measure ------------------------------------------------------------------
 @main.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
-@click.option("--target", "kind", type=click.Choice(["edge"]), default="edge", show_default=True)
+@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--pulse-width", callback=_length_option("px"),
+              help="bar width: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
+                   "estimated from the profile when omitted")
 @click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True,
-              help="ESF smoothing/resampling method")
+              help="profile smoothing/resampling method")
 @click.option("--roi", callback=_parse_roi, help="X,Y,W,H crop in pixels")
 @click.option("--band", type=int, help="1-based band (default: the only band, or RGB luminance)")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
-def measure(paths, kind, method, roi, band, fmt, plot_path, plot_dir):
-    """Measure the MTF of the edge in each image.  With --format json, one
-    JSON object per input per line (JSON Lines)."""
+def measure(paths, kind, pulse_width, method, roi, band, fmt, plot_path, plot_dir):
+    """Measure the MTF of the edge (or bar) in each image.  With --format
+    json, one JSON object per input per line (JSON Lines)."""
     if plot_path and len(paths) > 1:
         raise click.UsageError("--plot takes a single input; use --plot-dir for several")
-    estimator = EdgeEstimator(method)
+    if pulse_width and kind != "pulse":
+        raise click.UsageError("--pulse-width applies to --target pulse only")
+    with _reported_errors():
+        if pulse_width and pulse_width[1] == "px":
+            check_width(pulse_width[0])
+        estimator = EdgeEstimator(method) if kind == "edge" else PulseEstimator(method)
     if plot_dir:
         Path(plot_dir).mkdir(parents=True, exist_ok=True)
     failures = 0
     if fmt == "text":
+        last = "RER" if kind == "edge" else "W px"
         click.echo(f"{'path':<32} {'angle':>7} {'dir':>6} {'SNR':>7} {'MTF@Nyq':>8} "
-                   f"{'MTF50':>7} {'FWHM':>6} {'RER':>6}")
+                   f"{'MTF50':>7} {'FWHM':>6} {last:>6}")
     for path in paths:
         try:
             raster = read_raster(path, band)
-            result = estimator(raster.data, roi=roi, gsd_m=raster.gsd_m,
-                               saturation=saturation_levels(raster.dtype))
+            if kind == "edge":
+                result = estimator(raster.data, roi=roi, gsd_m=raster.gsd_m,
+                                   saturation=saturation_levels(raster.dtype))
+            else:
+                result = estimator(raster.data, width_px=_width_px(pulse_width, raster), roi=roi,
+                                   gsd_m=raster.gsd_m)
             figure_path = plot_path or (Path(plot_dir) / f"{Path(path).stem}_mtf.png" if plot_dir else None)
             if figure_path:
-                from .plot import plot_edge
-                _save_figure(plot_edge(result), figure_path)
+                from .plot import plot_measurement
+                _save_figure(plot_measurement(result), figure_path)
         except ImgmtfError as exc:
             failures += 1
             if fmt == "json":
@@ -183,12 +216,27 @@ def measure(paths, kind, method, roi, band, fmt, plot_path, plot_dir):
         if fmt == "json":
             click.echo(json.dumps({"path": path, "band": raster.band, **result.to_dict()}))
         else:
+            last = result.rer if kind == "edge" else result.pulse_width_px
             click.echo(f"{path:<32} {result.angle_deg:7.2f} {result.direction.split('-')[0]:>6} "
                        f"{result.snr:7.0f} {result.mtf_nyquist:8.4f} {result.mtf50_cy_px:7.4f} "
-                       f"{result.fwhm_px:6.3f} {result.rer:6.3f}")
+                       f"{result.fwhm_px:6.3f} {last:6.3f}")
             for warning in result.warnings:
                 click.echo(f"{'':<32} warning: {warning}")
     sys.exit(1 if failures else 0)
+
+
+def _width_px(width, raster) -> float | None:
+    """A --pulse-width in pixels for this raster (metres need its GSD)."""
+    if width is None:
+        return None
+    value, unit = width
+    if unit == "px":
+        return value
+    if raster.gsd_m is None:
+        raise ParameterError(f"{raster.path}: a width in metres needs a georeferenced image "
+                             "(its GSD is unknown); give the width in px")
+    check_width(value / raster.gsd_m)
+    return value / raster.gsd_m
 
 
 # -- selftest -----------------------------------------------------------------

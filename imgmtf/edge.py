@@ -17,20 +17,20 @@ Pipeline (Choi and Helder, with the corrections of :mod:`imgmtf.mtf`):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Callable
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from . import __version__
 from .detection import find_edge
 from .errors import ImageContentError, UnsuitableTargetError
 from .inputs import prepare_image, saturation_levels
 from .metrics import fwhm
 from .mtf import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
                   noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
-from .profile import EdgeGeometry, check_angle, locate_edge, profile_samples, vertical_frame
+from .profile import TargetGeometry, check_angle, locate_edge, profile_samples, vertical_frame
 from .resampling import METHODS, resample_profile
+from .results import MTFResult, finite
 
 SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
@@ -38,91 +38,22 @@ WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
 DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
 
 
-@dataclass(frozen=True, eq=False)
-class EdgeResult:
-    """MTF of one edge and everything it was computed from.
+@dataclass(frozen=True, eq=False, kw_only=True)
+class EdgeResult(MTFResult):
+    """MTF of one edge and everything it was computed from (see
+    :class:`imgmtf.results.MTFResult`).  ``esf`` is normalised to rise from
+    0 to 1 whatever the edge's polarity; ``levels_dn`` are the dark and
+    bright levels; ``rer`` the relative edge response."""
 
-    Distances are in pixels along the edge normal, frequencies in cycles per
-    pixel along the normal, the MTF is normalised to 1 at zero frequency.
-    ``esf`` is normalised to rise from 0 to 1 whatever the edge's polarity;
-    ``lsf`` integrates to 1 (1/px).  ``noise_limit_cy_px`` is the frequency
-    above which the MTF is within 3 standard deviations of noise (inf for a
-    noise-free chip): the curve beyond it is not signal.
-    """
-
-    method: str
-    params: dict
-    angle_deg: float
-    orientation: str
-    polarity: str
-    rows_used: int
-    rows_total: int
-    snr: float
-    mtf_nyquist: float
-    mtf50_cy_px: float
-    fwhm_px: float
+    target: ClassVar[str] = "edge"
     rer: float
-    mtfa: float
-    gsd_m: float | None
-    frequencies_cy_px: np.ndarray
-    mtf: np.ndarray
     esf_x_px: np.ndarray
     esf: np.ndarray
-    lsf_x_px: np.ndarray
-    lsf: np.ndarray
-    samples_x_px: np.ndarray
-    samples_dn: np.ndarray
     levels_dn: tuple[float, float]
-    geometry: EdgeGeometry
-    roi: tuple[int, int, int, int]
     window_half_width_px: float
-    noise_limit_cy_px: float
-    warnings: tuple[str, ...] = ()
-    mtf_function: Callable = field(default=None, repr=False)
 
-    @property
-    def direction(self) -> str:
-        """Which MTF this edge measures on a pushbroom image: rows are along
-        track, so a near-vertical edge gives the across-track MTF."""
-        return "across-track" if self.orientation == "vertical" else "along-track"
-
-    @property
-    def mtf50_cy_m(self) -> float | None:
-        return self.mtf50_cy_px / self.gsd_m if self.gsd_m else None
-
-    @property
-    def fwhm_m(self) -> float | None:
-        return self.fwhm_px * self.gsd_m if self.gsd_m else None
-
-    def mtf_at(self, f_cy_px) -> np.ndarray:
-        """The corrected MTF at any frequencies (cycles/pixel)."""
-        return self.mtf_function(f_cy_px)
-
-    def to_dict(self, curves: bool = True) -> dict:
-        """JSON-ready summary (units in the names); ``curves`` adds the MTF."""
-        out = {
-            "target": "edge", "method": self.method, "angle_deg": self.angle_deg,
-            "orientation": self.orientation, "direction": self.direction,
-            "polarity": self.polarity, "rows_used": self.rows_used, "snr": _finite(self.snr),
-            "mtf_nyquist": _finite(self.mtf_nyquist), "mtf50_cy_px": _finite(self.mtf50_cy_px),
-            "fwhm_px": _finite(self.fwhm_px), "rer": _finite(self.rer), "mtfa": _finite(self.mtfa),
-            "gsd_m": self.gsd_m, "mtf50_cy_m": _finite(self.mtf50_cy_m),
-            "fwhm_m": _finite(self.fwhm_m), "noise_limit_cy_px": _finite(self.noise_limit_cy_px),
-            "levels_dn": list(self.levels_dn),
-            "roi": list(self.roi), "warnings": list(self.warnings),
-            "params": self.params, "imgmtf_version": __version__,
-        }
-        if curves:
-            out["frequencies_cy_px"] = [float(f) for f in self.frequencies_cy_px]
-            out["mtf"] = [_finite(m) for m in self.mtf]
-        return out
-
-
-def _finite(value):
-    if value is None:
-        return None
-    value = float(value)
-    return round(value, 6) if math.isfinite(value) else None
+    def _specific(self) -> dict:
+        return {"rer": finite(self.rer), "levels_dn": list(self.levels_dn)}
 
 
 class EdgeEstimator:
@@ -174,7 +105,7 @@ class EdgeEstimator:
         return self._profile(work, geometry, (x0, y0, data.shape[1], data.shape[0]),
                              gsd_m, saturation)
 
-    def _profile(self, work, geometry: EdgeGeometry, roi, gsd_m, saturation) -> EdgeResult:
+    def _profile(self, work, geometry: TargetGeometry, roi, gsd_m, saturation) -> EdgeResult:
         d, v, half_range = profile_samples(work, geometry, "edge")
         esf = resample_profile(d, v, method=self.method, step=self.step_px,
                                half_range=half_range - 0.6, **self.method_options)

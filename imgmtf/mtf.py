@@ -67,8 +67,8 @@ def edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray
 
 
 def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
-                band_cy_px: tuple[float, float] = (1.5, 3.0),
-                out_step: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+                band_cy_px: tuple[float, float] = (1.5, 3.0), out_step: float = 0.05,
+                min_divisor: float = MIN_TRANSFER) -> tuple[np.ndarray, np.ndarray]:
     """The LSF behind a profile (an LSF or a pulse response sampled at the
     uniform positions ``x``, px): its spectrum, referenced to x = 0, divided
     by ``divisor`` (signed), rolled off (raised cosine) between
@@ -76,7 +76,7 @@ def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
     ``out_step`` px (band-limited interpolation).  Returns ``(x, lsf)``,
     centred on 0.
 
-    Where |divisor| < ``MIN_TRANSFER`` (near a zero of a pulse's sinc) the
+    Where |divisor| < ``min_divisor`` (near a zero of a pulse's sinc) the
     spectrum is interpolated linearly from its neighbours instead of being
     divided.  An imaging LSF sampled at 1 px has almost nothing above
     1.5 cy/px, while the resampled profile's noise grows with frequency:
@@ -90,7 +90,7 @@ def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
     spec = np.fft.rfft(profile, n=n) * np.exp(-2j * np.pi * f * x[0])
     passed = f < hi
     div = divisor(f[passed])
-    good = np.abs(div) >= MIN_TRANSFER
+    good = np.abs(div) >= min_divisor
     restored = np.zeros_like(spec)
     fp, sp = f[passed], spec[passed]
     restored[passed] = np.where(good, sp / np.where(good, div, 1.0), 0.0)

@@ -63,31 +63,37 @@ def plot_sensor(sensor):
     return fig
 
 
-# -- an edge measurement -----------------------------------------------------
-def plot_edge_locations(result, ax=None):
-    """Per-row sub-pixel edge locations and the fitted line (paper Fig. 5a)."""
+# -- a measurement (edge or pulse) ---------------------------------------------
+def plot_locations(result, ax=None):
+    """Per-row sub-pixel target locations and the fitted line (paper Fig. 5a)."""
     fig, ax = _axes(ax)
     g = result.geometry
-    ax.plot(g.locations[g.kept], g.rows[g.kept], "o", ms=3, mfc="none", label="row edge location")
+    ax.plot(g.locations[g.kept], g.rows[g.kept], "o", ms=3, mfc="none", label=f"row {result.target} location")
     if (~g.kept).any():
         ax.plot(g.locations[~g.kept], g.rows[~g.kept], "x", color="C3", label="rejected")
     ax.plot(g.slope * g.rows + g.intercept, g.rows, "-", color="C1", label="least-squares line")
     ax.invert_yaxis()
     frame = "columns" if not g.transposed else "rows"
-    ax.set(title=f"Edge at {result.angle_deg:.2f} deg", xlabel=f"position ({frame}, px)",
+    ax.set(title=f"{result.target.capitalize()} at {result.angle_deg:.2f} deg", xlabel=f"position ({frame}, px)",
            ylabel="row" if not g.transposed else "column")
     ax.legend(fontsize="small")
     return fig
 
 
-def plot_esf(result, ax=None):
-    """Over-sampled ESF samples and the resampled profile (paper Fig. 5b)."""
+def plot_profile(result, ax=None):
+    """Over-sampled profile samples and the resampled profile: the ESF of an
+    edge (paper Fig. 5b) or the PRF of a pulse, normalised."""
     fig, ax = _axes(ax)
-    lo, hi = result.levels_dn
+    if result.target == "edge":
+        lo, hi = result.levels_dn
+        x, profile, name = result.esf_x_px, result.esf, "ESF"
+    else:
+        lo, hi = result.background_dn, result.peak_dn
+        x, profile, name = result.prf_x_px, result.prf, f"PRF, bar {result.pulse_width_px:.2f} px"
     ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
             color="0.6", label="pixels")
-    ax.plot(result.esf_x_px, result.esf, "-", color="C0", label=f"{result.method} profile")
-    ax.set(xlim=(-6, 6), title=f"ESF (SNR {result.snr:.0f})", xlabel="distance from edge (px)",
+    ax.plot(x, profile, "-", color="C0", label=f"{result.method} profile")
+    ax.set(xlim=(-6, 6), title=f"{name} (SNR {result.snr:.0f})", xlabel="distance from line (px)",
            ylabel="normalised DN")
     ax.legend(fontsize="small")
     return fig
@@ -98,7 +104,7 @@ def plot_lsf(result, ax=None):
     fig, ax = _axes(ax)
     ax.plot(result.lsf_x_px, result.lsf, color="C0")
     ax.set(xlim=(-6, 6), title=f"LSF, FWHM {result.fwhm_px:.3f} px",
-           xlabel="distance from edge (px)", ylabel="LSF (1/px)")
+           xlabel="distance from line (px)", ylabel="LSF (1/px)")
     return fig
 
 
@@ -121,12 +127,13 @@ def plot_mtf(result, ax=None, truth=None):
     return fig
 
 
-def plot_edge(result, truth=None):
-    """Edge locations, ESF, LSF and MTF of one measurement."""
+def plot_measurement(result, truth=None):
+    """Target locations, profile (ESF or PRF), LSF and MTF of one
+    measurement."""
     fig = Figure(figsize=(11, 8), layout="constrained")
     axes = fig.subplots(2, 2)
-    plot_edge_locations(result, axes[0, 0])
-    plot_esf(result, axes[0, 1])
+    plot_locations(result, axes[0, 0])
+    plot_profile(result, axes[0, 1])
     plot_lsf(result, axes[1, 0])
     plot_mtf(result, axes[1, 1], truth=truth)
     return fig

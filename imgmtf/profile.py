@@ -3,7 +3,7 @@ line through the row locations, and every pixel's signed distance to it.
 
 Works in the *vertical frame*: the edge runs roughly down the rows
 (|tilt| < 45 deg) and each row crosses it once.  A near-horizontal edge is
-handled by transposing the image first; :class:`EdgeGeometry` remembers
+handled by transposing the image first; :class:`TargetGeometry` remembers
 that and reports angles in the original image.
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
 
 
 @dataclass(frozen=True, eq=False)
-class EdgeGeometry:
+class TargetGeometry:
     """The fitted edge line x = slope * y + intercept in the vertical frame.
 
     ``rows`` are the rows that were fitted, ``locations`` their Fermi edge
@@ -58,7 +58,7 @@ class EdgeGeometry:
 
 
 def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
-                transposed: bool = False) -> EdgeGeometry:
+                transposed: bool = False) -> TargetGeometry:
     """Fit the Fermi model in every row around ``seed_x`` (the seed edge
     column per row) and a robust line through the locations.
 
@@ -75,7 +75,7 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
     return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed)
 
 
-def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> EdgeGeometry:
+def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> TargetGeometry:
     """Robust least-squares line x = m y + k through per-row locations:
     refitted after discarding locations more than 4 robust standard
     deviations (and 0.05 px) off it."""
@@ -91,7 +91,7 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> EdgeGeom
             break
         keep = new_keep
     slope, intercept = np.polyfit(y[keep], x[keep], 1)
-    return EdgeGeometry(float(slope), float(intercept), y, x, keep, transposed)
+    return TargetGeometry(float(slope), float(intercept), y, x, keep, transposed)
 
 
 def row_windows(image: np.ndarray, centre_x: np.ndarray, half_window: int):
@@ -117,7 +117,7 @@ def vertical_frame(image: np.ndarray, line: Line) -> tuple[np.ndarray, np.ndarra
     return work, (line.rho_px - np.arange(work.shape[0]) * b) / a, transposed
 
 
-def check_angle(geometry: EdgeGeometry, name: str) -> None:
+def check_angle(geometry: TargetGeometry, name: str) -> None:
     """Refuse a target too close to an axis or to 45 deg for sub-pixel
     sampling."""
     a = abs(math.degrees(math.atan(geometry.slope)))
@@ -130,7 +130,7 @@ def check_angle(geometry: EdgeGeometry, name: str) -> None:
                                     f"to 45 deg for sub-pixel sampling {advice}")
 
 
-def profile_samples(work: np.ndarray, geometry: EdgeGeometry, name: str):
+def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
     """Every pixel of the kept rows as a profile sample: ``(d, v,
     half_range)``, the signed distance (px) to the line, the value, and the
     distance D within which samples are kept (the distance 3 rows in 4
