@@ -103,7 +103,8 @@ def robust_noise(image: np.ndarray) -> float:
     horizontally adjacent pixels, which an edge barely affects."""
     diff = np.diff(image, axis=1)
     mad = np.median(np.abs(diff - np.median(diff)))
-    return float(1.4826 * mad / np.sqrt(2.0)) or float(np.std(diff) / np.sqrt(2.0)) or 1e-12
+    # a noise-free (or coarsely quantised) image has MAD 0: its noise is nil
+    return max(float(1.4826 * mad / np.sqrt(2.0)), 1e-12)
 
 
 def step_contrast(image: np.ndarray, line: Line) -> float:
@@ -115,6 +116,19 @@ def step_contrast(image: np.ndarray, line: Line) -> float:
     if not near.any() or not far.any():
         return 0.0
     return float(abs(image[near].mean() - image[far].mean()))
+
+
+def bar_contrast(image: np.ndarray, line: Line) -> float:
+    """|mean level within 1.5 px of ``line`` - mean 4-10 px from it| (DN):
+    large for a bar along the line (or an edge, which the pulse estimator
+    refuses later), small for noise."""
+    t = math.radians(line.theta_deg)
+    y, x = np.indices(image.shape)
+    d = np.abs(x * math.cos(t) + y * math.sin(t) - line.rho_px)
+    on, off = d < 1.5, (d > 4) & (d < 10)
+    if not on.any() or not off.any():
+        return 0.0
+    return float(abs(image[on].mean() - image[off].mean()))
 
 
 def _separation(a: Line, b: Line, shape) -> float:

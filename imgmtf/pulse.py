@@ -22,7 +22,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .detection import find_lines, robust_noise
+from .detection import bar_contrast, find_lines, robust_noise
 from .edge import DEFAULT_FREQUENCIES, SNR_THRESHOLD
 from .errors import ImageContentError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .inputs import prepare_image
@@ -35,6 +35,7 @@ from .results import MTFResult, finite
 
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
+MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -100,6 +101,10 @@ class PulseEstimator:
         lines = find_lines(data)
         if not lines:
             raise TargetNotFoundError("no bar found: no straight line of strong contrast")
+        noise = robust_noise(data)
+        lines = [ln for ln in lines if bar_contrast(data, ln) >= 3.0 * noise]
+        if not lines:
+            raise TargetNotFoundError("no bar found: no straight line stands out of the noise")
         work, seed_x, transposed = vertical_frame(data, lines[0])
         geometry = locate_pulse(work, seed_x, transposed)
         check_angle(geometry, "bar")
@@ -116,7 +121,6 @@ class PulseEstimator:
         sign = 1.0 if values[centre] >= background else -1.0
         peak = sign * (values - background)
         height = peak[centre - 20: centre + 21].max()
-        noise = robust_noise(work)
         if height < 5 * noise:
             raise TargetNotFoundError(f"no bar found: the profile peaks {height:.1f} DN above "
                                       f"its background, within the noise ({noise:.1f} DN)")
@@ -221,18 +225,21 @@ def check_width(width_px: float) -> None:
 def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
     """Bar width from the first zero of the PRF's spectrum: |FT(PRF)| =
     |sinc(f W)| MTF(f), so its first zero is at 1/W as long as the MTF is
-    still above the noise there.  The zero is located as the sign change
+    still above the noise there.  Zeros are only sought below
+    ``MAX_ZERO_SEARCH_CY_PX``: the pixel aperture's own zero near 1 cy/px
+    would otherwise pass for a bar's.  The zero is located as the sign change
     of the spectrum referenced to the bar's centre (real for a symmetric
     bar)."""
-    f = np.arange(0.005, 1.5, 0.0025)
+    f = np.arange(0.005, MAX_ZERO_SEARCH_CY_PX, 0.0025)
     step = grid[1] - grid[0]
     real = np.cos(2 * np.pi * f[:, None] * grid[None, :]) @ prf01 * step
     area = prf01.sum() * step
     change = np.nonzero(np.sign(real[:-1]) != np.sign(real[1:]))[0]
     if change.size == 0 or area <= 0:
-        raise UnsuitableTargetError("the bar width cannot be estimated from this profile (no zero "
-                                    "in its spectrum below 1.5 cy/px: the bar is narrower than the "
-                                    "blur); give it with --pulse-width")
+        raise UnsuitableTargetError(
+            f"the bar width cannot be estimated from this profile (no zero in its spectrum below "
+            f"{MAX_ZERO_SEARCH_CY_PX} cy/px, so the bar is narrower than "
+            f"{1 / MAX_ZERO_SEARCH_CY_PX:.2f} px); give it with --pulse-width")
     i = change[0]
     zero = f[i] - real[i] * (f[i + 1] - f[i]) / (real[i + 1] - real[i])
     return float(1.0 / zero)
@@ -252,7 +259,9 @@ def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_wi
         total = weight.sum(axis=1)
         usable = (inside.sum(axis=1) == 2 * half_window + 1) & (total > 0)
         if usable.sum() < 5:
-            raise TargetNotFoundError("the bar does not cross enough rows of the image")
+            raise UnsuitableTargetError(
+                f"fewer than 5 rows hold the bar with {half_window} px of background on both "
+                "sides: the chip is too narrow, or the bar too wide or too close to its border")
         centres = (weight * cols).sum(axis=1)[usable] / total[usable]
         geometry = fit_line(rows[usable], centres, transposed)
         centre_x = geometry.slope * rows + geometry.intercept

@@ -1,0 +1,113 @@
+"""Pulse estimator against exact answers: bars whose every pixel is the
+exact pulse response (edge response at d + W/2 minus at d - W/2)."""
+import math
+
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
+from imgmtf.pulse import check_width, estimate_width, measure_pulse, usable_band
+
+from conftest import exact_edge_chip, exact_esf, gaussian_pixel_transfer, true_fwhm, true_mtf50
+
+
+def exact_pulse_chip(transfer, angle_deg, width, shape=(100, 60), offset=0.0, low=200.0,
+                     high=1200.0, noise_std=0.0, seed=0):
+    rows, cols = shape
+    a = math.radians(angle_deg)
+    y, x = np.mgrid[0:rows, 0:cols].astype(float)
+    d = (x - (cols - 1) / 2) * math.cos(a) + (y - (rows - 1) / 2) * math.sin(a) - offset
+    fx, esf = exact_esf(transfer)
+    resp = np.interp(d + width / 2, fx, esf) - np.interp(d - width / 2, fx, esf)
+    img = low + (high - low) * resp
+    if noise_std:
+        img = img + np.random.default_rng(seed).normal(0, noise_std, img.shape)
+    return np.clip(np.rint(img), 0, 65535).astype(np.uint16)
+
+
+@pytest.mark.parametrize("width, sigma, angle", [(1.2, 0.5, 6.0), (1.6, 0.5, 6.0), (1.6, 0.35, -9.0),
+                                                 (0.8, 0.45, 5.0)])
+def test_noise_free_accuracy(width, sigma, angle):
+    h = gaussian_pixel_transfer(sigma, angle)
+    r = measure_pulse(exact_pulse_chip(h, angle, width, offset=0.23), width_px=width)
+    assert abs(r.mtf_nyquist - h(0.5)) <= 0.005
+    assert r.fwhm_px == pytest.approx(true_fwhm(h), rel=0.01)
+    assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.005)
+    assert r.angle_deg == pytest.approx(angle, abs=0.03)
+    assert r.usable_band_cy_px == pytest.approx(usable_band(width))
+
+
+def test_width_is_estimated_from_the_spectrum_zero():
+    h = gaussian_pixel_transfer(0.45, 6.0)
+    r = measure_pulse(exact_pulse_chip(h, 6.0, 2.2))
+    assert r.width_estimated and r.pulse_width_px == pytest.approx(2.2, rel=0.01)
+
+
+def test_dark_bar_and_along_track_bar():
+    h = gaussian_pixel_transfer(0.5, 84.0)
+    r = measure_pulse(exact_pulse_chip(h, 84.0, 1.4, shape=(60, 100), low=1200, high=300), width_px=1.4)
+    assert r.polarity == "dark" and r.orientation == "horizontal"
+    assert abs(r.mtf_nyquist - h(0.5)) <= 0.005
+
+
+def test_sinc_zeros_are_masked_and_warned():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    r = measure_pulse(exact_pulse_chip(h, 6.0, 4.0, shape=(100, 70)), width_px=4.0)
+    # zeros of sinc(4 f) at 0.25, 0.5, 0.75 cy/px
+    assert np.isnan(r.mtf_at([0.25, 0.5, 0.75])).all()
+    assert np.isfinite(r.mtf_at([0.1, 0.375])).all()
+    assert r.usable_band_cy_px < 0.25 and any("before Nyquist" in w for w in r.warnings)
+    assert abs(r.mtf_at([0.375])[0] - h(0.375)) < 0.01
+
+
+def test_generic_sensor_pulse(paper_sensor):
+    chip = im.render(paper_sensor, im.Target("pulse", 6.0, 200, 1200, 0.1, 1.5), (100, 60))
+    r = measure_pulse(chip.image, width_px=1.5, gsd_m=chip.gsd_m)
+    assert abs(r.mtf_nyquist - chip.true_mtf(0.5)) <= 0.005
+    assert r.fwhm_px == pytest.approx(chip.true_fwhm_px(), rel=0.01)
+
+
+def test_noisy_pulse_has_snr_by_the_pulse_definition():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    r = measure_pulse(exact_pulse_chip(h, 6.0, 1.6, noise_std=10.0, seed=3), width_px=1.6)
+    peak = 1000 * (np.interp(0.8, *exact_esf(h)) - np.interp(-0.8, *exact_esf(h)))
+    assert r.snr == pytest.approx(peak / 10.0, rel=0.15)
+    assert abs(r.mtf_nyquist - h(0.5)) < 0.06
+
+
+def test_bad_widths():
+    with pytest.raises(ParameterError, match="> 0"):
+        check_width(-1.0)
+    with pytest.raises(ParameterError, match="below 0.1 cy/px"):
+        check_width(12.0)
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    with pytest.raises(ParameterError):
+        measure_pulse(exact_pulse_chip(h, 6.0, 1.6), width_px=0.0)
+
+
+def test_bar_too_wide_for_the_chip():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    chip = exact_pulse_chip(h, 6.0, 9.0, shape=(100, 24))
+    with pytest.raises(UnsuitableTargetError, match="too wide|too narrow"):
+        measure_pulse(chip, width_px=9.0)
+
+
+def test_no_bar_and_an_edge_are_refused():
+    with pytest.raises(TargetNotFoundError):
+        measure_pulse(np.random.default_rng(0).normal(300, 5, (60, 60)))
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    with pytest.raises(UnsuitableTargetError, match="step"):
+        measure_pulse(exact_edge_chip(h, 6.0), width_px=1.5)
+
+
+def test_narrow_bar_width_cannot_be_estimated():
+    h = gaussian_pixel_transfer(0.7, 6.0)
+    with pytest.raises(UnsuitableTargetError, match="--pulse-width"):
+        measure_pulse(exact_pulse_chip(h, 6.0, 0.5))
+
+
+def test_estimate_width_closed_form():
+    x = np.arange(-10, 10.0001, 0.05)
+    box = (np.abs(x) <= 1.25).astype(float)
+    assert estimate_width(x, box) == pytest.approx(2.5, rel=0.02)
