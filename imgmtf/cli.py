@@ -250,7 +250,8 @@ def selftest(method):
     for d in DIRECTIONS:
         click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
                    f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
-    click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r}:")
+    click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
+               "(! marks a figure out of tolerance):")
     click.echo(f"{'case':<28} {'':>5} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM px':>8}")
     rows = run_selftest(sensor, method=method)
     for row in rows:

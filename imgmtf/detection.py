@@ -118,17 +118,20 @@ def step_contrast(image: np.ndarray, line: Line) -> float:
     return float(abs(image[near].mean() - image[far].mean()))
 
 
-def bar_contrast(image: np.ndarray, line: Line) -> float:
-    """|mean level within 1.5 px of ``line`` - mean 4-10 px from it| (DN):
-    large for a bar along the line (or an edge, which the pulse estimator
-    refuses later), small for noise."""
+def bar_contrast(image: np.ndarray, line: Line, reach_px: float = 8.0) -> float:
+    """Largest |mean level of a 1-px strip parallel to ``line`` - the image's
+    median| within ``reach_px`` of the line (DN): large for a bar along it,
+    wherever across the strips the seed line fell; small for noise."""
     t = math.radians(line.theta_deg)
     y, x = np.indices(image.shape)
-    d = np.abs(x * math.cos(t) + y * math.sin(t) - line.rho_px)
-    on, off = d < 1.5, (d > 4) & (d < 10)
-    if not on.any() or not off.any():
+    d = x * math.cos(t) + y * math.sin(t) - line.rho_px
+    near = np.abs(d) < reach_px
+    if not near.any():
         return 0.0
-    return float(abs(image[on].mean() - image[off].mean()))
+    strips = np.floor(d[near] + reach_px).astype(int)
+    counts = np.bincount(strips)
+    means = np.bincount(strips, weights=image[near])[counts > 0] / counts[counts > 0]
+    return float(np.max(np.abs(means - np.median(image))))
 
 
 def _separation(a: Line, b: Line, shape) -> float:

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .edge import measure_edge
+from .pulse import measure_pulse
 from .rendering import Renderer
 from .sensor import Sensor
 from .targets import Target
@@ -14,6 +15,7 @@ from .targets import Target
 # MTF50 and FWHM).  Noise-free: the accuracy the estimator promises on exact
 # chips.  Noisy (SNR 100): about 3 standard deviations of the estimate.
 NOISE_FREE_TOLERANCE = {"mtf_nyquist": 0.003, "mtf50": 0.005, "fwhm": 0.005}
+PULSE_TOLERANCE = {"mtf_nyquist": 0.005, "mtf50": 0.005, "fwhm": 0.01}
 NOISY_TOLERANCE = {"mtf_nyquist": 0.03, "mtf50": 0.03, "fwhm": 0.05}
 
 
@@ -26,7 +28,9 @@ class SelftestCase:
 
     @property
     def tolerance(self) -> dict:
-        return NOISY_TOLERANCE if self.noise_std_dn else NOISE_FREE_TOLERANCE
+        if self.noise_std_dn:
+            return NOISY_TOLERANCE
+        return PULSE_TOLERANCE if self.target.kind == "pulse" else NOISE_FREE_TOLERANCE
 
 
 CASES = (
@@ -35,6 +39,8 @@ CASES = (
     SelftestCase("edge falling, -11 deg", Target("edge", -11.0, 1200.0, 200.0, 0.11)),
     SelftestCase("edge across-track, SNR 100", Target("edge", 6.0, 200.0, 1200.0, 0.4),
                  noise_std_dn=10.0, seed=7),
+    SelftestCase("pulse 1.5 px across-track", Target("pulse", 6.0, 200.0, 1200.0, 0.17, 1.5)),
+    SelftestCase("dark pulse 1.2 px along-track", Target("pulse", 85.0, 1200.0, 300.0, -0.2, 1.2)),
 )
 
 
@@ -59,7 +65,11 @@ def run_selftest(sensor: Sensor = Sensor(), size_px: int = 100, method: str = "m
     rows = []
     for case in CASES:
         chip = renderer(case.target, noise_std_dn=case.noise_std_dn, seed=case.seed)
-        result = measure_edge(chip.image, method=method, gsd_m=chip.gsd_m)
+        if case.target.kind == "edge":
+            result = measure_edge(chip.image, method=method, gsd_m=chip.gsd_m)
+        else:
+            result = measure_pulse(chip.image, width_px=case.target.width_px, method=method,
+                                   gsd_m=chip.gsd_m)
         true = {"mtf_nyquist": float(chip.true_mtf(0.5)), "mtf50": chip.true_mtf50_cy_px(),
                 "fwhm": chip.true_fwhm_px()}
         got = {"mtf_nyquist": result.mtf_nyquist, "mtf50": result.mtf50_cy_px,

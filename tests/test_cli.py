@@ -114,3 +114,39 @@ def test_simulated_chip_describes_itself(run, tmp_path):
     assert prov["target"]["width_px"] == 5.0 and prov["seed"] == 3
     assert prov["ground_noise"] == {"layers": 20, "layer_variance_dn2": 100.0}
     assert np.nanmax(raster.data) <= 255
+
+
+def test_pulse_measure_json_fields_and_width_units(run, tmp_path):
+    path = tmp_path / "bar.tif"
+    assert run("simulate", "--target", "pulse", "--pulse-width", "1.5", "--gsd", "0.5", "--size", 80,
+               "--out", path).exit_code == 0              # 1.5 m = 3 px at 0.5 m GSD
+    for width in ("3px", "3", "1.5m"):
+        r = run("measure", "--target", "pulse", "--pulse-width", width, "--format", "json", path)
+        assert r.exit_code == 0, r.output
+        row = json.loads(r.stdout)
+        assert row["target"] == "pulse" and row["pulse_width_px"] == pytest.approx(3.0)
+        assert row["usable_band_cy_px"] == pytest.approx(0.3027, abs=1e-3)
+        assert row["width_estimated"] is False
+    r = run("measure", "--target", "pulse", "--format", "json", path)
+    assert json.loads(r.stdout)["width_estimated"] is True
+    r = run("measure", "--target", "pulse", "--plot", tmp_path / "bar.png", path)
+    assert r.exit_code == 0 and "W px" in r.stdout and (tmp_path / "bar.png").exists()
+
+
+def test_pulse_width_errors(run, chip, tmp_path):
+    r = run("measure", "--target", "pulse", "--pulse-width", "-1", chip)
+    assert r.exit_code == 1 and "must be > 0" in r.stderr
+    r = run("measure", "--target", "pulse", "--pulse-width", "15px", chip)
+    assert r.exit_code == 1 and "below 0.1 cy/px" in r.stderr
+    assert run("measure", "--target", "pulse", "--pulse-width", "wide", chip).exit_code == 2
+    assert run("measure", "--pulse-width", "2", chip).exit_code == 2          # edge target
+    png = tmp_path / "plain.png"
+    import rasterio
+    import warnings
+    from rasterio.errors import NotGeoreferencedWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(png, "w", driver="PNG", width=40, height=40, count=1, dtype="uint8") as dst:
+            dst.write(np.full((1, 40, 40), 9, np.uint8))
+    r = run("measure", "--target", "pulse", "--pulse-width", "2m", "--format", "json", png)
+    assert r.exit_code == 1 and "needs a georeferenced image" in json.loads(r.stdout)["error"]
