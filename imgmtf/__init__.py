@@ -2,7 +2,7 @@
 
 The generic pushbroom sensor of Choi and Helder renders exact synthetic
 chips (:class:`Sensor`, :class:`Target`, :func:`render`); the estimators
-measure the MTF of any chip (:func:`measure_edge`).
+measure the MTF of any chip (:func:`measure_edge`, :func:`measure_pulse`).
 """
 __version__ = "0.1.0"
 
@@ -12,6 +12,7 @@ from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadEr
                      UnsuitableTargetError)
 from .io import Raster, read_raster, write_geotiff  # noqa: E402
 from .noise import GroundNoise  # noqa: E402
+from .pulse import PulseEstimator, PulseResult, measure_pulse  # noqa: E402
 from .rendering import Chip, Renderer, render  # noqa: E402
 from .resampling import METHODS, resample_profile  # noqa: E402
 from .selftest import run_selftest  # noqa: E402
@@ -21,7 +22,8 @@ from .targets import Target  # noqa: E402
 __all__ = [
     "__version__",
     "Sensor", "SampledPSF", "Target", "GroundNoise", "Chip", "Renderer", "render",
-    "measure_edge", "EdgeEstimator", "EdgeResult", "METHODS", "resample_profile",
+    "measure_edge", "EdgeEstimator", "EdgeResult", "measure_pulse", "PulseEstimator", "PulseResult",
+    "METHODS", "resample_profile",
     "Raster", "read_raster", "write_geotiff", "run_selftest",
     "ImgmtfError", "ParameterError", "ConfigError", "FileWriteError", "ImageReadError",
     "ImageContentError", "TargetNotFoundError", "MultipleTargetsError", "UnsuitableTargetError",
