@@ -137,3 +137,48 @@ def plot_measurement(result, truth=None):
     plot_lsf(result, axes[1, 0])
     plot_mtf(result, axes[1, 1], truth=truth)
     return fig
+
+
+# -- the reproduction study ----------------------------------------------------
+def plot_noise_sweep(rows, methods, true_nyquist, title):
+    """MTF at Nyquist against measured SNR, one panel per method, the true
+    MTF as a line (paper Figs. 12 and 14)."""
+    fig = Figure(figsize=(4 * len(methods), 3.6), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(methods), sharey=True))
+    for ax, method in zip(axes, methods):
+        values = np.array([r["results"][method] for r in rows], float)
+        ax.semilogx(values[:, 1], values[:, 0], "*", ms=4, color="C0", label="estimates")
+        ax.axhline(true_nyquist, color="C3", label=f"true {true_nyquist:.4f}")
+        ax.axvline(100, color="0.6", ls=":", lw=0.8)
+        ax.set(title=f"{title}: {method}", xlabel="estimated SNR", ylim=(0, 2 * true_nyquist))
+    axes[0].set_ylabel("MTF at Nyquist")
+    axes[0].legend(fontsize="small")
+    return fig
+
+
+def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20)):
+    """Example ground-noise layers and the composite (paper Fig. 13)."""
+    fig = Figure(figsize=(3.2 * (len(grains) + 1), 3.4), layout="constrained")
+    axes = fig.subplots(1, len(grains) + 1)
+    rng = np.random.default_rng(seed)
+    for ax, grain in zip(axes, grains):
+        ax.imshow(ground_noise.layer(grain, (size, size), rng), cmap="gray")
+        ax.set(title=f"{grain} x {grain} sub-pixel grains", xticks=[], yticks=[])
+    axes[-1].imshow(ground_noise.sample((size, size), rng), cmap="gray")
+    axes[-1].set(title=f"composite of {ground_noise.layers} layers", xticks=[], yticks=[])
+    return fig
+
+
+def plot_threshold(found, relative, fraction):
+    """Fraction of estimates within +-``relative`` of the truth against SNR,
+    per method, with the ``fraction`` criterion."""
+    fig, ax = _axes(None, (6, 4))
+    for method, info in found.items():
+        snrs = sorted(info["fractions"])
+        ax.semilogx(snrs, [info["fractions"][s] for s in snrs], "o-", ms=3,
+                    label=f"{method}: threshold {info['threshold']:g}")
+    ax.axhline(fraction, color="0.5", ls="--", lw=0.8)
+    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist",
+           xlabel="SNR (step / noise std)", ylabel="fraction", ylim=(0, 1.02))
+    ax.legend(fontsize="small")
+    return fig
