@@ -246,7 +246,7 @@ def _report(tables, found, heights, ground_sd, size, quick, seed, workers, elaps
              "FWHM is the LSF's for edges and the PRF's for the pulse "
              f"({PULSE_WIDTH_PX} px bar), as in the paper. 'as published' rows leave each method's own "
              "blur in; 'corrected' rows divide it out (imgmtf's default).", "",
-             "| target | method | | FWHM (px) | diff % | paper diff % | MTF@Nyq | diff % | paper diff % |",
+             "| target | method | | FWHM (m) | diff % | paper diff % | MTF@Nyq | diff % | paper diff % |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in tables:
         label = {"": "", "no": "as published", "yes": "corrected"}[r["corrected"]]

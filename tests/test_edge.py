@@ -158,3 +158,12 @@ def test_noisy_fwhm_and_noise_limit():
     assert 0.5 < r.noise_limit_cy_px < 1.5
     clean = measure_edge(exact_edge_chip(h, 6.0))
     assert clean.noise_limit_cy_px > r.noise_limit_cy_px
+
+
+def test_confident_snr_scales_with_rows():
+    from imgmtf.edge import CONFIDENT_SNR_40_ROWS, confident_snr
+    assert confident_snr(40) == CONFIDENT_SNR_40_ROWS
+    assert confident_snr(160) == pytest.approx(CONFIDENT_SNR_40_ROWS / 2)
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    quiet = measure_edge(exact_edge_chip(h, 6.0, noise_std=9.0, seed=2))     # SNR ~110, 100 rows
+    assert quiet.snr > confident_snr(quiet.rows_used) and not quiet.warnings
