@@ -69,3 +69,10 @@ def test_cli_reports_unwritable_folder(tmp_path):
     blocker.write_text("x")
     r = CliRunner().invoke(main, ["reproduce", "--quick", "--out", str(blocker / "sub")])
     assert r.exit_code == 1 and "cannot create" in r.stderr
+
+
+def test_cli_quick_run(tmp_path):
+    r = CliRunner().invoke(main, ["reproduce", "--quick", "--workers", "2", "--out", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "msg      trustworthy from SNR" in r.stdout
+    assert (tmp_path / "report.md").exists() and len(read(tmp_path / "system_noise.csv")) == 8 * 4
