@@ -63,7 +63,6 @@ def main():
           "error of MTF at Nyquist")
     renderer = im.Renderer(sensor(0.5), (100, 60))
     rng = np.random.default_rng(9)
-    peak = None
     for noise in (2.5, 5.0, 10.0, 20.0):
         errs, snrs = [], []
         for _ in range(a.realisations):

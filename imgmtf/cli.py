@@ -15,7 +15,7 @@ import click
 
 from . import __version__
 from .edge import EdgeEstimator
-from .errors import ImgmtfError, ParameterError
+from .errors import FileWriteError, ImgmtfError, ParameterError
 from .inputs import saturation_levels
 from .io import read_raster, write_geotiff
 from .noise import GroundNoise
@@ -45,12 +45,7 @@ def _save_figure(fig, path: str | Path) -> None:
     try:
         fig.savefig(path, dpi=110)
     except OSError as exc:
-        raise _write_error(path, exc) from None
-
-
-def _write_error(path, exc):
-    from .errors import FileWriteError
-    return FileWriteError(f"{path}: cannot write: {exc.strerror or exc}")
+        raise FileWriteError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
 
 def _length_option(default_unit: str):

@@ -28,8 +28,9 @@ from .inputs import prepare_image, saturation_levels
 from .metrics import fwhm
 from .mtf import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
                   noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
-from .profile import TargetGeometry, check_angle, locate_edge, profile_samples, vertical_frame
-from .resampling import METHODS, resample_profile
+from .profile import (ProfileEstimator, TargetGeometry, check_angle, locate_edge, profile_samples,
+                      vertical_frame)
+from .resampling import resample_profile
 from .results import MTFResult, finite
 
 SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
@@ -40,7 +41,6 @@ SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 CONFIDENT_SNR_40_ROWS = 125.0
 WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
 WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
-DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -61,41 +61,24 @@ class EdgeResult(MTFResult):
         return {"rer": finite(self.rer), "levels_dn": list(self.levels_dn)}
 
 
-class EdgeEstimator:
+class EdgeEstimator(ProfileEstimator):
     """A configured slanted-edge estimator: set up once, apply to many chips.
 
-    Parameters
-    ----------
-    method : resampling method, a key of :data:`imgmtf.resampling.METHODS`
-        ("msg", "sliding", "spline", "iso").
-    step_px : resampled ESF grid step (px); "iso" always uses its 1/4-px bins.
-    correct : divide out the blur of the estimator's own steps (central
-        difference and resampling kernel).  False reproduces the
-        uncorrected classic algorithms.
+    Takes the settings of :class:`imgmtf.profile.ProfileEstimator`, where
+    ``snr_threshold=None`` uses the measured threshold for the edge's length
+    (:func:`confident_snr`), and:
+
     lsf_half_width_px : half-width of the flat part of the LSF window (px);
         None chooses it from the measured edge width.
     lsf_window_factor : that half-width in units of the 10-90 % rise
         distance; None adapts it to the SNR (:func:`window_factor`).
-    frequencies_cy_px : where the reported MTF curve is sampled.
-    snr_threshold : below this SNR the result carries a warning; None uses
-        the measured threshold for the edge's length (:func:`confident_snr`).
-    method_options : overrides of the method's defaults (e.g. window_px).
     """
 
-    def __init__(self, method: str = "msg", *, step_px: float = 0.05, correct: bool = True,
-                 lsf_half_width_px: float | None = None, lsf_window_factor: float | None = None,
-                 frequencies_cy_px=DEFAULT_FREQUENCIES, snr_threshold: float | None = None,
-                 method_options: dict | None = None):
-        if method not in METHODS:
-            raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
-        self.method = method
-        self.step_px = step_px
-        self.correct = correct
+    def __init__(self, method: str = "msg", *, lsf_half_width_px: float | None = None,
+                 lsf_window_factor: float | None = None, **settings):
+        super().__init__(method, **settings)
         self.lsf_half_width_px = lsf_half_width_px
         self.lsf_window_factor = lsf_window_factor
-        self.frequencies_cy_px = np.asarray(frequencies_cy_px, float)
-        self.snr_threshold = snr_threshold
-        self.method_options = dict(method_options or {})
 
     def __call__(self, image, *, roi=None, gsd_m: float | None = None,
                  saturation: tuple[float, float] | None = None) -> EdgeResult:
@@ -149,10 +132,7 @@ class EdgeEstimator:
                             f"estimates from a {rows_used}-row edge fall within 5 % of the truth")
         density = d.size / (2.0 * half_range)
         noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
-        support = slice(*np.nonzero(lsf_w)[0][[0, -1]] + [0, 1])
-        band = (min(noise_limit, 1.5), min(2.0 * noise_limit, 3.0))
-        x_c, lsf_c = restore_lsf(lsf_w[support], x[support], divisor, band_cy_px=band)
-        area = np.sum(lsf_c) * (x_c[1] - x_c[0])
+        x_c, lsf_c = restore_lsf(lsf_w, x, divisor, noise_limit)
         params = {"method": self.method, **esf.params, "correct": self.correct,
                   "lsf_half_width_px": half_width, "lsf_taper_px": taper}
         return EdgeResult(
@@ -164,7 +144,7 @@ class EdgeEstimator:
             fwhm_px=fwhm(x_c, lsf_c), rer=relative_edge_response(grid, esf01, centre),
             mtfa=mtf_area(mtf), gsd_m=gsd_m,
             frequencies_cy_px=self.frequencies_cy_px, mtf=mtf(self.frequencies_cy_px),
-            esf_x_px=grid, esf=esf01, lsf_x_px=x_c, lsf=lsf_c / area,
+            esf_x_px=grid, esf=esf01, lsf_x_px=x_c, lsf=lsf_c,
             samples_x_px=d, samples_dn=v, levels_dn=(float(left), float(right)),
             geometry=geometry, roi=roi, window_half_width_px=half_width,
             noise_limit_cy_px=noise_limit,

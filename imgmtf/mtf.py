@@ -67,14 +67,15 @@ def edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray
 
 
 def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
-                band_cy_px: tuple[float, float] = (1.5, 3.0), out_step: float = 0.05,
+                noise_limit_cy_px: float = math.inf, out_step: float = 0.05,
                 min_divisor: float = MIN_TRANSFER) -> tuple[np.ndarray, np.ndarray]:
-    """The LSF behind a profile (an LSF or a pulse response sampled at the
-    uniform positions ``x``, px): its spectrum, referenced to x = 0, divided
-    by ``divisor`` (signed), rolled off (raised cosine) between
-    ``band_cy_px``, and transformed back on a grid no coarser than
-    ``out_step`` px (band-limited interpolation).  Returns ``(x, lsf)``,
-    centred on 0.
+    """The LSF behind a windowed profile (an LSF or a pulse response sampled
+    at the uniform positions ``x``, px, zero outside its window): its
+    spectrum, referenced to x = 0, divided by ``divisor`` (signed), rolled off
+    (raised cosine) from min(f_n, 1.5) to min(2 f_n, 3) cy/px, f_n the
+    noise limit, and transformed back on a grid no coarser than ``out_step``
+    px (band-limited interpolation).  Returns ``(x, lsf)``, centred on 0,
+    the LSF normalised to unit area (1/px).
 
     Where |divisor| < ``min_divisor`` (near a zero of a pulse's sinc) the
     spectrum is interpolated linearly from its neighbours instead of being
@@ -82,11 +83,13 @@ def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
     1.5 cy/px, while the resampled profile's noise grows with frequency:
     the roll-off removes that noise from the FWHM without shifting it
     (< 0.05 % on the sensors tested)."""
+    support = np.nonzero(profile)[0]
+    profile, x = (a[support[0]: support[-1] + 1] for a in (profile, x))
     step = x[1] - x[0]
     n = 2 * profile.size
     k = max(int(np.ceil(step / out_step - 1e-9)), 1)
     f = np.fft.rfftfreq(n, d=step)
-    lo, hi = band_cy_px
+    lo, hi = min(noise_limit_cy_px, 1.5), min(2.0 * noise_limit_cy_px, 3.0)
     spec = np.fft.rfft(profile, n=n) * np.exp(-2j * np.pi * f * x[0])
     passed = f < hi
     div = divisor(f[passed])
@@ -101,7 +104,8 @@ def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
                                     restored[passed])
     restored *= 0.5 - 0.5 * np.cos(np.pi * np.clip((hi - f) / (hi - lo), 0.0, 1.0))
     out = np.fft.fftshift(np.fft.irfft(restored, n=n * k) * k)
-    return (np.arange(n * k) - n * k // 2) * (step / k), out
+    out_step_px = step / k
+    return (np.arange(n * k) - n * k // 2) * out_step_px, out / (out.sum() * out_step_px)
 
 
 def corrected_mtf(profile: np.ndarray, step: float,

@@ -14,15 +14,45 @@ from dataclasses import dataclass
 import numpy as np
 
 from .detection import Line
-from .errors import TargetNotFoundError, UnsuitableTargetError
+from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .fermi import fit_fermi
-from .resampling import sample_gap
+from .resampling import METHODS, sample_gap
 
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
 MAX_SAMPLE_GAP_PX = 0.25       # at least 4 sample positions per pixel
 MAX_HALF_RANGE_PX = 32.0       # profile samples kept within this distance
 MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
+DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
+
+
+class ProfileEstimator:
+    """Settings every over-sampled-profile estimator shares.
+
+    Parameters
+    ----------
+    method : resampling method, a key of :data:`imgmtf.resampling.METHODS`
+        ("msg", "sliding", "spline", "iso").
+    step_px : resampled profile grid step (px); "iso" always uses its
+        1/4-px bins.
+    correct : divide out the blur of the estimator's own steps.  False
+        reproduces the uncorrected classic algorithms.
+    frequencies_cy_px : where the reported MTF curve is sampled.
+    snr_threshold : below this SNR the result carries a warning.
+    method_options : overrides of the method's defaults (e.g. window_px).
+    """
+
+    def __init__(self, method: str = "msg", *, step_px: float = 0.05, correct: bool = True,
+                 frequencies_cy_px=DEFAULT_FREQUENCIES, snr_threshold: float | None = None,
+                 method_options: dict | None = None):
+        if method not in METHODS:
+            raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+        self.method = method
+        self.step_px = step_px
+        self.correct = correct
+        self.frequencies_cy_px = np.asarray(frequencies_cy_px, float)
+        self.snr_threshold = snr_threshold
+        self.method_options = dict(method_options or {})
 
 
 @dataclass(frozen=True, eq=False)

@@ -23,14 +23,15 @@ from typing import ClassVar
 import numpy as np
 
 from .detection import bar_contrast, find_lines, robust_noise
-from .edge import DEFAULT_FREQUENCIES, SNR_THRESHOLD
-from .errors import ImageContentError, ParameterError, TargetNotFoundError, UnsuitableTargetError
+from .edge import SNR_THRESHOLD
+from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .inputs import prepare_image
 from .metrics import fwhm
 from .mtf import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50,
                   mtf_area, noise_limited_frequency, restore_lsf)
-from .profile import check_angle, fit_line, profile_samples, row_windows, vertical_frame
-from .resampling import METHODS, resample_profile
+from .profile import (ProfileEstimator, check_angle, fit_line, profile_samples, row_windows,
+                      vertical_frame)
+from .resampling import resample_profile
 from .results import MTFResult, finite
 
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
@@ -66,30 +67,13 @@ class PulseResult(MTFResult):
                 "peak_dn": finite(self.peak_dn)}
 
 
-class PulseEstimator:
+class PulseEstimator(ProfileEstimator):
     """A configured pulse estimator: set up once, apply to many chips.
 
-    Parameters
-    ----------
-    method : resampling method ("msg", "sliding", "spline", "iso").
-    step_px : resampled PRF grid step (px).
-    correct : divide out the resampling method's own blur.
-    frequencies_cy_px : where the reported MTF curve is sampled.
-    snr_threshold : below this SNR the result carries a warning.
-    method_options : overrides of the method's defaults.
+    Takes the settings of :class:`imgmtf.profile.ProfileEstimator`;
+    ``snr_threshold=None`` uses the paper's 100 (the reproduction study
+    measured edges only).
     """
-
-    def __init__(self, method: str = "msg", *, step_px: float = 0.05, correct: bool = True,
-                 frequencies_cy_px=DEFAULT_FREQUENCIES, snr_threshold: float = SNR_THRESHOLD,
-                 method_options: dict | None = None):
-        if method not in METHODS:
-            raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
-        self.method = method
-        self.step_px = step_px
-        self.correct = correct
-        self.frequencies_cy_px = np.asarray(frequencies_cy_px, float)
-        self.snr_threshold = snr_threshold
-        self.method_options = dict(method_options or {})
 
     def __call__(self, image, *, width_px: float | None = None, roi=None,
                  gsd_m: float | None = None) -> PulseResult:
@@ -148,16 +132,13 @@ class PulseEstimator:
         density = d.size / (2.0 * half_range)
         noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
         band = usable_band(width_px)
-        support = slice(*np.nonzero(prf_w)[0][[0, -1]] + [0, 1])
         # the division is bridged only right at the sinc's zeros: between them
         # even a small sinc carries LSF content the FWHM needs
-        x_c, lsf_c = restore_lsf(prf_w[support], grid[support], divisor,
-                                 band_cy_px=(min(noise_limit, 1.5), min(2 * noise_limit, 3.0)),
-                                 min_divisor=RESTORE_MIN_SINC)
-        lsf_c = lsf_c / (np.sum(lsf_c) * (x_c[1] - x_c[0]))
+        x_c, lsf_c = restore_lsf(prf_w, grid, divisor, noise_limit, min_divisor=RESTORE_MIN_SINC)
         warnings = []
-        if snr < self.snr_threshold:
-            warnings.append(f"SNR {snr:.0f} is below {self.snr_threshold:.0f}: the estimate is not confident")
+        threshold = self.snr_threshold or SNR_THRESHOLD
+        if snr < threshold:
+            warnings.append(f"SNR {snr:.0f} is below {threshold:.0f}: the estimate is not confident")
         if band < NYQUIST:
             warnings.append(f"the bar's sinc falls below {MIN_TRANSFER} at {band:.3f} cy/px, before "
                             "Nyquist: MTF values near its zeros are masked (NaN)")

@@ -1,7 +1,5 @@
 """Edge estimator against exact answers: chips whose every pixel is the
 analytic edge response (conftest.exact_edge_chip, no renderer involved)."""
-import math
-
 import numpy as np
 import pytest
 

@@ -1,5 +1,4 @@
 import numpy as np
-import pytest
 
 from imgmtf.fermi import fermi, fit_fermi
 
