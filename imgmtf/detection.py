@@ -98,6 +98,14 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0)
     return best
 
 
+def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
+    """Signed distance (px) of every pixel centre of an image of ``shape``
+    from ``line``."""
+    t = math.radians(line.theta_deg)
+    y, x = np.indices(shape)
+    return x * math.cos(t) + y * math.sin(t) - line.rho_px
+
+
 def robust_noise(image: np.ndarray) -> float:
     """Noise standard deviation (DN) from the median absolute difference of
     horizontally adjacent pixels, which an edge barely affects."""
@@ -109,9 +117,7 @@ def robust_noise(image: np.ndarray) -> float:
 
 def step_contrast(image: np.ndarray, line: Line) -> float:
     """|mean level 1-5 px on one side of ``line`` - on the other| (DN)."""
-    t = math.radians(line.theta_deg)
-    y, x = np.indices(image.shape)
-    d = x * math.cos(t) + y * math.sin(t) - line.rho_px
+    d = line_distance(image.shape, line)
     near, far = (d > 1) & (d < 5), (d < -1) & (d > -5)
     if not near.any() or not far.any():
         return 0.0
@@ -122,9 +128,7 @@ def bar_contrast(image: np.ndarray, line: Line, reach_px: float = 8.0) -> float:
     """Largest |mean level of a 1-px strip parallel to ``line`` - the image's
     median| within ``reach_px`` of the line (DN): large for a bar along it,
     wherever across the strips the seed line fell; small for noise."""
-    t = math.radians(line.theta_deg)
-    y, x = np.indices(image.shape)
-    d = x * math.cos(t) + y * math.sin(t) - line.rho_px
+    d = line_distance(image.shape, line)
     near = np.abs(d) < reach_px
     if not near.any():
         return 0.0

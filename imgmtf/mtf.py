@@ -56,14 +56,21 @@ def spectrum(lsf: np.ndarray, step: float, resolution: float = 1e-3) -> tuple[np
     return np.fft.rfftfreq(n, d=step), np.abs(np.fft.rfft(lsf, n=n)) * step
 
 
+def with_transfer(own: Callable[[np.ndarray], np.ndarray],
+                  transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
+    """The transfer ``own(f)`` times ``transfer(f)`` (the resampling
+    method's, when given), for f in cy/px."""
+    def divisor(f):
+        f = np.atleast_1d(np.asarray(f, float))
+        value = own(f)
+        return value * transfer(f) if transfer is not None else value
+    return divisor
+
+
 def edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
     """Transfer of an edge estimator's own steps: the central difference
     with ``step`` (sinc(2 f step)) times the resampling ``transfer``."""
-    def divisor(f):
-        f = np.atleast_1d(np.asarray(f, float))
-        central = np.sinc(2 * f * step)
-        return central * transfer(f) if transfer is not None else central
-    return divisor
+    return with_transfer(lambda f: np.sinc(2 * f * step), transfer)
 
 
 def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,

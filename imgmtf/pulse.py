@@ -28,7 +28,7 @@ from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .inputs import prepare_image
 from .metrics import fwhm
 from .mtf import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50,
-                  mtf_area, noise_limited_frequency, restore_lsf)
+                  mtf_area, noise_limited_frequency, restore_lsf, with_transfer)
 from .profile import (ProfileEstimator, check_angle, fit_line, profile_samples, row_windows,
                       vertical_frame)
 from .resampling import resample_profile
@@ -179,11 +179,7 @@ def measure_pulse(image, *, width_px: float | None = None, roi=None, method: str
 def pulse_divisor(width_px: float, transfer):
     """Transfer between the system LSF and the resampled PRF: the bar's
     sinc(f W) (signed) times the resampling method's transfer."""
-    def divisor(f):
-        f = np.atleast_1d(np.asarray(f, float))
-        s = np.sinc(f * width_px)
-        return s * transfer(f) if transfer is not None else s
-    return divisor
+    return with_transfer(lambda f: np.sinc(f * width_px), transfer)
 
 
 def usable_band(width_px: float) -> float:

@@ -11,6 +11,7 @@ vertical, the paper's sensor.
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -74,11 +75,16 @@ def _measure_all(image, methods) -> dict:
     return out
 
 
+@functools.lru_cache(maxsize=1)
+def _renderer() -> Renderer:
+    """The study's renderer, its PSF set up once per process."""
+    return Renderer(Sensor(), CHIP_PX)
+
+
 def _edge_task(task) -> dict:
     """Render one noisy edge chip and measure it; runs in a worker."""
     kind, index, std, high, ground, seed, methods = task
-    renderer = Renderer(Sensor(), CHIP_PX)
-    chip = renderer(Target("edge", ANGLE_DEG, 200.0, high), noise_std_dn=std,
+    chip = _renderer()(Target("edge", ANGLE_DEG, 200.0, high), noise_std_dn=std,
                     ground_noise=GroundNoise() if ground else None, seed=seed)
     return {"kind": kind, "index": index, "std_dn": std, "step_dn": high - 200.0,
             "results": _measure_all(chip.image, methods)}
@@ -206,9 +212,8 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
 def _ground_noise_output_std(seed: int) -> float:
     """Standard deviation (DN) of the ground noise in output chips: the
     2000 DN^2 field blurred by the PSF and sampled (a flat scene, 8 chips)."""
-    renderer = Renderer(Sensor(), CHIP_PX)
     flat = Target("edge", ANGLE_DEG, 1000.0, 1000.0)
-    return float(np.mean([renderer(flat, ground_noise=GroundNoise(), seed=_seed(seed, 4, k))
+    return float(np.mean([_renderer()(flat, ground_noise=GroundNoise(), seed=_seed(seed, 4, k))
                           .image.astype(float).std() for k in range(8)]))
 
 
