@@ -18,12 +18,13 @@ from .resampling import METHODS, resample_profile  # noqa: E402
 from .selftest import run_selftest  # noqa: E402
 from .sensor import SampledPSF, Sensor  # noqa: E402
 from .targets import Target  # noqa: E402
+from .uncertainty import Bootstrap, Interval  # noqa: E402
 
 __all__ = [
     "__version__",
     "Sensor", "SampledPSF", "Target", "GroundNoise", "Chip", "Renderer", "render",
     "measure_edge", "EdgeEstimator", "EdgeResult", "measure_pulse", "PulseEstimator", "PulseResult",
-    "METHODS", "resample_profile",
+    "METHODS", "resample_profile", "Bootstrap", "Interval",
     "Raster", "read_raster", "write_geotiff", "run_selftest",
     "ImgmtfError", "ParameterError", "ConfigError", "FileWriteError", "ImageReadError",
     "ImageContentError", "TargetNotFoundError", "MultipleTargetsError", "UnsuitableTargetError",

@@ -32,6 +32,7 @@ from .profile import (ProfileEstimator, TargetGeometry, check_angle, locate_edge
                       vertical_frame)
 from .resampling import resample_profile
 from .results import MTFResult, finite
+from .uncertainty import bootstrap_figures
 
 SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row
@@ -95,7 +96,7 @@ class EdgeEstimator(ProfileEstimator):
                              gsd_m, saturation)
 
     def _profile(self, work, geometry: TargetGeometry, roi, gsd_m, saturation) -> EdgeResult:
-        d, v, half_range = profile_samples(work, geometry, "edge")
+        d, v, row, half_range = profile_samples(work, geometry, "edge")
         esf = resample_profile(d, v, method=self.method, step=self.step_px,
                                half_range=half_range - 0.6, **self.method_options)
         grid, values = esf.grid, esf.values
@@ -133,14 +134,23 @@ class EdgeEstimator(ProfileEstimator):
         density = d.size / (2.0 * half_range)
         noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
         x_c, lsf_c = restore_lsf(lsf_w, x, divisor, noise_limit)
+
+        def windowed_lsf(grid_b, esf_b, weights_of):
+            x_b, lsf_b = central_difference(grid_b, esf_b)
+            return lsf_b * flat_top_window(x_b, centre, half_width, taper)
+        nyquist_ci, mtf50_ci = bootstrap_figures(
+            self.bootstrap, d, row, abs(centre) + half_width + taper + 2 * esf.step,
+            self._resampler(d, v), windowed_lsf, esf.step, divisor)
         params = {"method": self.method, **esf.params, "correct": self.correct,
-                  "lsf_half_width_px": half_width, "lsf_taper_px": taper}
+                  "lsf_half_width_px": half_width, "lsf_taper_px": taper,
+                  "bootstrap": self.bootstrap.as_dict()}
         return EdgeResult(
             method=self.method, params=params, angle_deg=geometry.angle_deg,
             orientation="horizontal" if geometry.transposed else "vertical",
             polarity="rising" if right > left else "falling",
             rows_used=rows_used, rows_total=int(work.shape[0]), snr=snr,
             mtf_nyquist=float(mtf(NYQUIST)[0]), mtf50_cy_px=mtf50(mtf),
+            mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
             fwhm_px=fwhm(x_c, lsf_c), rer=relative_edge_response(grid, esf01, centre),
             mtfa=mtf_area(mtf), gsd_m=gsd_m,
             frequencies_cy_px=self.frequencies_cy_px, mtf=mtf(self.frequencies_cy_px),

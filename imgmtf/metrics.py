@@ -28,13 +28,20 @@ def fwhm(x: np.ndarray, y: np.ndarray) -> float:
     return float(x_right - x_left)
 
 
-def first_crossing(x: np.ndarray, y: np.ndarray, level: float) -> float:
+def first_crossing(x: np.ndarray, y: np.ndarray, level: float):
     """First ``x`` at which a curve starting above ``level`` falls below it
-    (linear interpolation between samples); NaN if it never does."""
+    (linear interpolation between samples); NaN if it never does.  ``y`` may
+    stack curves on its leading axes (..., len(x)): one crossing each."""
     x = np.asarray(x, float)
     y = np.asarray(y, float)
-    below = np.nonzero(y < level)[0]
-    if below.size == 0 or below[0] == 0:
-        return float("nan")
-    i = below[0]
-    return float(x[i - 1] + (y[i - 1] - level) / (y[i - 1] - y[i]) * (x[i] - x[i - 1]))
+    below = y < level
+    i = np.argmax(below, axis=-1)
+    found = below.any(axis=-1) & (i > 0)
+    i = np.clip(i, 1, x.size - 1)[..., None]
+    y0 = np.take_along_axis(y, i - 1, axis=-1)[..., 0]
+    y1 = np.take_along_axis(y, i, axis=-1)[..., 0]
+    i = i[..., 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        crossing = x[i - 1] + (y0 - level) / (y0 - y1) * (x[i] - x[i - 1])
+    crossing = np.where(found, crossing, np.nan)
+    return float(crossing) if y.ndim == 1 else crossing

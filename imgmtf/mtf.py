@@ -31,9 +31,10 @@ NYQUIST = 0.5
 
 def central_difference(grid: np.ndarray, esf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """LSF by central difference of a uniformly sampled ESF: ``(x, lsf)``
-    on the interior grid points (1/px for an ESF normalised to a unit step)."""
+    on the interior grid points (1/px for an ESF normalised to a unit step).
+    ``esf`` may stack profiles on its leading axes."""
     step = grid[1] - grid[0]
-    return grid[1:-1], (esf[2:] - esf[:-2]) / (2 * step)
+    return grid[1:-1], (esf[..., 2:] - esf[..., :-2]) / (2 * step)
 
 
 def flat_top_window(x: np.ndarray, center: float, half_width: float, taper: float) -> np.ndarray:

@@ -16,7 +16,8 @@ import numpy as np
 from .detection import Line
 from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .fermi import fit_fermi
-from .resampling import METHODS, sample_gap
+from .resampling import METHODS, resample_profile, sample_gap
+from .uncertainty import Bootstrap
 
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
@@ -40,11 +41,13 @@ class ProfileEstimator:
     frequencies_cy_px : where the reported MTF curve is sampled.
     snr_threshold : below this SNR the result carries a warning.
     method_options : overrides of the method's defaults (e.g. window_px).
+    bootstrap : confidence-interval settings
+        (:class:`imgmtf.uncertainty.Bootstrap`; ``Bootstrap(0)`` for none).
     """
 
     def __init__(self, method: str = "msg", *, step_px: float = 0.05, correct: bool = True,
                  frequencies_cy_px=DEFAULT_FREQUENCIES, snr_threshold: float | None = None,
-                 method_options: dict | None = None):
+                 method_options: dict | None = None, bootstrap: Bootstrap = Bootstrap()):
         if method not in METHODS:
             raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
         self.method = method
@@ -53,6 +56,15 @@ class ProfileEstimator:
         self.frequencies_cy_px = np.asarray(frequencies_cy_px, float)
         self.snr_threshold = snr_threshold
         self.method_options = dict(method_options or {})
+        self.bootstrap = bootstrap
+
+    def _resampler(self, distance, values):
+        """``resample(keep, weights, half_range)`` over a subset of the
+        samples, with this estimator's method and step (for the bootstrap)."""
+        def resample(keep, weights, half_range):
+            return resample_profile(distance[keep], values[keep], method=self.method, step=self.step_px,
+                                    half_range=half_range, weights=weights, **self.method_options)
+        return resample
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,9 +173,10 @@ def check_angle(geometry: TargetGeometry, name: str) -> None:
 
 
 def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
-    """Every pixel of the kept rows as a profile sample: ``(d, v,
-    half_range)``, the signed distance (px) to the line, the value, and the
-    distance D within which samples are kept (the distance 3 rows in 4
+    """Every pixel of the kept rows as a profile sample: ``(d, v, row,
+    half_range)``, the signed distance (px) to the line, the value, the
+    sample's row (vertical frame), and the distance D within which samples
+    are kept (the distance 3 rows in 4
     reach on both sides, at most ``MAX_HALF_RANGE_PX``).
 
     Refuses a target too near the border or whose samples leave a gap wider
@@ -172,6 +185,7 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
     cols = np.arange(work.shape[1], dtype=float)
     d = geometry.distance(cols[None, :], rows[:, None].astype(float))
     v = work[rows]
+    row = np.broadcast_to(rows[:, None], d.shape)
     reach = np.minimum(-d[:, 0], d[:, -1])
     half_range = min(float(np.quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
     if half_range < MIN_HALF_RANGE_PX:
@@ -179,7 +193,7 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
             f"the {name} is {max(half_range, 0):.1f} px from the image border; at least "
             f"{MIN_HALF_RANGE_PX:g} px of flat level are needed on each side")
     inside = np.abs(d) <= half_range
-    d, v = d[inside], v[inside]
+    d, v, row = d[inside], v[inside], row[inside]
     if np.count_nonzero(np.abs(d) < 2.0) < 20:
         raise UnsuitableTargetError(f"too few samples near the {name}")
     gap = sample_gap(d)
@@ -188,4 +202,4 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
             f"the {name} at {geometry.angle_deg:.2f} deg samples sub-pixel phases with a gap of "
             f"{gap:.2f} px (at most {MAX_SAMPLE_GAP_PX} allowed): too few rows, or an angle "
             "whose phases repeat every 1-3 rows (near 45, 26.6, 18.4 deg)")
-    return d, v, half_range
+    return d, v, row, half_range

@@ -33,6 +33,7 @@ from .profile import (ProfileEstimator, check_angle, fit_line, profile_samples, 
                       vertical_frame)
 from .resampling import resample_profile
 from .results import MTFResult, finite
+from .uncertainty import bootstrap_figures
 
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
@@ -92,7 +93,7 @@ class PulseEstimator(ProfileEstimator):
         work, seed_x, transposed = vertical_frame(data, lines[0])
         geometry = locate_pulse(work, seed_x, transposed)
         check_angle(geometry, "bar")
-        d, v, half_range = profile_samples(work, geometry, "bar")
+        d, v, row, half_range = profile_samples(work, geometry, "bar")
         prf = resample_profile(d, v, method=self.method, step=self.step_px,
                                half_range=half_range - 0.6, **self.method_options)
         grid, values = prf.grid, prf.values
@@ -135,6 +136,17 @@ class PulseEstimator(ProfileEstimator):
         # the division is bridged only right at the sinc's zeros: between them
         # even a small sinc carries LSF content the FWHM needs
         x_c, lsf_c = restore_lsf(prf_w, grid, divisor, noise_limit, min_divisor=RESTORE_MIN_SINC)
+        # a replicate's background moves as the mean of its outer samples does
+        outer_band = np.abs(d) >= min(-grid[n_side - 1], grid[-n_side])
+
+        def windowed_prf(grid_b, values_b, weights_of):
+            weights = weights_of(outer_band)
+            shift = weights @ v[outer_band] / weights.sum(axis=1)
+            background_b = background + shift - v[outer_band].mean()
+            return (values_b - background_b[:, None]) * flat_top_window(grid_b, 0.0, half_width, taper)
+        nyquist_ci, mtf50_ci = bootstrap_figures(
+            self.bootstrap, d, row, half_width + taper + 2 * prf.step,
+            self._resampler(d, v), windowed_prf, prf.step, divisor)
         warnings = []
         threshold = self.snr_threshold or SNR_THRESHOLD
         if snr < threshold:
@@ -143,13 +155,15 @@ class PulseEstimator(ProfileEstimator):
             warnings.append(f"the bar's sinc falls below {MIN_TRANSFER} at {band:.3f} cy/px, before "
                             "Nyquist: MTF values near its zeros are masked (NaN)")
         params = {"method": self.method, **prf.params, "correct": self.correct,
-                  "window_half_width_px": half_width, "window_taper_px": taper}
+                  "window_half_width_px": half_width, "window_taper_px": taper,
+                  "bootstrap": self.bootstrap.as_dict()}
         return PulseResult(
             method=self.method, params=params, angle_deg=geometry.angle_deg,
             orientation="horizontal" if transposed else "vertical",
             polarity="bright" if sign > 0 else "dark",
             rows_used=int(geometry.kept.sum()), rows_total=int(work.shape[0]), snr=snr,
             mtf_nyquist=float(mtf(NYQUIST)[0]), mtf50_cy_px=mtf50(mtf), fwhm_px=fwhm(x_c, lsf_c),
+            mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
             mtfa=mtf_area(mtf), gsd_m=gsd_m, frequencies_cy_px=self.frequencies_cy_px,
             mtf=mtf(self.frequencies_cy_px), lsf_x_px=x_c, lsf=lsf_c, samples_x_px=d,
             samples_dn=v, geometry=geometry, roi=(x0, y0, data.shape[1], data.shape[0]),

@@ -31,6 +31,7 @@ from .rendering import Renderer
 from .resampling import METHODS
 from .sensor import Sensor
 from .targets import Target
+from .uncertainty import NO_BOOTSTRAP
 
 CHIP_PX = 40
 ANGLE_DEG = 6.0
@@ -68,7 +69,7 @@ def _measure_all(image, methods) -> dict:
     out = {}
     for method in methods:
         try:
-            r = EdgeEstimator(method, correct=True)(image)
+            r = EdgeEstimator(method, correct=True, bootstrap=NO_BOOTSTRAP)(image)
             out[method] = (r.mtf_nyquist, r.snr)
         except ImgmtfError:
             out[method] = (float("nan"), float("nan"))
@@ -117,10 +118,11 @@ def estimator_tables(methods) -> list[dict]:
         for correct in (False, True):
             for method in methods:
                 if kind == "edge":
-                    r = EdgeEstimator(method, correct=correct)(chip.image)
+                    r = EdgeEstimator(method, correct=correct, bootstrap=NO_BOOTSTRAP)(chip.image)
                     fw = r.fwhm_px
                 else:
-                    r = PulseEstimator(method, correct=correct)(chip.image, width_px=width)
+                    r = PulseEstimator(method, correct=correct, bootstrap=NO_BOOTSTRAP)(
+                        chip.image, width_px=width)
                     fw = r.prf_fwhm_px
                 paper = PAPER_TABLE[kind].get(method, ("", "")) if not correct else ("", "")
                 rows.append({"target": kind, "method": method, "corrected": "yes" if correct else "no",

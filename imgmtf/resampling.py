@@ -26,6 +26,7 @@ from typing import Callable
 
 import numpy as np
 from scipy.interpolate import make_smoothing_spline
+from scipy import sparse
 from scipy.ndimage import correlate1d
 
 from .errors import ImageContentError, ParameterError
@@ -59,14 +60,16 @@ class ResamplingMethod:
 
 
 def local_polynomial(distance, values, step: float, half_range: float, *,
-                     order: int = 4, window_px: float = 1.0) -> Resampled:
+                     order: int = 4, window_px: float = 1.0, weights=None) -> Resampled:
     """Least-squares polynomial of ``order`` fitted to the samples within
     ``window_px`` (centred) of each grid point, evaluated there.
 
     Samples are binned on the output grid and the window is a whole number
     of bins, so every window's moment sums are convolutions of per-bin
     moments (binomial expansion about the grid point): the cost is linear in
-    the number of samples, with no loop over grid points.
+    the number of samples, with no loop over grid points.  ``weights`` (see
+    :func:`resample_profile`) enter the moment sums linearly, so a stack of
+    weight vectors is fitted in one pass.
     """
     if order < 0 or order > 8:
         raise ParameterError(f"local polynomial order must be 0..8, got {order}")
@@ -78,41 +81,81 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     # points see full windows
     out = _grid(step, half_range)
     grid = _grid(step, half_range + half_bins * step)
-    bins = np.rint((distance - grid[0]) / step).astype(int)
-    keep = (bins >= 0) & (bins < grid.size)
-    bins, d, v = bins[keep], distance[keep], values[keep]
+    bins, keep = _bins(distance, grid, step)
+    d, v = distance[keep], values[keep]
+    w = _weights(weights, distance.size)[..., keep]
     scale = (half_bins + 0.5) * step      # local coordinates in [-1, 1]
     u = (d - grid[bins]) / scale
     nk = 2 * order + 1
     powers = np.vander(u, nk, increasing=True).T
-    s = np.stack([np.bincount(bins, weights=p, minlength=grid.size) for p in powers])
-    t = np.stack([np.bincount(bins, weights=p * v, minlength=grid.size) for p in powers[: order + 1]])
+    features = np.concatenate([powers, powers[: order + 1] * v])
+    sums = _bin_sums(bins, grid.size, w[..., None, :] * features)
+    s, t = sums[..., :nk, :], sums[..., nk:, :]
     offsets = np.arange(-half_bins, half_bins + 1) * step / scale
 
     def window_sums(moments):
         """Sum over each grid point's window of (u + offset)^k for every k,
         from the per-bin sums of u^j: sum_j C(k, j) (offset^(k-j) * S_j),
         one correlation per power of the offset for all moments at once."""
-        kmax = moments.shape[0] - 1
-        shifted = [correlate1d(moments, offsets ** p, axis=1, mode="constant") for p in range(kmax + 1)]
-        return np.array([sum(math.comb(k, j) * shifted[k - j][j] for j in range(k + 1))
-                         for k in range(kmax + 1)])
+        kmax = moments.shape[-2] - 1
+        # offset^p multiplies only the moments j <= kmax - p
+        shifted = [correlate1d(moments[..., : kmax + 1 - p, :], offsets ** p, axis=-1, mode="constant")
+                   for p in range(kmax + 1)]
+        return np.stack([sum(math.comb(k, j) * shifted[k - j][..., j, :] for j in range(k + 1))
+                         for k in range(kmax + 1)], axis=-2)
     m = window_sums(s)
-    rhs = window_sums(t)
+    rhs = np.moveaxis(window_sums(t), -1, -2)
     idx = np.arange(order + 1)
-    normal = m[idx[:, None] + idx[None, :]].transpose(2, 0, 1)
+    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
     # a window needs enough samples, spread over it (uniform spread gives
     # a variance of 1/3 in window coordinates), for a well-posed fit
-    count = np.maximum(m[0], 1)
-    spread = m[2] / count - (m[1] / count) ** 2
-    valid = (m[0] >= 2 * (order + 1)) & (spread > 0.05)
-    coef = np.full((grid.size, order + 1), np.nan)
+    count = np.where(m[..., 0, :] > 0, m[..., 0, :], 1.0)
+    spread = m[..., 2, :] / count - (m[..., 1, :] / count) ** 2
+    valid = (m[..., 0, :] >= 2 * (order + 1) * _unit_weight(w)) & (spread > 0.05)
+    level = np.full(valid.shape, np.nan)
     if valid.any():
-        coef[valid] = np.linalg.solve(normal[valid], rhs[:, valid].T[..., None])[..., 0]
+        level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
     width = (2 * half_bins + 1) * step
     trim = (grid.size - out.size) // 2
-    return Resampled(out, coef[trim: trim + out.size, 0], _local_polynomial_transfer(order, width),
+    return Resampled(out, level[..., trim: trim + out.size], _local_polynomial_transfer(order, width),
                      {"order": order, "window_px": width, "step_px": step})
+
+
+def _bins(distance, grid, step):
+    """Nearest grid index of every sample, and which samples fall on the grid."""
+    bins = np.rint((distance - grid[0]) / step).astype(int)
+    keep = (bins >= 0) & (bins < grid.size)
+    return bins[keep], keep
+
+
+def _weights(weights, n: int) -> np.ndarray:
+    """Sample weights as an array of shape (n,) or (replicates, n)."""
+    if weights is None:
+        return np.ones(n)
+    w = np.asarray(weights, float)
+    if w.shape[-1] != n or w.ndim > 2:
+        raise ParameterError(f"weights must have shape ({n},) or (replicates, {n}), got {w.shape}")
+    return w
+
+
+def _unit_weight(w: np.ndarray):
+    """The weight one sample counts with: 1 for counts, the mean otherwise,
+    so that minimum-count rules mean samples whatever the weights' scale."""
+    mean = w.mean(axis=-1, keepdims=True) if w.size else np.ones(1)
+    return np.where(mean > 0, mean, 1.0)
+
+
+def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray:
+    """Per-bin sums of ``features`` (..., F, n_samples) -> (..., F, n_bins)."""
+    lead = features.shape[:-1]
+    flat = features.reshape(-1, features.shape[-1])
+    if flat.shape[0] <= 16:
+        sums = np.stack([np.bincount(bins, weights=f, minlength=n_bins) for f in flat])
+    else:
+        onehot = sparse.csr_array((np.ones(bins.size), (np.arange(bins.size), bins)),
+                                  shape=(bins.size, n_bins))
+        sums = (onehot.T @ flat.T).T
+    return sums.reshape(*lead, n_bins)
 
 
 @functools.lru_cache(maxsize=32)
@@ -136,7 +179,7 @@ def _local_polynomial_transfer(order: int, width: float) -> Callable:
 
 
 def smoothing_spline(distance, values, step: float, half_range: float, *,
-                     cutoff_cy_px: float = 2.0) -> Resampled:
+                     cutoff_cy_px: float = 2.0, weights=None) -> Resampled:
     """Cubic smoothing spline through the samples (exact ties averaged).
 
     The smoothing weight is set so that the spline's response falls to 1/2
@@ -144,20 +187,28 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
     spline with weight lam has the transfer function
     1 / (1 + lam (2 pi f)^4 / rho) (its equivalent kernel), so
     lam = rho / (2 pi f_c)^4.  (Generalised cross-validation would choose
-    lam from the data but costs about a second per profile.)
+    lam from the data but costs about a second per profile.)  A stack of
+    weight vectors costs one spline fit each.
     """
     if not cutoff_cy_px > 0:
         raise ParameterError(f"spline cut-off must be > 0 cycles/pixel, got {cutoff_cy_px}")
     grid = _grid(step, half_range)
+    w = _weights(weights, distance.size)
     ux, inverse = np.unique(distance, return_inverse=True)
     if ux.size < 5:
         raise ImageContentError("too few distinct profile samples for a spline")
-    counts = np.bincount(inverse)
-    means = np.bincount(inverse, weights=values) / counts
     density = distance.size / (ux[-1] - ux[0])
     lam = density / (2 * np.pi * cutoff_cy_px) ** 4
-    spline = make_smoothing_spline(ux, means, w=counts.astype(float), lam=lam)
-    out = np.where((grid >= ux[0]) & (grid <= ux[-1]), spline(grid), np.nan)
+    inside = (grid >= ux[0]) & (grid <= ux[-1])
+
+    def fit(sample_weights):
+        counts = np.bincount(inverse, weights=sample_weights)
+        present = counts > 0
+        means = np.bincount(inverse, weights=sample_weights * values)[present] / counts[present]
+        scale = sample_weights.size / sample_weights.sum()     # lam assumes unit weights
+        spline = make_smoothing_spline(ux[present], means, w=counts[present] * scale, lam=lam)
+        return np.where(inside, spline(grid), np.nan)
+    out = fit(w) if w.ndim == 1 else np.stack([fit(row) for row in w])
 
     def transfer(f):
         return 1.0 / (1.0 + (np.atleast_1d(np.asarray(f, float)) / cutoff_cy_px) ** 4)
@@ -165,23 +216,27 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
 
 
 def binned(distance, values, step: float, half_range: float, *,
-           bin_px: float = 0.25) -> Resampled:
+           bin_px: float = 0.25, weights=None) -> Resampled:
     """Average of the samples in each bin of ``bin_px`` pixels (the output
     grid is the bin centres, whatever ``step`` asks for); empty bins are
     filled by linear interpolation.  Transfer: sinc(f * bin_px)."""
     grid = _grid(bin_px, half_range)
-    bins = np.rint((distance - grid[0]) / bin_px).astype(int)
-    keep = (bins >= 0) & (bins < grid.size)
-    counts = np.bincount(bins[keep], minlength=grid.size)
-    sums = np.bincount(bins[keep], weights=values[keep], minlength=grid.size)
+    bins, keep = _bins(distance, grid, bin_px)
+    w = _weights(weights, distance.size)[..., keep]
+    sums = _bin_sums(bins, grid.size, w[..., None, :] * np.stack([np.ones(bins.size), values[keep]]))
+    counts, totals = sums[..., 0, :], sums[..., 1, :]
     filled = counts > 0
-    if filled.sum() < 2:
+    if filled.sum(axis=-1).min() < 2:
         raise ImageContentError("too few profile samples to bin")
-    out = np.interp(grid, grid[filled], sums[filled] / counts[filled])
+    means = totals / np.where(filled, counts, 1.0)
+    out = np.stack([np.interp(grid, grid[f], m[f]) for f, m in
+                    zip(filled.reshape(-1, grid.size), means.reshape(-1, grid.size))])
+    out = out.reshape(means.shape)
 
     def transfer(f):
         return np.sinc(np.atleast_1d(np.asarray(f, float)) * bin_px)
-    return Resampled(grid, out, transfer, {"bin_px": bin_px, "empty_bins": int((~filled).sum())})
+    return Resampled(grid, out, transfer, {"bin_px": bin_px,
+                                           "empty_bins": int((~filled).sum(axis=-1).max())})
 
 
 def sample_gap(distance: np.ndarray, near_px: float = 2.0) -> float:
@@ -214,10 +269,17 @@ METHODS: dict[str, ResamplingMethod] = {
 
 
 def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = "msg",
-                     step: float = 0.05, half_range: float, **options) -> Resampled:
+                     step: float = 0.05, half_range: float, weights=None, **options) -> Resampled:
     """Resample profile samples (``distance`` in px, ``values`` in DN) onto a
     uniform grid of ``step`` px spanning +-``half_range`` px, by ``method``
-    (a key of :data:`METHODS`); ``options`` override the method's defaults."""
+    (a key of :data:`METHODS`); ``options`` override the method's defaults.
+
+    ``weights`` (optional) weight every sample: shape (n_samples,), or
+    (replicates, n_samples) to resample a stack of weightings at once (the
+    bootstrap of :mod:`imgmtf.uncertainty`), when ``values`` of the result
+    has shape (replicates, grid size).  The grid is symmetric about 0, so
+    grids of equal step share their points whatever ``half_range``.
+    """
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if not step > 0:
@@ -227,4 +289,4 @@ def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = 
     if unknown:
         raise ParameterError(f"method {method!r} takes no option(s) {', '.join(sorted(unknown))}")
     return spec.function(np.asarray(distance, float), np.asarray(values, float), step,
-                         half_range, **{**spec.defaults, **options})
+                         half_range, weights=weights, **{**spec.defaults, **options})

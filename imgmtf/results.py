@@ -10,6 +10,7 @@ import numpy as np
 
 from . import __version__
 from .profile import TargetGeometry
+from .uncertainty import Interval
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -36,6 +37,8 @@ class MTFResult:
     snr: float
     mtf_nyquist: float
     mtf50_cy_px: float
+    mtf_nyquist_ci: Interval
+    mtf50_ci_cy_px: Interval
     fwhm_px: float
     mtfa: float
     gsd_m: float | None
@@ -78,7 +81,10 @@ class MTFResult:
             "target": self.target, "method": self.method, "angle_deg": self.angle_deg,
             "orientation": self.orientation, "direction": self.direction,
             "polarity": self.polarity, "rows_used": self.rows_used, "snr": finite(self.snr),
-            "mtf_nyquist": finite(self.mtf_nyquist), "mtf50_cy_px": finite(self.mtf50_cy_px),
+            "mtf_nyquist": finite(self.mtf_nyquist),
+            "mtf_nyquist_ci": [finite(self.mtf_nyquist_ci.low), finite(self.mtf_nyquist_ci.high)],
+            "mtf50_cy_px": finite(self.mtf50_cy_px),
+            "mtf50_ci_cy_px": [finite(self.mtf50_ci_cy_px.low), finite(self.mtf50_ci_cy_px.high)],
             "fwhm_px": finite(self.fwhm_px), "mtfa": finite(self.mtfa), "gsd_m": self.gsd_m,
             "mtf50_cy_m": finite(self.mtf50_cy_m), "fwhm_m": finite(self.fwhm_m),
             "noise_limit_cy_px": finite(self.noise_limit_cy_px),
