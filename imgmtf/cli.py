@@ -14,17 +14,16 @@ from pathlib import Path
 import click
 
 from . import __version__
-from .edge import EdgeEstimator
+from .batch import MeasureSettings, expand_inputs, measure_file, measure_files, write_csv
 from .errors import FileWriteError, ImgmtfError, ParameterError
-from .inputs import saturation_levels
-from .io import read_raster, write_geotiff
+from .io import write_geotiff
 from .noise import GroundNoise
-from .pulse import PulseEstimator, check_width
 from .rendering import render
 from .resampling import METHODS
 from .selftest import run_selftest
 from .sensor import DIRECTIONS, Sensor
 from .targets import Target
+from .uncertainty import Bootstrap
 
 
 @contextmanager
@@ -158,6 +157,32 @@ def sensor_command(sensor_path, plot_path, save_path):
 
 
 # -- measure ------------------------------------------------------------------
+def _parse_band(ctx, param, value):
+    if value is None or value.lower() == "all":
+        return value and "all"
+    try:
+        return int(value)
+    except ValueError:
+        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}")
+
+
+def _parallel_options(command):
+    """--workers and --scheduler, shared by the batch commands."""
+    command = click.option("--scheduler", metavar="ADDRESS",
+                           help="run on a Dask distributed cluster (tcp://host:8786), or 'local' "
+                                "for a local Dask cluster of --workers processes; needs imgmtf[dask]")(command)
+    return click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
+                        help="parallel worker processes")(command)
+
+
+def _bootstrap_options(command):
+    command = click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True),
+                           default=0.95, show_default=True, help="confidence of the intervals")(command)
+    return click.option("--bootstrap", "replicates", type=click.IntRange(min=0), default=200,
+                        show_default=True,
+                        help="bootstrap replicates for the confidence intervals (0: none)")(command)
+
+
 @main.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
@@ -166,73 +191,76 @@ def sensor_command(sensor_path, plot_path, save_path):
                    "estimated from the profile when omitted")
 @click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True,
               help="profile smoothing/resampling method")
-@click.option("--roi", callback=_parse_roi, help="X,Y,W,H crop in pixels")
-@click.option("--band", type=int, help="1-based band (default: the only band, or RGB luminance)")
+@click.option("--roi", callback=_parse_roi, help="X,Y,W,H window in pixels (only it is read)")
+@click.option("--band", callback=_parse_band,
+              help="1-based band, or 'all' for one result per band "
+                   "(default: the only band, or the luminance of RGB)")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), help="also write a CSV summary")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
-def measure(paths, kind, pulse_width, method, roi, band, fmt, plot_path, plot_dir):
-    """Measure the MTF of the edge (or bar) in each image.  With --format
-    json, one JSON object per input per line (JSON Lines)."""
-    if plot_path and len(paths) > 1:
-        raise click.UsageError("--plot takes a single input; use --plot-dir for several")
+@click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
+@_bootstrap_options
+@_parallel_options
+def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
+            progress, replicates, confidence, workers, scheduler):
+    """Measure the MTF of the edge (or bar) in each image file, or in every
+    image of a folder.  With --format json, one JSON object per line (JSON
+    Lines) per file and band; a file that cannot be measured gives an error
+    line and the rest go on (exit status 1 if any failed)."""
+    if plot_path and plot_dir:
+        raise click.UsageError("give --plot or --plot-dir, not both")
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     with _reported_errors():
-        if pulse_width and pulse_width[1] == "px":
-            check_width(pulse_width[0])
-        estimator = EdgeEstimator(method) if kind == "edge" else PulseEstimator(method)
-    if plot_dir:
-        Path(plot_dir).mkdir(parents=True, exist_ok=True)
-    failures = 0
-    if fmt == "text":
-        last = "RER" if kind == "edge" else "W px"
-        click.echo(f"{'path':<32} {'angle':>7} {'dir':>6} {'SNR':>7} {'MTF@Nyq':>8} "
-                   f"{'MTF50':>7} {'FWHM':>6} {last:>6}")
-    for path in paths:
-        try:
-            raster = read_raster(path, band)
-            if kind == "edge":
-                result = estimator(raster.data, roi=roi, gsd_m=raster.gsd_m,
-                                   saturation=saturation_levels(raster.dtype))
-            else:
-                result = estimator(raster.data, width_px=_width_px(pulse_width, raster), roi=roi,
-                                   gsd_m=raster.gsd_m)
-            figure_path = plot_path or (Path(plot_dir) / f"{Path(path).stem}_mtf.png" if plot_dir else None)
-            if figure_path:
-                from .plot import plot_measurement
-                _save_figure(plot_measurement(result), figure_path)
-        except ImgmtfError as exc:
-            failures += 1
-            if fmt == "json":
-                click.echo(json.dumps({"path": path, "error": str(exc)}))
-            else:
-                click.echo(f"{path:<32} error: {exc}")
-            continue
-        if fmt == "json":
-            click.echo(json.dumps({"path": path, "band": raster.band, **result.to_dict()}))
+        settings = MeasureSettings(kind, method, band, roi, pulse_width, Bootstrap(replicates, confidence))
+        files = expand_inputs(paths, recursive)
+        if not files:
+            raise ParameterError(f"no image files in {', '.join(paths)}")
+        if plot_path and len(files) > 1:
+            raise ParameterError("--plot takes a single input; use --plot-dir for several")
+        if plot_path:
+            batches = [measure_file(files[0], settings, plot_path)]
         else:
-            last = result.rer if kind == "edge" else result.pulse_width_px
-            click.echo(f"{path:<32} {result.angle_deg:7.2f} {result.direction.split('-')[0]:>6} "
-                       f"{result.snr:7.0f} {result.mtf_nyquist:8.4f} {result.mtf50_cy_px:7.4f} "
-                       f"{result.fwhm_px:6.3f} {last:6.3f}")
-            for warning in result.warnings:
-                click.echo(f"{'':<32} warning: {warning}")
+            batches = measure_files(files, settings, workers=workers, scheduler=scheduler,
+                                    plot_dir=plot_dir, progress=progress)
+        records = []
+        if fmt == "text":
+            last = "RER" if kind == "edge" else "W px"
+            click.echo(f"{'path':<32} {'band':>4} {'angle':>7} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+                       f"{'95% interval':>15} {'MTF50':>7} {'FWHM':>6} {last:>6}".replace(
+                           "95%", f"{100 * confidence:g}%"))
+        for batch in batches:
+            for record in batch:
+                records.append(record)
+                click.echo(json.dumps(record) if fmt == "json" else _text_row(record, kind))
+        if csv_path:
+            write_csv(records, csv_path)
+    failures = sum(r["status"] == "error" for r in records)
+    if len(records) > 1 and fmt == "text":
+        click.echo(f"{len(records) - failures} measured, {failures} failed"
+                   + (f"; summary in {csv_path}" if csv_path else ""), err=True)
     sys.exit(1 if failures else 0)
 
 
-def _width_px(width, raster) -> float | None:
-    """A --pulse-width in pixels for this raster (metres need its GSD)."""
-    if width is None:
-        return None
-    value, unit = width
-    if unit == "px":
-        return value
-    if raster.gsd_m is None:
-        raise ParameterError(f"{raster.path}: a width in metres needs a georeferenced image "
-                             "(its GSD is unknown); give the width in px")
-    check_width(value / raster.gsd_m)
-    return value / raster.gsd_m
+def _text_row(record: dict, kind: str) -> str:
+    path = record["path"]
+    band = "" if record["band"] in (None, 1, "luminance") else str(record["band"])
+    if record["status"] == "error":
+        return f"{path:<32} {band:>4} error: {record['error']}"
+    last = record["rer"] if kind == "edge" else record["pulse_width_px"]
+    lo, hi = record["mtf_nyquist_ci"]
+    interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None else "-"
+    cells = [f"{path:<32} {band:>4} {record['angle_deg']:7.2f} {record['direction'].split('-')[0]:>6} "
+             f"{_num(record['snr'], 6, 0)} {_num(record['mtf_nyquist'], 7, 4)} {interval:>15} "
+             f"{_num(record['mtf50_cy_px'], 7, 4)} {_num(record['fwhm_px'], 6, 3)} {_num(last, 6, 3)}"]
+    cells += [f"{'':<32} warning: {w}" for w in record["warnings"]]
+    return "\n".join(cells)
+
+
+def _num(value, width: int, decimals: int) -> str:
+    return f"{value:{width}.{decimals}f}" if value is not None else f"{'-':>{width}}"
 
 
 # -- reproduce ----------------------------------------------------------------

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,6 +19,7 @@ import numpy as np
 import rasterio
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.transform import Affine
+from rasterio.windows import Window
 
 from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
 
@@ -37,6 +39,7 @@ class Raster:
     gsd_m : pixel size in metres when the file is georeferenced, else None.
     tags : the file's metadata tags.
     dtype : the stored sample type (e.g. "uint16").
+    origin : (x, y) of ``data``'s top-left pixel in the file (a window's).
     """
 
     data: np.ndarray
@@ -45,6 +48,7 @@ class Raster:
     gsd_m: float | None
     tags: dict = field(default_factory=dict)
     dtype: str = "float64"
+    origin: tuple[int, int] = (0, 0)
 
     @property
     def provenance(self) -> dict | None:
@@ -57,10 +61,12 @@ class Raster:
 
 
 def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
-                  provenance: dict | None = None) -> None:
+                  provenance: dict | None = None, crs: str | None = None,
+                  origin_m: tuple[float, float] = (0.0, 0.0)) -> None:
     """Write a uint8/uint16 chip (rows x cols, or bands x rows x cols) as a
     GeoTIFF whose geotransform carries ``gsd_m`` and whose tags carry
-    ``provenance``."""
+    ``provenance``; ``crs`` (e.g. "EPSG:32633") and ``origin_m`` (map x, y
+    of the top-left corner) place it on the map."""
     image = np.asarray(image)
     if image.dtype not in (np.uint8, np.uint16):
         raise ParameterError(f"{path}: GeoTIFF chips are 8 or 16 bit, got {image.dtype}")
@@ -76,7 +82,7 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
             tags[key.upper()] = str(provenance.get(key))
     profile = dict(driver="GTiff", width=bands.shape[2], height=bands.shape[1],
                    count=bands.shape[0], dtype=bands.dtype.name,
-                   transform=Affine(gsd_m, 0.0, 0.0, 0.0, -gsd_m, 0.0))
+                   transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -87,51 +93,141 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
         raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
 
 
-def read_raster(path: str | Path, band: int | None = None) -> Raster:
+@dataclass(frozen=True)
+class RasterInfo:
+    """What a raster file holds, read from its header only.
+
+    ``width``/``height`` in pixels; ``count`` bands; ``colours`` their
+    colour interpretations; ``gsd_m`` as in :class:`Raster`; ``transform``
+    the pixel-to-map affine and ``crs`` its CRS (WKT or None).
+    """
+
+    path: str
+    width: int
+    height: int
+    count: int
+    colours: tuple[str, ...]
+    dtype: str
+    gsd_m: float | None
+    transform: Affine
+    crs: str | None
+
+    @property
+    def is_rgb(self) -> bool:
+        return self.count in (3, 4) and list(self.colours[:3]) == ["red", "green", "blue"]
+
+    def bands(self, band: int | str | None) -> list[int | None]:
+        """The band selections ``band`` stands for: ``"all"`` every band,
+        otherwise just ``band`` (None: the single band or RGB luminance)."""
+        if band == "all":
+            return list(range(1, self.count + 1))
+        return [band]
+
+    def check_window(self, window) -> tuple[int, int, int, int]:
+        """``window`` = (x, y, width, height) validated against the image."""
+        try:
+            x, y, w, h = (int(v) for v in window)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{self.path}: ROI must be four integers x, y, width, height; "
+                                 f"got {window!r}") from None
+        if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > self.width or y + h > self.height:
+            raise ParameterError(f"{self.path}: ROI x={x}, y={y}, width={w}, height={h} is not "
+                                 f"inside the {self.width} x {self.height} image")
+        return x, y, w, h
+
+
+def raster_info(path: str | Path) -> RasterInfo:
+    """Read a raster file's header (size, bands, type, georeferencing)."""
+    with _opened(path) as src:
+        return RasterInfo(str(path), src.width, src.height, src.count,
+                          tuple(c.name for c in src.colorinterp), src.dtypes[0], _gsd_m(src),
+                          src.transform, src.crs.to_wkt() if src.crs else None)
+
+
+def read_raster(path: str | Path, band: int | None = None, window=None,
+                out_shape: tuple[int, int] | None = None) -> Raster:
     """Read one band of an image file as float64 DN.
 
     With ``band=None`` a single-band file gives its band and an RGB or RGBA
     file (8/16-bit, colour-interpreted as such) gives the Rec. 709 luminance
     of its stored values (alpha ignored; no gamma decoding).  Any other
     multi-band file needs ``band``.  Nodata pixels become NaN.
+
+    ``window`` = (x, y, width, height) reads only that part of the image
+    (``Raster.origin`` is its top-left pixel), so a large scene is never
+    loaded whole for a small ROI.  ``out_shape`` = (rows, cols) reads the
+    window decimated (nearest), for overviews.
     """
     path = str(path)
+    with _opened(path) as src:
+        count = src.count
+        colours = [c.name for c in src.colorinterp]
+        info = RasterInfo(path, src.width, src.height, count, tuple(colours), src.dtypes[0],
+                          _gsd_m(src), src.transform, None)
+        x, y, w, h = info.check_window(window) if window is not None else (0, 0, src.width, src.height)
+        region = Window(x, y, w, h)
+        if band is not None:
+            if not (isinstance(band, (int, np.integer)) and 1 <= band <= count):
+                raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
+            chosen: int | str = int(band)
+            data = _band(src, chosen, region, out_shape)
+        elif count == 1:
+            chosen, data = 1, _band(src, 1, region, out_shape)
+        elif info.is_rgb:
+            chosen = "luminance"
+            data = sum(w_ * _band(src, i + 1, region, out_shape) for i, w_ in enumerate(LUMA_WEIGHTS))
+        else:
+            raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
+                                 "choose one with --band N, or --band all")
+        tags = src.tags()
+    if data.size == 0:
+        raise ImageContentError(f"{path}: the image is empty")
+    return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y))
+
+
+@contextmanager
+def _opened(path):
+    """An open rasterio dataset, GDAL's failures turned into ImageReadError."""
+    path = str(path)
+    if Path(path).is_dir():
+        raise ImageReadError(f"{path}: is a folder, not an image")
     if not Path(path).exists():
         raise ImageReadError(f"{path}: no such file")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as src:
-                count = src.count
-                colours = [c.name for c in src.colorinterp]
-                if band is not None:
-                    if not 1 <= band <= count:
-                        raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
-                    chosen: int | str = band
-                    data = _band(src, band)
-                elif count == 1:
-                    chosen, data = 1, _band(src, 1)
-                elif count in (3, 4) and colours[:3] == ["red", "green", "blue"]:
-                    chosen = "luminance"
-                    data = sum(w * _band(src, i + 1) for i, w in enumerate(LUMA_WEIGHTS))
-                else:
-                    raise ParameterError(f"{path}: has {count} bands; choose one with --band")
-                gsd = _gsd_m(src)
-                tags = src.tags()
-                dtype = src.dtypes[0]
+                yield src
     except RasterioIOError as exc:
+        kind = _image_kind(path)
+        if kind:
+            raise ImageReadError(f"{path}: a {kind} file that is damaged or truncated "
+                                 f"(GDAL: {_reason(exc)})") from None
         raise ImageReadError(f"{path}: not an image GDAL can read ({_reason(exc)})") from None
     except OSError as exc:
         raise ImageReadError(f"{path}: cannot read: {_reason(exc)}") from None
-    if data.size == 0:
-        raise ImageContentError(f"{path}: the image is empty")
-    return Raster(data, path, chosen, gsd, tags, dtype)
 
 
-def _band(src, index: int) -> np.ndarray:
+# leading bytes of the formats users bring, to tell a damaged image from a non-image
+_SIGNATURES = {b"II*\x00": "TIFF", b"MM\x00*": "TIFF", b"II+\x00": "BigTIFF", b"MM\x00+": "BigTIFF",
+               b"\x89PNG": "PNG", b"\xff\xd8\xff": "JPEG", b"\x00\x00\x00\x0cjP  ": "JPEG 2000",
+               b"\xffO\xffQ": "JPEG 2000", b"NITF": "NITF"}
+
+
+def _image_kind(path: str) -> str | None:
+    """The image format a file's leading bytes announce, if any."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(12)
+    except OSError:
+        return None
+    return next((kind for magic, kind in _SIGNATURES.items() if head.startswith(magic)), None)
+
+
+def _band(src, index: int, window: Window, out_shape=None) -> np.ndarray:
     """Band ``index`` as float64 with nodata (mask) set to NaN."""
     try:
-        values = src.read(index, masked=True)
+        values = src.read(index, window=window, masked=True, out_shape=out_shape)
     except RasterioIOError as exc:
         raise ImageReadError(f"{src.name}: the file is damaged or truncated ({_reason(exc)})") from None
     data = values.data.astype(np.float64)
