@@ -92,7 +92,7 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
     for band in bands:
         try:
             raster = read_raster(path, band, window=settings.roi)
-            result = _measure(raster, settings)
+            result = measure_raster(raster, settings)
         except ImgmtfError as exc:
             records.append(error_record(path, band, settings, exc))
             continue
@@ -108,7 +108,7 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
     return records
 
 
-def _measure(raster, settings: MeasureSettings):
+def measure_raster(raster, settings: MeasureSettings):
     """The estimate of one raster (a window of the file when ``roi`` is
     set), its ROI reported in the file's pixel coordinates."""
     estimator = settings.estimator()

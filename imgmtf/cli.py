@@ -263,6 +263,68 @@ def _num(value, width: int, decimals: int) -> str:
     return f"{value:{width}.{decimals}f}" if value is not None else f"{'-':>{width}}"
 
 
+# -- scan ---------------------------------------------------------------------
+@main.command()
+@click.argument("scene", type=click.Path())
+@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--min-length", type=float, default=40.0, show_default=True,
+              help="shortest usable target, px along it")
+@click.option("--max-length", type=float, default=300.0, show_default=True,
+              help="longer targets are measured over their central part, px")
+@click.option("--margin", type=int, default=12, show_default=True, help="ROI extent beyond the target, px")
+@click.option("--pulse-width", callback=_length_option("px"),
+              help="bar width (px or m) for every bar; estimated per bar when omitted")
+@click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True)
+@click.option("--band", type=int, help="1-based band (default: the only band, or the luminance of RGB)")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False),
+              help="write targets.csv, targets.geojson and overview.png here")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
+@click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
+@_bootstrap_options
+@_parallel_options
+def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, out_dir, fmt, progress,
+         replicates, confidence, workers, scheduler):
+    """Find every straight edge (or bar) in SCENE, measure the usable ones
+    and say why the others were rejected.  Exit status 1 when none is
+    usable."""
+    from .io import raster_info
+    from .scan import ScanSettings, scan_scene, write_outputs
+    if pulse_width and kind != "pulse":
+        raise click.UsageError("--pulse-width applies to --target pulse only")
+    with _reported_errors():
+        settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
+                                pulse_width=pulse_width, bootstrap=Bootstrap(replicates, confidence))
+        info = raster_info(scene)
+        records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress)
+        written = write_outputs(records, info, out_dir, band) if out_dir else []
+    accepted = [r for r in records if r["status"] == "accepted"]
+    if fmt == "json":
+        for r in records:
+            click.echo(json.dumps(r))
+    else:
+        click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
+                   f"{kind}s, {len(accepted)} accepted")
+        click.echo(f"{'id':>3} {'rank':>4} {'dir':>6} {'len px':>6} {'tilt':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+                   f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
+        for r in records:
+            roi = ",".join(str(v) for v in r["roi"])
+            head = (f"{r['id']:>3} {r.get('rank', ''):>4} {r['direction'].split('-')[0]:>6} "
+                    f"{r['length_px']:6.0f} {r['tilt_deg']:6.2f}")
+            if r["status"] == "accepted":
+                lo, hi = r["mtf_nyquist_ci"]
+                interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None else "-"
+                click.echo(f"{head} {_num(r['snr'], 6, 0)} {_num(r['mtf_nyquist'], 7, 4)} {interval:>15} "
+                           f"{_num(r['mtf50_cy_px'], 7, 4)}  {roi}")
+            else:
+                click.echo(f"{head} {'rejected':>38}  {r['reason']}: {r['error']}")
+        for path in written:
+            click.echo(f"wrote {path}")
+    if not accepted:
+        click.echo(f"imgmtf: error: {scene}: no usable {kind} found "
+                   f"({len(records)} candidates, all rejected)", err=True)
+        sys.exit(1)
+
+
 # -- reproduce ----------------------------------------------------------------
 @main.command()
 @click.option("--out", required=True, type=click.Path(file_okay=False), help="output folder")

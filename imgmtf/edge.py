@@ -192,7 +192,7 @@ def _check_saturation(v, d, left, right, saturation) -> None:
         if at_limit > 0.2:
             raise UnsuitableTargetError(
                 f"the {name} side of the edge is saturated ({100 * at_limit:.0f} % of its "
-                f"pixels at {low:g} or {high:g} DN): its true level is unknown")
+                f"pixels at {low:g} or {high:g} DN): its true level is unknown", reason="saturated")
 
 
 def _crossing_nearest(grid, esf01) -> float:

@@ -7,7 +7,15 @@ are one line and name the offending value or file.
 
 
 class ImgmtfError(Exception):
-    """Base class of all deliberate imgmtf errors."""
+    """Base class of all deliberate imgmtf errors.  ``reason`` is a short
+    machine-readable code (what the scan reports for a rejected target)."""
+
+    reason = "error"
+
+    def __init__(self, message: str = "", *, reason: str | None = None):
+        super().__init__(message)
+        if reason is not None:
+            self.reason = reason
 
 
 class ParameterError(ImgmtfError, ValueError):
@@ -29,14 +37,22 @@ class ImageReadError(ImgmtfError):
 class ImageContentError(ImgmtfError):
     """An image was read but cannot be measured (NaN, flat, too small...)."""
 
+    reason = "image"
+
 
 class TargetNotFoundError(ImageContentError):
     """No usable edge or bar was found in the image."""
+
+    reason = "no-target"
 
 
 class MultipleTargetsError(ImageContentError):
     """More than one edge or bar was found where one was expected."""
 
+    reason = "two-targets"
+
 
 class UnsuitableTargetError(ImageContentError):
     """A target was found but cannot give a trustworthy MTF (angle, saturation...)."""
+
+    reason = "unsuitable"

@@ -139,6 +139,36 @@ def plot_measurement(result, truth=None):
     return fig
 
 
+# -- a scene scan ------------------------------------------------------------------
+def plot_scan(overview: np.ndarray, scale: float, records, levels=None, ax=None):
+    """The scene (``overview``, decimated by ``scale`` scene px per overview
+    px, shown between ``levels`` = (black, white) DN) with every candidate's
+    ROI: accepted ones green, labelled with their rank and MTF at Nyquist;
+    rejected ones red, labelled with id and reason."""
+    from matplotlib.patches import Rectangle
+    height, width = overview.shape
+    fig, ax = _axes(ax, size=(min(12.0, 3 + 8 * width / max(height, width)),
+                              min(9.0, 2 + 8 * height / max(height, width))))
+    lo, hi = levels or (np.nanpercentile(overview, [0.5, 99.5]) if np.isfinite(overview).any() else (0, 1))
+    ax.imshow(overview, cmap="gray", vmin=lo, vmax=hi if hi > lo else lo + 1,
+              extent=(-0.5, width * scale - 0.5, height * scale - 0.5, -0.5), interpolation="nearest")
+    for r in records:
+        x, y, w, h = r["roi"]
+        accepted = r["status"] == "accepted"
+        colour = "tab:green" if accepted else "tab:red"
+        ax.add_patch(Rectangle((x - 0.5, y - 0.5), w, h, fill=False, lw=1.2 if accepted else 0.7,
+                               ec=colour, alpha=1.0 if accepted else 0.7))
+        ax.plot([r["x0_px"], r["x1_px"]], [r["y0_px"], r["y1_px"]], color=colour, lw=0.8)
+        label = (f"#{r['rank']} {r['mtf_nyquist']:.3f}" if accepted and r.get("mtf_nyquist") is not None
+                 else f"{r['id']}: {r['reason']}")
+        ax.annotate(label, (x, y), xytext=(1, -1), textcoords="offset points", fontsize=6,
+                    color=colour, va="bottom", bbox=dict(fc="white", ec="none", alpha=0.6, pad=0.5))
+    n_ok = sum(r["status"] == "accepted" for r in records)
+    ax.set(title=f"{n_ok} accepted (rank, MTF at Nyquist), {len(records) - n_ok} rejected",
+           xlabel="x (px)", ylabel="y (px)")
+    return fig
+
+
 # -- the reproduction study ----------------------------------------------------
 def plot_noise_sweep(rows, methods, true_nyquist, title):
     """MTF at Nyquist against measured SNR, one panel per method, the true

@@ -166,10 +166,10 @@ def check_angle(geometry: TargetGeometry, name: str) -> None:
     advice = f"(tilt it by {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)"
     if a < MIN_ANGLE_DEG:
         raise UnsuitableTargetError(f"the {name} is {a:.2f} deg from the image axis: too close "
-                                    f"for sub-pixel sampling {advice}")
+                                    f"for sub-pixel sampling {advice}", reason="angle")
     if a > MAX_ANGLE_DEG:
         raise UnsuitableTargetError(f"the {name} is {a:.2f} deg from the image axis, too close "
-                                    f"to 45 deg for sub-pixel sampling {advice}")
+                                    f"to 45 deg for sub-pixel sampling {advice}", reason="angle")
 
 
 def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
@@ -191,7 +191,7 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
     if half_range < MIN_HALF_RANGE_PX:
         raise UnsuitableTargetError(
             f"the {name} is {max(half_range, 0):.1f} px from the image border; at least "
-            f"{MIN_HALF_RANGE_PX:g} px of flat level are needed on each side")
+            f"{MIN_HALF_RANGE_PX:g} px of flat level are needed on each side", reason="border")
     inside = np.abs(d) <= half_range
     d, v, row = d[inside], v[inside], row[inside]
     if np.count_nonzero(np.abs(d) < 2.0) < 20:

@@ -111,7 +111,8 @@ class PulseEstimator(ProfileEstimator):
                                       f"its background, within the noise ({noise:.1f} DN)")
         if abs(left - right) > 0.25 * height:
             raise UnsuitableTargetError("the profile is a step, not a bar (its two sides differ "
-                                        "by more than a quarter of its height): measure it as an edge")
+                                        "by more than a quarter of its height): measure it as an edge",
+                                        reason="not-a-bar")
         prf01 = peak / height
         h10 = _half_width_at(grid, prf01, 0.1)
         outer = np.abs(d) > min(1.5 * h10 + 1.0, half_range - 1.0)
