@@ -34,6 +34,8 @@ def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
         array = array[y0:y0 + h, x0:x0 + w]
     data = array.astype(np.float64)
     bad = ~np.isfinite(data)
+    if bad.all():
+        raise ImageContentError("every pixel is NaN or nodata: nothing to measure")
     if bad.any():
         raise ImageContentError(f"{int(bad.sum())} pixel(s) are NaN, infinite or nodata")
     if min(data.shape) < MIN_SIZE_PX:

@@ -214,7 +214,7 @@ def merge_segments(pieces: np.ndarray) -> list[Segment]:
                 group = group + shift * n
                 grown = True
         out.append(Segment(*group[0], *group[1]))
-    return out
+    return sorted(out, key=lambda s: -s.length_px)
 
 
 def pair_bars(segments: list[Segment]) -> tuple[list[Segment], list[tuple[Segment, Segment]]]:
@@ -399,7 +399,7 @@ def _segment_record(path, segment: Segment, roi, info: RasterInfo, settings: Sca
     if settings.target == "pulse":
         record["bar_width_px"] = round(segment.width_px, 2)
     if not info.transform.is_identity:
-        (mx0, my0), (mx1, my1) = (info.transform * (x + 0.5, y + 0.5)
+        (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
                                   for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
         record.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
     return record

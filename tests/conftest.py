@@ -39,6 +39,8 @@ def exact_edge_chip(transfer, angle_deg, shape=(100, 100), offset=0.0, low=200.0
     img = low + (high - low) * np.interp(d, fx, esf)
     if noise_std:
         img = img + np.random.default_rng(seed).normal(0, noise_std, img.shape)
+    if not np.issubdtype(dtype, np.integer):
+        return img.astype(dtype)
     top = np.iinfo(dtype).max
     return np.clip(np.rint(img), 0, top).astype(dtype)
 

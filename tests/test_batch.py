@@ -1,0 +1,160 @@
+"""Batches over files and folders, and every kind of bad input: each gives a
+one-line error naming its file, exit status 1, and the batch goes on."""
+import csv
+import json
+import os
+
+import numpy as np
+import pytest
+import rasterio
+from rasterio.errors import NotGeoreferencedWarning
+from click.testing import CliRunner
+from conftest import exact_edge_chip, gaussian_pixel_transfer
+
+import imgmtf as im
+from imgmtf.batch import MeasureSettings, expand_inputs, measure_file
+from imgmtf.cli import main
+
+TRANSFER = gaussian_pixel_transfer(0.5, 6.0)
+pytestmark = pytest.mark.filterwarnings(f"ignore::{NotGeoreferencedWarning.__module__}.NotGeoreferencedWarning")
+
+
+def write(path, bands, dtype=None, nodata=None, colours=None):
+    """A plain GeoTIFF of ``bands`` (rows x cols or bands x rows x cols)."""
+    bands = np.asarray(bands)
+    bands = bands[None] if bands.ndim == 2 else bands
+    with rasterio.open(path, "w", driver="GTiff", width=bands.shape[2], height=bands.shape[1],
+                       count=bands.shape[0], dtype=dtype or bands.dtype.name, nodata=nodata) as dst:
+        dst.write(bands.astype(dtype or bands.dtype))
+        if colours:
+            dst.colorinterp = colours
+    return path
+
+
+@pytest.fixture
+def good(tmp_path):
+    return write(tmp_path / "good.tif", exact_edge_chip(TRANSFER, 6.0, (64, 64), noise_std=2.0, seed=3))
+
+
+def bad_inputs(tmp_path):
+    """name -> (path, words the one-line error must contain)."""
+    edge = exact_edge_chip(TRANSFER, 6.0, (64, 64)).astype(float)
+    (tmp_path / "notes.tif").write_text("not an image\n")
+    full = write(tmp_path / "full.tif", edge.astype(np.uint16))
+    (tmp_path / "truncated.tif").write_bytes(full.read_bytes()[:600])
+    (tmp_path / "empty.tif").write_bytes(b"")
+    nan = edge.copy()
+    nan[10:12, 20:30] = np.nan
+    two = edge + np.where(np.arange(64)[None, :] > 50, 800.0, 0.0)
+    saturated = np.clip(edge * 60, 0, 65535)
+    cases = {
+        "non-image": (tmp_path / "notes.tif", "not an image"),
+        "truncated": (tmp_path / "truncated.tif", "damaged or truncated"),
+        "empty file": (tmp_path / "empty.tif", "not an image"),
+        "flat": (write(tmp_path / "flat.tif", np.full((64, 64), 500, np.uint16)), "flat"),
+        "all nodata": (write(tmp_path / "nodata.tif", np.zeros((64, 64), np.uint16), nodata=0),
+                       "every pixel is nan or nodata"),
+        "NaNs": (write(tmp_path / "nans.tif", nan.astype(np.float32)), "20 pixel(s) are nan"),
+        "saturated": (write(tmp_path / "saturated.tif", saturated.astype(np.uint16)), "saturated"),
+        "two edges": (write(tmp_path / "two.tif", two.astype(np.uint16)), "two edges"),
+        "too small": (write(tmp_path / "small.tif", edge[:12, 26:38].astype(np.uint16)), "at least 16 x 16"),
+        "4 bands": (write(tmp_path / "four.tif", np.stack([edge] * 4).astype(np.uint16)), "has 4 bands"),
+        "unreadable": (tmp_path / "missing" / "nowhere.tif", "no such file"),
+    }
+    return cases
+
+
+def test_every_bad_input_is_one_line_naming_its_file_and_the_batch_goes_on(tmp_path, good):
+    cases = bad_inputs(tmp_path)
+    paths = [str(p) for p, _ in cases.values()]
+    result = CliRunner().invoke(main, ["measure", "--format", "json", *paths, str(good)])
+    assert result.exit_code == 1
+    assert "Traceback" not in result.output
+    records = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [r["path"] for r in records] == [*paths, str(good)]
+    for (name, (path, words)), record in zip(cases.items(), records):
+        assert record["status"] == "error", name
+        assert record["error"].startswith(str(path)), name
+        assert words in record["error"].lower(), (name, record["error"])
+        assert "\n" not in record["error"]
+        assert record["imgmtf_version"] == im.__version__ and record["method"] == "msg"
+    assert records[-1]["status"] == "ok"
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--roi", "50,50,40,40"], "roi x=50, y=50, width=40, height=40 is not inside the 64 x 64 image"),
+    (["--band", "3"], "band 3 does not exist (the file has 1)"),
+])
+def test_roi_outside_and_missing_band_name_file_and_exit_1(good, args, words):
+    result = CliRunner().invoke(main, ["measure", *args, str(good)])
+    assert result.exit_code == 1
+    assert f"{good}: " in result.stdout and words in result.stdout.lower()
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their permissions")
+def test_unreadable_file(tmp_path, good):
+    good.chmod(0)
+    result = CliRunner().invoke(main, ["measure", str(good)])
+    assert result.exit_code == 1 and str(good) in result.stdout
+
+
+def test_rgb_photo_is_luminance_by_default_and_per_channel_with_band_all(tmp_path):
+    edge = exact_edge_chip(TRANSFER, 6.0, (64, 64), low=20, high=220, dtype=np.uint8).astype(float)
+    rgb = np.stack([edge, 0.5 * edge, 0.25 * edge]).astype(np.uint8)
+    path = write(tmp_path / "photo.tif", rgb, colours=[rasterio.enums.ColorInterp.red,
+                                                        rasterio.enums.ColorInterp.green,
+                                                        rasterio.enums.ColorInterp.blue])
+    settings = MeasureSettings()
+    (lum,) = measure_file(str(path), settings)
+    assert lum["band"] == "luminance" and lum["status"] == "ok"
+    per_band = measure_file(str(path), MeasureSettings(band="all"))
+    assert [r["band"] for r in per_band] == [1, 2, 3]
+    # the same edge in every channel: the same MTF (to quantisation of the dimmer channels)
+    for r in per_band:
+        assert r["mtf_nyquist"] == pytest.approx(lum["mtf_nyquist"], abs=0.01)
+
+
+def test_float_image_with_negative_values_measures_like_its_offset_copy(tmp_path):
+    edge = exact_edge_chip(TRANSFER, 6.0, (64, 64), low=-300.0, high=700.0, noise_std=1.0, seed=2,
+                           dtype=np.float32)
+    negative = write(tmp_path / "negative.tif", edge)
+    shifted = write(tmp_path / "shifted.tif", edge + 1000.0)
+    a, = measure_file(str(negative), MeasureSettings())
+    b, = measure_file(str(shifted), MeasureSettings())
+    assert a["status"] == "ok" and a["levels_dn"][0] < 0
+    assert a["mtf_nyquist"] == pytest.approx(b["mtf_nyquist"], abs=2e-4)
+
+
+def test_folder_batch_with_workers_csv_and_plots(tmp_path, good):
+    folder = tmp_path / "chips"
+    folder.mkdir()
+    for seed in range(3):
+        write(folder / f"c{seed}.tif", exact_edge_chip(TRANSFER, 6.0 + seed, (64, 64), noise_std=2.0,
+                                                      seed=seed))
+    (folder / "readme.txt").write_text("ignored: not an image suffix")
+    (folder / "broken.tif").write_text("not a tiff")
+    assert len(expand_inputs([folder])) == 4
+    out_csv, plots = tmp_path / "summary.csv", tmp_path / "plots"
+    result = CliRunner().invoke(main, ["measure", str(folder), "--workers", "2", "--csv", str(out_csv),
+                                       "--plot-dir", str(plots)])
+    assert result.exit_code == 1                       # broken.tif
+    rows = list(csv.DictReader(out_csv.open()))
+    assert [r["status"] for r in rows] == ["error", "ok", "ok", "ok"]
+    for r in rows[1:]:
+        assert abs(float(r["angle_deg"]) - (6.0 + int(r["path"][-5]))) < 0.05
+        assert float(r["mtf_nyquist_ci_low"]) <= float(r["mtf_nyquist"]) <= float(r["mtf_nyquist_ci_high"])
+        assert json.loads(r["params"])["bootstrap"]["replicates"] == 200
+        assert r["imgmtf_version"] == im.__version__ and r["band"] == "1"
+        assert (plots / f"{os.path.basename(r['path'])[:-4]}_mtf.png").stat().st_size > 10_000
+    assert "broken.tif" in rows[0]["error"]
+
+
+def test_windowed_read_reports_roi_in_file_coordinates(tmp_path):
+    scene = np.full((200, 300), 200.0)
+    scene[60:124, 100:164] = exact_edge_chip(TRANSFER, 6.0, (64, 64))
+    path = write(tmp_path / "scene.tif", scene.astype(np.uint16))
+    raster = im.read_raster(path, window=(100, 60, 64, 64))
+    assert raster.data.shape == (64, 64) and raster.origin == (100, 60)
+    record, = measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64)))
+    assert record["roi"] == [100, 60, 64, 64]
+    assert record["angle_deg"] == pytest.approx(6.0, abs=0.05)

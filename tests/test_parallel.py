@@ -1,0 +1,44 @@
+"""Parallel runs give the serial results, in input order, on local
+processes and on a Dask distributed cluster."""
+import json
+import math
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from imgmtf.cli import main
+from imgmtf.errors import ParameterError
+from imgmtf.parallel import run_tasks
+
+DATA = Path(__file__).parent.parent / "data"
+
+
+def test_processes_keep_input_order():
+    assert list(run_tasks(math.sqrt, [16, 9, 4, 1, 0], workers=2)) == [4, 3, 2, 1, 0]
+
+
+def test_bad_worker_count_and_unreachable_scheduler():
+    with pytest.raises(ParameterError):
+        list(run_tasks(math.sqrt, [1, 4], workers=0))
+    pytest.importorskip("distributed")
+    with pytest.raises(ParameterError, match="cannot reach the Dask scheduler"):
+        list(run_tasks(math.sqrt, [1, 4], scheduler="tcp://127.0.0.1:9"))
+
+
+def test_measure_and_scan_on_a_local_dask_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    files = [str(DATA / "edge_16bit.tif"), str(DATA / "edge_8bit_noisy.tif"), str(tmp_path / "missing.tif")]
+    serial = CliRunner().invoke(main, ["measure", "--format", "json", *files])
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        on_dask = CliRunner().invoke(main, ["measure", "--format", "json", "--scheduler",
+                                            cluster.scheduler_address, *files])
+        scan = CliRunner().invoke(main, ["scan", "--format", "json", "--scheduler",
+                                         cluster.scheduler_address, str(DATA / "scene.tif")])
+    assert on_dask.exit_code == serial.exit_code == 1          # the missing file
+    assert on_dask.stdout == serial.stdout
+    assert [json.loads(line)["path"] for line in on_dask.stdout.splitlines()] == files
+    assert scan.exit_code == 0
+    accepted = [r for r in map(json.loads, scan.stdout.splitlines()) if r["status"] == "accepted"]
+    assert len(accepted) == 2

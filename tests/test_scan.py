@@ -1,0 +1,96 @@
+"""Scanning a scene: data/scene.tif holds one target per verdict, with its
+truth in the IMGMTF tag."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import imgmtf as im
+from imgmtf.cli import main
+from imgmtf.scan import Segment, ScanSettings, merge_segments, pair_bars, scan_scene
+
+SCENE = Path(__file__).parent.parent / "data" / "scene.tif"
+TRUTH = json.loads(im.read_raster(SCENE).tags["IMGMTF"])["tiles"]
+
+
+def tile_of(record):
+    x = (record["x0_px"] + record["x1_px"]) / 2
+    y = (record["y0_px"] + record["y1_px"]) / 2
+    for t in TRUTH:
+        tx, ty, tw, th = t["tile_xywh"]
+        if tx <= x < tx + tw and ty <= y < ty + th:
+            return t
+
+
+@pytest.fixture(scope="module")
+def edge_scan():
+    return scan_scene(str(SCENE))
+
+
+def test_scan_accepts_the_good_edges_with_true_mtf_in_their_intervals(edge_scan):
+    accepted = [r for r in edge_scan if r["status"] == "accepted"]
+    assert [r["rank"] for r in accepted] == [1, 2]
+    assert {tile_of(r)["verdict"] for r in accepted} == {"accepted"}
+    assert {r["direction"] for r in accepted} == {"across-track", "along-track"}
+    for r in accepted:
+        truth = tile_of(r)
+        assert abs(r["mtf_nyquist"] - truth["true_mtf_nyquist"]) < 0.006
+        lo, hi = r["mtf50_ci_cy_px"]
+        assert lo - 0.002 <= truth["true_mtf50_cy_px"] <= hi + 0.002
+        assert r["line_rms_px"] < 0.1 and r["side_variation"] < 0.1
+
+
+@pytest.mark.parametrize("verdict", ["angle", "saturated", "non-uniform", "two-targets", "too-short"])
+def test_scan_rejects_each_unsuitable_target_with_its_reason(edge_scan, verdict):
+    slanted = [r for r in edge_scan if r["tilt_deg"] > 1.0 and tile_of(r)["verdict"] == verdict]
+    assert slanted and all(r["status"] == "rejected" and r["reason"] == verdict for r in slanted)
+    assert all(r["error"] for r in slanted)
+
+
+def test_scan_rejects_the_mosaic_seams_as_axis_aligned(edge_scan):
+    seams = [r for r in edge_scan if r["tilt_deg"] < 0.5]
+    assert len(seams) >= 5 and all(r["reason"] == "angle" for r in seams)
+
+
+def test_scan_measures_the_bar_as_a_pulse_target():
+    records = scan_scene(str(SCENE), ScanSettings(target="pulse", pulse_width=(3.0, "px")))
+    accepted = [r for r in records if r["status"] == "accepted"]
+    assert len(accepted) == 1 and tile_of(accepted[0])["verdict"] == "bar"
+    assert accepted[0]["bar_width_px"] == pytest.approx(3.0, abs=0.6)
+    assert abs(accepted[0]["mtf_nyquist"] - tile_of(accepted[0])["true_mtf_nyquist"]) < 0.006
+
+
+def test_merge_joins_collinear_pieces_and_pairs_make_bars():
+    pieces = np.array([[10, 0, 11, 40], [11.1, 42, 12.2, 80], [30, 0, 30.5, 50]], float)
+    merged = merge_segments(pieces)
+    assert len(merged) == 2 and merged[0].length_px == pytest.approx(80.0, abs=0.1)
+    lone, bars = pair_bars([Segment(10, 0, 12, 80), Segment(13, 0, 15, 80), Segment(40, 0, 41, 80)])
+    assert len(lone) == 1 and len(bars) == 1
+    assert bars[0][0].width_px == pytest.approx(3.0 * 80 / np.hypot(80, 2), abs=0.01)
+
+
+def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
+    out = tmp_path / "scan"
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
+    assert result.exit_code == 0, result.output
+    geo = json.loads((out / "targets.geojson").read_text())
+    assert geo["imgmtf_coordinates"].startswith("longitude/latitude")
+    first = geo["features"][0]
+    lon, lat = first["geometry"]["coordinates"][0]
+    assert 14.9 < lon < 15.1 and 41.9 < lat < 42.1          # EPSG:32633 at 500000, 4650000
+    props = first["properties"]
+    assert props["status"] == "accepted" and props["imgmtf_version"] == im.__version__
+    assert props["params"]["scan"]["min_length_px"] == 40.0 and props["path"] == str(SCENE)
+    assert props["map_x0"] == pytest.approx(500000 + props["x0_px"] + 0.5)
+    assert (out / "targets.csv").read_text().count("\n") == len(geo["features"]) + 1
+    assert (out / "overview.png").stat().st_size > 20_000
+
+
+def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
+    flat = tmp_path / "noise.tif"
+    rng = np.random.default_rng(0)
+    im.write_geotiff(flat, (1000 + rng.normal(0, 5, (128, 128))).astype(np.uint16))
+    result = CliRunner().invoke(main, ["scan", str(flat)])
+    assert result.exit_code == 1 and f"{flat}: no usable edge found" in result.output

@@ -1,0 +1,82 @@
+"""Bootstrap intervals: the weighting is exact, the spectral figures match
+closed forms, and intervals behave as intervals should."""
+import math
+
+import numpy as np
+import pytest
+from conftest import exact_edge_chip, gaussian_pixel_transfer
+
+import imgmtf as im
+from imgmtf.errors import ParameterError
+from imgmtf.resampling import resample_profile
+from imgmtf.uncertainty import Bootstrap, percentile_interval, row_weights, spectral_figures
+
+
+def test_row_weights_resample_whole_rows():
+    rows = np.repeat(np.arange(30), 7)
+    weights = row_weights(rows, 50, np.random.default_rng(0))(np.ones(rows.size, bool))
+    assert weights.shape == (50, rows.size)
+    per_row = weights.reshape(50, 30, 7)
+    assert (per_row == per_row[..., :1]).all()                # a row's samples share its count
+    assert (per_row[..., 0].sum(axis=1) == 30).all()          # as many rows drawn as there are
+
+
+@pytest.mark.parametrize("method", ["msg", "sliding", "spline", "iso"])
+def test_integer_weights_equal_repeated_samples(method):
+    rng = np.random.default_rng(1)
+    d = rng.uniform(-6, 6, 1500)
+    v = np.tanh(d) + rng.normal(0, 0.02, d.size)
+    w = rng.integers(0, 3, d.size).astype(float)
+    weighted = resample_profile(d, v, method=method, half_range=4, weights=np.stack([w, w]))
+    repeated = resample_profile(np.repeat(d, w.astype(int)), np.repeat(v, w.astype(int)),
+                                method=method, half_range=4)
+    tol = 1e-9 if method != "spline" else 2e-3   # the spline's smoothing follows the sample count
+    np.testing.assert_allclose(weighted.values[1], repeated.values, atol=tol, equal_nan=True)
+
+
+def test_spectral_figures_of_a_gaussian_lsf_match_closed_forms():
+    sigma, step = 0.6, 0.05
+    x = np.arange(-6, 6 + step / 2, step)
+    lsf = np.exp(-x**2 / (2 * sigma**2))
+    nyquist, fifty = spectral_figures(np.stack([lsf, 2 * lsf]), step, lambda f: np.ones_like(f))
+    np.testing.assert_allclose(nyquist, math.exp(-2 * math.pi**2 * sigma**2 * 0.25), atol=1e-9)
+    np.testing.assert_allclose(fifty, math.sqrt(math.log(2) / 2) / (math.pi * sigma), rtol=2e-4)
+
+
+def test_percentile_interval_and_settings():
+    interval = percentile_interval(np.arange(1001.0), 0.95)
+    assert (interval.low, interval.high) == pytest.approx((25.0, 975.0))
+    assert math.isnan(percentile_interval(np.r_[np.full(20, np.nan), np.ones(80)], 0.95).low)
+    for bad in (dict(replicates=5), dict(replicates=-1), dict(confidence=1.0)):
+        with pytest.raises(ParameterError):
+            Bootstrap(**bad)
+
+
+def test_intervals_cover_the_truth_and_scale_with_the_noise():
+    transfer = gaussian_pixel_transfer(0.5, 6.0)
+    true_nyquist = abs(transfer(np.array([0.5]))[0])
+    widths = []
+    for noise in (5.0, 10.0):
+        chip = exact_edge_chip(transfer, 6.0, noise_std=noise, seed=4)
+        r = im.measure_edge(chip)
+        assert true_nyquist in r.mtf_nyquist_ci
+        assert r.mtf_nyquist_ci.low < r.mtf_nyquist < r.mtf_nyquist_ci.high
+        assert r.mtf50_ci_cy_px.low < r.mtf50_cy_px < r.mtf50_ci_cy_px.high
+        widths.append(r.mtf_nyquist_ci.width)
+    assert 1.5 < widths[1] / widths[0] < 2.6       # the noise doubled
+    again = im.measure_edge(chip)
+    assert again.mtf_nyquist_ci == r.mtf_nyquist_ci  # seeded: the same image gives the same interval
+
+
+def test_switched_off_bootstrap_gives_nan_intervals():
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=5.0)
+    r = im.measure_edge(chip, bootstrap=Bootstrap(0))
+    assert math.isnan(r.mtf_nyquist_ci.low) and r.to_dict()["mtf_nyquist_ci"] == [None, None]
+
+
+def test_pulse_interval_covers_the_truth():
+    chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, width_px=1.5), 64,
+                     noise_std_dn=8.0, seed=2)
+    r = im.measure_pulse(chip.image, width_px=1.5)
+    assert float(chip.true_mtf(0.5)) in r.mtf_nyquist_ci
+    assert chip.true_mtf50_cy_px() in r.mtf50_ci_cy_px
