@@ -45,9 +45,11 @@ def main():
     print(f"render incl. PSF set-up (im.render):                 {1000 * t:7.1f} ms")
     chip = im.Renderer(im.Sensor(), 100)(target, noise_std_dn=10.0, seed=1).image
     for method in ("msg", "sliding", "spline", "iso"):
-        est = EdgeEstimator(method)
-        t = median_time(lambda: est(chip), a.runs)
-        print(f"measure_edge 100 x 100 chip, method {method:8s}:        {1000 * t:7.1f} ms")
+        est, bare = EdgeEstimator(method), EdgeEstimator(method, bootstrap=im.Bootstrap(0))
+        t = median_time(lambda: est(chip), a.runs if method != "spline" else 5)
+        t0 = median_time(lambda: bare(chip), a.runs)
+        print(f"measure_edge 100 x 100 chip, method {method:8s}:        {1000 * t:7.1f} ms "
+              f"({1000 * t0:.1f} ms without intervals)")
     with tempfile.TemporaryDirectory() as tmp:
         r = im.Renderer(im.Sensor(), 100)
         paths = []
@@ -56,12 +58,26 @@ def main():
             path = Path(tmp) / f"chip{i:03d}.tif"
             write_geotiff(path, c.image, gsd_m=c.gsd_m)
             paths.append(str(path))
-        t = time.perf_counter()
-        run = subprocess.run([sys.executable, "-m", "imgmtf.cli", "measure", "--format", "json", *paths],
-                             capture_output=True, text=True)
-        elapsed = time.perf_counter() - t
-        ok = sum(1 for line in run.stdout.splitlines() if '"error"' not in line)
-        print(f"CLI: imgmtf measure on 100 chips in one call:        {elapsed:7.2f} s ({ok} measured)")
+        for workers in (1, 2):
+            t = time.perf_counter()
+            run = subprocess.run([sys.executable, "-m", "imgmtf.cli", "measure", "--format", "json",
+                                  "--workers", str(workers), *paths], capture_output=True, text=True)
+            elapsed = time.perf_counter() - t
+            ok = sum(1 for line in run.stdout.splitlines() if '"status": "ok"' in line)
+            print(f"CLI: imgmtf measure, 100 chips, {workers} worker(s):      {elapsed:7.2f} s ({ok} measured)")
+        # a 4096 x 2048 px scene: data/scene.tif repeated 8 x 8 times
+        scene = np.tile(im.read_raster(Path(__file__).parent.parent / "data" / "scene.tif").data, (8, 8))
+        big = Path(tmp) / "big_scene.tif"
+        write_geotiff(big, scene.astype(np.uint16), gsd_m=1.0)
+        for workers in (1, 2):
+            t = time.perf_counter()
+            run = subprocess.run([sys.executable, "-m", "imgmtf.cli", "scan", "--format", "json",
+                                  "--workers", str(workers), str(big)], capture_output=True, text=True)
+            elapsed = time.perf_counter() - t
+            lines = run.stdout.splitlines()
+            ok = sum(1 for line in lines if '"status": "accepted"' in line)
+            print(f"CLI: imgmtf scan, 4096 x 2048 px scene, {workers} worker(s): {elapsed:6.2f} s "
+                  f"({len(lines)} candidates, {ok} accepted)")
 
 
 if __name__ == "__main__":
