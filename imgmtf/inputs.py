@@ -23,14 +23,7 @@ def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
         raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
     x0, y0 = 0, 0
     if roi is not None:
-        try:
-            x0, y0, w, h = (int(v) for v in roi)
-        except (TypeError, ValueError):
-            raise ParameterError(f"ROI must be four integers x, y, width, height; got {roi!r}") from None
-        rows, cols = array.shape
-        if w <= 0 or h <= 0 or x0 < 0 or y0 < 0 or x0 + w > cols or y0 + h > rows:
-            raise ParameterError(f"ROI x={x0}, y={y0}, width={w}, height={h} is not inside "
-                                 f"the {cols} x {rows} image")
+        x0, y0, w, h = check_roi(roi, array.shape)
         array = array[y0:y0 + h, x0:x0 + w]
     data = array.astype(np.float64)
     bad = ~np.isfinite(data)
@@ -44,6 +37,21 @@ def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
     if data.max() == data.min():
         raise ImageContentError("the image is flat: no contrast to measure")
     return data, (x0, y0)
+
+
+def check_roi(roi, shape: tuple[int, int], where: str = "") -> tuple[int, int, int, int]:
+    """``roi`` = (x, y, width, height) as integers, checked to lie inside an
+    image of ``shape`` = (rows, cols); ``where`` (a file) prefixes errors."""
+    prefix = f"{where}: " if where else ""
+    try:
+        x, y, w, h = (int(v) for v in roi)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{prefix}ROI must be four integers x, y, width, height; got {roi!r}") from None
+    rows, cols = shape
+    if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > cols or y + h > rows:
+        raise ParameterError(f"{prefix}ROI x={x}, y={y}, width={w}, height={h} is not inside "
+                             f"the {cols} x {rows} image")
+    return x, y, w, h
 
 
 def saturation_levels(dtype) -> tuple[float, float] | None:

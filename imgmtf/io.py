@@ -22,6 +22,7 @@ from rasterio.transform import Affine
 from rasterio.windows import Window
 
 from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
+from .inputs import check_roi
 
 # Rec. 709 luma weights, applied to the stored (encoded) values of RGB input
 LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
@@ -125,15 +126,7 @@ class RasterInfo:
 
     def check_window(self, window) -> tuple[int, int, int, int]:
         """``window`` = (x, y, width, height) validated against the image."""
-        try:
-            x, y, w, h = (int(v) for v in window)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{self.path}: ROI must be four integers x, y, width, height; "
-                                 f"got {window!r}") from None
-        if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > self.width or y + h > self.height:
-            raise ParameterError(f"{self.path}: ROI x={x}, y={y}, width={w}, height={h} is not "
-                                 f"inside the {self.width} x {self.height} image")
-        return x, y, w, h
+        return check_roi(window, (self.height, self.width), self.path)
 
 
 def raster_info(path: str | Path) -> RasterInfo:
