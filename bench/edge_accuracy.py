@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import imgmtf as im
-from imgmtf.edge import EdgeEstimator
+from imgmtf.estimate.edge import EdgeEstimator
 
 
 def gaussian_sensor(sigma):

@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 import imgmtf as im
-from imgmtf.pulse import PulseEstimator
+from imgmtf.estimate.pulse import PulseEstimator
 
 
 def sensor(sigma=None):

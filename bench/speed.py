@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import imgmtf as im
-from imgmtf.edge import EdgeEstimator
+from imgmtf.estimate.edge import EdgeEstimator
 from imgmtf.io import write_geotiff
 
 

@@ -3,29 +3,45 @@
 The generic pushbroom sensor of Choi and Helder renders exact synthetic
 chips (:class:`Sensor`, :class:`Target`, :func:`render`); the estimators
 measure the MTF of any chip (:func:`measure_edge`, :func:`measure_pulse`).
-"""
-__version__ = "0.1.0"
 
-from .edge import EdgeEstimator, EdgeResult, measure_edge  # noqa: E402
-from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadError,  # noqa: E402
-                     ImgmtfError, MultipleTargetsError, ParameterError, TargetNotFoundError,
-                     UnsuitableTargetError)
-from .io import Raster, read_raster, write_geotiff  # noqa: E402
-from .noise import GroundNoise  # noqa: E402
-from .pulse import PulseEstimator, PulseResult, measure_pulse  # noqa: E402
-from .rendering import Chip, Renderer, render  # noqa: E402
-from .resampling import METHODS, resample_profile  # noqa: E402
-from .selftest import run_selftest  # noqa: E402
-from .sensor import SampledPSF, Sensor  # noqa: E402
-from .targets import Target  # noqa: E402
-from .uncertainty import Bootstrap, Interval  # noqa: E402
+Names are imported on first use, so ``import imgmtf`` stays cheap and a
+command pays only for the libraries it needs.
+"""
+from __future__ import annotations
+
+import importlib
+
+from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadError, ImgmtfError,
+                     MultipleTargetsError, ParameterError, TargetNotFoundError, UnsuitableTargetError)
+from .version import __version__
+
+# public name -> the module that defines it
+_LAZY = {
+    "Sensor": "sensor.model", "SampledPSF": "sensor.model", "Target": "sensor.targets",
+    "GroundNoise": "sensor.noise", "Chip": "sensor.rendering", "Renderer": "sensor.rendering",
+    "render": "sensor.rendering",
+    "measure_edge": "estimate.edge", "EdgeEstimator": "estimate.edge", "EdgeResult": "estimate.edge",
+    "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
+    "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
+    "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals",
+    "Raster": "io", "read_raster": "io", "write_geotiff": "io",
+    "run_selftest": "selftest",
+}
 
 __all__ = [
-    "__version__",
-    "Sensor", "SampledPSF", "Target", "GroundNoise", "Chip", "Renderer", "render",
-    "measure_edge", "EdgeEstimator", "EdgeResult", "measure_pulse", "PulseEstimator", "PulseResult",
-    "METHODS", "resample_profile", "Bootstrap", "Interval",
-    "Raster", "read_raster", "write_geotiff", "run_selftest",
+    "__version__", *_LAZY,
     "ImgmtfError", "ParameterError", "ConfigError", "FileWriteError", "ImageReadError",
     "ImageContentError", "TargetNotFoundError", "MultipleTargetsError", "UnsuitableTargetError",
 ]
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'imgmtf' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -14,14 +14,14 @@ import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from . import __version__
-from .edge import EdgeEstimator
+from .version import __version__
+from .estimate.edge import EdgeEstimator
 from .errors import FileWriteError, ImgmtfError, ParameterError
 from .inputs import saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
-from .pulse import PulseEstimator, check_width
-from .uncertainty import Bootstrap
+from .estimate.pulse import PulseEstimator, check_width
+from .estimate.intervals import Bootstrap
 
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})

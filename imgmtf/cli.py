@@ -13,17 +13,17 @@ from pathlib import Path
 
 import click
 
-from . import __version__
+from .version import __version__
 from .batch import MeasureSettings, expand_inputs, measure_file, measure_files, write_csv
 from .errors import FileWriteError, ImgmtfError, ParameterError
 from .io import write_geotiff
-from .noise import GroundNoise
-from .rendering import render
-from .resampling import METHODS
+from .sensor.noise import GroundNoise
+from .sensor.rendering import render
+from .estimate.resampling import METHODS
 from .selftest import run_selftest
-from .sensor import DIRECTIONS, Sensor
-from .targets import Target
-from .uncertainty import Bootstrap
+from .sensor.model import DIRECTIONS, Sensor
+from .sensor.targets import Target
+from .estimate.intervals import Bootstrap
 
 
 @contextmanager

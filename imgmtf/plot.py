@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from .mtf import NYQUIST
+from .estimate.spectrum import NYQUIST
 
 
 def _axes(ax, size=(5.0, 3.6)):

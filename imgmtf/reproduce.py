@@ -21,17 +21,17 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from . import __version__
-from .edge import EdgeEstimator
+from .version import __version__
+from .estimate.edge import EdgeEstimator
 from .errors import FileWriteError, ImgmtfError
 from .metrics import fwhm
-from .noise import GroundNoise
-from .pulse import PulseEstimator
-from .rendering import Renderer
-from .resampling import METHODS
-from .sensor import Sensor
-from .targets import Target
-from .uncertainty import NO_BOOTSTRAP
+from .sensor.noise import GroundNoise
+from .estimate.pulse import PulseEstimator
+from .sensor.rendering import Renderer
+from .estimate.resampling import METHODS
+from .sensor.model import Sensor
+from .sensor.targets import Target
+from .estimate.intervals import NO_BOOTSTRAP
 
 CHIP_PX = 40
 ANGLE_DEG = 6.0

@@ -32,15 +32,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from . import __version__
+from .version import __version__
 from .batch import MeasureSettings, measure_raster, write_csv
 from .batch import csv_row as batch_csv_row
 from .errors import FileWriteError, ImgmtfError, ParameterError
 from .inputs import saturation_levels
 from .io import RasterInfo, raster_info, read_raster
 from .parallel import run_tasks
-from .profile import MAX_ANGLE_DEG, MIN_ANGLE_DEG
-from .uncertainty import Bootstrap
+from .estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
+from .estimate.intervals import Bootstrap
 
 MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
 MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .edge import measure_edge
-from .pulse import measure_pulse
-from .rendering import Renderer
-from .sensor import Sensor
-from .targets import Target
+from .estimate.edge import measure_edge
+from .estimate.pulse import measure_pulse
+from .sensor.rendering import Renderer
+from .sensor.model import Sensor
+from .sensor.targets import Target
 
 # Tolerances each case must meet (absolute for MTF at Nyquist, relative for
 # MTF50 and FWHM).  Noise-free: the accuracy the estimator promises on exact

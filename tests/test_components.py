@@ -1,7 +1,7 @@
 import numpy as np
 from numpy.testing import assert_allclose
 
-from imgmtf import components as c
+from imgmtf.sensor import components as c
 
 
 def test_gaussian_ft_closed_form():

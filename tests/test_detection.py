@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.detection import find_edge
+from imgmtf.estimate.detection import find_edge
 from imgmtf.errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.edge import EdgeEstimator, measure_edge, window_factor
+from imgmtf.estimate.edge import EdgeEstimator, measure_edge, window_factor
 from imgmtf.errors import (ImageContentError, MultipleTargetsError, ParameterError,
                            TargetNotFoundError, UnsuitableTargetError)
 
@@ -159,7 +159,7 @@ def test_noisy_fwhm_and_noise_limit():
 
 
 def test_confident_snr_scales_with_rows():
-    from imgmtf.edge import CONFIDENT_SNR_40_ROWS, confident_snr
+    from imgmtf.estimate.edge import CONFIDENT_SNR_40_ROWS, confident_snr
     assert confident_snr(40) == CONFIDENT_SNR_40_ROWS
     assert confident_snr(160) == pytest.approx(CONFIDENT_SNR_40_ROWS / 2)
     h = gaussian_pixel_transfer(0.5, 6.0)

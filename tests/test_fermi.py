@@ -1,6 +1,6 @@
 import numpy as np
 
-from imgmtf.fermi import fermi, fit_fermi
+from imgmtf.estimate.fermi import fermi, fit_fermi
 
 
 def test_recovers_exact_parameters_for_every_row_at_once():

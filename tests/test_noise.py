@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from imgmtf.errors import ParameterError
-from imgmtf.noise import GroundNoise, add_system_noise
+from imgmtf.sensor.noise import GroundNoise, add_system_noise
 
 
 def test_ground_noise_variance_is_sum_of_layers():

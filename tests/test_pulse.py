@@ -7,7 +7,7 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
-from imgmtf.pulse import check_width, estimate_width, measure_pulse, usable_band
+from imgmtf.estimate.pulse import check_width, estimate_width, measure_pulse, usable_band
 
 from conftest import exact_edge_chip, exact_esf, gaussian_pixel_transfer, true_fwhm, true_mtf50
 

@@ -3,7 +3,7 @@ import pytest
 from scipy.special import erf
 
 from imgmtf.errors import ParameterError
-from imgmtf.resampling import METHODS, resample_profile, sample_gap
+from imgmtf.estimate.resampling import METHODS, resample_profile, sample_gap
 
 
 def erf_edge(x, sigma=0.6):

@@ -5,7 +5,7 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.targets import cell_coverage
+from imgmtf.sensor.targets import cell_coverage
 
 
 @pytest.mark.parametrize("angle", [0.0, 6.0, 30.0, 45.0, 84.0, -20.0])

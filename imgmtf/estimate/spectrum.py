@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from .metrics import first_crossing
+from ..metrics import first_crossing
 
 MIN_TRANSFER = 0.1
 NYQUIST = 0.5

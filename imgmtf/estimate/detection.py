@@ -17,7 +17,7 @@ import numpy as np
 from skimage.feature import canny
 from skimage.transform import hough_line
 
-from .errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
+from ..errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
 
 _THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
 _THETAS = np.deg2rad(np.arange(-90.0, 90.0, _THETA_STEP_DEG))

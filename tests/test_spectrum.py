@@ -3,7 +3,7 @@ import pytest
 from scipy.special import erf
 
 from imgmtf.metrics import first_crossing, fwhm
-from imgmtf.mtf import (central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
+from imgmtf.estimate.spectrum import (central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
                         relative_edge_response, restore_lsf, rise_distance)
 
 
@@ -75,7 +75,7 @@ def test_first_crossing():
 def test_noise_limited_frequency_closed_form():
     from scipy.optimize import brentq
 
-    from imgmtf.mtf import noise_limited_frequency
+    from imgmtf.estimate.spectrum import noise_limited_frequency
 
     def mtf(f):
         return np.exp(-4.0 * np.asarray(f))

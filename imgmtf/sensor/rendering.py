@@ -20,11 +20,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from . import __version__
-from .errors import ParameterError
-from .metrics import first_crossing, fwhm
+from ..version import __version__
+from ..errors import ParameterError
+from ..metrics import first_crossing, fwhm
 from .noise import GroundNoise, add_system_noise
-from .sensor import Sensor
+from .model import Sensor
 from .targets import Target
 
 BITS = (8, 16)

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError
-from .metrics import first_crossing
-from .mtf import MIN_TRANSFER, NYQUIST
+from ..errors import ParameterError
+from ..metrics import first_crossing
+from .spectrum import MIN_TRANSFER, NYQUIST
 
 FREQUENCY_STEP_CY_PX = 0.0025   # MTF50 is read on this grid, linearly interpolated
 

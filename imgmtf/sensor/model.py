@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from . import components
-from .errors import ConfigError, FileWriteError, ParameterError
-from .metrics import fwhm
+from ..errors import ConfigError, FileWriteError, ParameterError
+from ..metrics import fwhm
 
 DIRECTIONS = ("across", "along")
 

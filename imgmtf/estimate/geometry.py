@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .detection import Line
-from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
+from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .fermi import fit_fermi
 from .resampling import METHODS, resample_profile, sample_gap
-from .uncertainty import Bootstrap
+from .intervals import Bootstrap
 
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px

@@ -24,16 +24,16 @@ import numpy as np
 
 from .detection import bar_contrast, find_lines, robust_noise
 from .edge import SNR_THRESHOLD
-from .errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
-from .inputs import prepare_image
-from .metrics import fwhm
-from .mtf import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50,
+from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
+from ..inputs import prepare_image
+from ..metrics import fwhm
+from .spectrum import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50,
                   mtf_area, noise_limited_frequency, restore_lsf, with_transfer)
-from .profile import (ProfileEstimator, check_angle, fit_line, profile_samples, row_windows,
+from .geometry import (ProfileEstimator, check_angle, fit_line, profile_samples, row_windows,
                       vertical_frame)
 from .resampling import resample_profile
 from .results import MTFResult, finite
-from .uncertainty import bootstrap_figures
+from .intervals import bootstrap_figures
 
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated

@@ -29,7 +29,7 @@ from scipy.interpolate import make_smoothing_spline
 from scipy import sparse
 from scipy.ndimage import correlate1d
 
-from .errors import ImageContentError, ParameterError
+from ..errors import ImageContentError, ParameterError
 
 
 @dataclass(frozen=True, eq=False)

@@ -23,16 +23,16 @@ from typing import ClassVar
 import numpy as np
 
 from .detection import find_edge
-from .errors import ImageContentError, UnsuitableTargetError
-from .inputs import prepare_image, saturation_levels
-from .metrics import fwhm
-from .mtf import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
+from ..errors import ImageContentError, UnsuitableTargetError
+from ..inputs import prepare_image, saturation_levels
+from ..metrics import fwhm
+from .spectrum import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
                   noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
-from .profile import (ProfileEstimator, TargetGeometry, check_angle, locate_edge, profile_samples,
+from .geometry import (ProfileEstimator, TargetGeometry, check_angle, locate_edge, profile_samples,
                       vertical_frame)
 from .resampling import resample_profile
 from .results import MTFResult, finite
-from .uncertainty import bootstrap_figures
+from .intervals import bootstrap_figures
 
 SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row

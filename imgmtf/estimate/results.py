@@ -8,9 +8,9 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
-from . import __version__
-from .profile import TargetGeometry
-from .uncertainty import Interval
+from ..version import __version__
+from .geometry import TargetGeometry
+from .intervals import Interval
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
