@@ -111,12 +111,19 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     # a variance of 1/3 in window coordinates), for a well-posed fit
     count = np.where(m[..., 0, :] > 0, m[..., 0, :], 1.0)
     spread = m[..., 2, :] / count - (m[..., 1, :] / count) ** 2
-    valid = (m[..., 0, :] >= 2 * (order + 1) * _unit_weight(w)) & (spread > 0.05)
+    # ... and order + 1 distinct sample positions (occupied bins), without
+    # which its normal matrix is singular (sample lattices, partial windows)
+    occupied = _bin_sums(bins, grid.size, (w > 0)[..., None, :].astype(float))[..., 0, :] > 0
+    distinct = correlate1d(occupied.astype(float), np.ones(2 * half_bins + 1), axis=-1, mode="constant")
+    trim = (grid.size - out.size) // 2
+    inner = np.zeros(grid.size, bool)
+    inner[trim: trim + out.size] = True
+    valid = ((m[..., 0, :] >= 2 * (order + 1) * _unit_weight(w)) & (spread > 0.05)
+             & (distinct >= order + 1) & inner)
     level = np.full(valid.shape, np.nan)
     if valid.any():
         level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
     width = (2 * half_bins + 1) * step
-    trim = (grid.size - out.size) // 2
     return Resampled(out, level[..., trim: trim + out.size], _local_polynomial_transfer(order, width),
                      {"order": order, "window_px": width, "step_px": step})
 
