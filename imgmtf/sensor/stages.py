@@ -105,6 +105,8 @@ class Stage:
 
     name: ClassVar[str] = ""
     title: ClassVar[str] = ""
+    #: False when the PSF is a set of points, which has no FWHM
+    has_width: ClassVar[bool] = True
 
     def __post_init__(self):
         for f in fields(self):
@@ -341,6 +343,7 @@ class OLPF(Stage):
 
     name: ClassVar[str] = "olpf"
     title: ClassVar[str] = "4-spot OLPF"
+    has_width: ClassVar[bool] = False
     split_m: float = _param(0.5, "m", FitSpec(upper_px=2.0, rank=5))
 
     def transfer(self, fx, fy, gsd_m):
