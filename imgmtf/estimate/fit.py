@@ -53,7 +53,7 @@ import numpy as np
 from ..errors import ImgmtfError, ParameterError
 from ..metrics import first_crossing
 from ..sensor.model import DIRECTIONS, PAPER_STAGES, Sensor, direction_angle
-from ..sensor.stages import STAGES, Stage
+from ..sensor.stages import STAGES, Stage, check_number
 
 #: a free parameter is determined when its 1-SE range of blur length is
 #: narrower than this fraction of the length ...
@@ -257,13 +257,18 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     """
     if not (isinstance(confidence, (int, float, np.floating)) and 0 < confidence < 1):
         raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
+    if gsd_m is not None:
+        gsd_m = check_number("gsd_m", gsd_m, positive=True)
+    if start is not None and not isinstance(start, Sensor):
+        raise ParameterError(f"start must be a Sensor, got {start!r}")
+    names = _stage_names(stages, start)
     if isinstance(edges, (str, Path, np.ndarray)):
         edges = [edges]
     data = [_edge_data(item, k, gsd_m, band) for k, item in enumerate(edges)]
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
-    model = _Model(gsd, _initial_stages(stages, start, gsd), data)
+    model = _Model(gsd, _initial_stages(names, start, gsd), data)
     notes = model.screen_axes(_hold_keys(hold, model))
     z = model.initial_vector()
     while True:
@@ -364,7 +369,7 @@ def profile_noise(x: np.ndarray, y: np.ndarray) -> float:
 
 
 # -- the model --------------------------------------------------------------------
-def _initial_stages(names, start: Sensor | None, gsd: float) -> list[Stage]:
+def _stage_names(names, start: Sensor | None) -> list[str]:
     if names is None:
         names = [s.name for s in start.stages] if start is not None else list(PAPER_STAGES)
     elif isinstance(names, str):
@@ -377,6 +382,10 @@ def _initial_stages(names, start: Sensor | None, gsd: float) -> list[Stage]:
             raise ParameterError(f"unknown stage {name!r}; known: {', '.join(STAGES)}")
     if len(set(names)) != len(names):
         raise ParameterError(f"a stage is named twice in {', '.join(names)}")
+    return names
+
+
+def _initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[Stage]:
     given = {s.name: s for s in (start.stages if start is not None else ())}
     out = []
     for name in names:
