@@ -63,7 +63,7 @@ def part_noisy(n: int):
     sensor = im.Sensor(optics_sigma_x_m=0.5, optics_sigma_y_m=0.5, motion_m=0.0, electronics_cutoff_cy_m=0.0)
     renderer = im.Renderer(sensor, 100)
     rng = np.random.default_rng(25)
-    fit_err, np_err, covered, held = [], [], 0, 0
+    fit_err, np_err, covered, held, warned = [], [], 0, 0, 0
     started = time.perf_counter()
     for _ in range(n):
         angle = float(rng.uniform(3, 12) * rng.choice([-1, 1]))
@@ -76,12 +76,13 @@ def part_noisy(n: int):
         np_err.append(e.measured_mtf_nyquist - truth)
         covered += e.mtf_nyquist_ci[0] <= truth <= e.mtf_nyquist_ci[1]
         held += any(p.key == "detector.width_x_m" and p.status == "held" for p in fit.parameters)
+        warned += any("does not fit" in w for w in fit.warnings)
     seconds = (time.perf_counter() - started) / n
     for name, err in (("fit", fit_err), ("non-parametric (msg)", np_err)):
         err = np.array(err)
         print(f"  {name:22s} bias {err.mean():+.4f}  RMS {np.sqrt(np.mean(err**2)):.4f}  worst {np.abs(err).max():.4f}")
     print(f"  fit: 95 % interval covers the truth on {covered}/{n}; detector width held on {held}/{n}; "
-          f"{seconds:.2f} s per chip (measure + fit)\n")
+          f"misfit warning (false alarm) on {warned}/{n}; {seconds:.2f} s per chip (measure + fit)\n")
 
 
 def part_diffraction(snr: float | None):

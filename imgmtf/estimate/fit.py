@@ -57,9 +57,9 @@ from ..sensor.stages import STAGES, Stage, check_number
 
 #: a free parameter is determined when its 1-SE range of blur length is
 #: narrower than this fraction of the length ...
-DETERMINED_RELATIVE = 0.25
+DETERMINED_RELATIVE = 0.5
 #: ... or than this many pixels
-DETERMINED_PX = 0.05
+DETERMINED_PX = 0.2
 #: residual bins along the normal (px) for the misfit test
 MISFIT_BIN_PX = 0.25
 #: misfit warning: binned residuals significant at this level ...
@@ -534,10 +534,11 @@ class _Model:
             row += d.x.size
         return jac
 
-    def solve(self, z: np.ndarray, max_iterations: int = 100):
+    def solve(self, z: np.ndarray, max_iterations: int = 200):
         """Bounded Levenberg-Marquardt from ``z``: steps solve the small
-        normal equations (a few parameters, many samples) and are clipped
-        to the bounds.  Returns the solution and its Jacobian."""
+        normal equations (a few parameters, many samples) for the
+        parameters not held at a bound by the gradient (an active set), and
+        are clipped to the bounds.  Returns the solution and its Jacobian."""
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
         r = self.residuals(z)
@@ -545,12 +546,15 @@ class _Model:
         for _ in range(max_iterations):
             jac = self.jacobian(z)
             a, g = jac.T @ jac, jac.T @ r
+            pinned = ((z <= lower) & (g > 0)) | ((z >= upper) & (g < 0))
+            free = ~pinned
             scale = np.where(np.diag(a) > 0, np.diag(a), 1.0)
             while True:
+                step = np.zeros(z.size)
                 try:
-                    step = np.linalg.solve(a + damping * np.diag(scale), -g)
+                    step[free] = np.linalg.solve(a[np.ix_(free, free)] + damping * np.diag(scale[free]), -g[free])
                 except np.linalg.LinAlgError:
-                    step = np.full(z.size, np.nan)
+                    step[:] = np.nan
                 trial = np.clip(z + step, lower, upper)
                 r_trial = self.residuals(trial) if np.all(np.isfinite(trial)) else None
                 cost_trial = float(r_trial @ r_trial) if r_trial is not None else math.inf
@@ -561,7 +565,7 @@ class _Model:
                 return z, jac
             gain, moved = cost - cost_trial, np.abs(trial - z).max()
             z, r, cost, damping = trial, r_trial, cost_trial, max(damping / 3.0, 1e-9)
-            if gain <= 1e-10 * cost or moved <= 1e-12:
+            if gain <= 1e-9 * cost or moved <= 1e-12:
                 return z, self.jacobian(z)
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
                           f"{max_iterations} iterations; try fewer stages (--stages) or hold some (--hold)",
