@@ -185,6 +185,13 @@ class SensorFit:
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
 
+    @property
+    def misfit(self) -> bool:
+        """True when the model does not fit: an edge's residuals are
+        structured, or a fitted parameter sits at the bound of its range."""
+        return any(e.misfit_p < MISFIT_P and e.misfit_fraction > MISFIT_FRACTION for e in self.edges) or any(
+            p.note == "at the bound of its range" for p in self.parameters)
+
     def mtf_band(self, f_cy_px, angle_deg: float, gsd_m: float | None = None):
         """The model's MTF along the normal of an edge tilted ``angle_deg``,
         at ``f_cy_px`` cycles per pixel of ``gsd_m`` (default the sensor's),
@@ -200,6 +207,7 @@ class SensorFit:
         return {"imgmtf_version": __version__, "method": "fit",
                 "stages": [s.name for s in self.sensor.stages], "gsd_m": self.sensor.gsd_m,
                 "confidence": self.confidence, "reduced_chi_square": self.reduced_chi_square,
+                "misfit": self.misfit,
                 "parameters": [p.to_dict() for p in self.parameters],
                 "correlations": [{"a": a, "b": b, "r": r} for a, b, r in self.correlations],
                 "directions": {k: {kk: _json(vv) if not isinstance(vv, (list, tuple)) else [_json(x) for x in vv]
@@ -640,7 +648,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
     warnings = []
 
     parameters = []
-    fitted_se = {}
+    _, upper = model.bounds()
     for stage_before, stage in zip(model.stages, sensor.stages):
         units = stage.units()
         for name, value in stage.to_dict(include_name=False).items():
@@ -649,7 +657,11 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
                 i = model.free.index(key)
                 se = _value_error(stage, name, u[i], math.sqrt(max(covariance[i, i], 0.0)), model.gsd)
                 status, note = "fitted", ""
-                fitted_se[key] = se
+                if u[i] >= upper[i] * (1 - 1e-6):
+                    note = "at the bound of its range"
+                    warnings.append(f"{key} is at the bound of its range ({value:.4g} {units[name]}): the model "
+                                    "strains to fit the edges, whose blur may have another form; its MTF may be "
+                                    "biased: try other stages (e.g. diffraction, defocus, olpf)")
             elif key in notes:
                 se, (status, note) = math.nan, notes[key]
             else:  # a parameter the fit does not touch (wavelength, pitch)
