@@ -290,11 +290,12 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
         notes[model.free[worst]] = ("held", f"not determined by the data (1-SE range {undetermined[worst]:.2g} px); "
                                             "held at its starting value")
         z = model.hold(z, worst)
-    # hold, best-known first, each parameter the data do not need: holding it
-    # at its starting value costs less than the likelihood-ratio threshold
+    # hold, best-known first, each parameter the data do not need (holding it
+    # at its starting value costs less than the likelihood-ratio threshold),
+    # but keep one free parameter on each axis an edge sees
     for key in sorted(model.free, key=lambda k: -model.specs[k].rank):
-        if model.n_free == 0:
-            break
+        if not model.covers_axes([k for k in model.free if k != key]):
+            continue            # the last free parameter of an axis: its uncertainty belongs in the intervals
         index = model.free.index(key)
         trial = model.copy()
         z_held = trial.hold(z, index)
@@ -440,7 +441,7 @@ class _Model:
     def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
         """Tie or hold what no edge's axis constrains; hold ``held``."""
         notes = {k: ("held", "held by request at its starting value") for k in held}
-        seen = {("across" if abs(d.angle_deg) < 45 else "along") for d in self.data}
+        seen = {"across" if axis == "x" else "along" for axis in self.seen_axes()}
         axis_of = {"x": "across", "y": "along"}
         for key, spec in self.specs.items():
             if key in held or spec.axis == "xy" or axis_of[spec.axis] in seen:
@@ -460,6 +461,19 @@ class _Model:
         other.__dict__.update(self.__dict__)
         other.values, other.ties, other.free = dict(self.values), dict(self.ties), list(self.free)
         return other
+
+    def seen_axes(self) -> set[str]:
+        """Image axes some edge mostly constrains: "x" (across), "y" (along)."""
+        return {"x" if abs(d.angle_deg) < 45 else "y" for d in self.data}
+
+    def covers_axes(self, free: list[str]) -> bool:
+        """Whether parameters ``free`` (with those tied to them) act on every
+        axis an edge sees."""
+        axes = set()
+        for key in free:
+            for k in [key] + [t for t, source in self.ties.items() if source == key]:
+                axes.update(("x", "y") if self.specs[k].axis == "xy" else (self.specs[k].axis,))
+        return self.seen_axes() <= axes
 
     def hold(self, z: np.ndarray, index: int) -> np.ndarray:
         key = self.free.pop(index)
@@ -698,6 +712,9 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
                             f"along the normal ({100 * fraction:.2f} % of the step, p = {p:.1g}); its MTF may be "
                             "biased: try other stages (e.g. diffraction, defocus, olpf)")
 
+    if not model.covers_axes(model.free):
+        warnings.append("no parameter acting on every axis an edge sees could be determined: the MTF there is "
+                        "the starting sensor's; give more or sharper edges, or other stages")
     seen = {e.direction for e in edges}
     directions = {}
     for direction in DIRECTIONS:
