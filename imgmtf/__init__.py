@@ -24,6 +24,7 @@ _LAZY = {
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals",
+    "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io",
     "run_selftest": "selftest",
 }

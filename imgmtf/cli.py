@@ -131,22 +131,31 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
 # -- sensor -------------------------------------------------------------------
 @main.command("sensor")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False), help="sensor TOML file")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="save PSF/LSF/MTF figure (PNG)")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
+              help="save the PSF, LSFs and each stage's MTF beside the system's (PNG)")
 @click.option("--save", "save_path", type=click.Path(dir_okay=False), help="write the sensor as TOML")
 def sensor_command(sensor_path, plot_path, save_path):
-    """Print the sensor's component and system FWHM and MTF at Nyquist."""
+    """Print the sensor's stages, and each stage's and the system's FWHM and
+    MTF at Nyquist across and along track."""
     with _reported_errors():
         sensor = _load_sensor(sensor_path)
-        click.echo(f"generic sensor, GSD {sensor.gsd_m:g} m "
-                   f"({'paper defaults' if sensor == Sensor() else sensor_path})")
+        click.echo(f"sensor, GSD {sensor.gsd_m:g} m "
+                   f"({'the paper' + chr(39) + 's generic sensor' if sensor == Sensor() else sensor_path})")
+        for stage in sensor.stages:
+            units = stage.units()
+            values = ", ".join(f"{k} {v:.6g}{(' ' + units[k]) if units[k] else ''}"
+                               for k, v in stage.to_dict(include_name=False).items())
+            click.echo(f"  {stage.name:<12} {stage.title}: {values}")
         click.echo(f"{'stage':<12} {'FWHM across (m)':>16} {'FWHM along (m)':>15} "
                    f"{'MTF@Nyq across':>15} {'MTF@Nyq along':>14}")
-        stages = {**sensor.components(), "system": sensor}
-        for name, stage in stages.items():
-            fw = [stage.fwhm_m(d) if stage.mtf_nyquist(d) < 1 - 1e-12 else None for d in DIRECTIONS]
+        parts = {**sensor.components(), "system": sensor}
+        for name, part in parts.items():
+            has_width = part is sensor or part.stages[0].has_width
+            fw = [part.fwhm_m(d) if has_width and part.mtf_nyquist(d) < 1 - 1e-12 else None
+                  for d in DIRECTIONS]
             cells = [f"{v:16.4f}" if v is not None else f"{'-':>16}" for v in fw]
             click.echo(f"{name:<12} {cells[0]} {cells[1][1:]} "
-                       f"{stage.mtf_nyquist('across'):15.4f} {stage.mtf_nyquist('along'):14.4f}")
+                       f"{part.mtf_nyquist('across'):15.4f} {part.mtf_nyquist('along'):14.4f}")
         if save_path:
             sensor.to_toml(save_path)
             click.echo(f"wrote {save_path}")
@@ -154,6 +163,86 @@ def sensor_command(sensor_path, plot_path, save_path):
             from .plot import plot_sensor
             _save_figure(plot_sensor(sensor), plot_path)
             click.echo(f"wrote {plot_path}")
+
+
+# -- fit ----------------------------------------------------------------------
+@main.command()
+@click.argument("paths", nargs=-1, required=True, type=click.Path())
+@click.option("--stages", metavar="NAMES",
+              help="comma-separated stages to fit: optics, detector, motion, electronics, diffraction, "
+                   "defocus, olpf, jitter (default: those of --sensor, else the paper's four)")
+@click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False),
+              help="sensor TOML giving starting (and held) values, e.g. a known detector or wavelength")
+@click.option("--hold", metavar="PARAMS",
+              help="comma-separated parameters held at their starting values: a stage (detector) or "
+                   "stage.parameter (detector.width_x_m)")
+@click.option("--gsd", type=float, help="GSD in metres (default: the files', else 1: parameters in px)")
+@click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
+@click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+              show_default=True, help="confidence of the intervals")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True,
+              help="json: one object with the parameters, directions and a record per edge")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
+              help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
+def fit(paths, stages, sensor_path, hold, gsd, band, recursive, confidence, out_path, fmt, plot_path):
+    """Fit the sensor's stages to the edges of one or more images (one edge
+    each; across- and along-track edges together constrain both axes), and
+    read the MTF in every direction off the fitted model."""
+    from .batch import expand_inputs
+    from .estimate.fit import fit_sensor
+    from .sensor.model import Sensor
+    with _reported_errors():
+        files = expand_inputs(paths, recursive)
+        if not files:
+            raise ParameterError(f"no image files in {', '.join(paths)}")
+        start = Sensor.from_toml(sensor_path) if sensor_path else None
+        result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
+                            confidence=confidence)
+        written = []
+        if out_path:
+            result.sensor.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(files)} edge(s): "
+                                                     f"{', '.join(e.source for e in result.edges)}")
+            written.append(out_path)
+        if plot_path:
+            from .plot import plot_fit
+            _save_figure(plot_fit(result), plot_path)
+            written.append(plot_path)
+    if fmt == "json":
+        click.echo(json.dumps({**result.to_dict(), "written": written}))
+        return
+    _fit_report(result)
+    for path in written:
+        click.echo(f"wrote {path}")
+
+
+def _fit_report(result) -> None:
+    edges = result.edges
+    click.echo(f"fit of {', '.join(s.name for s in result.sensor.stages)} to {len(edges)} edge(s), "
+               f"GSD {result.sensor.gsd_m:g} m; reduced chi-square {result.reduced_chi_square:.3g}")
+    click.echo(f"{'parameter':<28} {'value':>11} {'std err':>10} {'unit':<5} status")
+    for p in result.parameters:
+        se = f"{p.standard_error:10.4g}" if p.status == "fitted" else f"{'-':>10}"
+        click.echo(f"{p.key:<28} {p.value:11.5g} {se} {p.unit:<5} {p.status}{': ' + p.note if p.note else ''}")
+    for a, b, r in result.correlations:
+        click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
+                   "better than each")
+    pct = f"{100 * result.confidence:g}%"
+    click.echo(f"{'edge':<32} {'angle':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+               f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
+    for e in edges:
+        lo, hi = e.mtf_nyquist_ci
+        click.echo(f"{e.source:<32} {e.angle_deg:6.2f} {e.direction:>6} {e.mtf_nyquist:7.4f} "
+                   f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
+                   f"{100 * e.misfit_fraction:6.2f}%")
+    click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
+    for name, d in result.directions.items():
+        lo, hi = d["mtf_nyquist_ci"]
+        click.echo(f"{name:<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
+                   f"{_num(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
+    for warning in result.warnings:
+        click.echo(f"warning: {warning}")
 
 
 # -- measure ------------------------------------------------------------------

@@ -17,13 +17,23 @@ def _axes(ax, size=(5.0, 3.6)):
 
 
 # -- the sensor model --------------------------------------------------------
+def _view_radius_m(sensor) -> float:
+    """Half-width (m) of the view that shows the PSF's core and shoulders."""
+    return 1.5 * max(sensor.fwhm_m("across"), sensor.fwhm_m("along"), sensor.gsd_m)
+
+
 def plot_psf(sensor, ax=None, oversampling: int = 20):
-    """The system PSF image (paper Fig. 2a), axes in metres."""
+    """The system PSF image (paper Fig. 2a), axes in metres, its core and
+    shoulders shown in a square of 3 FWHM."""
     fig, ax = _axes(ax)
     psf = sensor.psf(oversampling)
     half = psf.data.shape[0] // 2 * psf.step_m
-    ax.imshow(psf.data, extent=(-half, half, half, -half), cmap="magma")
-    ax.set(title="System PSF", xlabel="across track x (m)", ylabel="along track y (m)")
+    image = ax.imshow(psf.data / psf.data.max(), extent=(-half, half, half, -half), cmap="magma",
+                      interpolation="nearest")
+    r = _view_radius_m(sensor)
+    ax.set(xlim=(-r, r), ylim=(r, -r), title="System PSF (peak = 1)", xlabel="across track x (m)",
+           ylabel="along track y (m)")
+    fig.colorbar(image, ax=ax, shrink=0.8)
     return fig
 
 
@@ -34,32 +44,117 @@ def plot_sensor_lsf(sensor, ax=None):
         x, lsf = sensor.lsf(direction)
         ax.plot(x, lsf / lsf.max(), label=f"{direction} track, FWHM {sensor.fwhm_m(direction):.3f} m")
     ax.axhline(0.5, color="0.6", lw=0.8, ls=":")
-    ax.set(xlim=(-2.5, 2.5), title="Line spread functions", xlabel="distance (m)",
-           ylabel="normalised LSF")
+    r = 2 * _view_radius_m(sensor)
+    ax.set(xlim=(-r, r), title="Line spread functions", xlabel="distance (m)", ylabel="normalised LSF")
     ax.legend(fontsize="small")
     return fig
 
 
-def plot_sensor_mtf(sensor, ax=None):
-    """Across- and along-track MTFs with the Nyquist values (paper Fig. 3)."""
+def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
+    """The system MTF with its value at Nyquist (paper Fig. 3): across and
+    along track, or in one ``direction`` with each stage's MTF beside it."""
     fig, ax = _axes(ax)
     f = np.linspace(0, 1.0, 401)
-    for direction in ("across", "along"):
-        ax.plot(f, sensor.mtf(f, direction),
-                label=f"{direction} track, MTF@Nyquist {sensor.mtf_nyquist(direction):.4f}")
+    if direction is None:
+        for d in ("across", "along"):
+            ax.plot(f, sensor.mtf(f, d), label=f"{d} track, MTF@Nyquist {sensor.mtf_nyquist(d):.4f}")
+        title = "System MTF"
+    else:
+        for i, (name, part) in enumerate(sensor.components().items()):
+            ax.plot(f, part.mtf(f, direction), lw=1.0, ls=("--", "-.", ":")[i % 3], color=f"C{i + 1}",
+                    label=f"{name}: {part.mtf_nyquist(direction):.4f}")
+        ax.plot(f, sensor.mtf(f, direction), color="k", lw=2.0,
+                label=f"system: {sensor.mtf_nyquist(direction):.4f}")
+        title = f"MTF {direction} track (at Nyquist)"
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
-    ax.set(title="System MTF", xlabel="frequency (cycles/pixel)", ylabel="MTF", ylim=(0, 1.02))
+    ax.set(title=title, xlabel="frequency (cycles/pixel)", ylabel="MTF", ylim=(0, 1.02), xlim=(0, 1))
     ax.legend(fontsize="small")
     return fig
 
 
 def plot_sensor(sensor):
-    """PSF, LSFs and MTFs of the sensor side by side."""
-    fig = Figure(figsize=(14, 4), layout="constrained")
-    axes = fig.subplots(1, 3)
+    """PSF, LSFs, and each stage's MTF beside the system's across and along
+    track (the paper's Figs. 2-3)."""
+    fig = Figure(figsize=(17, 4), layout="constrained")
+    axes = fig.subplots(1, 4)
     plot_psf(sensor, axes[0])
     plot_sensor_lsf(sensor, axes[1])
-    plot_sensor_mtf(sensor, axes[2])
+    plot_sensor_mtf(sensor, axes[2], "across")
+    plot_sensor_mtf(sensor, axes[3], "along")
+    fig.suptitle(f"Sensor, GSD {sensor.gsd_m:g} m: {', '.join(s.name for s in sensor.stages)}")
+    return fig
+
+
+# -- a sensor fit ----------------------------------------------------------------
+def plot_fit_edge(fit, index: int, ax=None):
+    """One edge of a sensor fit: its measured (non-parametric) MTF against
+    the fitted model's along its normal, with the model's interval."""
+    fig, ax = _axes(ax)
+    edge = fit.edges[index]
+    m = edge.measurement
+    f = np.linspace(0.0, 1.0, 201)
+    value, low, high = fit.mtf_band(f, edge.angle_deg, edge.gsd_m)
+    lo, hi = edge.mtf_nyquist_ci
+    ax.fill_between(f, low, high, color="C0", alpha=0.3, lw=0)
+    ax.plot(f, value, color="C0", lw=2.0, label=f"model: {edge.mtf_nyquist:.4f} [{lo:.4f}, {hi:.4f}]")
+    ax.plot(m.frequencies_cy_px, m.mtf, "--", color="k", lw=1.0,
+            label=f"measured: {edge.measured_mtf_nyquist:.4f}")
+    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
+    name = edge.source if len(edge.source) <= 32 else "..." + edge.source[-29:]
+    ax.set(title=f"{name}: {edge.angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
+           xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF")
+    ax.legend(fontsize="small", title=f"at Nyquist ({100 * fit.confidence:g} % interval)",
+              title_fontsize="small")
+    return fig
+
+
+def plot_fit_residuals(fit, ax=None):
+    """Each edge's residuals (data - model) averaged in 0.25 px bins along
+    its normal, in % of its step, with the noise's 2-sigma band of a bin
+    mean: structure outside it is what the misfit warning reports."""
+    fig, ax = _axes(ax)
+    for i, edge in enumerate(fit.edges):
+        x = edge.samples_x_px - edge.offset_px
+        keep = np.abs(x) <= 6.0
+        bins = np.floor(x[keep] / 0.25).astype(int)
+        bins -= bins.min()
+        count = np.bincount(bins)
+        used = count >= 3
+        mean = np.bincount(bins, weights=edge.residuals_dn[keep])[used] / count[used]
+        centre = (np.nonzero(used)[0] + 0.5) * 0.25 + np.floor(x[keep].min() / 0.25) * 0.25
+        scale = 100.0 / abs(edge.step_dn)
+        line, = ax.plot(centre, mean * scale, ".-", lw=0.8, ms=3, color=f"C{i % 10}",
+                        label=f"{edge.source[-24:]}: {100 * edge.misfit_fraction:.2f} %")
+        ax.fill_between(centre, -2 * edge.noise_dn / np.sqrt(count[used]) * scale,
+                        2 * edge.noise_dn / np.sqrt(count[used]) * scale, color=line.get_color(), alpha=0.12, lw=0)
+    ax.axhline(0, color="0.4", lw=0.8)
+    ax.set(title="Residuals along the normal (0.25 px bins)", xlabel="distance from the edge (px)",
+           ylabel="data - model (% of the step)")
+    ax.legend(fontsize="small", title="structure (RMS)", title_fontsize="small", loc="lower right")
+    return fig
+
+
+def plot_fit(fit, max_edges: int = 6):
+    """Measured against model MTF for each edge (the first ``max_edges``),
+    the residuals along the normals, and the fitted sensor's 2-D PSF."""
+    shown = min(len(fit.edges), max_edges)
+    panels = shown + 2
+    cols = min(panels, 4)
+    rows = -(-panels // cols)
+    fig = Figure(figsize=(4.4 * cols, 3.7 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
+    for i in range(shown):
+        plot_fit_edge(fit, i, axes[i])
+    plot_fit_residuals(fit, axes[shown])
+    plot_psf(fit.sensor, axes[shown + 1])
+    axes[shown + 1].set_title("Fitted system PSF (peak = 1)")
+    for ax in axes[panels:]:
+        ax.set_visible(False)
+    held = [p.key for p in fit.parameters if p.status != "fitted" and p.note != "not fitted"]
+    more = f" (first {shown} of {len(fit.edges)} edges)" if shown < len(fit.edges) else ""
+    fig.suptitle(f"Fit of {', '.join(s.name for s in fit.sensor.stages)}{more}: reduced chi-square "
+                 f"{fit.reduced_chi_square:.3g}" + (f"; held or tied: {', '.join(held)}" if held else ""),
+                 fontsize="medium")
     return fig
 
 

@@ -6,6 +6,9 @@ from numpy.testing import assert_allclose
 
 import imgmtf as im
 from imgmtf.errors import ConfigError, FileWriteError, ParameterError
+from imgmtf.sensor import stages as st
+
+from conftest import exact_esf
 
 
 def test_psf_fft_matches_analytic_transfer_to_twice_nyquist(paper_sensor):
@@ -55,22 +58,46 @@ def test_lsf_integrates_to_one(paper_sensor):
 
 def test_components_each_keep_one_stage(paper_sensor):
     parts = paper_sensor.components()
-    assert set(parts) == {"optics", "detector", "motion", "electronics"}
+    assert list(parts) == ["optics", "detector", "motion", "electronics"]
     assert parts["motion"].mtf_nyquist("across") == 1.0
     assert parts["optics"].fwhm_m() == pytest.approx(2.35482 * 0.39, rel=1e-4)
 
 
-def test_toml_round_trip(tmp_path):
-    s = im.Sensor(gsd_m=0.5, motion_m=0.1)
+def test_paper_keywords_build_the_stages_and_zero_removes_one():
+    s = im.Sensor(gsd_m=np.int64(2), motion_m=0, electronics_cutoff_cy_m=np.float32(1.5))
+    assert s.gsd_m == 2.0 and [x.name for x in s.stages] == ["optics", "detector", "electronics"]
+    assert s.stages[2] == st.Electronics(1.5) and s == im.Sensor(2.0, list(s.stages))
+    assert im.Sensor() == im.Sensor(1.0, [st.GaussianOptics(), st.Detector(), st.Motion(), st.Electronics()])
+
+
+def test_toml_round_trip_every_stage(tmp_path):
+    s = im.Sensor(0.5, [stage() for stage in st.STAGES.values()] + [st.Electronics(math.inf)])
     path = tmp_path / "s.toml"
-    s.to_toml(path)
+    s.to_toml(path, comment="fitted\nby hand")
+    text = path.read_text()
+    assert text.startswith("# fitted\n# by hand") and text.count("[[stages]]") == len(st.STAGES) + 1
     assert im.Sensor.from_toml(path) == s
 
 
-def test_toml_top_level_keys_and_defaults(tmp_path):
+def test_old_sensor_tables_still_read(tmp_path):
     path = tmp_path / "s.toml"
+    path.write_text("[sensor]\ngsd_m = 0.5\nmotion_m = 0.1\nelectronics_cutoff_cy_m = 0.0\n")
+    assert im.Sensor.from_toml(path) == im.Sensor(gsd_m=0.5, motion_m=0.1, electronics_cutoff_cy_m=0)
     path.write_text("gsd_m = 2.0\n")
     assert im.Sensor.from_toml(path) == im.Sensor(gsd_m=2.0)
+
+
+def test_line_response_keeps_the_diffraction_tail():
+    """Edge response of an f/16 diffraction-limited lens: its tail falls as
+    1/x, which the closed-form Cauchy part carries without a long grid."""
+    s = im.Sensor(1.0, [st.Diffraction(16.0)])
+    response = s.line_response(7.0, reach_px=40)
+    assert response.esf_remainder.size <= 1 << 15
+    x, esf = exact_esf(lambda f: s.normal_transfer(f, 7.0), dx=1 / 64, n=1 << 21)
+    d = np.linspace(-40, 40, 801)
+    assert np.abs(response.esf(d) - np.interp(d, x, esf)).max() < 1e-5
+    assert 1 - response.esf(40.0) > 1e-3            # 40 px out, still 0.1 % short of the plateau
+    assert response.lsf(d).sum() * 0.1 == pytest.approx(response.esf(40.0) - response.esf(-40.0), rel=1e-3)
 
 
 @pytest.mark.parametrize("text, message", [
@@ -78,10 +105,14 @@ def test_toml_top_level_keys_and_defaults(tmp_path):
     ("[sensor]\nfocal = 3\n", r"unknown sensor parameter\(s\) focal"),
     ("[sensor]\nmotion_m = -1\n", "motion_m must be finite and >= 0"),
     ("[sensor]\ngsd_m = 'x'\n", "gsd_m must be a number"),
+    ("gsd_m = 1\n[[stages]]\nstage = 'lens'\n", "unknown stage 'lens'"),
+    ("gsd_m = 1\n[[stages]]\nstage = 'olpf'\nsplit_m = -1\n", "olpf split_m must be finite and >= 0"),
+    ("gsd_m = 1\nstages = []\n", "at least one stage"),
+    (b"\x89PNG\r\n\x1a\n\x00\xff\xfe", "not a text"),
 ])
 def test_bad_toml_is_a_config_error_naming_the_file(tmp_path, text, message):
     path = tmp_path / "bad.toml"
-    path.write_text(text)
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
     with pytest.raises(ConfigError, match=message) as err:
         im.Sensor.from_toml(path)
     assert str(path) in str(err.value)
@@ -97,7 +128,20 @@ def test_missing_and_unwritable_files(tmp_path):
 def test_invalid_parameters():
     with pytest.raises(ParameterError, match="gsd_m must be > 0"):
         im.Sensor(gsd_m=0)
-    with pytest.raises(ParameterError, match="finite"):
+    with pytest.raises(ParameterError, match="optics_sigma_x_m must be finite"):
         im.Sensor(optics_sigma_x_m=float("nan"))
+    with pytest.raises(ParameterError, match="gsd_m must be a number"):
+        im.Sensor(gsd_m=True)
     with pytest.raises(ParameterError, match="direction"):
         im.Sensor().mtf(0.5, "diagonal")
+    with pytest.raises(ParameterError, match="not both"):
+        im.Sensor(1.0, [st.Detector()], motion_m=0.2)
+    with pytest.raises(ParameterError, match="unknown sensor parameter"):
+        im.Sensor(focal_m=3)
+
+
+def test_absurd_blur_is_refused_before_allocating():
+    huge = im.Sensor(optics_sigma_x_m=1e5, optics_sigma_y_m=1e5)
+    for call in (huge.psf, huge.fwhm_m, lambda: huge.line_response(6.0)):
+        with pytest.raises(ParameterError, match="check the stage parameters"):
+            call()

@@ -5,49 +5,29 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.sensor.targets import cell_coverage
 
 
-@pytest.mark.parametrize("angle", [0.0, 6.0, 30.0, 45.0, 84.0, -20.0])
-def test_cell_coverage_is_area_exact(angle):
-    """Cells of a fine grid covering a large square: the covered fractions
-    add up to the exact area on the positive side of the line."""
-    a = math.radians(angle)
-    c, s = math.cos(a), math.sin(a)
-    n = 200
-    centres = np.arange(n) - (n - 1) / 2
-    # line through (0.3, -0.2): area of the square [-n/2, n/2]^2 where d > 0
-    d = (centres[None, :] - 0.3) * c + (centres[:, None] + 0.2) * s
-    total = cell_coverage(d, abs(c), abs(s)).sum()
-    # exact area by fine sampling is too slow; use the 1-D integral of the chord
-    t = np.linspace(-n / 2, n / 2, 200001)
-    if abs(s) > 1e-9:
-        # for each x, the y range above/below the line inside the square
-        y_line = 0.2 * -1 + (0.3 - t) * c / s
-        inside = np.clip(n / 2 - y_line, 0, n) if s > 0 else np.clip(y_line + n / 2, 0, n)
-    else:
-        inside = np.where((t - 0.3) * c > 0, n, 0.0)
-    exact = np.trapezoid(inside, t)
-    assert total == pytest.approx(exact, abs=1e-3 * n)
+def test_signed_distance_follows_the_normal():
+    t = im.Target("edge", 30.0, offset_px=0.5)
+    a = math.radians(30.0)
+    d = t.signed_distance(np.array([2.0 + math.cos(a)]), np.array([3.0 + math.sin(a)]), (2.0, 3.0))
+    assert d[0] == pytest.approx(0.5)
 
 
-def test_cell_coverage_limits_and_symmetry():
-    t = np.array([-5.0, 0.0, 5.0])
-    for c, s in [(1.0, 0.0), (0.8, 0.6), (math.sqrt(0.5), math.sqrt(0.5))]:
-        assert np.allclose(cell_coverage(t, c, s), [0.0, 0.5, 1.0])
-    t = np.linspace(-1, 1, 41)
-    v = cell_coverage(t, 0.8, 0.6)
-    assert np.allclose(v + v[::-1], 1.0)
-    assert np.all(np.diff(v) >= -1e-12)
-    # a vertical line at distance 0.25 from a cell centre covers 3/4 of it
-    assert cell_coverage(np.array([0.25]), 1.0, 0.0)[0] == pytest.approx(0.75)
+def test_pulse_values_are_the_difference_of_two_edges():
+    def ramp(d):  # a 2 px linear edge response
+        return np.clip(d / 2 + 0.5, 0, 1)
+    pulse = im.Target("pulse", 6.0, 100.0, 300.0, width_px=3.0)
+    d = np.array([-5.0, -1.5, 0.0, 1.5, 5.0])
+    assert np.allclose(pulse.image_values(d, ramp), [100.0, 200.0, 100.0 + 200.0 * 1.0, 200.0, 100.0])
+    edge = im.Target("edge", 6.0, 100.0, 300.0)
+    assert np.allclose(edge.image_values(d, ramp), 100.0 + 200.0 * ramp(d))
 
 
-def test_scene_pulse_has_width_times_height():
-    t = im.Target("pulse", 6.0, 0.0, 1.0, 0.0, 2.5)
-    scene = t.scene((41, 41), 10, 0)
-    # one row of cells crosses the bar: its covered length is width / cos(a)
-    assert scene[200].sum() / 10 == pytest.approx(2.5 / math.cos(math.radians(6.0)), rel=1e-6)
+def test_numpy_scalars_are_accepted():
+    t = im.Target("edge", np.float32(6), np.int64(10), np.float64(500))
+    assert t.angle_deg == pytest.approx(6.0) and type(t.angle_deg) is float
+    assert t == im.Target("edge", 6.0, 10.0, 500.0)
 
 
 @pytest.mark.parametrize("kwargs, message", [
@@ -57,6 +37,8 @@ def test_scene_pulse_has_width_times_height():
     (dict(kind="pulse", width_px=-1.0), "pulse width must be > 0"),
     (dict(kind="edge", width_px=2.0), "no width"),
     (dict(low_dn=float("nan")), "finite"),
+    (dict(angle_deg="6"), "finite number"),
+    (dict(angle_deg=True), "finite number"),
 ])
 def test_invalid_targets(kwargs, message):
     with pytest.raises(ParameterError, match=message):

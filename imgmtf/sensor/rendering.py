@@ -1,20 +1,22 @@
-"""Render targets through the generic sensor into quantised image chips.
+"""Render targets through a sensor into quantised image chips.
 
-The scene is built area-exact on a grid ``oversampling`` times finer than
-the output GSD, ground noise (if any) is added, the scene is convolved with
-the sampled system PSF by OpenCV (the PSF with the sub-pixel cell's box
-divided out, so that cell averaging adds no blur of its own), and the result is point-sampled at the
-output pixel centres.  The detector aperture is part of the PSF, so it is
-applied exactly once (point sampling adds no second aperture).  System
-noise is added after sampling, then the values are rounded and clipped to
-8 or 16 bits.
-
-The scene carries a margin of the PSF's radius on every side, so every
-output pixel sees a complete neighbourhood of the analytic scene and the
-image border never creates a false edge.
+Each output pixel is a point sample, at its centre, of the scene convolved
+with the system PSF (which holds the detector aperture, so the aperture is
+applied exactly once).  A target is a straight edge or bar, so by linearity
+its part of every pixel is the sensor's edge response along the target's
+normal at the pixel's signed distance from it
+(:meth:`imgmtf.sensor.model.Sensor.line_response`): exact for every stage,
+long-tailed diffraction included, with no grid to truncate and no border to
+hide.  Ground noise (if any) is a field on a grid ``oversampling`` times
+finer than the output GSD; it is convolved with the sampled PSF by OpenCV
+(the PSF with the sub-pixel cell's box divided out, so that the cells add
+no blur of their own), point-sampled and added.  System noise is added
+after sampling, then the values are rounded and clipped to 8 or 16 bits.
 """
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -24,7 +26,7 @@ from ..version import __version__
 from ..errors import ParameterError
 from ..metrics import first_crossing, fwhm
 from .noise import GroundNoise, add_system_noise
-from .model import Sensor
+from .model import MAX_GRID_CELLS, SampledPSF, Sensor
 from .targets import Target
 
 BITS = (8, 16)
@@ -78,42 +80,60 @@ class Chip:
 
 
 class Renderer:
-    """Set up once (sensor, chip size, PSF), render many targets.
+    """Set up once (sensor, chip size), render many targets.
 
     Parameters
     ----------
-    sensor : the generic sensor.
+    sensor : the sensor.
     shape : output chip size (rows, cols) in pixels, or one int for a square.
     gsd_m : output ground sample distance (m); default the sensor's.
-    oversampling : sub-pixel samples per output pixel in each axis.
+    oversampling : sub-pixel cells per output pixel in each axis, for the
+        ground-noise field.
     bits : 8 or 16, the output integer depth.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.Renderer(imgmtf.Sensor(), 40)(imgmtf.Target("edge", 6.0))
+    >>> chip.image.shape, chip.image.dtype.name
+    ((40, 40), 'uint16')
     """
 
     def __init__(self, sensor: Sensor = Sensor(), shape: int | tuple[int, int] = 50, *,
                  gsd_m: float | None = None, oversampling: int = 20, bits: int = 16):
         shape = (shape, shape) if isinstance(shape, (int, np.integer)) else tuple(shape)
-        if len(shape) != 2 or any(not isinstance(n, (int, np.integer)) or n < 2 for n in shape):
+        if len(shape) != 2 or any(isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer))
+                                  or n < 2 for n in shape):
             raise ParameterError(f"chip size must be at least 2 x 2 pixels, got {shape}")
+        if shape[0] * shape[1] > MAX_GRID_CELLS:
+            raise ParameterError(f"a {shape[0]} x {shape[1]} px chip is over the {MAX_GRID_CELLS}-pixel limit")
         if bits not in BITS:
             raise ParameterError(f"bits must be 8 or 16, got {bits}")
+        if isinstance(oversampling, (bool, np.bool_)) or not (
+                isinstance(oversampling, (int, np.integer)) and oversampling >= 1):
+            raise ParameterError(f"oversampling must be a positive integer, got {oversampling!r}")
         self.gsd_m = sensor.gsd_m if gsd_m is None else float(gsd_m)
-        if not self.gsd_m > 0:
+        if not self.gsd_m > 0 or not math.isfinite(self.gsd_m):
             raise ParameterError(f"GSD must be > 0 m, got {gsd_m}")
-        self.sensor, self.shape, self.oversampling, self.bits = sensor, shape, oversampling, bits
-        self.psf = sensor.psf(oversampling, gsd_m=self.gsd_m, deconvolve_cell=True)
-        # cv2.filter2D correlates; flipping the kernel makes it a convolution
-        self._kernel = np.ascontiguousarray(self.psf.data[::-1, ::-1])
-        self._margin = self.psf.data.shape[0] // 2
+        self.sensor, self.shape, self.oversampling, self.bits = sensor, tuple(int(n) for n in shape), int(oversampling), bits
+        rows, cols = self.shape
+        self._y, self._x = np.mgrid[0:rows, 0:cols].astype(float)
+        self._responses: dict[float, object] = {}
+
+    @functools.cached_property
+    def psf(self) -> SampledPSF:
+        """The sampled PSF, with the sub-pixel cell's box divided out, that
+        blurs the ground noise."""
+        return self.sensor.psf(self.oversampling, gsd_m=self.gsd_m, deconvolve_cell=True)
 
     def __call__(self, target: Target, *, noise_std_dn: float = 0.0,
                  ground_noise: GroundNoise | None = None, seed: int | None = None) -> Chip:
         rng = np.random.default_rng(seed)
-        scene = target.scene(self.shape, self.oversampling, self._margin)
+        rows, cols = self.shape
+        d = target.signed_distance(self._x, self._y, ((cols - 1) / 2.0, (rows - 1) / 2.0))
+        sampled = target.image_values(d, self._response(target).esf)
         if ground_noise is not None:
-            scene = scene + ground_noise.sample(scene.shape, rng)
-        blurred = cv2.filter2D(scene, cv2.CV_64F, self._kernel, borderType=cv2.BORDER_REFLECT)
-        m, os_ = self._margin, self.oversampling
-        sampled = blurred[m: scene.shape[0] - m: os_, m: scene.shape[1] - m: os_]
+            sampled = sampled + self._blurred_ground_noise(ground_noise, rng)
         sampled = add_system_noise(sampled, noise_std_dn, rng)
         top = 2**self.bits - 1
         rounded = np.rint(sampled)
@@ -121,6 +141,31 @@ class Renderer:
         image = np.clip(rounded, 0, top).astype(np.uint8 if self.bits == 8 else np.uint16)
         return Chip(image, self.sensor, target, self.gsd_m, self.oversampling, self.bits,
                     float(noise_std_dn), ground_noise, seed, clipped)
+
+    def _response(self, target: Target):
+        """The sensor's line response along the target's normal, kept per angle."""
+        if target.angle_deg not in self._responses:
+            rows, cols = self.shape
+            reach = math.hypot(rows, cols) / 2.0 + abs(target.offset_px) + target.width_px + 2.0
+            self._responses[target.angle_deg] = self.sensor.line_response(
+                target.angle_deg, self.gsd_m, reach_px=reach)
+        return self._responses[target.angle_deg]
+
+    def _blurred_ground_noise(self, ground_noise: GroundNoise, rng: np.random.Generator) -> np.ndarray:
+        """Ground noise on the sub-pixel grid (with a margin of the PSF's
+        radius), convolved with the PSF and sampled at the pixel centres."""
+        rows, cols = self.shape
+        os_, margin = self.oversampling, self.psf.data.shape[0] // 2
+        shape = ((rows - 1) * os_ + 1 + 2 * margin, (cols - 1) * os_ + 1 + 2 * margin)
+        if shape[0] * shape[1] > MAX_GRID_CELLS:
+            raise ParameterError(f"ground noise on a {rows} x {cols} px chip at {os_} sub-pixels per pixel "
+                                 f"needs a {shape[0]} x {shape[1]} grid (over {MAX_GRID_CELLS} cells); "
+                                 "render a smaller chip or lower the oversampling")
+        field = ground_noise.sample(shape, rng)
+        # cv2.filter2D correlates; flipping the kernel makes it a convolution
+        kernel = np.ascontiguousarray(self.psf.data[::-1, ::-1])
+        blurred = cv2.filter2D(field, cv2.CV_64F, kernel, borderType=cv2.BORDER_REFLECT)
+        return blurred[margin: field.shape[0] - margin: os_, margin: field.shape[1] - margin: os_]
 
 
 def render(sensor: Sensor, target: Target, shape: int | tuple[int, int] = 50, *,

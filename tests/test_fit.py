@@ -1,0 +1,129 @@
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import imgmtf as im
+from imgmtf.cli import main
+from imgmtf.errors import ImageContentError, ImgmtfError, ParameterError
+from imgmtf.estimate import fit as fit_module
+from imgmtf.sensor import stages as st
+
+TRUTH = im.Sensor(1.0, [st.GaussianOptics(0.45, 0.35), st.Detector(1.0, 1.0)])
+
+
+@pytest.fixture(scope="module")
+def pair():
+    """Noise-free across- and along-track chips of a Gaussian + pixel sensor."""
+    renderer = im.Renderer(TRUTH, 60)
+    return [renderer(im.Target("edge", a, 200.0, 1200.0, o)) for a, o in ((5.0, 0.3), (-84.0, -0.2))]
+
+
+def test_recovers_the_parameters_and_each_edges_mtf(pair):
+    fit = im.fit_sensor([c.image for c in pair], stages="optics,detector", hold="detector")
+    values = {p.key: p for p in fit.parameters}
+    assert values["optics.sigma_x_m"].value == pytest.approx(0.45, rel=0.01)
+    assert values["optics.sigma_y_m"].value == pytest.approx(0.35, rel=0.01)
+    assert values["optics.sigma_x_m"].status == "fitted" and values["detector.width_x_m"].status == "held"
+    for chip, edge in zip(pair, fit.edges):
+        assert abs(edge.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002
+        assert edge.direction == ("across" if abs(chip.target.angle_deg) < 45 else "along")
+    assert fit.directions["along"]["mtf_nyquist"] == pytest.approx(TRUTH.mtf_nyquist("along"), abs=0.002)
+    assert not fit.misfit and not any("does not fit" in w for w in fit.warnings)
+
+
+def test_one_direction_ties_the_other_axis_and_says_so(pair):
+    fit = im.fit_sensor(pair[0].image, stages="optics,detector,motion")
+    status = {p.key: (p.status, p.note) for p in fit.parameters}
+    assert status["optics.sigma_y_m"][0] == "tied" and "optics.sigma_x_m" in status["optics.sigma_y_m"][1]
+    assert status["motion.length_m"][0] == "held" and "no along-track edge" in status["motion.length_m"][1]
+    assert fit.directions["along"]["constrained"] is False
+    assert any("no along-track edge" in w for w in fit.warnings)
+    assert abs(fit.edges[0].mtf_nyquist - float(pair[0].true_mtf(0.5))) < 0.002
+
+
+def test_diffraction_is_recovered_and_a_wrong_model_warns():
+    sensor = im.Sensor(1.0, [st.Diffraction(11.0), st.Detector()])     # the fit starts at f/8
+    chip = im.render(sensor, im.Target("edge", 7.0, 200.0, 1200.0, 0.17), 60)
+    right = im.fit_sensor(chip.image, stages="diffraction,detector", hold="detector")
+    f_number = next(p for p in right.parameters if p.key == "diffraction.f_number")
+    assert f_number.value == pytest.approx(11.0, rel=0.01) and f_number.standard_error < 0.1
+    assert abs(right.edges[0].mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002
+    wrong = im.fit_sensor(chip.image, stages="optics,detector", hold="detector")
+    assert wrong.misfit and any("does not fit" in w for w in wrong.warnings)
+    assert wrong.edges[0].misfit_p < 1e-3
+
+
+def test_profile_noise_needs_no_model():
+    rng = np.random.default_rng(4)
+    x = np.sort(rng.uniform(-20, 20, 4000))
+    y = 1000 * (0.5 + np.arctan(x / 0.7) / np.pi) + rng.normal(0, 7.0, x.size)
+    assert fit_module.profile_noise(x, y) == pytest.approx(7.0, rel=0.06)
+
+
+def test_a_fit_that_does_not_converge_is_an_imgmtf_error(pair):
+    data = [fit_module._edge_data(pair[0].image, 0, None, None)]
+    model = fit_module._Model(1.0, fit_module._initial_stages(["optics"], None, 1.0), data)
+    with pytest.raises(ImgmtfError, match="did not converge"):
+        model.solve(model.initial_vector(), max_iterations=0)
+
+
+@pytest.mark.parametrize("kwargs, error, message", [
+    (dict(stages="optics,lens"), ParameterError, "unknown stage 'lens'"),
+    (dict(stages="optics,optics"), ParameterError, "named twice"),
+    (dict(hold="motion"), ParameterError, "cannot hold 'motion'"),
+    (dict(gsd_m=-1.0), ParameterError, "gsd_m must be"),
+    (dict(confidence=1.5), ParameterError, "confidence"),
+])
+def test_bad_fit_arguments(pair, kwargs, error, message):
+    with pytest.raises(error, match=message):
+        im.fit_sensor([pair[0].image], **{"stages": "optics,detector", **kwargs})
+
+
+def test_an_image_without_an_edge_is_named():
+    with pytest.raises(ImageContentError, match="array 2"):
+        im.fit_sensor([im.render(TRUTH, im.Target("edge", 6.0), 40).image, np.full((40, 40), 500, np.uint16)])
+
+
+def test_cli_json_contract_toml_and_plot(pair, tmp_path):
+    from imgmtf.io import write_geotiff
+    paths = []
+    for k, chip in enumerate(pair):
+        paths.append(tmp_path / f"edge{k}.tif")
+        write_geotiff(paths[-1], chip.image, gsd_m=1.0)
+    out, png = tmp_path / "fitted.toml", tmp_path / "fit.png"
+    result = CliRunner().invoke(main, ["fit", *map(str, paths), "--stages", "optics,detector", "--hold",
+                                       "detector", "--format", "json", "--out", str(out), "--plot", str(png)])
+    assert result.exit_code == 0, result.output
+    record = json.loads(result.stdout)                 # one JSON object
+    assert [e["path"] for e in record["edges"]] == list(map(str, paths))
+    for edge, chip in zip(record["edges"], pair):
+        assert abs(edge["mtf_nyquist"] - float(chip.true_mtf(0.5))) < 0.002
+        assert edge["mtf_nyquist_ci"][0] <= edge["mtf_nyquist"] <= edge["mtf_nyquist_ci"][1]
+    assert {"parameters", "reduced_chi_square", "directions", "warnings", "sensor"} <= set(record)
+    assert set(record["directions"]["across"]) >= {"mtf_nyquist", "mtf_nyquist_ci", "mtf50_cy_px"}
+    assert png.stat().st_size > 20_000
+    fitted = im.Sensor.from_toml(out)
+    assert fitted.mtf_nyquist("across") == pytest.approx(record["directions"]["across"]["mtf_nyquist"])
+    text = CliRunner().invoke(main, ["sensor", "--sensor", str(out)])
+    assert text.exit_code == 0 and "optics" in text.stdout
+    assert CliRunner().invoke(main, ["simulate", "--sensor", str(out), "--size", "20",
+                                     "--out", str(tmp_path / "again.tif")]).exit_code == 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["fit", "{tmp}/flat.tif"], "flat.tif"),
+    (["fit", "{tmp}/missing.tif"], "missing.tif"),
+    (["fit", "{tmp}/flat.tif", "--stages", "optics,focus"], "unknown stage 'focus'"),
+    (["fit", "{tmp}"], "no image files"),
+])
+def test_cli_bad_input_is_one_line_and_exit_1(tmp_path, args, message):
+    from imgmtf.io import write_geotiff
+    (tmp_path / "sub").mkdir()
+    write_geotiff(tmp_path / "flat.tif", np.full((32, 32), 700, np.uint16))
+    if args[1] == "{tmp}":
+        args = ["fit", "{tmp}/sub"]
+    result = CliRunner().invoke(main, [a.format(tmp=tmp_path) for a in args])
+    assert result.exit_code == 1 and message in result.stderr
+    assert "Traceback" not in result.output and len(result.stderr.strip().splitlines()) == 1
