@@ -54,9 +54,9 @@ def part_generic():
         fit = im.fit_sensor(chips, gsd_m=sensor.gsd_m)
         held = ", ".join(p.key for p in fit.parameters if p.status != "fitted" and p.note != "not fitted")
         for e in fit.edges:
-            truth = true_nyquist(sensor, e.angle_deg, e.gsd_m)
+            truth = true_nyquist(sensor, e.normal_angle_deg, e.gsd_m)
             worst = max(worst, abs(e.mtf_nyquist - truth))
-            print(f"{i + 1:>6} {e.angle_deg:6.1f} {truth:7.4f} {e.mtf_nyquist:7.4f} {e.mtf_nyquist - truth:+8.4f} "
+            print(f"{i + 1:>6} {e.normal_angle_deg:6.1f} {truth:7.4f} {e.mtf_nyquist:7.4f} {e.mtf_nyquist - truth:+8.4f} "
                   f"{e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3f}  {held or '-'}")
     print(f"worst |error| at Nyquist: {worst:.4f} (target 0.002)\n")
 

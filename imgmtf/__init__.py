@@ -23,7 +23,7 @@ _LAZY = {
     "measure_edge": "estimate.edge", "EdgeEstimator": "estimate.edge", "EdgeResult": "estimate.edge",
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
-    "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals",
+    "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io",
     "run_selftest": "selftest",

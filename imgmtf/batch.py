@@ -26,7 +26,7 @@ from .estimate.intervals import Bootstrap
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
 
-CSV_COLUMNS = ("path", "band", "target", "method", "status", "error", "angle_deg", "direction",
+CSV_COLUMNS = ("path", "band", "target", "method", "status", "error", "normal_angle_deg", "tilt_deg", "direction",
                "polarity", "rows_used", "snr", "mtf_nyquist", "mtf_nyquist_ci_low",
                "mtf_nyquist_ci_high", "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
                "fwhm_px", "mtfa", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "rer",

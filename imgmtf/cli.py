@@ -233,7 +233,7 @@ def _fit_report(result) -> None:
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
-        click.echo(f"{e.source:<32} {e.angle_deg:6.2f} {e.direction:>6} {e.mtf_nyquist:7.4f} "
+        click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {e.direction:>6} {e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")
     click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
@@ -341,7 +341,7 @@ def _text_row(record: dict, kind: str) -> str:
     last = record["rer"] if kind == "edge" else record["pulse_width_px"]
     lo, hi = record["mtf_nyquist_ci"]
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None else "-"
-    cells = [f"{path:<32} {band:>4} {record['angle_deg']:7.2f} {record['direction'].split('-')[0]:>6} "
+    cells = [f"{path:<32} {band:>4} {record['normal_angle_deg']:7.2f} {record['direction'].split('-')[0]:>6} "
              f"{_num(record['snr'], 6, 0)} {_num(record['mtf_nyquist'], 7, 4)} {interval:>15} "
              f"{_num(record['mtf50_cy_px'], 7, 4)} {_num(record['fwhm_px'], 6, 3)} {_num(last, 6, 3)}"]
     cells += [f"{'':<32} warning: {w}" for w in record["warnings"]]

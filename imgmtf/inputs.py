@@ -2,11 +2,42 @@
 that can be measured."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .errors import ImageContentError, ParameterError
 
 MIN_SIZE_PX = 16
+MAX_ABS_DN = 1e15                 # no sensor records more; beyond, squares overflow
+
+
+def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = False,
+                 low: float | None = None, high: float | None = None, integer: bool = False,
+                 signed: bool = False) -> float:
+    """``value`` as a float (an int with ``integer``) if it is a finite real
+    number >= 0 (> 0 with ``positive``; any sign with ``signed``; inf
+    allowed with ``allow_inf``; within [``low``, ``high``] when given),
+    NumPy scalars included; else a :class:`ParameterError` naming ``name``.
+
+    Examples
+    --------
+    >>> check_number("gsd_m", 0.5, positive=True)
+    0.5
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    number = float(value)
+    bad = math.isnan(number) or (math.isinf(number) and not (allow_inf and number > 0))
+    if bad or (number < 0 and not signed):
+        raise ParameterError(f"{name} must be finite{'' if signed else ' and >= 0'}, got {value!r}")
+    if positive and number <= 0:
+        raise ParameterError(f"{name} must be > 0, got {value!r}")
+    if integer and number != int(number):
+        raise ParameterError(f"{name} must be a whole number, got {value!r}")
+    if (low is not None and number < low) or (high is not None and number > high):
+        raise ParameterError(f"{name} must lie in [{low:g}, {high:g}], got {value!r}")
+    return int(number) if integer else number
 
 
 def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
@@ -34,9 +65,21 @@ def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
     if min(data.shape) < MIN_SIZE_PX:
         raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
+    if np.abs(data).max() > MAX_ABS_DN:
+        raise ImageContentError(f"pixel values reach {np.abs(data).max():.3g}: beyond {MAX_ABS_DN:g} "
+                                "they are not DN an imaging sensor records; rescale the image")
     if data.max() == data.min():
         raise ImageContentError("the image is flat: no contrast to measure")
     return data, (x0, y0)
+
+
+def quantum(data: np.ndarray, dtype) -> float:
+    """The DN step of the recorded values: 1 for integer types and for
+    floats that hold only whole numbers, else 0 (not quantised).  Its
+    rounding noise, quantum / sqrt(12), is the floor of any noise estimate."""
+    if np.issubdtype(np.dtype(dtype), np.integer) or np.allclose(data, np.round(data), rtol=0, atol=1e-6):
+        return 1.0
+    return 0.0
 
 
 def check_roi(roi, shape: tuple[int, int], where: str = "") -> tuple[int, int, int, int]:

@@ -93,7 +93,7 @@ def plot_fit_edge(fit, index: int, ax=None):
     edge = fit.edges[index]
     m = edge.measurement
     f = np.linspace(0.0, 1.0, 201)
-    value, low, high = fit.mtf_band(f, edge.angle_deg, edge.gsd_m)
+    value, low, high = fit.mtf_band(f, edge.normal_angle_deg, edge.gsd_m)
     lo, hi = edge.mtf_nyquist_ci
     ax.fill_between(f, low, high, color="C0", alpha=0.3, lw=0)
     ax.plot(f, value, color="C0", lw=2.0, label=f"model: {edge.mtf_nyquist:.4f} [{lo:.4f}, {hi:.4f}]")
@@ -101,7 +101,7 @@ def plot_fit_edge(fit, index: int, ax=None):
             label=f"measured: {edge.measured_mtf_nyquist:.4f}")
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
     name = edge.source if len(edge.source) <= 32 else "..." + edge.source[-29:]
-    ax.set(title=f"{name}: {edge.angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
+    ax.set(title=f"{name}: {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
            xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF")
     ax.legend(fontsize="small", title=f"at Nyquist ({100 * fit.confidence:g} % interval)",
               title_fontsize="small")
@@ -169,7 +169,7 @@ def plot_locations(result, ax=None):
     ax.plot(g.slope * g.rows + g.intercept, g.rows, "-", color="C1", label="least-squares line")
     ax.invert_yaxis()
     frame = "columns" if not g.transposed else "rows"
-    ax.set(title=f"{result.target.capitalize()} at {result.angle_deg:.2f} deg", xlabel=f"position ({frame}, px)",
+    ax.set(title=f"{result.target.capitalize()} at {result.normal_angle_deg:.2f} deg normal", xlabel=f"position ({frame}, px)",
            ylabel="row" if not g.transposed else "column")
     ax.legend(fontsize="small")
     return fig

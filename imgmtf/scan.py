@@ -429,7 +429,7 @@ def _ranked(records: list[dict]) -> list[dict]:
 # -- outputs ------------------------------------------------------------------------
 CSV_COLUMNS = ("id", "rank", "status", "reason", "error", "path", "band", "target", "method",
                "direction", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "tilt_deg",
-               "map_x0", "map_y0", "map_x1", "map_y1", "roi", "angle_deg", "snr",
+               "map_x0", "map_y0", "map_x1", "map_y1", "roi", "normal_angle_deg", "snr",
                "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high", "mtf50_cy_px",
                "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px", "fwhm_px", "gsd_m", "mtf50_cy_m",
                "fwhm_m", "rows_used", "line_rms_px", "side_variation", "bar_width_px",

@@ -141,9 +141,9 @@ def test_folder_batch_with_workers_csv_and_plots(tmp_path, good):
     rows = list(csv.DictReader(out_csv.open()))
     assert [r["status"] for r in rows] == ["error", "ok", "ok", "ok"]
     for r in rows[1:]:
-        assert abs(float(r["angle_deg"]) - (6.0 + int(r["path"][-5]))) < 0.05
+        assert abs(float(r["normal_angle_deg"]) - (6.0 + int(r["path"][-5]))) < 0.05
         assert float(r["mtf_nyquist_ci_low"]) <= float(r["mtf_nyquist"]) <= float(r["mtf_nyquist_ci_high"])
-        assert json.loads(r["params"])["bootstrap"]["replicates"] == 200
+        assert json.loads(r["params"])["intervals"]["confidence"] == 0.95
         assert r["imgmtf_version"] == im.__version__ and r["band"] == "1"
         assert (plots / f"{os.path.basename(r['path'])[:-4]}_mtf.png").stat().st_size > 10_000
     assert "broken.tif" in rows[0]["error"]
@@ -157,4 +157,4 @@ def test_windowed_read_reports_roi_in_file_coordinates(tmp_path):
     assert raster.data.shape == (64, 64) and raster.origin == (100, 60)
     record, = measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64)))
     assert record["roi"] == [100, 60, 64, 64]
-    assert record["angle_deg"] == pytest.approx(6.0, abs=0.05)
+    assert record["normal_angle_deg"] == pytest.approx(6.0, abs=0.05)

@@ -28,12 +28,12 @@ def test_simulate_then_measure_json_contract(run, chip, tmp_path):
     rows = [json.loads(line) for line in result.stdout.splitlines()]
     assert len(rows) == 1
     row = rows[0]
-    for key in ("path", "target", "method", "angle_deg", "orientation", "snr", "mtf_nyquist",
+    for key in ("path", "target", "method", "normal_angle_deg", "orientation", "snr", "mtf_nyquist",
                 "mtf50_cy_px", "fwhm_px", "rer", "mtfa", "gsd_m", "frequencies_cy_px", "mtf",
                 "warnings", "imgmtf_version", "params", "band"):
         assert key in row
     assert row["path"] == str(chip) and row["target"] == "edge" and row["gsd_m"] == 1.0
-    assert abs(row["angle_deg"] - 6.0) < 0.05
+    assert abs(row["normal_angle_deg"] - 6.0) < 0.05
     assert len(row["frequencies_cy_px"]) == len(row["mtf"]) and row["frequencies_cy_px"][-1] == 1.0
 
 

@@ -19,7 +19,7 @@ def test_noise_free_accuracy(sigma, angle):
     assert abs(r.mtf_nyquist - h(0.5)) <= 0.003
     assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.005)
     assert r.fwhm_px == pytest.approx(true_fwhm(h), rel=0.005)
-    assert r.angle_deg == pytest.approx(angle, abs=0.02)
+    assert r.normal_angle_deg == pytest.approx(angle, abs=0.02)
     f = r.frequencies_cy_px
     assert np.nanmax(np.abs(r.mtf[f <= 1.0] - h(f[f <= 1.0]))) < 0.004
     assert r.mtf[0] == pytest.approx(1.0)
@@ -30,7 +30,7 @@ def test_along_track_edge_is_measured_transposed():
     h = gaussian_pixel_transfer(0.45, angle)
     r = measure_edge(exact_edge_chip(h, angle))
     assert r.orientation == "horizontal" and r.direction == "along-track"
-    assert r.angle_deg == pytest.approx(angle, abs=0.02)
+    assert r.normal_angle_deg == pytest.approx(angle, abs=0.02)
     assert abs(r.mtf_nyquist - h(0.5)) <= 0.003
 
 
@@ -143,7 +143,7 @@ def test_estimator_is_reusable_and_result_serialises():
     b = est(exact_edge_chip(h, 6.0, offset=0.4))
     assert a.mtf.shape == (6,) and abs(a.mtf_nyquist - b.mtf_nyquist) < 1e-3
     d = json.loads(json.dumps(a.to_dict()))
-    for key in ("angle_deg", "orientation", "snr", "mtf_nyquist", "mtf50_cy_px", "fwhm_px", "rer",
+    for key in ("normal_angle_deg", "orientation", "snr", "mtf_nyquist", "mtf50_cy_px", "fwhm_px", "rer",
                 "mtfa", "gsd_m", "frequencies_cy_px", "mtf", "warnings", "params"):
         assert key in d
     assert a.mtf_at([0.5])[0] == pytest.approx(a.mtf_nyquist)

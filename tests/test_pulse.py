@@ -34,7 +34,7 @@ def test_noise_free_accuracy(width, sigma, angle):
     assert abs(r.mtf_nyquist - h(0.5)) <= 0.005
     assert r.fwhm_px == pytest.approx(true_fwhm(h), rel=0.01)
     assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.005)
-    assert r.angle_deg == pytest.approx(angle, abs=0.03)
+    assert r.normal_angle_deg == pytest.approx(angle, abs=0.03)
     assert r.usable_band_cy_px == pytest.approx(usable_band(width))
 
 

@@ -75,12 +75,16 @@ def test_first_crossing():
 def test_noise_limited_frequency_closed_form():
     from scipy.optimize import brentq
 
-    from imgmtf.estimate.spectrum import noise_limited_frequency
+    from imgmtf.estimate.spectrum import noise_limited_frequency, white_noise_mtf_sd
 
     def mtf(f):
         return np.exp(-4.0 * np.asarray(f))
     k = 3 * 2 * np.pi / 100 * np.sqrt(4.0 / 200.0)
     exact = brentq(lambda f: np.exp(-4 * f) - k * f, 0.01, 3.0)
-    got = noise_limited_frequency(mtf, 100.0, 4.0, 100.0)
+    edge_noise = white_noise_mtf_sd(100.0, 4.0, 100.0, lambda f: 2 * np.pi * f)
+    got = noise_limited_frequency(mtf, edge_noise)
     assert exact <= got < exact + 0.02
-    assert noise_limited_frequency(mtf, float("inf"), 4.0, 100.0) == float("inf")
+    assert noise_limited_frequency(mtf, white_noise_mtf_sd(float("inf"), 4.0, 100.0, lambda f: f)) == float("inf")
+    # masked frequencies (NaN) are skipped, not taken for noise
+    masked = noise_limited_frequency(lambda f: np.where((f > 0.5) & (f < 0.7), np.nan, mtf(f)), edge_noise)
+    assert masked == got

@@ -17,7 +17,7 @@ import numpy as np
 from skimage.feature import canny
 from skimage.transform import hough_line
 
-from ..errors import ImageContentError, MultipleTargetsError, TargetNotFoundError
+from ..errors import ImageContentError, TargetNotFoundError
 
 _THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
 _THETAS = np.deg2rad(np.arange(-90.0, 90.0, _THETA_STEP_DEG))
@@ -33,12 +33,27 @@ class Line:
     votes: int
 
 
+SEED_MAX_SIDE_PX = 512         # larger chips are seeded on a block-averaged copy
+
+
 def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> list[Line]:
     """Straight lines of strong gradient, strongest first.
 
     Canny thresholds are set relative to the image's strongest gradients,
-    so the result does not depend on the DN scale.
+    so the result does not depend on the DN scale.  A chip larger than
+    ``SEED_MAX_SIDE_PX`` is searched on a block-averaged copy (the per-row
+    fits refine the seed anyway), the lines mapped back to full resolution.
     """
+    factor = int(math.ceil(max(image.shape) / SEED_MAX_SIDE_PX))
+    if factor > 1:
+        rows, cols = (n // factor * factor for n in image.shape)
+        small = image[:rows, :cols].reshape(rows // factor, factor, cols // factor, factor).mean(axis=(1, 3))
+        centre = (factor - 1) / 2.0      # a block's centre in full-resolution pixels
+        return [Line(ln.theta_deg,
+                     factor * ln.rho_px + centre * (math.cos(math.radians(ln.theta_deg))
+                                                    + math.sin(math.radians(ln.theta_deg))),
+                     ln.votes)
+                for ln in find_lines(small, max_lines, sigma)]
     lo, hi = np.percentile(image, [1, 99])
     if not hi > lo:
         raise ImageContentError("the image is flat: no contrast to measure")
@@ -70,18 +85,20 @@ def _peaks(acc, thetas, rhos, max_lines, min_distance_px=5, min_angle_deg=8.0) -
     return lines
 
 
-def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0) -> Line:
-    """The single straight edge of a chip.
+def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0) -> tuple[Line, Line | None]:
+    """The strongest straight edge of a chip, and a competitor if there is
+    one.
 
     A line counts when at least ``min_votes`` Canny pixels lie on it and the
     mean levels 1-5 px either side of it differ by ``min_contrast`` times
-    the image noise.
+    the image noise.  The competitor is a second such line with at least
+    half the support of the first lying more than 3 px away from it inside
+    the chip: another edge, or the far side of a bar (the quality gate
+    tells them apart, :mod:`.gate`).
 
     Raises
     ------
     TargetNotFoundError : no such line.
-    MultipleTargetsError : a second line with at least half the support of
-        the first lies more than 3 px away from it inside the chip.
     """
     noise = robust_noise(image)
     lines = [ln for ln in find_lines(image)
@@ -90,12 +107,21 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0)
         raise TargetNotFoundError("no straight edge found: no line of strong contrast "
                                   "stands out of the noise")
     best = lines[0]
-    for other in lines[1:]:
-        if other.votes >= 0.5 * best.votes and _separation(best, other, image.shape) > 3.0:
-            raise MultipleTargetsError(
-                f"two edges found (at {_describe(best)} and {_describe(other)}); "
-                "crop the image to one edge with --roi")
-    return best
+    rival = next((other for other in lines[1:]
+                  if other.votes >= 0.5 * best.votes and _separation(best, other, image.shape) > 3.0), None)
+    return best, rival
+
+
+def parallel_within(a: Line, b: Line, shape, distance_px: float, angle_deg: float = 3.0) -> bool:
+    """Are ``a`` and ``b`` parallel (within ``angle_deg``) and nowhere in
+    the chip more than ``distance_px`` apart: the two sides of one bar?"""
+    da = abs((a.theta_deg - b.theta_deg + 90.0) % 180.0 - 90.0)
+    return da <= angle_deg and _separation(a, b, shape) <= distance_px
+
+
+def describe(line: Line) -> str:
+    """A line as a user reads it (angle of its normal and offset)."""
+    return f"{line.theta_deg:.1f} deg, rho {line.rho_px:.1f} px"
 
 
 def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
@@ -151,7 +177,3 @@ def _separation(a: Line, b: Line, shape) -> float:
         x = ts * (cols - 1)
         y = (a.rho_px - x * math.cos(ta)) / math.sin(ta)
     return float(np.max(np.abs(x * math.cos(tb) + y * math.sin(tb) - b.rho_px)))
-
-
-def _describe(line: Line) -> str:
-    return f"{line.theta_deg:.1f} deg, rho {line.rho_px:.1f} px"

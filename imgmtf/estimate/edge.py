@@ -1,18 +1,12 @@
 """Slanted-edge MTF estimator.
 
-Pipeline (Choi and Helder, with the corrections of :mod:`imgmtf.mtf`):
-
-1. seed: Canny + Hough finds the edge and its rough angle
-   (:mod:`imgmtf.detection`); a near-horizontal edge is measured in the
-   transposed image (along-track MTF);
-2. a Fermi fit in every row gives sub-pixel edge locations, all rows solved
-   at once (:mod:`imgmtf.fermi`); a robust least-squares line goes through
-   them (:mod:`imgmtf.profile`);
-3. every pixel's signed distance to that line gives the over-sampled ESF;
-4. the ESF is smoothed and resampled onto a uniform grid by the chosen
-   method (:mod:`imgmtf.resampling`);
-5. the LSF is its central difference, cut to its support by a flat-topped
-   window, and the MTF the corrected modulus of its Fourier transform.
+The edge's part of the shared pipeline (:mod:`.pipeline`): Canny + Hough
+seeds the edge (:mod:`.detection`); a Fermi fit in every row gives its
+sub-pixel locations (:mod:`.fermi`, :mod:`.geometry`); the profile is the
+ESF, its levels the two sides, its width the 10-90 % rise, and the
+LSF-like profile its central difference, whose transfer sinc(2 f step) is
+divided out with the resampling method's.  An ESF's tails approach their
+levels as A / |x|, so the LSF's as A / x^2.
 """
 from __future__ import annotations
 
@@ -22,19 +16,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from .detection import find_edge
-from ..errors import ImageContentError, UnsuitableTargetError
-from ..inputs import prepare_image, saturation_levels
-from ..metrics import fwhm
-from .spectrum import (NYQUIST, central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
-                  noise_limited_frequency, relative_edge_response, restore_lsf, rise_distance)
-from .geometry import (ProfileEstimator, TargetGeometry, check_angle, locate_edge, profile_samples,
-                      vertical_frame)
-from .resampling import resample_profile
+from . import gate
+from .detection import describe, find_edge, parallel_within
+from .geometry import TargetGeometry, locate_edge
+from .pipeline import Settings, Shape, TargetKind, make_settings, run
 from .results import MTFResult, finite
-from .intervals import bootstrap_figures
+from .spectrum import MIN_TRANSFER, edge_divisor, relative_edge_response, rise_distance
 
-SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row
 # edge chips, 95 % of msg estimates fall within +-5 % of the true MTF at
 # Nyquist from SNR 125 on.  The noise falls as 1 / (SNR sqrt(rows)), so the
@@ -42,157 +30,206 @@ SNR_THRESHOLD = 100.0          # the paper's threshold for a confident estimate
 CONFIDENT_SNR_40_ROWS = 125.0
 WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
 WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
+BAR_MAX_SEPARATION_PX = 8.0    # two parallel lines closer than this are one bar's sides
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
+@dataclass(frozen=True, eq=False, kw_only=True, repr=False)
 class EdgeResult(MTFResult):
     """MTF of one edge and everything it was computed from (see
-    :class:`imgmtf.results.MTFResult`).  ``esf`` is normalised to rise from
-    0 to 1 whatever the edge's polarity; ``levels_dn`` are the dark and
-    bright levels; ``rer`` the relative edge response."""
+    :class:`imgmtf.estimate.results.MTFResult`).  ``esf`` is normalised to
+    rise from 0 to 1 whatever the edge's polarity; ``levels_dn`` are the
+    left and right levels (the vertical frame's: left is -x, or up for a
+    near-horizontal edge); ``bright_side`` names where the bright side
+    lies in the image as stored; ``rer`` is the relative edge response."""
 
     target: ClassVar[str] = "edge"
     rer: float
     esf_x_px: np.ndarray
     esf: np.ndarray
     levels_dn: tuple[float, float]
-    window_half_width_px: float
+    bright_side: str
 
     def _specific(self) -> dict:
-        return {"rer": finite(self.rer), "levels_dn": list(self.levels_dn)}
+        return {"rer": finite(self.rer), "levels_dn": [finite(v) for v in self.levels_dn],
+                "bright_side": self.bright_side}
 
 
-class EdgeEstimator(ProfileEstimator):
-    """A configured slanted-edge estimator: set up once, apply to many chips.
+class EdgeKind(TargetKind):
+    """What an edge brings to the pipeline."""
 
-    Takes the settings of :class:`imgmtf.profile.ProfileEstimator`, where
-    ``snr_threshold=None`` uses the measured threshold for the edge's length
-    (:func:`confident_snr`), and:
+    name = "edge"
+    profile = "edge"
+    tail_power = 1
+    subtracts_background = False
+    restore_min_divisor = MIN_TRANSFER
 
-    lsf_half_width_px : half-width of the flat part of the LSF window (px);
-        None chooses it from the measured edge width.
-    lsf_window_factor : that half-width in units of the 10-90 % rise
-        distance; None adapts it to the SNR (:func:`window_factor`).
-    """
+    def seed(self, data):
+        line, rival = find_edge(data)
+        checks = []
+        if rival is not None and not parallel_within(line, rival, data.shape, BAR_MAX_SEPARATION_PX):
+            checks.append(gate.Check("two-targets", False, f"two edges found (at {describe(line)} and "
+                                     f"{describe(rival)}): crop the image to one edge with --roi"))
+        return line, checks
 
-    def __init__(self, method: str = "msg", *, lsf_half_width_px: float | None = None,
-                 lsf_window_factor: float | None = None, **settings):
-        super().__init__(method, **settings)
-        self.lsf_half_width_px = lsf_half_width_px
-        self.lsf_window_factor = lsf_window_factor
+    def locate(self, work, seed_x, transposed) -> TargetGeometry:
+        return locate_edge(work, seed_x, transposed=transposed)
 
-    def __call__(self, image, *, roi=None, gsd_m: float | None = None,
-                 saturation: tuple[float, float] | None = None) -> EdgeResult:
-        """Measure the edge in ``image`` (2-D array, DN), optionally within
-        ``roi`` = (x, y, width, height).  ``saturation`` is the (min, max)
-        the sensor can record; it defaults to an integer dtype's range."""
-        data, (x0, y0) = prepare_image(image, roi)
-        if saturation is None:
-            saturation = saturation_levels(np.asarray(image).dtype)
-        work, seed_x, transposed = vertical_frame(data, find_edge(data))
-        geometry = locate_edge(work, seed_x, transposed=transposed)
-        check_angle(geometry, "edge")
-        return self._profile(work, geometry, (x0, y0, data.shape[1], data.shape[0]),
-                             gsd_m, saturation)
-
-    def _profile(self, work, geometry: TargetGeometry, roi, gsd_m, saturation) -> EdgeResult:
-        d, v, row, half_range = profile_samples(work, geometry, "edge")
-        esf = resample_profile(d, v, method=self.method, step=self.step_px,
-                               half_range=half_range - 0.6, **self.method_options)
-        grid, values = esf.grid, esf.values
-        good = np.isfinite(values)
-        if not good[len(good) // 2 - 5: len(good) // 2 + 6].all():
-            raise UnsuitableTargetError("the edge profile has gaps at the edge: too few "
-                                        "sub-pixel samples (edge too short or angle unsuitable)")
-        grid, values = grid[good], values[good]
+    def shape(self, grid, values, d, v, half_range) -> Shape:
         n_side = max(len(values) // 8, 2)
-        left, right = values[:n_side].mean(), values[-n_side:].mean()
+        left, right = float(values[:n_side].mean()), float(values[-n_side:].mean())
         if left == right:
-            raise ImageContentError("the two sides of the edge have the same level")
-        _check_saturation(v, d, left, right, saturation)
+            raise gate.UnsuitableTargetError("the two sides of the edge have the same level", reason="not-an-edge")
         esf01 = (values - left) / (right - left)
-        x, lsf = central_difference(grid, esf01)
         centre = _crossing_nearest(grid, esf01)
         rise = rise_distance(grid, esf01, centre)
         if not rise > 0:
-            raise UnsuitableTargetError("the edge profile does not rise cleanly from 10 % to 90 %: "
-                                        "no usable edge (noise or a second feature?)")
-        plateau = np.abs(d - centre) >= max(3.0 * rise, 2.0)
-        snr = _edge_snr(v[plateau & (d < centre)], v[plateau & (d > centre)])
-        factor = self.lsf_window_factor or window_factor(snr)
-        half_width = self.lsf_half_width_px or factor * rise
-        taper = 0.5 * half_width
-        lsf_w = lsf * flat_top_window(x, centre, half_width, taper)
-        divisor = edge_divisor(esf.step, esf.transfer if self.correct else None)
-        mtf = corrected_mtf(lsf_w, esf.step, divisor)
-        warnings = []
-        rows_used = int(geometry.kept.sum())
-        threshold = self.snr_threshold or confident_snr(rows_used)
-        if snr < threshold:
-            warnings.append(f"SNR {snr:.0f} is below {threshold:.0f}, the lowest at which 95 % of "
-                            f"estimates from a {rows_used}-row edge fall within 5 % of the truth")
-        density = d.size / (2.0 * half_range)
-        noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
-        x_c, lsf_c = restore_lsf(lsf_w, x, divisor, noise_limit)
+            raise gate.UnsuitableTargetError("the edge profile does not rise cleanly from 10 % to 90 %: "
+                                             "no usable edge (noise or a second feature?)", reason="not-straight")
+        return Shape(centre, rise, left, right, min(max(3.0 * rise, 2.0), 0.7 * half_range),
+                     {"esf01": esf01, "rer": relative_edge_response(grid, esf01, centre)})
 
-        def windowed_lsf(grid_b, esf_b, weights_of):
-            x_b, lsf_b = central_difference(grid_b, esf_b)
-            return lsf_b * flat_top_window(x_b, centre, half_width, taper)
-        nyquist_ci, mtf50_ci = bootstrap_figures(
-            self.bootstrap, d, row, abs(centre) + half_width + taper + 2 * esf.step,
-            self._resampler(d, v), windowed_lsf, esf.step, divisor)
-        params = {"method": self.method, **esf.params, "correct": self.correct,
-                  "lsf_half_width_px": half_width, "lsf_taper_px": taper,
-                  "bootstrap": self.bootstrap.as_dict()}
+    def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:
+        return (factor or window_factor(snr)) * shape.scale_px
+
+    @staticmethod
+    def confident_snr(rows: int) -> float:
+        return confident_snr(rows)
+
+    def lsf(self, grid, values, background):
+        step = float(grid[1] - grid[0])
+
+        def adjoint(h):
+            out = np.zeros((*np.shape(h)[:-1], grid.size))
+            out[..., 2:] += h / (2 * step)
+            out[..., :-2] -= h / (2 * step)
+            return out
+        return grid[1:-1], (values[..., 2:] - values[..., :-2]) / (2 * step), adjoint
+
+    def lsf_tail_amplitudes(self):
+        # ESF = level + A / |s|: its slope is +A / s^2 on the left, -A / s^2 on the right
+        return [np.array([0.0, 1.0]), np.array([0.0, -1.0])]
+
+    def divisor(self, step, transfer, shape):
+        return edge_divisor(step, transfer)
+
+    def noise_gain(self, shape, contrast):
+        return lambda f: 2 * np.pi * f
+
+    def saturation_sides(self, sides):
+        return sides
+
+    def peak_mask(self, s, shape):
+        return None
+
+
+class EdgeEstimator:
+    """A configured slanted-edge estimator: set up once, apply to many chips.
+
+    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
+    keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
+    intervals); ``snr_threshold=None`` uses the measured threshold for the
+    edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
+    adapts the LSF window to the SNR (:func:`window_factor`).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100)
+    >>> estimate = imgmtf.EdgeEstimator("msg", intervals=imgmtf.Intervals("none"))
+    >>> round(estimate(chip.image).mtf_nyquist, 3)
+    0.267
+    """
+
+    def __init__(self, method: str = "msg", **settings):
+        self.settings: Settings = make_settings(method, **settings)
+
+    @property
+    def method(self) -> str:
+        return self.settings.method
+
+    def __call__(self, image, *, roi=None, gsd_m: float | None = None,
+                 saturation: tuple[float, float] | None = None, dtype=None,
+                 track_azimuth_deg: float | None = 0.0) -> EdgeResult:
+        """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
+        m = run(EdgeKind(), image, self.settings, roi=roi, gsd_m=gsd_m, saturation=saturation,
+                dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        f, a = m.figures, m.arrays
+        left, right = f["side_levels"]
         return EdgeResult(
-            method=self.method, params=params, angle_deg=geometry.angle_deg,
-            orientation="horizontal" if geometry.transposed else "vertical",
+            method=self.settings.method, params=m.params, normal_angle_deg=f["normal_angle_deg"],
+            tilt_deg=f["tilt_deg"], direction=f["direction"], orientation=f["orientation"],
             polarity="rising" if right > left else "falling",
-            rows_used=rows_used, rows_total=int(work.shape[0]), snr=snr,
-            mtf_nyquist=float(mtf(NYQUIST)[0]), mtf50_cy_px=mtf50(mtf),
-            mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
-            fwhm_px=fwhm(x_c, lsf_c), rer=relative_edge_response(grid, esf01, centre),
-            mtfa=mtf_area(mtf), gsd_m=gsd_m,
-            frequencies_cy_px=self.frequencies_cy_px, mtf=mtf(self.frequencies_cy_px),
-            esf_x_px=grid, esf=esf01, lsf_x_px=x_c, lsf=lsf_c,
-            samples_x_px=d, samples_dn=v, levels_dn=(float(left), float(right)),
-            geometry=geometry, roi=roi, window_half_width_px=half_width,
-            noise_limit_cy_px=noise_limit,
-            warnings=tuple(warnings), mtf_function=mtf)
+            bright_side=_bright_side(right > left, f["transposed"]),
+            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
+            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
+            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
+            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
+            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
+            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
+            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=m.warnings,
+            mtf_function=a["mtf_function"], rer=f["rer"], esf_x_px=a["grid"],
+            esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
 
 
 def measure_edge(image, *, roi=None, method: str = "msg", gsd_m: float | None = None,
-                 saturation: tuple[float, float] | None = None, **options) -> EdgeResult:
+                 saturation: tuple[float, float] | None = None, force: bool = False,
+                 track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> EdgeResult:
     """Measure the MTF of the straight edge in ``image``.
 
     Parameters
     ----------
-    image : 2-D array (DN), one edge crossing it.
-    roi : optional (x, y, width, height) crop, pixels.
-    method : "msg" (default), "sliding", "spline" or "iso".
-    gsd_m : ground sample distance (m), to report cycles/m and metres.
-    saturation : (min, max) DN the sensor records; default an integer
-        image's dtype range, none for float images.
-    **options : see :class:`EdgeEstimator`.
+    image : array_like
+        2-D image (DN) with one straight edge crossing it, 16 x 16 px at
+        least.
+    roi : (int, int, int, int), optional
+        (x, y, width, height) crop, px.
+    method : str
+        "msg" (default), "sliding", "spline" or "iso".
+    gsd_m : float, optional
+        Ground sample distance (m), to report cycles/m and metres.
+    saturation : (float, float), optional
+        (low, high) DN the sensor records; default an integer image's
+        type range, none declared for floats (clipping is still detected
+        from the values).
+    force : bool
+        Measure even when a quality check fails, each failure a warning.
+    track_azimuth_deg : float or None
+        The ground track's direction, degrees clockwise from the image's
+        up (0: rows along track); None when unknown.
+    dtype : numpy dtype, optional
+        The type the values were stored as, when ``image`` is a copy.
+    **options
+        Settings of :class:`imgmtf.estimate.pipeline.Settings`
+        (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``...).
 
     Returns
     -------
     EdgeResult
+
+    Raises
+    ------
+    ParameterError
+        A setting out of range or unknown.
+    ImageContentError, TargetNotFoundError, UnsuitableTargetError
+        The image cannot be measured; ``reason`` says why (the quality
+        gate's codes, :mod:`imgmtf.estimate.gate`).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100, noise_std_dn=5.0, seed=1)
+    >>> r = imgmtf.measure_edge(chip.image)
+    >>> abs(r.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.02
+    True
     """
-    return EdgeEstimator(method, **options)(image, roi=roi, gsd_m=gsd_m, saturation=saturation)
+    return EdgeEstimator(method, force=force, **options)(
+        image, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype, track_azimuth_deg=track_azimuth_deg)
 
 
-def _check_saturation(v, d, left, right, saturation) -> None:
-    if saturation is None:
-        return
-    low, high = saturation
-    for name, side, level in (("dark", d < 0 if left < right else d > 0, min(left, right)),
-                              ("bright", d > 0 if left < right else d < 0, max(left, right))):
-        at_limit = np.mean((v[side] <= low) | (v[side] >= high)) if side.any() else 0.0
-        if at_limit > 0.2:
-            raise UnsuitableTargetError(
-                f"the {name} side of the edge is saturated ({100 * at_limit:.0f} % of its "
-                f"pixels at {low:g} or {high:g} DN): its true level is unknown", reason="saturated")
+def _bright_side(rising: bool, transposed: bool) -> str:
+    if transposed:
+        return "below" if rising else "above"
+    return "right" if rising else "left"
 
 
 def _crossing_nearest(grid, esf01) -> float:
@@ -216,22 +253,11 @@ def window_factor(snr: float) -> float:
     """Half-width of the flat LSF window in units of the 10-90 % rise.
 
     A bias-variance trade measured on exact chips (docs/accuracy.md): 1.35
-    rises (plus a taper of half that) keeps the truncation bias at Nyquist
-    below 0.0005 for Gaussian, pixel and Butterworth blurs, and is used at
-    SNR >= 100; the noise of the flat tails grows with the window, so at
-    SNR <= 30 the window shrinks to 1 rise (bias up to 0.002, noise 20 %
-    lower), log-linearly in between."""
+    rises keeps the truncation bias at Nyquist below 0.0005 for Gaussian,
+    pixel and Butterworth blurs (longer tails are the tail model's), and is
+    used at SNR >= 100; the noise of the flat tails grows with the window,
+    so at SNR <= 30 the window shrinks to 1 rise, log-linearly in between."""
     if not math.isfinite(snr):
         return WINDOW_FACTOR_CLEAN
-    t = min(max(math.log(snr / 30.0) / math.log(100.0 / 30.0), 0.0), 1.0)
+    t = min(max(math.log(max(snr, 1e-9) / 30.0) / math.log(100.0 / 30.0), 0.0), 1.0)
     return WINDOW_FACTOR_NOISY + t * (WINDOW_FACTOR_CLEAN - WINDOW_FACTOR_NOISY)
-
-
-def _edge_snr(v_left, v_right) -> float:
-    """Paper's edge SNR: difference of the side means over the mean of the
-    side standard deviations."""
-    if v_left.size < 3 or v_right.size < 3:
-        return float("nan")
-    noise = (v_left.std(ddof=1) + v_right.std(ddof=1)) / 2.0
-    signal = abs(v_right.mean() - v_left.mean())
-    return float(signal / noise) if noise > 0 else float("inf")

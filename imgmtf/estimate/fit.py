@@ -52,8 +52,9 @@ import numpy as np
 
 from ..errors import ImgmtfError, ParameterError
 from ..metrics import first_crossing
+from ..inputs import check_number
 from ..sensor.model import DIRECTIONS, PAPER_STAGES, Sensor, direction_angle
-from ..sensor.stages import STAGES, Stage, check_number
+from ..sensor.stages import STAGES, Stage
 
 #: a free parameter is determined when its 1-SE range of blur length is
 #: narrower than this fraction of the length ...
@@ -109,8 +110,8 @@ class EdgeFit:
     ----------
     source : str
         The file (or "array 1", ... for arrays).
-    angle_deg : float
-        Tilt of the edge from the column axis (its normal from the x axis).
+    normal_angle_deg : float
+        Angle of the edge normal from the x axis (the edge's tilt from the column axis).
     direction : str
         "across" (|angle| < 45 deg) or "along" track: the axis it mostly constrains.
     mtf_nyquist, mtf_nyquist_ci : float, (float, float)
@@ -130,7 +131,7 @@ class EdgeFit:
     """
 
     source: str
-    angle_deg: float
+    normal_angle_deg: float
     direction: str
     gsd_m: float
     rows_used: int
@@ -151,7 +152,7 @@ class EdgeFit:
     measurement: object = field(repr=False)
 
     def to_dict(self) -> dict:
-        return {"path": self.source, "angle_deg": self.angle_deg, "direction": self.direction,
+        return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
                 "gsd_m": self.gsd_m, "rows_used": self.rows_used, "snr": _json(self.snr),
                 "mtf_nyquist": self.mtf_nyquist, "mtf_nyquist_ci": [_json(v) for v in self.mtf_nyquist_ci],
                 "mtf50_cy_px": _json(self.mtf50_cy_px),
@@ -319,7 +320,7 @@ class _EdgeData:
     source: str
     x: np.ndarray
     y: np.ndarray
-    angle_deg: float
+    normal_angle_deg: float
     gsd_m: float
     gsd_known: bool
     noise: float
@@ -359,7 +360,7 @@ def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
     floor = 1 / math.sqrt(12) if integer else 1e-5 * step
     noise = max(profile_noise(x, y), floor)
     gsd = result.gsd_m if result.gsd_m else (gsd_m or 1.0)
-    return _EdgeData(source, x, y, float(result.angle_deg), float(gsd), bool(result.gsd_m), noise,
+    return _EdgeData(source, x, y, float(result.normal_angle_deg), float(gsd), bool(result.gsd_m), noise,
                      levels, result)
 
 
@@ -464,7 +465,7 @@ class _Model:
 
     def seen_axes(self) -> set[str]:
         """Image axes some edge mostly constrains: "x" (across), "y" (along)."""
-        return {"x" if abs(d.angle_deg) < 45 else "y" for d in self.data}
+        return {"x" if abs(d.normal_angle_deg) < 45 else "y" for d in self.data}
 
     def covers_axes(self, free: list[str]) -> bool:
         """Whether parameters ``free`` (with those tied to them) act on every
@@ -511,7 +512,7 @@ class _Model:
 
     def responses(self, u: np.ndarray):
         sensor = self.sensor(u)
-        return [sensor.line_response(d.angle_deg, d.gsd_m, reach_px=float(np.abs(d.x).max()) + 2.0)
+        return [sensor.line_response(d.normal_angle_deg, d.gsd_m, reach_px=float(np.abs(d.x).max()) + 2.0)
                 for d in self.data]
 
     # -- least squares ------------------------------------------------------------
@@ -698,12 +699,12 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
         start_row += d.x.size
         chi = float(np.sum((res / d.noise) ** 2) / max(d.x.size - 3 - n / len(model.data), 1))
         p, fraction = _misfit(d.x - x0, res, d.noise, abs(hi - lo), r, chi2)
-        value, low, high = _mtf_band(model, u, covariance, np.array(0.5), d.angle_deg, d.gsd_m, confidence)
+        value, low, high = _mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
-        edge = EdgeFit(d.source, d.angle_deg, "across" if abs(d.angle_deg) < 45 else "along", d.gsd_m,
+        edge = EdgeFit(d.source, d.normal_angle_deg, "across" if abs(d.normal_angle_deg) < 45 else "along", d.gsd_m,
                        int(measured.rows_used), float(measured.snr), float(value), (float(low), float(high)),
-                       first_crossing(f, np.abs(sensor.normal_transfer(f, d.angle_deg, d.gsd_m)), 0.5),
+                       first_crossing(f, np.abs(sensor.normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5),
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
                        (float(lo), float(hi)), float(x0), chi, p, fraction, d.x, res, measured)
         edges.append(edge)

@@ -13,58 +13,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import TargetNotFoundError, UnsuitableTargetError
 from .detection import Line
-from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from .fermi import fit_fermi
-from .resampling import METHODS, resample_profile, sample_gap
-from .intervals import Bootstrap
+from .resampling import sample_gap
 
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
 MAX_SAMPLE_GAP_PX = 0.25       # at least 4 sample positions per pixel
-MAX_HALF_RANGE_PX = 32.0       # profile samples kept within this distance
+MAX_HALF_RANGE_PX = 64.0       # profile samples kept within this distance (a long tail's reach)
 MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
-DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
-
-
-class ProfileEstimator:
-    """Settings every over-sampled-profile estimator shares.
-
-    Parameters
-    ----------
-    method : resampling method, a key of :data:`imgmtf.resampling.METHODS`
-        ("msg", "sliding", "spline", "iso").
-    step_px : resampled profile grid step (px); "iso" always uses its
-        1/4-px bins.
-    correct : divide out the blur of the estimator's own steps.  False
-        reproduces the uncorrected classic algorithms.
-    frequencies_cy_px : where the reported MTF curve is sampled.
-    snr_threshold : below this SNR the result carries a warning.
-    method_options : overrides of the method's defaults (e.g. window_px).
-    bootstrap : confidence-interval settings
-        (:class:`imgmtf.uncertainty.Bootstrap`; ``Bootstrap(0)`` for none).
-    """
-
-    def __init__(self, method: str = "msg", *, step_px: float = 0.05, correct: bool = True,
-                 frequencies_cy_px=DEFAULT_FREQUENCIES, snr_threshold: float | None = None,
-                 method_options: dict | None = None, bootstrap: Bootstrap = Bootstrap()):
-        if method not in METHODS:
-            raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
-        self.method = method
-        self.step_px = step_px
-        self.correct = correct
-        self.frequencies_cy_px = np.asarray(frequencies_cy_px, float)
-        self.snr_threshold = snr_threshold
-        self.method_options = dict(method_options or {})
-        self.bootstrap = bootstrap
-
-    def _resampler(self, distance, values):
-        """``resample(keep, weights, half_range)`` over a subset of the
-        samples, with this estimator's method and step (for the bootstrap)."""
-        def resample(keep, weights, half_range):
-            return resample_profile(distance[keep], values[keep], method=self.method, step=self.step_px,
-                                    half_range=half_range, weights=weights, **self.method_options)
-        return resample
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,7 +31,10 @@ class TargetGeometry:
 
     ``rows`` are the rows that were fitted, ``locations`` their Fermi edge
     positions (px), ``kept`` which of them the line fit accepted;
-    ``transposed`` is True when the vertical frame is the image transposed.
+    ``transposed`` is True when the vertical frame is the image transposed;
+    ``location_sd_px`` is how far a row's location strays through pixel
+    noise alone (the median over rows), what a straight target's scatter
+    is judged against.
     """
 
     slope: float
@@ -82,6 +43,12 @@ class TargetGeometry:
     locations: np.ndarray
     kept: np.ndarray
     transposed: bool
+    location_sd_px: float = 0.0
+
+    @property
+    def tilt_deg(self) -> float:
+        """Angle (deg, 0 to 45) between the target and the nearest image axis."""
+        return abs(math.degrees(math.atan(self.slope)))
 
     @property
     def angle_deg(self) -> float:
@@ -114,10 +81,17 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
         raise TargetNotFoundError("the edge does not cross enough rows of the image")
     fit = fit_fermi(cols[usable].astype(float), values[usable], inside[usable].astype(float),
                     seed_x[usable])
-    return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed)
+    # a Fermi step a with width c under noise s locates its edge to about
+    # s sqrt(30 c) / |a| (the location's Cramer-Rao bound on a 1-px grid)
+    a, c = np.abs(fit.params[fit.ok, 0]), np.abs(fit.params[fit.ok, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sd = fit.rms[fit.ok] * np.sqrt(30.0 * np.maximum(c, 0.05)) / a
+    expected = float(np.median(sd)) if sd.size else 0.0
+    return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed, expected)
 
 
-def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> TargetGeometry:
+def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,
+             location_sd_px: float = 0.0) -> TargetGeometry:
     """Robust least-squares line x = m y + k through per-row locations:
     refitted after discarding locations more than 4 robust standard
     deviations (and 0.05 px) off it."""
@@ -133,7 +107,7 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False) -> TargetGe
             break
         keep = new_keep
     slope, intercept = np.polyfit(y[keep], x[keep], 1)
-    return TargetGeometry(float(slope), float(intercept), y, x, keep, transposed)
+    return TargetGeometry(float(slope), float(intercept), y, x, keep, transposed, location_sd_px)
 
 
 def row_windows(image: np.ndarray, centre_x: np.ndarray, half_window: int):

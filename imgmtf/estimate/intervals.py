@@ -1,23 +1,28 @@
-"""Confidence intervals for MTF figures: a bootstrap over the target's rows.
+"""Confidence intervals for MTF figures.
 
-The rows of an edge or bar chip are the independent units of its noise
-(and of ground texture, which is correlated along a row but not from one
-row to the next in the vertical frame), so a replicate draws as many rows
-as the chip has, with replacement, and weights every profile sample by how
-often its row was drawn.  The resampling methods take a stack of such
-weights at once (:func:`imgmtf.resampling.resample_profile`), and every
-replicate's spectrum is one row of a matrix product, so the replicates
-cost no Python loop (the smoothing spline excepted: one fit per replicate).
+Two methods behind one setting (:class:`Intervals`):
 
-What a replicate re-estimates: the smoothed profile, its derivative (for
-an edge), the background (for a bar) and so the MTF.  What it keeps fixed:
-the fitted target line, the LSF window and the corrections, whose own
-variability is far below the noise's (a line-slope error of 0.01 px over
-the chip blurs the profile by less than 1e-4 in MTF at Nyquist).
+``influence`` (the default) linearises the estimate: with the target line,
+the LSF window and the corrections held fixed, every stage from the pixel
+values to the MTF (resampling, differentiation, tail fit, Fourier
+transform) is linear, so the MTF at a frequency is a smooth function of
+the samples whose gradient costs one pass backwards through the stages
+(:attr:`imgmtf.estimate.resampling.Resampled.adjoint`).  Each row's
+influence is the sum over its samples of gradient times residual; the
+variance is that of the row influences (the infinitesimal jackknife),
+with the covariances of neighbouring rows added (a Bartlett-weighted sum
+over a few lags, as Newey and West) so that ground texture spanning
+several rows is not counted as independent.  The interval is the estimate
+plus or minus Student's t times the standard error, widened in quadrature
+by the estimator's own systematic error budget.  It costs about one fit.
 
-The interval is the percentile interval of the replicates.  Its coverage
-was measured on noisy synthetic chips of known MTF (``bench/coverage.py``,
-docs/accuracy.md).
+``bootstrap`` redraws the rows with replacement (``replicates`` times) and
+takes the percentile interval of the re-estimates; the local polynomial
+and binning fit every replicate in one vectorised pass, the spline one fit
+each.
+
+The interval's coverage is measured on noisy chips of known MTF by
+``bench/coverage.py`` (docs/accuracy.md).
 """
 from __future__ import annotations
 
@@ -25,41 +30,113 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import stdtrit
 
 from ..errors import ParameterError
 from ..metrics import first_crossing
 from .spectrum import MIN_TRANSFER, NYQUIST
 
-FREQUENCY_STEP_CY_PX = 0.0025   # MTF50 is read on this grid, linearly interpolated
+FREQUENCY_STEP_CY_PX = 0.0025   # a bootstrap replicate's MTF50 is read on this grid
+METHODS = ("influence", "bootstrap", "none")
+MAX_REPLICATES = 5000           # 200 are plenty; more only costs memory and time
 
 
 @dataclass(frozen=True)
-class Bootstrap:
-    """Bootstrap settings.
+class Intervals:
+    """How confidence intervals are computed.
 
-    replicates : number of row resamplings; 0 switches intervals off.
-    confidence : coverage the interval aims at (0.95 for 95 %).
-    seed : random seed, so that the same image gives the same interval.
+    Parameters
+    ----------
+    method : {"influence", "bootstrap", "none"}
+        Linearised (row influence) intervals, a bootstrap over rows, or none.
+    confidence : float
+        Coverage the interval aims at, in (0, 1) (0.95 for 95 %).
+    replicates : int
+        Bootstrap replicates (20 to 5000); ignored by the other methods.
+    seed : int
+        Bootstrap random seed, so that one image always gets one interval.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown method or a value out of range.
+
+    Examples
+    --------
+    >>> Intervals()                                  # doctest: +ELLIPSIS
+    Intervals(method='influence', confidence=0.95, ...)
+    >>> Intervals("bootstrap", replicates=500).replicates
+    500
     """
 
-    replicates: int = 200
+    method: str = "influence"
     confidence: float = 0.95
+    replicates: int = 200
     seed: int = 0
 
     def __post_init__(self):
-        if not (isinstance(self.replicates, int) and self.replicates >= 0):
-            raise ParameterError(f"bootstrap replicates must be an integer >= 0, got {self.replicates!r}")
-        if self.replicates and self.replicates < 20:
-            raise ParameterError(f"a bootstrap needs at least 20 replicates for an interval, "
-                                 f"got {self.replicates}")
-        if not 0 < self.confidence < 1:
-            raise ParameterError(f"confidence must be in (0, 1), got {self.confidence}")
+        if self.method not in METHODS:
+            raise ParameterError(f"interval method must be one of {', '.join(METHODS)}, got {self.method!r}")
+        if (isinstance(self.replicates, bool) or not isinstance(self.replicates, (int, np.integer))
+                or not 20 <= self.replicates <= MAX_REPLICATES):
+            raise ParameterError(f"bootstrap replicates must be an integer from 20 to {MAX_REPLICATES}, "
+                                 f"got {self.replicates!r}")
+        if (isinstance(self.confidence, bool) or not isinstance(self.confidence, (int, float, np.floating))
+                or not 0 < self.confidence < 1):
+            raise ParameterError(f"confidence must be a number in (0, 1), got {self.confidence!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise ParameterError(f"the interval seed must be an integer >= 0, got {self.seed!r}")
+        object.__setattr__(self, "replicates", int(self.replicates))
+        object.__setattr__(self, "confidence", float(self.confidence))
+        object.__setattr__(self, "seed", int(self.seed))
+
+    @property
+    def enabled(self) -> bool:
+        return self.method != "none"
 
     def as_dict(self) -> dict:
-        return {"replicates": self.replicates, "confidence": self.confidence, "seed": self.seed}
+        out = {"method": self.method, "confidence": self.confidence}
+        if self.method == "bootstrap":
+            out.update(replicates=self.replicates, seed=self.seed)
+        return out
 
 
-NO_BOOTSTRAP = Bootstrap(0)
+NO_INTERVALS = Intervals("none")
+
+
+def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) -> Intervals:  # noqa: N802
+    """Bootstrap interval settings: ``replicates`` row resamplings (0: no
+    intervals at all).
+
+    Examples
+    --------
+    >>> Bootstrap(0).method
+    'none'
+    >>> Bootstrap(300).replicates
+    300
+    """
+    if isinstance(replicates, (int, np.integer)) and not isinstance(replicates, bool) and replicates == 0:
+        return Intervals("none", confidence)
+    return Intervals("bootstrap", confidence, replicates, seed)
+
+
+NO_BOOTSTRAP = NO_INTERVALS
+
+
+def as_intervals(value) -> Intervals:
+    """Interval settings from what a caller gives: None (the default
+    influence intervals), an :class:`Intervals`, an int N (a bootstrap of N
+    replicates; 0 for none), or False (none)."""
+    if value is None or value is True:
+        return Intervals()
+    if value is False:
+        return NO_INTERVALS
+    if isinstance(value, Intervals):
+        return value
+    if isinstance(value, (int, np.integer)):
+        return Bootstrap(int(value))
+    raise ParameterError(f"intervals must be None, an Intervals, or a number of bootstrap replicates; "
+                         f"got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -81,6 +158,38 @@ class Interval:
         return self.high - self.low
 
 
+# -- linearised (influence) intervals -------------------------------------------
+def influence_sd(influence: np.ndarray, rows: np.ndarray) -> tuple[float, int]:
+    """Standard error of a linearised estimate from per-sample influences
+    (gradient times residual) and each sample's row: the rows' summed
+    influences, their variance plus Bartlett-weighted covariances of
+    neighbouring rows (lags up to 4 (n / 100)^(2/9)).  Returns (sd, number
+    of rows)."""
+    ids, inverse = np.unique(rows, return_inverse=True)
+    per_row = np.bincount(inverse, weights=influence, minlength=ids.size)
+    n = per_row.size
+    if n < 3:
+        return math.nan, n
+    centred = per_row - per_row.mean()
+    variance = float(centred @ centred)
+    lags = int(math.ceil(4 * (n / 100.0) ** (2.0 / 9.0)))
+    for lag in range(1, min(lags, n - 1) + 1):
+        variance += 2.0 * (1.0 - lag / (lags + 1.0)) * float(centred[lag:] @ centred[:-lag])
+    return math.sqrt(max(variance, 0.0) * n / (n - 1)), n
+
+
+def linearised_interval(value: float, sd: float, rows: int, confidence: float,
+                        systematic: float = 0.0) -> Interval:
+    """``value`` plus or minus Student's t (rows - 1 degrees of freedom)
+    times the standard error ``sd`` widened by a ``systematic`` standard
+    deviation in quadrature."""
+    if not (math.isfinite(value) and math.isfinite(sd)) or rows < 3:
+        return Interval.none()
+    half = float(stdtrit(rows - 1, 0.5 + confidence / 2)) * math.hypot(sd, systematic)
+    return Interval(value - half, value + half)
+
+
+# -- bootstrap ----------------------------------------------------------------
 def row_weights(rows: np.ndarray, replicates: int, rng: np.random.Generator):
     """Bootstrap weights: ``weights_of(mask)`` -> array (replicates,
     mask.sum()), each selected sample weighted by how often its row
@@ -100,7 +209,7 @@ def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.nda
     """MTF at Nyquist and MTF50 (cy/px) of every windowed profile (rows of
     ``profiles``, sampled every ``step`` px): |DFT| normalised at zero,
     divided by |divisor(f)| (NaN where it is below ``MIN_TRANSFER``), as
-    :func:`imgmtf.mtf.corrected_mtf` does for one profile."""
+    :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile."""
     f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
     x = np.arange(profiles.shape[-1]) * step
     modulus = np.abs(profiles @ np.exp(-2j * np.pi * x[:, None] * f[None, :]))
@@ -124,29 +233,26 @@ def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:
     return Interval(float(low), float(high))
 
 
-def bootstrap_figures(settings: Bootstrap, distance: np.ndarray, rows: np.ndarray, span_px: float,
-                      resample, windowed_profile, step: float,
-                      divisor) -> tuple[Interval, Interval]:
+def bootstrap_figures(settings: Intervals, distance: np.ndarray, rows: np.ndarray, span_px: float,
+                      resample, windowed_profile, step: float, divisor) -> tuple[Interval, Interval]:
     """Intervals for MTF at Nyquist and MTF50 (cy/px) by resampling rows.
 
     Parameters
     ----------
-    settings : the bootstrap's settings.
+    settings : the interval settings (method "bootstrap").
     distance : every profile sample's distance from the target line (px).
     rows : every sample's row.
     span_px : the profile is needed within +-span_px of the line.
     resample : ``resample(keep, weights, half_range)`` -> Resampled, the
         estimator's own resampling of the samples selected by ``keep``
         under a stack of ``weights``.
-    windowed_profile : ``(grid, values, weights_of) -> profile`` the
+    windowed_profile : ``(grid, values, weights_of) -> profiles``: the
         estimator's windowed LSF (or PRF) of each replicate, shape
         (replicates, n); ``weights_of(mask)`` gives the replicates' weights
         of the samples selected by ``mask`` (see :func:`row_weights`).
     step : the profile's sample step (px).
-    divisor : the estimator's transfer correction (see :mod:`imgmtf.mtf`).
+    divisor : the estimator's transfer correction (see :mod:`.spectrum`).
     """
-    if settings.replicates == 0:
-        return Interval.none(), Interval.none()
     rng = np.random.default_rng(settings.seed)
     keep = np.abs(distance) <= span_px + 2.0
     weights_of = row_weights(rows, settings.replicates, rng)

@@ -1,18 +1,14 @@
 """Pulse-target MTF estimator: bridges, tarp strips, painted lines.
 
-Pipeline (Choi and Helder, Figure 8), sharing the edge estimator's stages:
-
-1. seed: Canny + Hough finds the bar's direction (:mod:`imgmtf.detection`);
-2. the bar's centre in every row is the centroid of its background-
-   subtracted profile, re-centred twice on the fitted line; a robust
-   least-squares line goes through the centres (:mod:`imgmtf.profile`);
-3. every pixel's signed distance to that line gives the over-sampled pulse
-   response function (PRF), smoothed and resampled by the same methods as
-   an ESF (:mod:`imgmtf.resampling`);
-4. MTF = |FT(PRF)| / (|sinc(f W)| H_method(f)), normalised at zero, for a bar
-   W px wide; frequencies where |sinc(f W)| < 0.1 are masked (NaN).
-
-No derivative is taken, so there is no central-difference correction.
+The bar's part of the shared pipeline (:mod:`.pipeline`; Choi and Helder,
+Figure 8): Canny + Hough finds the bar's direction (:mod:`.detection`);
+the bar's centre in every row is the centroid of its background-subtracted
+profile, re-centred twice on the fitted line; the profile is the pulse
+response (PRF), its levels the background and the peak, and the LSF-like
+profile the PRF above its background.  No derivative is taken: the
+transform is divided by the bar's sinc(f W) (and the resampling method's
+transfer), and frequencies where |sinc(f W)| < 0.1 are masked (NaN).  A
+PRF's tails fall as C / x^2, like an LSF's.
 """
 from __future__ import annotations
 
@@ -22,27 +18,28 @@ from typing import ClassVar
 
 import numpy as np
 
-from .detection import bar_contrast, find_lines, robust_noise
-from .edge import SNR_THRESHOLD
 from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
-from ..inputs import prepare_image
+from ..inputs import check_number
 from ..metrics import fwhm
-from .spectrum import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50,
-                  mtf_area, noise_limited_frequency, restore_lsf, with_transfer)
-from .geometry import (ProfileEstimator, check_angle, fit_line, profile_samples, row_windows,
-                      vertical_frame)
-from .resampling import resample_profile
+from . import gate
+from .detection import bar_contrast, describe, find_lines, parallel_within, robust_noise
+from .geometry import fit_line, row_windows
+from .pipeline import Shape, TargetKind, make_settings, run
 from .results import MTFResult, finite
-from .intervals import bootstrap_figures
+from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
+MIN_WIDTH_PX = 0.2              # narrower, a bar's signal is below any noise
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
 MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
+SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
+MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
+BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
+@dataclass(frozen=True, eq=False, kw_only=True, repr=False)
 class PulseResult(MTFResult):
-    """MTF from one bar (see :class:`imgmtf.results.MTFResult`).
+    """MTF from one bar (see :class:`imgmtf.estimate.results.MTFResult`).
 
     ``prf`` is the pulse response normalised to a unit peak above the
     background (positive for dark bars too); ``pulse_width_px`` the bar
@@ -68,21 +65,20 @@ class PulseResult(MTFResult):
                 "peak_dn": finite(self.peak_dn)}
 
 
-class PulseEstimator(ProfileEstimator):
-    """A configured pulse estimator: set up once, apply to many chips.
+class PulseKind(TargetKind):
+    """What a bar brings to the pipeline; ``width_px`` the bar's width, or
+    None to estimate it from the profile."""
 
-    Takes the settings of :class:`imgmtf.profile.ProfileEstimator`;
-    ``snr_threshold=None`` uses the paper's 100 (the reproduction study
-    measured edges only).
-    """
+    name = "bar"
+    profile = "bar"
+    tail_power = 2
+    subtracts_background = True
+    restore_min_divisor = RESTORE_MIN_SINC
 
-    def __call__(self, image, *, width_px: float | None = None, roi=None,
-                 gsd_m: float | None = None) -> PulseResult:
-        """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
-        (estimated from the profile when None)."""
-        if width_px is not None:
-            check_width(width_px)
-        data, (x0, y0) = prepare_image(image, roi)
+    def __init__(self, width_px: float | None = None):
+        self.width_px = None if width_px is None else check_width(width_px)
+
+    def seed(self, data):
         lines = find_lines(data)
         if not lines:
             raise TargetNotFoundError("no bar found: no straight line of strong contrast")
@@ -90,105 +86,164 @@ class PulseEstimator(ProfileEstimator):
         lines = [ln for ln in lines if bar_contrast(data, ln) >= 3.0 * noise]
         if not lines:
             raise TargetNotFoundError("no bar found: no straight line stands out of the noise")
-        work, seed_x, transposed = vertical_frame(data, lines[0])
-        geometry = locate_pulse(work, seed_x, transposed)
-        check_angle(geometry, "bar")
-        d, v, row, half_range = profile_samples(work, geometry, "bar")
-        prf = resample_profile(d, v, method=self.method, step=self.step_px,
-                               half_range=half_range - 0.6, **self.method_options)
-        grid, values = prf.grid, prf.values
-        good = np.isfinite(values)
-        grid, values = grid[good], values[good]
+        best = lines[0]
+        reach = BAR_SIDES_PX + (self.width_px or 0.0)
+        others = [ln for ln in lines[1:] if not parallel_within(best, ln, data.shape, reach, angle_deg=8.0)
+                  and ln.votes >= 0.5 * best.votes]
+        checks = [gate.Check("two-targets", False, f"another line of strong contrast at {describe(others[0])} "
+                             f"besides the bar at {describe(best)}: crop the image to one bar with --roi")
+                  ] if others else []
+        return best, checks
+
+    def locate(self, work, seed_x, transposed):
+        return locate_pulse(work, seed_x, transposed)
+
+    def shape(self, grid, values, d, v, half_range) -> Shape:
         n_side = max(len(values) // 6, 2)
         left, right = values[:n_side].mean(), values[-n_side:].mean()
         background = (left + right) / 2
-        centre = np.argmin(np.abs(grid))
+        centre = int(np.argmin(np.abs(grid)))
         sign = 1.0 if values[centre] >= background else -1.0
         peak = sign * (values - background)
-        height = peak[centre - 20: centre + 21].max()
-        if height < 5 * noise:
-            raise TargetNotFoundError(f"no bar found: the profile peaks {height:.1f} DN above "
-                                      f"its background, within the noise ({noise:.1f} DN)")
-        if abs(left - right) > 0.25 * height:
-            raise UnsuitableTargetError("the profile is a step, not a bar (its two sides differ "
-                                        "by more than a quarter of its height): measure it as an edge",
-                                        reason="not-a-bar")
+        height = float(peak[max(centre - 20, 0): centre + 21].max())
+        outer = np.abs(d) > 0.6 * half_range
+        noise = float(np.std(v[outer])) if outer.sum() > 3 else 0.0
+        if height <= MIN_HEIGHT_NOISE * noise or height <= 0:
+            raise TargetNotFoundError(f"no bar found: the profile peaks {height:.1f} DN above its "
+                                      f"background, within the noise ({noise:.1f} DN)")
         prf01 = peak / height
         h10 = _half_width_at(grid, prf01, 0.1)
-        outer = np.abs(d) > min(1.5 * h10 + 1.0, half_range - 1.0)
-        snr = _pulse_snr(height, v[outer])
-        width_estimated = width_px is None
-        if width_estimated:
-            width_px = estimate_width(grid, prf01)
-            check_width(width_px)
-        if width_px / 2 + 2.0 > half_range:
+        width = self.width_px if self.width_px is not None else check_width(estimate_width(grid, prf01))
+        if width / 2 + 2.0 > half_range:
             raise UnsuitableTargetError(
-                f"the bar ({width_px:.1f} px) is too wide for the chip: it needs "
-                f"{width_px / 2 + 2:.1f} px of background on each side of its centre")
-        half_width = max(1.6 * h10, width_px / 2 + 1.0)
-        taper = 0.5 * half_width
-        prf_w = prf01 * flat_top_window(grid, 0.0, half_width, taper)
-        transfer = prf.transfer if self.correct else None
-        divisor = pulse_divisor(width_px, transfer)
-        mtf = corrected_mtf(prf_w, prf.step, divisor)
-        density = d.size / (2.0 * half_range)
-        noise_limit = noise_limited_frequency(mtf, snr, 2.0 * half_width + taper, density)
-        band = usable_band(width_px)
-        # the division is bridged only right at the sinc's zeros: between them
-        # even a small sinc carries LSF content the FWHM needs
-        x_c, lsf_c = restore_lsf(prf_w, grid, divisor, noise_limit, min_divisor=RESTORE_MIN_SINC)
-        # a replicate's background moves as the mean of its outer samples does
-        outer_band = np.abs(d) >= min(-grid[n_side - 1], grid[-n_side])
+                f"the bar ({width:.1f} px) is too wide for the chip: it needs "
+                f"{width / 2 + 2:.1f} px of background on each side of its centre", reason="border")
+        area = float(np.sum(prf01[np.abs(grid) <= max(1.6 * h10, width / 2 + 1.0)]) * (grid[1] - grid[0]))
+        return Shape(0.0, h10, float(background), float(background + sign * height),
+                     min(1.5 * h10 + 1.0, half_range - 1.0),
+                     {"width_px": width, "width_estimated": self.width_px is None, "prf01": prf01,
+                      "sign": sign, "area_px": area, "h10": h10})
 
-        def windowed_prf(grid_b, values_b, weights_of):
-            weights = weights_of(outer_band)
-            shift = weights @ v[outer_band] / weights.sum(axis=1)
-            background_b = background + shift - v[outer_band].mean()
-            return (values_b - background_b[:, None]) * flat_top_window(grid_b, 0.0, half_width, taper)
-        nyquist_ci, mtf50_ci = bootstrap_figures(
-            self.bootstrap, d, row, half_width + taper + 2 * prf.step,
-            self._resampler(d, v), windowed_prf, prf.step, divisor)
-        warnings = []
-        threshold = self.snr_threshold or SNR_THRESHOLD
-        if snr < threshold:
-            warnings.append(f"SNR {snr:.0f} is below {threshold:.0f}: the estimate is not confident")
+    def core_px(self, shape, snr, factor):
+        width = shape.extra["width_px"]
+        return max((factor or 1.6) * shape.scale_px, width / 2 + 1.0)
+
+    @staticmethod
+    def confident_snr(rows: int) -> float:
+        return SNR_THRESHOLD
+
+    def lsf(self, grid, values, background):
+        return grid, values - background, lambda h: np.asarray(h, float)
+
+    def lsf_tail_amplitudes(self):
+        return [np.array([0.0, 1.0]), np.array([0.0, 1.0])]
+
+    def divisor(self, step, transfer, shape):
+        return pulse_divisor(shape.extra["width_px"], transfer)
+
+    def noise_gain(self, shape, contrast):
+        area = shape.extra["area_px"]
+        return lambda f: np.full(np.shape(f), 1.0 / max(area, 1e-9))
+
+    def saturation_sides(self, sides):
+        return [("background " + ("left" if i == 0 else "right"), mask, level)
+                for i, (_, mask, level) in enumerate(sides)]
+
+    def peak_mask(self, s, shape):
+        return np.abs(s - shape.centre) <= max(0.5 * shape.extra["width_px"], 0.5)
+
+
+class PulseEstimator:
+    """A configured pulse estimator: set up once, apply to many chips.
+
+    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
+    keywords; ``snr_threshold=None`` uses the paper's 100 (the reproduction
+    study measured edges only).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("pulse", 6.0, width_px=1.5), 100)
+    >>> r = imgmtf.PulseEstimator()(chip.image, width_px=1.5)
+    >>> round(r.mtf_nyquist, 2)
+    0.27
+    """
+
+    def __init__(self, method: str = "msg", **settings):
+        self.settings = make_settings(method, **settings)
+
+    @property
+    def method(self) -> str:
+        return self.settings.method
+
+    def __call__(self, image, *, width_px: float | None = None, roi=None, gsd_m: float | None = None,
+                 saturation=None, dtype=None, track_azimuth_deg: float | None = 0.0) -> PulseResult:
+        """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
+        (estimated from the profile when None); see :func:`measure_pulse`."""
+        m = run(PulseKind(width_px), image, self.settings, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+                track_azimuth_deg=track_azimuth_deg)
+        f, a = m.figures, m.arrays
+        width = f["width_px"]
+        band = usable_band(width)
+        warnings = list(m.warnings)
         if band < NYQUIST:
             warnings.append(f"the bar's sinc falls below {MIN_TRANSFER} at {band:.3f} cy/px, before "
                             "Nyquist: MTF values near its zeros are masked (NaN)")
-        params = {"method": self.method, **prf.params, "correct": self.correct,
-                  "window_half_width_px": half_width, "window_taper_px": taper,
-                  "bootstrap": self.bootstrap.as_dict()}
+        background, peak = f["levels"]
         return PulseResult(
-            method=self.method, params=params, angle_deg=geometry.angle_deg,
-            orientation="horizontal" if transposed else "vertical",
-            polarity="bright" if sign > 0 else "dark",
-            rows_used=int(geometry.kept.sum()), rows_total=int(work.shape[0]), snr=snr,
-            mtf_nyquist=float(mtf(NYQUIST)[0]), mtf50_cy_px=mtf50(mtf), fwhm_px=fwhm(x_c, lsf_c),
-            mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
-            mtfa=mtf_area(mtf), gsd_m=gsd_m, frequencies_cy_px=self.frequencies_cy_px,
-            mtf=mtf(self.frequencies_cy_px), lsf_x_px=x_c, lsf=lsf_c, samples_x_px=d,
-            samples_dn=v, geometry=geometry, roi=(x0, y0, data.shape[1], data.shape[0]),
-            noise_limit_cy_px=noise_limit, warnings=tuple(warnings), mtf_function=mtf,
-            pulse_width_px=float(width_px), width_estimated=width_estimated,
-            usable_band_cy_px=band, prf_x_px=grid, prf=prf01, prf_fwhm_px=fwhm(grid, prf01),
-            background_dn=float(background), peak_dn=float(background + sign * height))
+            method=self.settings.method, params={**m.params, "pulse_width_px": width},
+            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
+            orientation=f["orientation"], polarity="bright" if f["sign"] > 0 else "dark",
+            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
+            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
+            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
+            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
+            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
+            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
+            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=tuple(warnings),
+            mtf_function=a["mtf_function"], pulse_width_px=float(width),
+            width_estimated=f["width_estimated"], usable_band_cy_px=band, prf_x_px=a["grid"],
+            prf=f["prf01"], prf_fwhm_px=fwhm(a["grid"], f["prf01"]), background_dn=float(background),
+            peak_dn=float(peak))
 
 
 def measure_pulse(image, *, width_px: float | None = None, roi=None, method: str = "msg",
-                  gsd_m: float | None = None, **options) -> PulseResult:
+                  gsd_m: float | None = None, saturation=None, force: bool = False,
+                  track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> PulseResult:
     """Measure the MTF from the bar (pulse) in ``image``.
 
     Parameters
     ----------
-    image : 2-D array (DN) with one straight bar, bright or dark.
-    width_px : the bar's width along its normal (px); estimated from the
-        first zero of the PRF's spectrum when None.
-    roi : optional (x, y, width, height) crop, pixels.
-    method : "msg" (default), "sliding", "spline" or "iso".
-    gsd_m : ground sample distance (m), to report cycles/m and metres.
-    **options : see :class:`PulseEstimator`.
+    image : array_like
+        2-D image (DN) with one straight bar, bright or dark.
+    width_px : float, optional
+        The bar's width along its normal (px); estimated from the first
+        zero of the PRF's spectrum when None.
+    roi, method, gsd_m, saturation, force, track_azimuth_deg, dtype, **options
+        As for :func:`imgmtf.measure_edge`.
+
+    Returns
+    -------
+    PulseResult
+
+    Raises
+    ------
+    ParameterError, ImageContentError, TargetNotFoundError, UnsuitableTargetError
+        As for :func:`imgmtf.measure_edge`; also a width that is not a
+        positive number, or so wide that its sinc's first zero lies below
+        0.1 cy/px.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("pulse", 6.0, width_px=1.5), 100)
+    >>> r = imgmtf.measure_pulse(chip.image, width_px=1.5)
+    >>> abs(r.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.005
+    True
     """
-    return PulseEstimator(method, **options)(image, width_px=width_px, roi=roi, gsd_m=gsd_m)
+    return PulseEstimator(method, force=force, **options)(
+        image, width_px=width_px, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+        track_azimuth_deg=track_azimuth_deg)
 
 
 def pulse_divisor(width_px: float, transfer):
@@ -203,15 +258,21 @@ def usable_band(width_px: float) -> float:
     return float(f[np.argmax(np.abs(np.sinc(f * width_px)) < MIN_TRANSFER)])
 
 
-def check_width(width_px: float) -> None:
-    """Refuse a non-positive width and one whose sinc has its first zero
-    below ``MIN_FIRST_ZERO_CY_PX``."""
-    if not (isinstance(width_px, (int, float)) and math.isfinite(width_px) and width_px > 0):
-        raise ParameterError(f"the pulse width must be > 0 px, got {width_px}")
+def check_width(width_px: float) -> float:
+    """The width (px) as a float; refuses a width that is not a number of
+    at least ``MIN_WIDTH_PX`` and one whose sinc has its first zero below
+    ``MIN_FIRST_ZERO_CY_PX``."""
+    if isinstance(width_px, (int, float, np.integer, np.floating)) and not width_px > 0:
+        raise ParameterError(f"the pulse width must be > 0 px, got {width_px!r}")
+    width_px = check_number("the pulse width (px)", width_px, positive=True)
+    if width_px < MIN_WIDTH_PX:
+        raise ParameterError(f"a {width_px:g} px wide bar is narrower than {MIN_WIDTH_PX} px: its signal "
+                             "would be below any noise (is the unit right?)")
     if 1.0 / width_px < MIN_FIRST_ZERO_CY_PX:
         raise ParameterError(
             f"a {width_px:g} px wide bar puts the first zero of its sinc at {1 / width_px:.3f} cy/px, "
             f"below {MIN_FIRST_ZERO_CY_PX} cy/px: too little of the MTF can be recovered")
+    return width_px
 
 
 def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
@@ -266,12 +327,3 @@ def _half_width_at(grid: np.ndarray, prf01: np.ndarray, level: float) -> float:
     if above.size == 0:
         return 0.0
     return float(max(-grid[above[0]], grid[above[-1]]))
-
-
-def _pulse_snr(height: float, background: np.ndarray) -> float:
-    """Paper's pulse SNR: PRF peak above the mean background over the
-    background's standard deviation (pulse excluded)."""
-    if background.size < 3:
-        return float("nan")
-    sd = background.std(ddof=1)
-    return float(height / sd) if sd > 0 else float("inf")

@@ -38,13 +38,20 @@ class Resampled:
 
     ``grid`` (px) and ``values`` (DN) have equal length; ``transfer(f)`` is
     the method's transfer function at ``f`` cycles/pixel; ``params`` the
-    settings actually used (recorded as provenance).
+    settings actually used (recorded as provenance).  The resampling is
+    linear in the sample values, ``values = S v``: ``adjoint(h)`` returns
+    ``S^T h`` for grid weights ``h`` (..., grid size), one weight per input
+    sample, and ``leverage`` each sample's weight in the fit at its own
+    position (about S[i, i]).  Both are for the linearised intervals
+    (:mod:`imgmtf.estimate.intervals`); they are None for stacked weights.
     """
 
     grid: np.ndarray
     values: np.ndarray
     transfer: Callable[[np.ndarray], np.ndarray]
     params: dict = field(default_factory=dict)
+    adjoint: Callable[[np.ndarray], np.ndarray] | None = None
+    leverage: np.ndarray | None = None
 
     @property
     def step(self) -> float:
@@ -120,12 +127,44 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     inner[trim: trim + out.size] = True
     valid = ((m[..., 0, :] >= 2 * (order + 1) * _unit_weight(w)) & (spread > 0.05)
              & (distinct >= order + 1) & inner)
-    level = np.full(valid.shape, np.nan)
-    if valid.any():
-        level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
     width = (2 * half_bins + 1) * step
-    return Resampled(out, level[..., trim: trim + out.size], _local_polynomial_transfer(order, width),
-                     {"order": order, "window_px": width, "step_px": step})
+    params = {"order": order, "window_px": width, "step_px": step}
+    transfer = _local_polynomial_transfer(order, width)
+    if w.ndim > 1:      # a stack of weightings (the bootstrap): solve each window directly
+        level = np.full(valid.shape, np.nan)
+        if valid.any():
+            level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
+        return Resampled(out, level[..., trim: trim + out.size], transfer, params)
+    # one weighting: each window's equivalent-kernel coefficients M^-1 e0,
+    # which give the fitted level and, transposed, every sample's weight
+    coef = np.zeros((grid.size, order + 1))
+    if valid.any():
+        coef[valid] = np.linalg.solve(normal[valid], np.eye(order + 1)[0][None, :, None]
+                                      .repeat(valid.sum(), axis=0))[..., 0]
+    level = np.where(valid, np.einsum("kj,kj->k", coef, rhs), np.nan)
+    u0 = np.vander(u, order + 1, increasing=True)                 # (n_kept, order + 1)
+
+    def adjoint(h):
+        """Sample weights S^T h of grid weights ``h`` (..., n_out): what
+        each sample contributes to sum_k h_k level_k, per unit value."""
+        h = np.asarray(h, float)
+        full = np.zeros((*h.shape[:-1], grid.size))
+        full[..., trim: trim + out.size] = np.where(valid[trim: trim + out.size], h, 0.0)
+        a = full[..., None, :] * coef.T                          # (..., order + 1, n_grid)
+        # sum over the windows holding a sample's bin of a_k^(j) (u0 + offset)^j,
+        # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
+        conv = [correlate1d(a, (-1.0) ** p * offsets ** p, axis=-1, mode="constant")
+                for p in range(order + 1)]
+        g = np.stack([sum(math.comb(j, m_) * conv[j - m_][..., j, :] for j in range(m_, order + 1))
+                      for m_ in range(order + 1)], axis=-2)      # (..., order + 1, n_grid)
+        kept = np.einsum("...mi,im->...i", g[..., bins], u0) * w
+        result = np.zeros((*h.shape[:-1], distance.size))
+        result[..., keep] = kept
+        return result
+
+    leverage = np.zeros(distance.size)
+    leverage[keep] = np.einsum("ij,ij->i", coef[bins], u0) * w
+    return Resampled(out, level[trim: trim + out.size], transfer, params, adjoint, leverage)
 
 
 def _bins(distance, grid, step):
@@ -219,7 +258,22 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
 
     def transfer(f):
         return 1.0 / (1.0 + (np.atleast_1d(np.asarray(f, float)) / cutoff_cy_px) ** 4)
-    return Resampled(grid, out, transfer, {"cutoff_cy_px": cutoff_cy_px, "lam": lam, "step_px": step})
+    params = {"cutoff_cy_px": cutoff_cy_px, "lam": lam, "step_px": step}
+    if w.ndim > 1:
+        return Resampled(grid, out, transfer, params)
+    # the spline's smoother matrix is not formed; its transpose is taken as
+    # the equivalent kernel's (exact for uniformly dense samples)
+    local_density = _local_density(distance, w)
+
+    def adjoint(h):
+        h = np.where(inside, np.asarray(h, float), 0.0)
+        n = 2 * grid.size
+        smoothed = np.fft.irfft(np.fft.rfft(h, n=n) * transfer(np.fft.rfftfreq(n, d=step)), n=n)
+        at_samples = np.stack([np.interp(distance, grid, s[: grid.size]) for s in
+                               smoothed.reshape(-1, n)]).reshape(*h.shape[:-1], distance.size)
+        return at_samples * w / (step * local_density)
+    kernel_at_zero = np.pi * cutoff_cy_px / math.sqrt(2.0)     # integral of the transfer over all f
+    return Resampled(grid, out, transfer, params, adjoint, kernel_at_zero * w / local_density)
 
 
 def binned(distance, values, step: float, half_range: float, *,
@@ -242,8 +296,46 @@ def binned(distance, values, step: float, half_range: float, *,
 
     def transfer(f):
         return np.sinc(np.atleast_1d(np.asarray(f, float)) * bin_px)
-    return Resampled(grid, out, transfer, {"bin_px": bin_px,
-                                           "empty_bins": int((~filled).sum(axis=-1).max())})
+    params = {"bin_px": bin_px, "empty_bins": int((~filled).sum(axis=-1).max())}
+    if w.ndim > 1:
+        return Resampled(grid, out, transfer, params)
+    fill = _interpolation_matrix(grid, filled)
+
+    def adjoint(h):
+        per_bin = np.asarray(h, float) @ fill / np.where(filled, counts, 1.0)
+        result = np.zeros((*np.shape(h)[:-1], distance.size))
+        result[..., keep] = per_bin[..., bins] * w
+        return result
+    leverage = np.zeros(distance.size)
+    leverage[keep] = w / counts[bins]
+    return Resampled(grid, out, transfer, params, adjoint, leverage)
+
+
+def _interpolation_matrix(grid: np.ndarray, filled: np.ndarray) -> np.ndarray:
+    """Matrix P with ``P @ means`` = the bin means, empty bins linearly
+    interpolated from their filled neighbours (held constant past the ends),
+    as ``np.interp`` does."""
+    source = np.nonzero(filled)[0]
+    right = np.clip(np.searchsorted(source, np.arange(grid.size)), 0, source.size - 1)
+    left = np.clip(right - 1, 0, source.size - 1)
+    lo, hi = source[left], source[right]
+    span = np.where(hi > lo, grid[hi] - grid[lo], 1.0)
+    t = np.clip(np.where(hi > lo, (grid - grid[lo]) / span, 1.0), 0.0, 1.0)
+    matrix = np.zeros((grid.size, grid.size))
+    rows = np.arange(grid.size)
+    np.add.at(matrix, (rows, lo), 1.0 - t)
+    np.add.at(matrix, (rows, hi), t)
+    matrix[filled] = 0.0
+    matrix[np.nonzero(filled)[0], np.nonzero(filled)[0]] = 1.0
+    return matrix
+
+
+def _local_density(distance: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Weighted samples per pixel around each sample (1-px bins)."""
+    edges = np.floor(distance).astype(int)
+    edges -= edges.min()
+    counts = np.bincount(edges, weights=weights)
+    return np.maximum(counts[edges], 1e-12)
 
 
 def sample_gap(distance: np.ndarray, near_px: float = 2.0) -> float:

@@ -3,7 +3,7 @@ results, and its JSON form."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, ClassVar
 
 import numpy as np
@@ -17,24 +17,55 @@ from .intervals import Interval
 class MTFResult:
     """An MTF estimate and what it was computed from.
 
-    Distances are in pixels along the target's normal, frequencies in cycles
-    per pixel along the normal; the MTF is normalised to 1 at zero
-    frequency.  ``lsf`` integrates to 1 (1/px).  ``noise_limit_cy_px`` is
-    the frequency above which the MTF is within 3 standard deviations of
-    its noise (inf for a noise-free chip): the curve beyond it is not
-    signal.  ``samples_x_px``/``samples_dn`` are the over-sampled profile's
-    raw samples; ``geometry`` the fitted target line.
+    Conventions: distances in pixels along the target's normal, frequencies
+    in cycles per pixel along the normal (cycles per metre when ``gsd_m``
+    is known); the MTF is 1 at zero frequency.
+
+    Attributes
+    ----------
+    normal_angle_deg : float
+        Angle of the target's normal from the image's x (column) axis,
+        towards +y (down), in (-90, 90]: the tilt of the target from the
+        column axis.  The MTF is measured along this normal.
+    tilt_deg : float
+        Angle between the target and the nearest image axis (0 to 45).
+    direction : str
+        "across-track" or "along-track" when the normal lies within 10 deg
+        of the ground track's perpendicular or of the track (rows along
+        track unless a track azimuth was given), "oblique" otherwise,
+        "unknown" for a map-projected image without a track azimuth.
+    snr, noise_dn : float
+        Contrast over the sides' noise (quantisation included), and that
+        noise (DN).
+    mtf_nyquist, mtf50_cy_px : float
+        MTF at 0.5 cy/px, and the frequency where it falls to 0.5.
+    mtf_nyquist_ci, mtf50_ci_cy_px : Interval
+        Their confidence intervals (NaN when switched off).
+    fwhm_px : float
+        Full width at half maximum of the recovered LSF.
+    noise_limit_cy_px : float
+        Above it the MTF is within 3 standard deviations of its noise.
+    lsf_half_width_px, tail_fraction : float
+        The LSF window's flat core, and the share of the LSF's area the
+        tail model supplies beyond it.
+    checks : tuple of imgmtf.estimate.gate.Check
+        Every quality check and its outcome.
+    warnings : tuple of str
+        What the user should know (low SNR, forced checks...).
     """
 
     target: ClassVar[str] = ""
     method: str
     params: dict
-    angle_deg: float
+    normal_angle_deg: float
+    tilt_deg: float
+    direction: str
     orientation: str
     polarity: str
     rows_used: int
     rows_total: int
     snr: float
+    noise_dn: float
     mtf_nyquist: float
     mtf50_cy_px: float
     mtf_nyquist_ci: Interval
@@ -42,23 +73,28 @@ class MTFResult:
     fwhm_px: float
     mtfa: float
     gsd_m: float | None
-    frequencies_cy_px: np.ndarray
-    mtf: np.ndarray
-    lsf_x_px: np.ndarray
-    lsf: np.ndarray
-    samples_x_px: np.ndarray
-    samples_dn: np.ndarray
-    geometry: TargetGeometry
+    frequencies_cy_px: np.ndarray = field(repr=False)
+    mtf: np.ndarray = field(repr=False)
+    lsf_x_px: np.ndarray = field(repr=False)
+    lsf: np.ndarray = field(repr=False)
+    samples_x_px: np.ndarray = field(repr=False)
+    samples_dn: np.ndarray = field(repr=False)
+    geometry: TargetGeometry = field(repr=False)
     roi: tuple[int, int, int, int]
     noise_limit_cy_px: float
+    lsf_half_width_px: float
+    tail_fraction: float
+    checks: tuple = field(default=(), repr=False)
     warnings: tuple[str, ...] = ()
-    mtf_function: Callable | None = None
+    mtf_function: Callable | None = field(default=None, repr=False)
 
-    @property
-    def direction(self) -> str:
-        """Which MTF this target measures on a pushbroom image: rows are
-        along track, so a near-vertical target gives the across-track MTF."""
-        return "across-track" if self.orientation == "vertical" else "along-track"
+    def __repr__(self) -> str:
+        ci = self.mtf_nyquist_ci
+        interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if math.isfinite(ci.low) else ""
+        return (f"{type(self).__name__}(MTF@Nyquist {self.mtf_nyquist:.4f}{interval}, MTF50 "
+                f"{self.mtf50_cy_px:.4f} cy/px, FWHM {self.fwhm_px:.3f} px, SNR {self.snr:.0f}, "
+                f"normal {self.normal_angle_deg:.2f} deg, {self.direction}, {self.rows_used} rows, "
+                f"method {self.method!r}{', %d warning(s)' % len(self.warnings) if self.warnings else ''})")
 
     @property
     def mtf50_cy_m(self) -> float | None:
@@ -78,9 +114,10 @@ class MTFResult:
     def to_dict(self, curves: bool = True) -> dict:
         """JSON-ready summary (units in the names); ``curves`` adds the MTF."""
         out = {
-            "target": self.target, "method": self.method, "angle_deg": self.angle_deg,
-            "orientation": self.orientation, "direction": self.direction,
-            "polarity": self.polarity, "rows_used": self.rows_used, "snr": finite(self.snr),
+            "target": self.target, "method": self.method, "normal_angle_deg": finite(self.normal_angle_deg),
+            "tilt_deg": finite(self.tilt_deg), "direction": self.direction,
+            "orientation": self.orientation, "polarity": self.polarity, "rows_used": self.rows_used,
+            "snr": finite(self.snr), "noise_dn": finite(self.noise_dn),
             "mtf_nyquist": finite(self.mtf_nyquist),
             "mtf_nyquist_ci": [finite(self.mtf_nyquist_ci.low), finite(self.mtf_nyquist_ci.high)],
             "mtf50_cy_px": finite(self.mtf50_cy_px),
@@ -88,8 +125,11 @@ class MTFResult:
             "fwhm_px": finite(self.fwhm_px), "mtfa": finite(self.mtfa), "gsd_m": self.gsd_m,
             "mtf50_cy_m": finite(self.mtf50_cy_m), "fwhm_m": finite(self.fwhm_m),
             "noise_limit_cy_px": finite(self.noise_limit_cy_px),
+            "lsf_half_width_px": finite(self.lsf_half_width_px), "tail_fraction": finite(self.tail_fraction),
             **self._specific(),
             "roi": list(self.roi), "warnings": list(self.warnings),
+            "checks": [{"reason": c.reason, "passed": bool(c.passed), "message": c.message}
+                       for c in self.checks if not c.passed],
             "params": self.params, "imgmtf_version": __version__,
         }
         if curves:

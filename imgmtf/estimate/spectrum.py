@@ -10,8 +10,13 @@ Corrections applied (each divides the measured modulus):
 * the resampling method's own blur, its transfer H_method(f)
   (:mod:`imgmtf.resampling`): sinc(f B) for bins of B px, the equivalent
   kernel of a local polynomial, 1 / (1 + (f / f_c)^4) for the spline;
-* the LSF window is flat (1) over the LSF's support and only tapers beyond
+* the LSF window is flat (1) over the LSF's core and only tapers beyond
   it, so it needs no correction; it removes the noise of the flat tails.
+
+Beyond the core the window does not throw the LSF's tails away: there
+the estimators (:mod:`.pipeline`) replace the noisy data by a smooth
+model fitted to it, so the tails are kept out to the end of the data
+without their noise.
 
 A correction factor is never allowed to exceed 1 / ``MIN_TRANSFER``:
 frequencies where a divisor is smaller are reported as NaN.
@@ -137,22 +142,30 @@ def corrected_mtf(profile: np.ndarray, step: float,
     return mtf
 
 
-def noise_limited_frequency(mtf: Callable, snr: float, window_px: float, density: float,
-                            f_max: float = 3.0) -> float:
+def noise_limited_frequency(mtf: Callable, noise: Callable, f_max: float = 3.0) -> float:
     """First frequency (cy/px) where the MTF falls below 3 times its own
-    noise, or inf if it never does below ``f_max``.
-
-    White noise of relative level 1/SNR on ESF samples of ``density`` per
-    pixel, differentiated and transformed over a window of ``window_px``,
-    gives the MTF a standard deviation of 2 pi f / SNR * sqrt(window / (2
-    density)) (the in-phase half of the noise's power).
-    """
-    if not (math.isfinite(snr) and snr > 0):
-        return float("inf")
+    noise ``noise(f)`` (its standard deviation), or inf if it never does
+    below ``f_max``.  Masked frequencies (NaN, near a divisor's zeros) are
+    skipped."""
     f = np.arange(0.02, f_max + 1e-9, 0.02)
-    sigma = 2 * np.pi * f / snr * math.sqrt(window_px / (2 * density))
-    below = np.nonzero(~(mtf(f) >= 3 * sigma))[0]
+    values = mtf(f)
+    below = np.nonzero(np.isfinite(values) & (values < 3 * noise(f)))[0]
     return float(f[below[0]]) if below.size else float("inf")
+
+
+def white_noise_mtf_sd(snr: float, window_px: float, density: float, gain: Callable) -> Callable:
+    """Standard deviation of an MTF estimate at f under white sample noise:
+    noise of relative level 1/``snr`` on profile samples of ``density`` per
+    pixel, transformed over a window of ``window_px``, gives |FT| a standard
+    deviation of sqrt(window / (2 density)) / snr (the in-phase half of
+    the noise's power), times ``gain(f)``: 2 pi f for a differentiated ESF,
+    1 / (the pulse's area) for a pulse response.  Zero noise for an
+    infinite SNR."""
+    scale = math.sqrt(window_px / (2 * density)) / snr if math.isfinite(snr) and snr > 0 else 0.0
+
+    def sd(f):
+        return scale * gain(np.asarray(f, float))
+    return sd
 
 
 def mtf50(mtf: Callable, f_max: float = 2.0, coarse: float = 0.02) -> float:

@@ -34,7 +34,8 @@ import numpy as np
 
 from ..errors import ConfigError, FileWriteError, ParameterError
 from ..metrics import first_crossing, fwhm
-from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, check_number, stage_from_dict
+from ..inputs import check_number
+from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 
 DIRECTIONS = ("across", "along")
 #: the paper's stages, what ``imgmtf fit`` fits by default

@@ -43,6 +43,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..inputs import check_number
 from ..errors import ParameterError
 
 #: name -> stage class, in the order the stages were registered
@@ -55,20 +56,6 @@ def register(cls: type["Stage"]) -> type["Stage"]:
         raise ValueError(f"stage name {cls.name!r} registered twice")
     STAGES[cls.name] = cls
     return cls
-
-
-def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = False) -> float:
-    """``value`` as a float if it is a finite real number >= 0 (> 0 with
-    ``positive``; inf allowed with ``allow_inf``), NumPy scalars included;
-    else a :class:`ParameterError` naming ``name``."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError(f"{name} must be a number, got {value!r}")
-    number = float(value)
-    if math.isnan(number) or (math.isinf(number) and not (allow_inf and number > 0)) or number < 0:
-        raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
-    if positive and number == 0:
-        raise ParameterError(f"{name} must be > 0, got {value!r}")
-    return number
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,310 @@
+"""The quality gate: every check that decides whether a chip's MTF can be
+trusted, each with a machine-readable reason and a one-line message.
+
+``measure`` and ``scan`` run the same checks through the same pipeline
+(:mod:`.pipeline`), so one chip gets one verdict.  A failed check refuses
+the chip (:class:`QualityError`, naming every failed check); a caller who
+insists (``force=True``) gets the number with each failed check in its
+warnings.  Reasons:
+
+========================  ===================================================
+``fill``                  fill or nodata (0 or an integer type's limit with a
+                          hard, unblurred boundary) inside the chip
+``saturated``             a side or the bar's peak clipped (integer limits, a
+                          given saturation range, or a pile-up at one value)
+``not-straight``          the per-row locations do not lie on one line (no
+                          edge at all, a curved edge, texture)
+``two-targets``           a second edge or bar beside the target
+``non-uniform``           a side with a level trend or texture
+``too-short``             too few rows for a stable estimate
+``mtf-above-one``         the MTF rises above 1 by more than its noise
+``snr``                   noise too strong to measure anything
+``not-an-edge``,          the profile is a bar where an edge was asked for,
+``not-a-bar``             or a step where a bar was
+========================  ===================================================
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import MultipleTargetsError, UnsuitableTargetError
+
+MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
+MIN_SNR = 8.0                   # below this an edge's MTF at Nyquist is mostly noise (about +-0.1)
+MAX_SIDE_TREND = 0.10           # level change across a side, fraction of the contrast
+MAX_SIDE_TEXTURE = 0.05         # texture standard deviation beyond the pixel noise, fraction of contrast
+MAX_SECOND_FEATURE = 0.08       # a 1-px band of a side off its model by this fraction: another feature
+MAX_LINE_SCATTER_PX = 0.3       # robust scatter of row locations about the line, at the least
+MIN_ROWS_ON_LINE = 0.7          # fraction of rows the line must hold
+MAX_SAGITTA_PX = 0.3            # bow of the row locations over the edge's length
+FILL_BOUNDARY = 0.25            # a fill region's neighbours differ from it by this fraction of the contrast
+MIN_FILL_FRACTION = 0.005
+SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
+PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
+MAX_MTF_EXCESS = 0.05           # MTF above 1 + this (plus 3 noise sd) refuses the chip
+EDGE_STEP_RATIO = 0.5           # |right - left| / largest excursion: above it a step, below a bar
+
+
+@dataclass(frozen=True)
+class Check:
+    """The outcome of one quality check.
+
+    ``reason`` is the machine-readable code, ``message`` one line saying
+    what was measured against what limit; ``value`` and ``limit`` are the
+    numbers (units in the message).
+    """
+
+    reason: str
+    passed: bool
+    message: str
+    value: float | None = None
+    limit: float | None = None
+
+
+class QualityError(UnsuitableTargetError):
+    """A chip refused by the quality gate; ``checks`` lists the failed
+    checks, the first one's reason is the error's."""
+
+    def __init__(self, failed: list[Check]):
+        extra = f" (also: {'; '.join(c.message for c in failed[1:])})" if len(failed) > 1 else ""
+        super().__init__(f"{failed[0].message}{extra}; measure it anyway with force=True (--force)",
+                         reason=failed[0].reason)
+        self.checks = tuple(failed)
+
+
+class TwoTargetsError(QualityError, MultipleTargetsError):
+    """A chip refused because it holds a second edge or bar."""
+
+
+def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
+    """Raise :class:`QualityError` for failed checks, unless ``force``:
+    then return them as warnings."""
+    failed = [c for c in checks if not c.passed]
+    if failed and not force:
+        raise (TwoTargetsError if failed[0].reason == "two-targets" else QualityError)(failed)
+    return tuple(f"{c.reason}: {c.message} (forced)" for c in failed)
+
+
+# -- before the profile ---------------------------------------------------------
+def fill_check(image: np.ndarray, dtype) -> Check:
+    """Fill or nodata that no tag declared: a sizeable region at exactly 0
+    (or at an integer type's limit) whose boundary is hard, its neighbours
+    differing from it by a large part of the image's contrast.  A blurred
+    plateau (a noise-free side, a clipped one) has neighbours close to it."""
+    candidates = {0.0}
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        info = np.iinfo(np.dtype(dtype))
+        candidates |= {float(info.min), float(info.max)}
+    for value in sorted(candidates):
+        mask = image == value
+        count = int(mask.sum())
+        if count < 8 or count < MIN_FILL_FRACTION * image.size or count == image.size:
+            continue
+        border = np.zeros_like(mask)
+        border[1:, :] |= mask[:-1, :]
+        border[:-1, :] |= mask[1:, :]
+        border[:, 1:] |= mask[:, :-1]
+        border[:, :-1] |= mask[:, 1:]
+        border &= ~mask
+        rest = image[~mask]
+        contrast = float(np.percentile(rest, 99) - np.percentile(rest, 1)) or float(np.ptp(rest))
+        if not border.any() or contrast <= 0:
+            continue
+        jump = float(np.median(np.abs(image[border] - value))) / contrast
+        if jump > FILL_BOUNDARY:
+            return Check("fill", False, f"{100 * count / image.size:.1f} % of the chip is fill at "
+                         f"{value:g} DN with a hard boundary (no nodata tag declares it): crop the "
+                         "ROI away from it", jump, FILL_BOUNDARY)
+    return Check("fill", True, "no fill in the chip")
+
+
+def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
+    """Does the target run straight through the rows?  The kept fraction of
+    rows, their robust scatter about the line (against what the pixel noise
+    explains), and the bow of a quadratic through them."""
+    rows, loc, kept = geometry.rows, geometry.locations, geometry.kept
+    fraction = kept.sum() / max(rows.size, 1)
+    resid = loc[kept] - (geometry.slope * rows[kept] + geometry.intercept)
+    scatter = float(1.4826 * np.median(np.abs(resid))) if resid.size else math.inf
+    limit = max(MAX_LINE_SCATTER_PX, 3.0 * expected_scatter_px)
+    checks = [
+        Check("not-straight", fraction >= MIN_ROWS_ON_LINE,
+              f"only {100 * fraction:.0f} % of the rows hold the {name} on one line (at least "
+              f"{100 * MIN_ROWS_ON_LINE:.0f} % needed): no straight {name}", fraction, MIN_ROWS_ON_LINE),
+        Check("not-straight", scatter <= limit,
+              f"the per-row {name} locations scatter {scatter:.2f} px about the line (at most "
+              f"{limit:.2f} px expected from the noise): no straight {name}", scatter, limit),
+    ]
+    if kept.sum() >= 10:
+        y, x = rows[kept].astype(float), loc[kept]
+        t = (y - y.mean()) / max(np.ptp(y) / 2, 1.0)
+        design = np.column_stack([np.ones_like(t), t, t * t - np.mean(t * t)])
+        coef, *_ = np.linalg.lstsq(design, x, rcond=None)
+        sigma = math.sqrt(max(np.sum((x - design @ coef) ** 2) / max(x.size - 3, 1), 1e-12))
+        cov = np.linalg.pinv(design.T @ design) * sigma ** 2
+        sagitta, sd = abs(coef[2]), math.sqrt(cov[2, 2])
+        bowed = sagitta > MAX_SAGITTA_PX and sagitta > 4 * sd
+        checks.append(Check("not-straight", not bowed,
+                            f"the {name} bows by {sagitta:.2f} px over its length (at most "
+                            f"{MAX_SAGITTA_PX} px): a curved {name}", sagitta, MAX_SAGITTA_PX))
+    return checks
+
+
+def rows_check(rows_used: int, name: str) -> Check:
+    return Check("too-short", rows_used >= MIN_ROWS,
+                 f"the {name} crosses {rows_used} usable rows (at least {MIN_ROWS} needed)",
+                 rows_used, MIN_ROWS)
+
+
+# -- on the profile -------------------------------------------------------------
+def classify_profile(values: np.ndarray) -> str:
+    """"edge" or "bar": a step keeps most of its largest excursion between
+    its two ends; a bar returns to where it started.  ``values`` is the
+    resampled profile across the target."""
+    n_side = max(values.size // 8, 2)
+    left, right = values[:n_side].mean(), values[-n_side:].mean()
+    excursion = np.max(np.abs(values - left))
+    return "edge" if excursion > 0 and abs(right - left) >= EDGE_STEP_RATIO * excursion else "bar"
+
+
+def kind_check(kind: str, wanted: str) -> Check:
+    if kind == wanted:
+        return Check(f"not-a-{'bar' if wanted == 'bar' else 'n-edge'}", True, f"the profile is a {kind}")
+    if wanted == "edge":
+        return Check("not-an-edge", False, "the profile rises and falls back: a bar, not an edge "
+                     "(measure it with --target pulse)")
+    return Check("not-a-bar", False, "the profile is a step, not a bar (measure it as an edge)")
+
+
+def saturation_checks(distance, values, centre, core_px, sides, limits, quantum, noise_free,
+                      bright_core=None) -> list[Check]:
+    """Clipping on either side (``sides``: list of (name, mask, level)) or,
+    for a bar, at its peak (``bright_core``: mask of the peak samples).
+    ``limits`` = (low, high) DN the sensor records (integer type limits or
+    the user's), or None."""
+    checks = []
+    regions = list(sides) + ([("peak", bright_core, None)] if bright_core is not None else [])
+    for name, mask, _ in regions:
+        v = values[mask]
+        if v.size < 5:
+            continue
+        if limits is not None:
+            low, high = limits
+            at_limit = float(np.mean((v <= low) | (v >= high)))
+            if at_limit > SATURATED_SIDE:
+                checks.append(Check("saturated", False, f"the {name} side is saturated ({100 * at_limit:.0f} % "
+                                    f"of its samples at {low:g} or {high:g} DN): its true level is unknown",
+                                    at_limit, SATURATED_SIDE))
+                continue
+        checks.append(_pile_up(name, distance, values, mask, centre, core_px, quantum, noise_free,
+                               peak=name == "peak"))
+    return checks or [Check("saturated", True, "no side reaches a saturation limit")]
+
+
+def _pile_up(name, distance, values, mask, centre, core_px, quantum, noise_free, peak=False) -> Check:
+    """Clipping that no limit declares (float data, 12 bits in 16): with
+    noise, many samples at exactly the side's extreme value and few just
+    inside it; without noise, the extreme value reached inside the
+    transition, where an unclipped profile is still changing, or a bar's
+    peak flattened over much of its width."""
+    v = values[mask]
+    side_mean = v.mean()
+    others = values[~mask]
+    outward = 1.0 if side_mean >= np.median(others) else -1.0
+    extreme = v.max() if outward > 0 else v.min()
+    at_extreme = v == extreme
+    if noise_free and peak:
+        flat = float(at_extreme.mean())
+        return Check("saturated", flat <= 0.3, f"{100 * flat:.0f} % of the bar's peak sits at exactly "
+                     f"{extreme:g} DN: its top is clipped flat", flat, 0.3)
+    if noise_free:
+        reach = np.abs(distance[mask][at_extreme] - centre)
+        first = float(reach.min()) if reach.size else math.inf
+        clipped = first < 0.5 * core_px and at_extreme.mean() > 0.02
+        return Check("saturated", not clipped,
+                     f"the {name} side reaches its extreme {extreme:g} DN already {first:.2f} px from the "
+                     f"target's centre, inside the transition: clipped", first, 0.5 * core_px)
+    inside = outward * (extreme - v)
+    # the next value inward: one quantum in (for unquantised data, the
+    # nearest distinct value): a natural noise tail thins out towards the
+    # extreme, a clip piles up on it
+    q = quantum if quantum > 0 else (float(inside[inside > 0].min()) if (inside > 0).any() else 1.0)
+    just_inside = np.count_nonzero((inside > 0) & (inside <= 1.5 * q))
+    ratio = at_extreme.sum() / max(just_inside, 1)
+    clipped = at_extreme.mean() > 0.05 and ratio > PILE_UP
+    return Check("saturated", not clipped,
+                 f"{100 * at_extreme.mean():.0f} % of the {name} side's samples sit at exactly "
+                 f"{extreme:g} DN, {ratio:.1f} x as many as just inside it: clipped", ratio, PILE_UP)
+
+
+def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power) -> list[Check]:
+    """Uniform sides: each side's samples beyond ``start_px`` from the
+    centre fitted with its level, its tail (a / |s|^p), a trend across and
+    a trend along the target; a trend over the side larger than
+    ``MAX_SIDE_TREND`` of the contrast, texture beyond the pixel noise, or
+    a 1-px band far off the model (another edge or bar) fail."""
+    checks = []
+    s = distance - centre
+    for name, mask in (("left", s <= -start_px), ("right", s >= start_px)):
+        if mask.sum() < 20:
+            continue
+        ss, v, t = np.abs(s[mask]), values[mask], along[mask]
+        design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
+        coef, *_ = np.linalg.lstsq(design, v, rcond=None)
+        resid = v - design @ coef
+        trend = max(abs(coef[2]) * np.ptp(ss), abs(coef[3]) * np.ptp(t)) / contrast
+        texture = math.sqrt(max(np.var(resid) - pixel_noise ** 2, 0.0)) / contrast
+        bands = np.floor(ss).astype(int)
+        counts = np.bincount(bands)
+        sums = np.bincount(bands, weights=resid)
+        full = counts >= 10
+        band_means = np.abs(sums[full] / counts[full])
+        band_noise = np.sqrt(np.var(resid) / counts[full])
+        worst = int(np.argmax(band_means - 5 * band_noise)) if full.any() else 0
+        second = (float(band_means[worst]) / contrast
+                  if full.any() and band_means[worst] > 5 * band_noise[worst] else 0.0)
+        checks += [
+            Check("non-uniform", trend <= MAX_SIDE_TREND,
+                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast (at most "
+                  f"{100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
+            Check("non-uniform", texture <= MAX_SIDE_TEXTURE,
+                  f"the {name} side carries texture of {100 * texture:.0f} % of the contrast beyond the "
+                  f"pixel noise (at most {100 * MAX_SIDE_TEXTURE:g} %): not a uniform field",
+                  texture, MAX_SIDE_TEXTURE),
+            Check("two-targets", second <= MAX_SECOND_FEATURE,
+                  f"another feature lies on the {name} side, {np.nonzero(full)[0][worst] if full.any() else 0}"
+                  f" px from the target ({100 * second:.0f} % of the contrast): crop it out with --roi",
+                  second, MAX_SECOND_FEATURE),
+        ]
+    return checks
+
+
+def snr_checks(snr: float, threshold: float, rows: int, name: str) -> tuple[list[Check], list[str]]:
+    """Refuse an SNR that cannot be measured or is below ``MIN_SNR``; warn
+    below ``threshold``, the lowest at which the estimate is confident."""
+    if not math.isfinite(snr) and not snr > 0:
+        return [Check("snr", False, f"the {name}'s SNR cannot be measured (its sides hold too few samples)")], []
+    checks = [Check("snr", snr >= MIN_SNR, f"SNR {snr:.1f} is below {MIN_SNR:g}: the MTF would be noise",
+                    snr, MIN_SNR)]
+    warnings = []
+    if snr < threshold:
+        warnings.append(f"SNR {snr:.0f} is below {threshold:.0f}, the lowest at which 95 % of estimates "
+                        f"from a {rows}-row {name} fall within 5 % of the truth")
+    return checks, warnings
+
+
+def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
+    """The MTF of an imaging system does not exceed 1; sharpening or a
+    wrong profile does.  Checked up to the noise limit (and 1 cy/px)."""
+    f = np.arange(0.01, min(limit_cy_px, 1.0) + 1e-9, 0.01)
+    if f.size == 0:
+        return Check("mtf-above-one", True, "MTF not checked")
+    excess = mtf(f) - 1.0 - 3.0 * noise_sd(f)
+    worst = int(np.nanargmax(excess)) if np.isfinite(excess).any() else 0
+    over = float(excess[worst]) if np.isfinite(excess).any() else -1.0
+    return Check("mtf-above-one", over <= MAX_MTF_EXCESS,
+                 f"the MTF reaches {float(mtf(f[worst:worst + 1])[0]):.2f} at {f[worst]:.2f} cy/px, above 1 "
+                 "beyond its noise: a sharpened image or not a clean target", over, MAX_MTF_EXCESS)

@@ -1,0 +1,590 @@
+"""One profile pipeline for edges and bars.
+
+Every estimate runs the same stages; a target kind (:class:`TargetKind`:
+:class:`imgmtf.estimate.edge.EdgeKind`, :class:`imgmtf.estimate.pulse.PulseKind`)
+supplies only what differs:
+
+1. chip: validation, fill check (:mod:`imgmtf.inputs`, :mod:`.gate`);
+2. seed and geometry: the kind finds its line and locates it row by row
+   (an edge by a Fermi fit, a bar by centroids); a robust line through the
+   locations (:mod:`.geometry`);
+3. samples: every pixel's signed distance from the line and its value;
+4. resample: the over-sampled profile smoothed onto a uniform grid by the
+   chosen method (:mod:`.resampling`); the profile is classified as an
+   edge or a bar;
+5. normalise: the kind's levels (an edge's two sides, a bar's background
+   and peak), the noise and SNR from the sides' scatter about their model,
+   with the quantisation floor q / sqrt(12);
+6. window and tails: the kind's LSF-like profile (an ESF's central
+   difference, a pulse response above its background) is kept as measured
+   over a core chosen from its width and the SNR; beyond it, out to the
+   end of the data, it is replaced by a model fitted to each side's samples
+   (level + A / |x|^p, whose LSF-like tail falls as a / x^2: the asymptote
+   of every blur with a hard-edged aperture, diffraction and stray light
+   among them), blended in under the window's taper.  The tails are so
+   kept whole without their noise; a blur without tails fits a = 0;
+7. divide: the transform divided by the transfer of everything between
+   the system's LSF and that profile (the kind's: the central difference or
+   the bar's sinc, times the resampling method's);
+8. figures, quality gate and intervals (:mod:`.spectrum`, :mod:`.gate`,
+   :mod:`.intervals`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, ClassVar
+
+import numpy as np
+
+from ..errors import ImgmtfError, ParameterError, UnsuitableTargetError
+from ..inputs import check_number, prepare_image, quantum, saturation_levels
+from ..metrics import fwhm
+from . import gate
+from .detection import robust_noise
+from .geometry import TargetGeometry, check_angle, profile_samples, vertical_frame
+from .intervals import (Interval, Intervals, as_intervals, bootstrap_figures, influence_sd,
+                        linearised_interval)
+from .resampling import METHODS, resample_profile
+from .spectrum import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50, mtf_area,
+                       noise_limited_frequency, restore_lsf, white_noise_mtf_sd)
+
+DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
+STEP_RANGE_PX = (0.005, 0.25)     # finer costs time for nothing; coarser misses the LSF's shape
+MAX_FREQUENCY_CY_PX = 4.0
+TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
+TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
+MIN_TAIL_SAMPLES = 12
+# The estimator's own error where noise is not the whole error, added in
+# quadrature to the interval: on exact chips the worst error at Nyquist is
+# about 0.0005 for Gaussian-type blurs; the tail model's share of the
+# signal is uncertain to about a tenth of itself.
+SYSTEMATIC_NYQUIST = 0.0008
+SYSTEMATIC_MTF50 = 0.001          # relative
+TAIL_MODEL_UNCERTAINTY = 0.1
+LEVERAGE_CAP = 0.9
+
+
+@dataclass(frozen=True, eq=False)
+class Settings:
+    """How an over-sampled-profile estimator measures (shared by edges and
+    bars).
+
+    Parameters
+    ----------
+    method : str
+        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
+        ("msg", "sliding", "spline", "iso").
+    step_px : float
+        Resampled profile grid step (px), 0.005 to 0.25; "iso" always uses
+        its 1/4-px bins.
+    correct : bool
+        Divide out the blur of the estimator's own steps.  False
+        reproduces the uncorrected classic algorithms.
+    frequencies_cy_px : array_like
+        Where the reported MTF curve is sampled (cy/px, 0 to 4).
+    snr_threshold : float or None
+        Below this SNR the result carries a warning; None uses the
+        measured threshold for the target's length.
+    method_options : dict
+        Overrides of the method's defaults (e.g. ``window_px``).
+    lsf_half_width_px : float or None
+        Half-width of the flat core of the LSF window (px); None chooses
+        it from the target's width and the SNR.
+    lsf_window_factor : float or None
+        That half-width in units of the 10-90 % rise (edges); None adapts
+        it to the SNR.
+    intervals : Intervals
+        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`).
+    force : bool
+        Measure even when a quality check fails (each failure becomes a
+        warning) instead of refusing.
+
+    Raises
+    ------
+    ParameterError
+        For any value out of its range or of the wrong kind.
+    """
+
+    method: str = "msg"
+    step_px: float = 0.05
+    correct: bool = True
+    frequencies_cy_px: np.ndarray = field(default_factory=lambda: DEFAULT_FREQUENCIES)
+    snr_threshold: float | None = None
+    method_options: dict = field(default_factory=dict)
+    lsf_half_width_px: float | None = None
+    lsf_window_factor: float | None = None
+    intervals: Intervals = field(default_factory=Intervals)
+    force: bool = False
+
+    def __post_init__(self):
+        if not isinstance(self.method, str) or self.method not in METHODS:
+            raise ParameterError(f"unknown method {self.method!r}; choose one of {', '.join(METHODS)}")
+        set_ = object.__setattr__
+        set_(self, "step_px", check_number("step_px", self.step_px, low=STEP_RANGE_PX[0], high=STEP_RANGE_PX[1]))
+        if not isinstance(self.correct, (bool, np.bool_)):
+            raise ParameterError(f"correct must be True or False, got {self.correct!r}")
+        try:
+            f = np.asarray(self.frequencies_cy_px, float).ravel()
+        except (TypeError, ValueError):
+            raise ParameterError(f"frequencies_cy_px must be numbers, got {self.frequencies_cy_px!r}") from None
+        if f.size == 0 or not np.all(np.isfinite(f)) or f.min() < 0 or f.max() > MAX_FREQUENCY_CY_PX:
+            raise ParameterError(f"frequencies_cy_px must be finite, in [0, {MAX_FREQUENCY_CY_PX:g}] cy/px")
+        set_(self, "frequencies_cy_px", f)
+        if self.snr_threshold is not None:
+            set_(self, "snr_threshold", check_number("snr_threshold", self.snr_threshold, positive=True))
+        if not isinstance(self.method_options, dict):
+            raise ParameterError(f"method_options must be a dict, got {self.method_options!r}")
+        _check_method_options(self.method, self.method_options)
+        if self.lsf_half_width_px is not None:
+            set_(self, "lsf_half_width_px", check_number("lsf_half_width_px", self.lsf_half_width_px,
+                                                         low=0.5, high=64.0))
+        if self.lsf_window_factor is not None:
+            set_(self, "lsf_window_factor", check_number("lsf_window_factor", self.lsf_window_factor,
+                                                         low=0.5, high=10.0))
+        set_(self, "intervals", as_intervals(self.intervals))
+        if not isinstance(self.force, (bool, np.bool_)):
+            raise ParameterError(f"force must be True or False, got {self.force!r}")
+
+    def as_dict(self) -> dict:
+        out = {"method": self.method, "step_px": self.step_px, "correct": self.correct,
+               "intervals": self.intervals.as_dict(), "force": self.force}
+        for key in ("snr_threshold", "lsf_half_width_px", "lsf_window_factor"):
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key)
+        if self.method_options:
+            out["method_options"] = dict(self.method_options)
+        return out
+
+
+def _check_method_options(method: str, options: dict) -> None:
+    """Bounds of the resampling methods' options (unknown names are the
+    dispatcher's to refuse)."""
+    bounds = {"window_px": (0.05, 8.0), "order": (0, 8), "cutoff_cy_px": (0.1, 20.0), "bin_px": (0.02, 1.0)}
+    for name, value in options.items():
+        if name in bounds:
+            low, high = bounds[name]
+            check_number(name, value, low=low, high=high, integer=name == "order")
+    unknown = set(options) - set(METHODS[method].defaults)
+    if unknown:
+        raise ParameterError(f"method {method!r} takes no option(s) {', '.join(sorted(unknown))}; "
+                             f"it takes {', '.join(METHODS[method].defaults)}")
+
+
+def make_settings(method: str = "msg", *, bootstrap=None, **options) -> Settings:
+    """:class:`Settings` from keywords, with ``bootstrap=N`` meaning N
+    bootstrap replicates (0: no intervals) and unknown keywords refused by
+    name."""
+    known = set(Settings.__dataclass_fields__)
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise ParameterError(f"unknown option(s) {', '.join(unknown)}; valid: bootstrap, "
+                             f"{', '.join(sorted(known - {'method'}))}")
+    if bootstrap is not None:
+        if "intervals" in options:
+            raise ParameterError("give intervals= or bootstrap=, not both")
+        options["intervals"] = as_intervals(bootstrap)
+    return Settings(method, **options)
+
+
+class TargetKind:
+    """What differs between targets; see :class:`imgmtf.estimate.edge.EdgeKind`
+    and :class:`imgmtf.estimate.pulse.PulseKind`.
+
+    ``name`` is the target as a user names it ("edge", "bar"), ``profile``
+    what its profile must look like (:func:`.gate.classify_profile`),
+    ``tail_power`` p of its profile's tails, level + A / |s|^p.
+    """
+
+    name: ClassVar[str]
+    profile: ClassVar[str]
+    tail_power: ClassVar[int]
+
+    def seed(self, data: np.ndarray):
+        """(line, list of gate checks) for the chip."""
+        raise NotImplementedError
+
+    def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
+        raise NotImplementedError
+
+    def shape(self, grid, values, d, v, half_range) -> "Shape":
+        raise NotImplementedError
+
+    def lsf(self, grid, values, background):
+        """(x, lsf, adjoint): the LSF-like profile on ``x`` and the map of
+        weights on ``x`` back to weights on ``grid``."""
+        raise NotImplementedError
+
+    def lsf_tail_amplitudes(self, coefficients) -> tuple[np.ndarray, np.ndarray]:
+        """Per side, the linear map from that side's tail coefficients
+        (level, A) to the LSF-like tail amplitude a (a / s^2)."""
+        raise NotImplementedError
+
+    def divisor(self, step: float, transfer, shape: "Shape"):
+        """The transfer between the system's LSF and the LSF-like profile."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Shape:
+    """What a kind reads off its resampled profile: ``centre`` (px, the
+    target's middle along the normal), ``scale_px`` (its width: an edge's
+    10-90 % rise, a bar's half-width at 10 %), the reference levels
+    ``low``/``high`` (DN: an edge's left and right, a bar's background and
+    peak), the ``core_px`` the LSF window keeps flat at the given SNR
+    factor, where the ``plateau_px`` sides begin, and ``extra`` figures."""
+
+    centre: float
+    scale_px: float
+    low: float
+    high: float
+    plateau_px: float
+    extra: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class SideFit:
+    """Level + A / |s|^p fitted to one side's samples: ``coef`` (level, A),
+    ``operator`` the least-squares map from the selected samples' values to
+    ``coef`` (2 x n), ``mask`` which samples, ``sd`` the residual standard
+    deviation (DN)."""
+
+    coef: np.ndarray
+    operator: np.ndarray
+    mask: np.ndarray
+    sd: float
+
+
+def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> SideFit:
+    """Least-squares level and tail of the samples selected by ``mask``
+    (``s``: distance from the target's centre).  Too few samples, or too
+    little spread in |s|^-p to tell a tail from a level: a flat level."""
+    x = np.abs(s[mask])
+    values = v[mask]
+    if x.size < 3:
+        return SideFit(np.array([np.nan, 0.0]), np.zeros((2, x.size)), mask, math.nan)
+    u = x ** -float(power)
+    if x.size >= MIN_TAIL_SAMPLES and np.std(u) > 1e-3 * np.mean(u):
+        design = np.column_stack([np.ones_like(u), u])
+        operator = np.linalg.pinv(design)
+    else:
+        design = np.ones((x.size, 1))
+        operator = np.vstack([np.full(x.size, 1.0 / x.size), np.zeros(x.size)])
+    coef = operator @ values
+    resid = values - np.column_stack([np.ones_like(u), u]) @ coef
+    dof = max(x.size - design.shape[1], 1)
+    return SideFit(coef, operator, mask, float(math.sqrt(resid @ resid / dof)))
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """The pipeline's output, which each kind turns into its result type."""
+
+    figures: dict
+    arrays: dict
+    checks: tuple
+    warnings: tuple
+    params: dict
+
+
+def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, saturation=None,
+        dtype=None, track_azimuth_deg: float | None = 0.0) -> Measurement:
+    """Measure the target of ``kind`` in ``image`` (2-D array, DN).
+
+    Parameters
+    ----------
+    roi : (x, y, width, height) crop, px, or None.
+    gsd_m : ground sample distance (m) or None.
+    saturation : (low, high) DN the sensor records, or None for an
+        integer image's type range (floats: none declared).
+    dtype : the type the values were stored as when ``image`` is a float
+        copy (a file's samples), for quantisation and integer limits.
+    track_azimuth_deg : direction of the ground track in the image,
+        degrees clockwise from the image's up direction (0: rows along
+        track, as in L0/L1 products); None when unknown (map-projected).
+
+    Raises
+    ------
+    ImgmtfError
+        Every refusal: unusable input, no target, a failed quality check.
+    """
+    array = np.asarray(image)
+    stored = np.dtype(dtype) if dtype is not None else array.dtype
+    data, (x0, y0) = prepare_image(array, roi)
+    gsd_m = None if gsd_m is None else check_number("gsd_m", gsd_m, positive=True)
+    if track_azimuth_deg is not None:
+        track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
+    limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
+    q = quantum(data, stored)
+    checks = [gate.fill_check(data, stored)]
+
+    try:
+        line, seed_checks = kind.seed(data)
+        checks += seed_checks
+        work, seed_x, transposed = vertical_frame(data, line)
+        geometry = kind.locate(work, seed_x, transposed)
+        check_angle(geometry, kind.name)
+        d, v, row, half_range = profile_samples(work, geometry, kind.name)
+    except ImgmtfError:
+        # what the gate already knows (fill, a second target) explains more
+        # than the failure it caused further on
+        gate.enforce(checks, force=False)
+        raise
+    rows_used = int(geometry.kept.sum())
+    checks += gate.line_checks(geometry, geometry.location_sd_px, kind.name)
+    checks.append(gate.rows_check(rows_used, kind.name))
+
+    resampled = resample_profile(d, v, method=settings.method, step=settings.step_px,
+                                 half_range=half_range - 0.6, **settings.method_options)
+    grid, values, span = _central_run(resampled.grid, resampled.values, kind.name)
+    if not gate.kind_check(gate.classify_profile(values), kind.profile).passed:
+        failed = gate.kind_check(gate.classify_profile(values), kind.profile)
+        raise UnsuitableTargetError(failed.message, reason=failed.reason)
+    shape = kind.shape(grid, values, d, v, half_range)
+    c = shape.centre
+    s = d - c
+
+    # noise and SNR: each side's scatter about its own level and tail
+    plateau = [fit_side(s, v, side & (np.abs(s) >= shape.plateau_px), kind.tail_power)
+               for side in (s < 0, s > 0)]
+    side_sd = [p.sd for p in plateau if math.isfinite(p.sd)]
+    noise = max(float(np.mean(side_sd)) if side_sd else math.nan, q / math.sqrt(12.0))
+    contrast = abs(shape.high - shape.low)
+    snr = contrast / noise if noise > 0 else math.inf
+    if not math.isfinite(noise):
+        snr = math.nan
+    threshold = settings.snr_threshold or kind.confident_snr(rows_used)
+
+    # the LSF window's core and taper, and the tails beyond them
+    core = settings.lsf_half_width_px or kind.core_px(shape, snr, settings.lsf_window_factor)
+    taper = TAPER_FACTOR * core
+    start = [min(core, TAIL_FIT_MAX_START * abs(grid[0] - c)), min(core, TAIL_FIT_MAX_START * abs(grid[-1] - c))]
+    sides = [fit_side(s, v, (s <= -start[0]), kind.tail_power), fit_side(s, v, (s >= start[1]), kind.tail_power)]
+    if any(not np.isfinite(sf.coef).all() for sf in sides):
+        raise UnsuitableTargetError(f"a side of the {kind.name} holds too few samples for its level")
+    background = 0.5 * (sides[0].coef[0] + sides[1].coef[0])
+    x, lsf, lsf_adjoint = kind.lsf(grid, values, background)
+    step = float(grid[1] - grid[0])
+    to_amplitude = kind.lsf_tail_amplitudes()
+    amplitudes = [float(to_amplitude[i] @ sides[i].coef) for i in range(2)]
+    w = flat_top_window(x, c, core, taper)
+    sx = x - c
+    tail_shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
+    model = np.where(sx < 0, amplitudes[0], amplitudes[1]) * tail_shape
+    combined = w * lsf + (1.0 - w) * model
+    divisor = kind.divisor(step, resampled.transfer if settings.correct else None, shape)
+    mtf = corrected_mtf(combined, step, divisor)
+    total = float(np.sum(combined) * step)
+    if total == 0 or not math.isfinite(total):
+        raise UnsuitableTargetError(f"the {kind.name}'s profile has no net signal")
+    tail_share = float(np.sum((1.0 - w) * model) * step) / total
+
+    density = d.size / (2.0 * half_range)
+    white = white_noise_mtf_sd(snr, 2.0 * core + taper, density, kind.noise_gain(shape, contrast))
+
+    def noise_sd(f):
+        # the noise is divided by the corrections as the MTF is
+        f = np.atleast_1d(np.asarray(f, float))
+        return white(f) / np.maximum(np.abs(divisor(f) / divisor(np.zeros(1))), MIN_TRANSFER)
+    noise_limit = noise_limited_frequency(mtf, noise_sd)
+    x_c, lsf_c = restore_lsf(combined, x, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
+    mtf_nyquist = float(mtf(NYQUIST)[0])
+    f50 = mtf50(mtf)
+
+    # the gate
+    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", m, None)
+                  for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
+    checks += gate.saturation_checks(d, v, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
+                                     noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
+                                     bright_core=kind.peak_mask(s, shape))
+    checks += gate.side_checks(d, v, row.astype(float), c, max(core, shape.plateau_px), contrast,
+                               robust_noise(data), kind.tail_power)
+    snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
+    checks += snr_failures
+    checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
+
+    # intervals
+    nyquist_ci = mtf50_ci = Interval.none()
+    if settings.intervals.method == "influence":
+        nyquist_ci, mtf50_ci = _influence_intervals(
+            settings.intervals, mtf, mtf_nyquist, f50, resampled, grid, span, x, c, w, lsf_adjoint,
+            tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, background, tail_share)
+    elif settings.intervals.method == "bootstrap":
+        nyquist_ci, mtf50_ci = _bootstrap_intervals(
+            settings, kind, d, v, row, c, core, taper, start, divisor, step, grid)
+
+    figures = dict(
+        normal_angle_deg=_normal_angle(geometry), tilt_deg=geometry.tilt_deg,
+        direction=direction_label(_normal_angle(geometry), track_azimuth_deg),
+        orientation="horizontal" if transposed else "vertical",
+        rows_used=rows_used, rows_total=int(work.shape[0]), snr=snr, noise_dn=noise,
+        mtf_nyquist=mtf_nyquist, mtf50_cy_px=f50, mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
+        fwhm_px=fwhm(x_c, lsf_c), mtfa=mtf_area(mtf), gsd_m=gsd_m, noise_limit_cy_px=noise_limit,
+        lsf_half_width_px=core, tail_fraction=tail_share, roi=(x0, y0, data.shape[1], data.shape[0]),
+        centre_px=c, levels=(shape.low, shape.high), side_levels=(sides[0].coef[0], sides[1].coef[0]),
+        scale_px=shape.scale_px, transposed=transposed, **shape.extra)
+    arrays = dict(grid=grid, values=values, lsf_x=x_c, lsf=lsf_c, samples_x=d, samples_dn=v,
+                  geometry=geometry, mtf_function=mtf, frequencies=settings.frequencies_cy_px,
+                  mtf=mtf(settings.frequencies_cy_px))
+    if track_azimuth_deg is None:
+        warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
+                        "track, so the direction is unknown; give the track's azimuth to label it")
+    params = {**settings.as_dict(), **resampled.params, "lsf_half_width_px": core, "lsf_taper_px": taper,
+              "track_azimuth_deg": track_azimuth_deg}
+    return Measurement(figures, arrays, tuple(checks), tuple(warnings), params)
+
+
+def _saturation(value) -> tuple[float, float]:
+    try:
+        low, high = value
+    except (TypeError, ValueError):
+        raise ParameterError(f"saturation must be two numbers (low, high) in DN, got {value!r}") from None
+    low = check_number("saturation low", low, signed=True)
+    high = check_number("saturation high", high, signed=True)
+    if not low < high:
+        raise ParameterError(f"saturation low must be below high, got ({low:g}, {high:g})")
+    return low, high
+
+
+def _central_run(grid, values, name):
+    """The longest run of finite resampled values around the target
+    (gaps at the far ends come from sparse samples)."""
+    good = np.isfinite(values)
+    mid = grid.size // 2
+    if not good[max(mid - 5, 0): mid + 6].all():
+        raise UnsuitableTargetError(f"the {name} profile has gaps at the target: too few sub-pixel "
+                                    "samples (target too short or angle unsuitable)")
+    bad_left = np.nonzero(~good[:mid])[0]
+    bad_right = np.nonzero(~good[mid:])[0]
+    lo = bad_left[-1] + 1 if bad_left.size else 0
+    hi = mid + bad_right[0] if bad_right.size else grid.size
+    return grid[lo:hi], values[lo:hi], (lo, hi)
+
+
+def _normal_angle(geometry: TargetGeometry) -> float:
+    """Angle (deg, in (-90, 90]) of the target's normal from the image's x
+    axis (y down): the tilt of the target from the column axis."""
+    vertical = -math.degrees(math.atan(geometry.slope))
+    if not geometry.transposed:
+        return vertical
+    angle = 90.0 - vertical
+    return angle - 180.0 if angle > 90.0 else angle
+
+
+DIRECTION_TOLERANCE_DEG = 10.0
+
+
+def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) -> str:
+    """"along-track" when the normal lies within 10 deg of the ground
+    track, "across-track" within 10 deg of its perpendicular, "oblique"
+    otherwise, "unknown" without a track.
+
+    ``track_azimuth_deg`` is the track's direction clockwise from the
+    image's up (0: rows along track); the normal angle is measured from
+    +x towards +y (down), so the track lies at azimuth - 90 on that scale.
+
+    Examples
+    --------
+    >>> direction_label(5.0, 0.0), direction_label(84.0, 0.0), direction_label(30.0, 0.0)
+    ('across-track', 'along-track', 'oblique')
+    """
+    if track_azimuth_deg is None:
+        return "unknown"
+    offset = abs((normal_angle_deg - (track_azimuth_deg - 90.0) + 90.0) % 180.0 - 90.0)
+    if offset <= DIRECTION_TOLERANCE_DEG:
+        return "along-track"
+    if offset >= 90.0 - DIRECTION_TOLERANCE_DEG:
+        return "across-track"
+    return "oblique"
+
+
+def _influence_intervals(intervals, mtf, nyquist, f50, resampled, grid, span, x, c, w, lsf_adjoint,
+                         tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, background, tail_share):
+    """Linearised intervals for MTF at Nyquist and MTF50 (see
+    :mod:`.intervals`).
+
+    The transform F(f) = sum_k e_k(f) [w_k lsf_k + (1 - w_k) model_k] is
+    linear in the samples: through the LSF operator and the resampling
+    (their adjoints), through each side's tail amplitude (its least-squares
+    operator), and for a bar through the background under the window.
+    Each figure is |F(f)| / |F(0)| divided by the corrections, so its
+    gradient follows, and with each sample's residual (scaled up by its
+    leverage) gives the row influences."""
+    step = float(grid[1] - grid[0])
+    freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
+    e = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                   # (n_f, n_x)
+    left = x < c
+    model = np.where(left, amplitudes[0], amplitudes[1]) * tail_shape
+    _, lsf, _ = kind.lsf(grid, resampled.values[span[0]: span[1]], background)
+    transform = e @ (w * lsf + (1.0 - w) * model)
+    on_grid = lsf_adjoint(np.concatenate([(e * w).real, (e * w).imag]))
+    full = np.zeros((on_grid.shape[0], resampled.grid.size))
+    full[:, span[0]: span[1]] = on_grid
+    through = resampled.adjoint(full)
+    n_f = freqs.size
+    grad_f = through[:n_f] + 1j * through[n_f:]                                  # dF(f) / dv
+    for i, side in enumerate(sides):
+        in_side = left if i == 0 else ~left
+        per_amplitude = e @ ((1.0 - w) * tail_shape * in_side)
+        idx = np.nonzero(side.mask)[0]
+        grad_f[:, idx] += per_amplitude[:, None] * (to_amplitude[i] @ side.operator)[None, :]
+        if kind.subtracts_background:
+            grad_f[:, idx] -= 0.5 * (e @ w)[:, None] * side.operator[0][None, :]
+    f0 = transform[0].real
+    run_grid, run_values = resampled.grid[span[0]: span[1]], resampled.values[span[0]: span[1]]
+    residual = v - np.interp(d, run_grid, run_values)
+    if resampled.leverage is not None:
+        residual = residual / np.sqrt(1.0 - np.minimum(resampled.leverage, LEVERAGE_CAP))
+    out = []
+    for j in range(1, n_f):
+        fj, f = transform[j], freqs[j]
+        ratio = abs(fj) / abs(f0)
+        # the MTF is this ratio divided by the corrections: scale the gradient alike
+        scale = float(mtf(np.array([f]))[0]) / ratio if ratio else 0.0
+        grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
+        sd, n_rows = influence_sd(grad * residual, row)
+        if j == 1:
+            systematic = SYSTEMATIC_NYQUIST + TAIL_MODEL_UNCERTAINTY * abs(tail_share) * abs(nyquist)
+            out.append(linearised_interval(nyquist, sd, n_rows, intervals.confidence, systematic))
+        else:
+            h = 1e-3
+            slope = float(mtf(np.array([f50 + h]))[0] - mtf(np.array([f50 - h]))[0]) / (2 * h)
+            sd50 = sd / abs(slope) if slope else math.inf
+            systematic = f50 * (SYSTEMATIC_MTF50 + TAIL_MODEL_UNCERTAINTY * abs(tail_share))
+            out.append(linearised_interval(f50, sd50, n_rows, intervals.confidence, systematic))
+    while len(out) < 2:
+        out.append(Interval.none())
+    return out[0], out[1]
+
+
+def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, step, grid):
+    """Bootstrap intervals: every replicate re-resamples the rows it drew,
+    refits its sides' levels and tails, and is windowed as the estimate."""
+    s = d - c
+    masks = [s <= -start[0], s >= start[1]]
+    to_amplitude = kind.lsf_tail_amplitudes()
+
+    def resample(keep, weights, span):
+        return resample_profile(d[keep], v[keep], method=settings.method, step=settings.step_px,
+                                half_range=span, weights=weights, **settings.method_options)
+
+    def windowed(grid_b, values_b, weights_of):
+        coefs = []
+        for mask in masks:
+            u = np.abs(s[mask]) ** -float(kind.tail_power)
+            design = np.column_stack([np.ones_like(u), u])
+            wts = weights_of(mask)
+            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
+            rhs = np.einsum("ri,ij,i->rj", wts, design, v[mask])
+            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
+        background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
+        x, lsf, _ = kind.lsf(grid_b, values_b, background[:, None])
+        amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
+        w = flat_top_window(x, c, core, taper)
+        sx = x - c
+        shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
+        model = np.where(sx < 0, amp[0][:, None], amp[1][:, None]) * shape
+        return w * lsf + (1.0 - w) * model
+    span = max(abs(grid[0]), abs(grid[-1]))
+    return bootstrap_figures(settings.intervals, d, row, span, resample, windowed, step, divisor)
