@@ -30,6 +30,8 @@ from .spectrum import MIN_TRANSFER, edge_divisor, relative_edge_response, rise_d
 CONFIDENT_SNR_40_ROWS = 125.0
 WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
 WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
+TAPER_FACTOR_CLEAN = 1.0       # the window's taper / its flat half-width, high SNR
+TAPER_FACTOR_NOISY = 0.5       # ... and at SNR <= 30
 BAR_MAX_SEPARATION_PX = 8.0    # two parallel lines closer than this are one bar's sides
 
 
@@ -60,6 +62,7 @@ class EdgeKind(TargetKind):
     name = "edge"
     profile = "edge"
     tail_power = 1
+    monotone = True
     subtracts_background = False
     restore_min_divisor = MIN_TRANSFER
 
@@ -90,6 +93,9 @@ class EdgeKind(TargetKind):
 
     def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:
         return (factor or window_factor(snr)) * shape.scale_px
+
+    def taper_factor(self, snr: float) -> float:
+        return _snr_blend(snr, TAPER_FACTOR_NOISY, TAPER_FACTOR_CLEAN)
 
     @staticmethod
     def confident_snr(rows: int) -> float:
@@ -257,7 +263,12 @@ def window_factor(snr: float) -> float:
     pixel and Butterworth blurs (longer tails are the tail model's), and is
     used at SNR >= 100; the noise of the flat tails grows with the window,
     so at SNR <= 30 the window shrinks to 1 rise, log-linearly in between."""
+    return _snr_blend(snr, WINDOW_FACTOR_NOISY, WINDOW_FACTOR_CLEAN)
+
+
+def _snr_blend(snr: float, noisy: float, clean: float) -> float:
+    """``noisy`` at SNR <= 30, ``clean`` at SNR >= 100, log-linear between."""
     if not math.isfinite(snr):
-        return WINDOW_FACTOR_CLEAN
+        return clean
     t = min(max(math.log(max(snr, 1e-9) / 30.0) / math.log(100.0 / 30.0), 0.0), 1.0)
-    return WINDOW_FACTOR_NOISY + t * (WINDOW_FACTOR_CLEAN - WINDOW_FACTOR_NOISY)
+    return noisy + t * (clean - noisy)

@@ -45,6 +45,7 @@ from .detection import robust_noise
 from .geometry import TargetGeometry, check_angle, profile_samples, vertical_frame
 from .intervals import (Interval, Intervals, as_intervals, bootstrap_figures, influence_sd,
                         linearised_interval)
+from .quantisation import dequantise
 from .resampling import METHODS, resample_profile
 from .spectrum import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50, mtf_area,
                        noise_limited_frequency, restore_lsf, white_noise_mtf_sd)
@@ -55,6 +56,9 @@ MAX_FREQUENCY_CY_PX = 4.0
 TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
 TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
 MIN_TAIL_SAMPLES = 12
+CORE_STEP_PX = 0.5                # the core grows in these steps while the tail model misfits
+MODEL_CHECK_PX = 3.0              # the model must explain this much of the profile past the core
+MODEL_BIN_PX = 0.5
 # The estimator's own error where noise is not the whole error, added in
 # quadrature to the interval: on exact chips the worst error at Nyquist is
 # about 0.0005 for Gaussian-type blurs; the tail model's share of the
@@ -276,6 +280,41 @@ def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> Side
     return SideFit(coef, operator, mask, float(math.sqrt(resid @ resid / dof)))
 
 
+def model_reach(s: np.ndarray, v: np.ndarray, side: int, start: float, power: int, step: float,
+                floor: float = 0.0) -> float:
+    """Where a side's tail model takes over: the smallest distance from
+    ``start`` on (in ``step`` px steps, at most half the side's range) from
+    which level + A / |s|^p, fitted out to the end of the data, explains the
+    next few pixels to within their noise.  Before it the LSF still carries
+    structure of its own (a shoulder, a halo) that the window must keep as
+    measured; at low SNR the test has little power and the core stays at
+    ``start``.  ``floor`` (DN) is a part of each bin's error that does not
+    average down (rounding shared by neighbouring samples)."""
+    reach = np.abs(s[np.sign(s) == side])
+    values = v[np.sign(s) == side]
+    if reach.size < 4 * MIN_TAIL_SAMPLES:
+        return start
+    far = float(reach.max())
+    x0 = start
+    while x0 <= 0.5 * far:
+        fit = fit_side(reach, values, reach >= x0, power)
+        near = (reach >= x0) & (reach < x0 + MODEL_CHECK_PX)
+        if not math.isfinite(fit.sd) or fit.sd == 0 or near.sum() < MIN_TAIL_SAMPLES:
+            return x0
+        u = reach[near] ** -float(power)
+        resid = values[near] - (fit.coef[0] + fit.coef[1] * u)
+        bins = np.floor((reach[near] - x0) / MODEL_BIN_PX).astype(int)
+        counts = np.bincount(bins)
+        full = counts >= 3
+        means = np.bincount(bins, weights=resid)[full] / counts[full]
+        chi2 = float(np.sum(means ** 2 / (fit.sd ** 2 / counts[full] + floor ** 2)))
+        dof = int(full.sum())
+        if dof == 0 or chi2 <= dof + 3.0 * math.sqrt(2.0 * dof):
+            return x0
+        x0 += step
+    return x0
+
+
 @dataclass(frozen=True)
 class Measurement:
     """The pipeline's output, which each kind turns into its result type."""
@@ -334,6 +373,10 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     checks += gate.line_checks(geometry, geometry.location_sd_px, kind.name)
     checks.append(gate.rows_check(rows_used, kind.name))
 
+    # the values the profile is built from: a noise-free quantised edge's
+    # staircase rebuilt as the smooth ESF it samples; the gate reads the raw ones
+    rebuilt = dequantise(d, v, q) if kind.monotone else None
+    raw, v = v, (v if rebuilt is None else rebuilt)
     resampled = resample_profile(d, v, method=settings.method, step=settings.step_px,
                                  half_range=half_range - 0.6, **settings.method_options)
     grid, values, span = _central_run(resampled.grid, resampled.values, kind.name)
@@ -357,7 +400,13 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
 
     # the LSF window's core and taper, and the tails beyond them
     core = settings.lsf_half_width_px or kind.core_px(shape, snr, settings.lsf_window_factor)
-    taper = TAPER_FACTOR * core
+    if settings.lsf_half_width_px is None and settings.lsf_window_factor is None:
+        # a noise-free quantised profile rounds neighbouring samples alike:
+        # its residuals do not average down below the rounding's own q / sqrt(12)
+        floor = q / math.sqrt(12.0) if noise < 0.5 * q else 0.0
+        core = max(core, max(model_reach(s, v, side, core, kind.tail_power, CORE_STEP_PX, floor)
+                             for side in (-1, 1)))
+    taper = kind.taper_factor(snr) * core if settings.lsf_half_width_px is None else TAPER_FACTOR * core
     start = [min(core, TAIL_FIT_MAX_START * abs(grid[0] - c)), min(core, TAIL_FIT_MAX_START * abs(grid[-1] - c))]
     sides = [fit_side(s, v, (s <= -start[0]), kind.tail_power), fit_side(s, v, (s >= start[1]), kind.tail_power)]
     if any(not np.isfinite(sf.coef).all() for sf in sides):
@@ -394,10 +443,10 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     # the gate
     side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", m, None)
                   for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
-    checks += gate.saturation_checks(d, v, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
+    checks += gate.saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
                                      bright_core=kind.peak_mask(s, shape))
-    checks += gate.side_checks(d, v, row.astype(float), c, max(core, shape.plateau_px), contrast,
+    checks += gate.side_checks(d, raw, row.astype(float), c, max(core, shape.plateau_px), contrast,
                                robust_noise(data), kind.tail_power)
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
     checks += snr_failures
@@ -424,14 +473,14 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
         lsf_half_width_px=core, tail_fraction=tail_share, roi=(x0, y0, data.shape[1], data.shape[0]),
         centre_px=c, levels=(shape.low, shape.high), side_levels=(sides[0].coef[0], sides[1].coef[0]),
         scale_px=shape.scale_px, transposed=transposed, **shape.extra)
-    arrays = dict(grid=grid, values=values, lsf_x=x_c, lsf=lsf_c, samples_x=d, samples_dn=v,
+    arrays = dict(grid=grid, values=values, lsf_x=x_c, lsf=lsf_c, samples_x=d, samples_dn=raw,
                   geometry=geometry, mtf_function=mtf, frequencies=settings.frequencies_cy_px,
                   mtf=mtf(settings.frequencies_cy_px))
     if track_azimuth_deg is None:
         warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
                         "track, so the direction is unknown; give the track's azimuth to label it")
     params = {**settings.as_dict(), **resampled.params, "lsf_half_width_px": core, "lsf_taper_px": taper,
-              "track_azimuth_deg": track_azimuth_deg}
+              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None}
     return Measurement(figures, arrays, tuple(checks), tuple(warnings), params)
 
 

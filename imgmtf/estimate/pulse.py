@@ -24,7 +24,7 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, parallel_within, robust_noise
 from .geometry import fit_line, row_windows
-from .pipeline import Shape, TargetKind, make_settings, run
+from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, run
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 
@@ -72,6 +72,7 @@ class PulseKind(TargetKind):
     name = "bar"
     profile = "bar"
     tail_power = 2
+    monotone = False
     subtracts_background = True
     restore_min_divisor = RESTORE_MIN_SINC
 
@@ -127,6 +128,9 @@ class PulseKind(TargetKind):
     def core_px(self, shape, snr, factor):
         width = shape.extra["width_px"]
         return max((factor or 1.6) * shape.scale_px, width / 2 + 1.0)
+
+    def taper_factor(self, snr: float) -> float:
+        return TAPER_FACTOR
 
     @staticmethod
     def confident_snr(rows: int) -> float:
