@@ -119,6 +119,20 @@ def parallel_within(a: Line, b: Line, shape, distance_px: float, angle_deg: floa
     return da <= angle_deg and _separation(a, b, shape) <= distance_px
 
 
+def meet_inside(a: Line, b: Line, shape, min_angle_deg: float = 2.0) -> bool:
+    """Do ``a`` and ``b``, at least ``min_angle_deg`` apart in direction,
+    intersect inside the chip (a bent edge, a corner), rather than lie
+    side by side?"""
+    ta, tb = math.radians(a.theta_deg), math.radians(b.theta_deg)
+    det = math.cos(ta) * math.sin(tb) - math.sin(ta) * math.cos(tb)
+    if abs((a.theta_deg - b.theta_deg + 90.0) % 180.0 - 90.0) < min_angle_deg or abs(det) < 1e-12:
+        return False
+    x = (a.rho_px * math.sin(tb) - b.rho_px * math.sin(ta)) / det
+    y = (b.rho_px * math.cos(ta) - a.rho_px * math.cos(tb)) / det
+    rows, cols = shape
+    return -0.5 <= x <= cols - 0.5 and -0.5 <= y <= rows - 0.5
+
+
 def describe(line: Line) -> str:
     """A line as a user reads it (angle of its normal and offset)."""
     return f"{line.theta_deg:.1f} deg, rho {line.rho_px:.1f} px"

@@ -17,7 +17,7 @@ from typing import ClassVar
 import numpy as np
 
 from . import gate
-from .detection import describe, find_edge, parallel_within
+from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import TargetGeometry, locate_edge
 from .pipeline import Settings, Shape, TargetKind, make_settings, run
 from .results import MTFResult, finite
@@ -32,6 +32,7 @@ WINDOW_FACTOR_CLEAN = 1.35     # LSF window half-width / 10-90 % rise, high SNR
 WINDOW_FACTOR_NOISY = 1.0      # ... and at SNR <= 30
 TAPER_FACTOR_CLEAN = 1.0       # the window's taper / its flat half-width, high SNR
 TAPER_FACTOR_NOISY = 0.5       # ... and at SNR <= 30
+IQR_TO_RISE = 1.9              # 10-90 % rise / 25-75 % distance of a Gaussian edge
 BAR_MAX_SEPARATION_PX = 8.0    # two parallel lines closer than this are one bar's sides
 
 
@@ -69,7 +70,12 @@ class EdgeKind(TargetKind):
     def seed(self, data):
         line, rival = find_edge(data)
         checks = []
-        if rival is not None and not parallel_within(line, rival, data.shape, BAR_MAX_SEPARATION_PX):
+        if rival is None or parallel_within(line, rival, data.shape, BAR_MAX_SEPARATION_PX):
+            return line, checks      # one edge, or a bar's two sides (the profile tells)
+        if meet_inside(line, rival, data.shape, min_angle_deg=2.0):
+            checks.append(gate.Check("not-straight", False, f"the edge bends: two straight pieces (at "
+                                     f"{describe(line)} and {describe(rival)}) meet inside the chip"))
+        else:
             checks.append(gate.Check("two-targets", False, f"two edges found (at {describe(line)} and "
                                      f"{describe(rival)}): crop the image to one edge with --roi"))
         return line, checks
@@ -88,7 +94,12 @@ class EdgeKind(TargetKind):
         if not rise > 0:
             raise gate.UnsuitableTargetError("the edge profile does not rise cleanly from 10 % to 90 %: "
                                              "no usable edge (noise or a second feature?)", reason="not-straight")
-        return Shape(centre, rise, left, right, min(max(3.0 * rise, 2.0), 0.7 * half_range),
+        # the sides begin 3 rises out, the rise taken from the 25-75 % distance
+        # (1.9 x it is the 10-90 % rise of a Gaussian edge) so that a slow drift
+        # of a level cannot stretch it
+        core_rise = IQR_TO_RISE * rise_distance(grid, esf01, centre, 0.25, 0.75)
+        plateau = min(max(3.0 * min(rise, core_rise), 2.0), 0.7 * half_range)
+        return Shape(centre, rise, left, right, plateau,
                      {"esf01": esf01, "rer": relative_edge_response(grid, esf01, centre)})
 
     def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:

@@ -40,10 +40,12 @@ MAX_SECOND_FEATURE = 0.08       # a 1-px band of a side off its model by this fr
 MAX_LINE_SCATTER_PX = 0.3       # robust scatter of row locations about the line, at the least
 MIN_ROWS_ON_LINE = 0.7          # fraction of rows the line must hold
 MAX_SAGITTA_PX = 0.3            # bow of the row locations over the edge's length
-FILL_BOUNDARY = 0.25            # a fill region's neighbours differ from it by this fraction of the contrast
+FILL_BOUNDARY = 0.05            # a fill region's neighbours differ from it by this fraction of the contrast
 MIN_FILL_FRACTION = 0.005
 SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
 PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
+CLIP_REACH = 0.4                # a noise-free side holding its extreme this much sooner than the other: clipped
+FLAT_PEAK = 0.3                 # fraction of a noise-free bar's peak at exactly one value: clipped flat
 MAX_MTF_EXCESS = 0.05           # MTF above 1 + this (plus 3 noise sd) refuses the chip
 EDGE_STEP_RATIO = 0.5           # |right - left| / largest excursion: above it a step, below a bar
 
@@ -69,7 +71,8 @@ class QualityError(UnsuitableTargetError):
     checks, the first one's reason is the error's."""
 
     def __init__(self, failed: list[Check]):
-        extra = f" (also: {'; '.join(c.message for c in failed[1:])})" if len(failed) > 1 else ""
+        others = list(dict.fromkeys(c.reason for c in failed[1:]))
+        extra = f" (also failed: {', '.join(others)})" if others else ""
         super().__init__(f"{failed[0].message}{extra}; measure it anyway with force=True (--force)",
                          reason=failed[0].reason)
         self.checks = tuple(failed)
@@ -90,18 +93,21 @@ def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
 
 # -- before the profile ---------------------------------------------------------
 def fill_check(image: np.ndarray, dtype) -> Check:
-    """Fill or nodata that no tag declared: a sizeable region at exactly 0
-    (or at an integer type's limit) whose boundary is hard, its neighbours
-    differing from it by a large part of the image's contrast.  A blurred
-    plateau (a noise-free side, a clipped one) has neighbours close to it."""
-    candidates = {0.0}
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        info = np.iinfo(np.dtype(dtype))
-        candidates |= {float(info.min), float(info.max)}
-    for value in sorted(candidates):
+    """Fill or nodata that no tag declared: a sizeable region at exactly one
+    value, 0 or the image's extreme, whose boundary is hard (its neighbours
+    differ from it by a large part of the contrast, where a blurred or
+    clipped plateau meets values close to it); a value other than 0 must
+    also lie well outside the rest's range (a sentinel such as 65535 or
+    -9999, not a clipped target's level)."""
+    for value in sorted({0.0, float(image.min()), float(image.max())}):
         mask = image == value
         count = int(mask.sum())
         if count < 8 or count < MIN_FILL_FRACTION * image.size or count == image.size:
+            continue
+        rest = image[~mask]
+        lo, hi = float(rest.min()), float(rest.max())
+        contrast = hi - lo
+        if contrast <= 0 or (value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast):
             continue
         border = np.zeros_like(mask)
         border[1:, :] |= mask[:-1, :]
@@ -109,9 +115,7 @@ def fill_check(image: np.ndarray, dtype) -> Check:
         border[:, 1:] |= mask[:, :-1]
         border[:, :-1] |= mask[:, 1:]
         border &= ~mask
-        rest = image[~mask]
-        contrast = float(np.percentile(rest, 99) - np.percentile(rest, 1)) or float(np.ptp(rest))
-        if not border.any() or contrast <= 0:
+        if not border.any():
             continue
         jump = float(np.median(np.abs(image[border] - value))) / contrast
         if jump > FILL_BOUNDARY:
@@ -179,58 +183,73 @@ def kind_check(kind: str, wanted: str) -> Check:
     return Check("not-a-bar", False, "the profile is a step, not a bar (measure it as an edge)")
 
 
-def saturation_checks(distance, values, centre, core_px, sides, limits, quantum, noise_free,
-                      bright_core=None) -> list[Check]:
+def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum, noise_free,
+                      bright_core=None, monotone=True) -> list[Check]:
     """Clipping on either side (``sides``: list of (name, mask, level)) or,
     for a bar, at its peak (``bright_core``: mask of the peak samples).
     ``limits`` = (low, high) DN the sensor records (integer type limits or
-    the user's), or None."""
+    the user's), or None.  Clipping no limit declares (float data, 12 bits
+    in 16) shows as a pile-up at one value (with noise), or, without
+    noise, as an edge's side that reaches its exact extreme far sooner than
+    the other side does (:func:`_first_reach`; ``monotone`` profiles only)."""
     checks = []
-    regions = list(sides) + ([("peak", bright_core, None)] if bright_core is not None else [])
-    for name, mask, _ in regions:
-        v = values[mask]
-        if v.size < 5:
+    sides = list(sides)
+    for name, mask, _ in sides:
+        if limits is None or mask.sum() < 5:
             continue
-        if limits is not None:
-            low, high = limits
-            at_limit = float(np.mean((v <= low) | (v >= high)))
-            if at_limit > SATURATED_SIDE:
-                checks.append(Check("saturated", False, f"the {name} side is saturated ({100 * at_limit:.0f} % "
-                                    f"of its samples at {low:g} or {high:g} DN): its true level is unknown",
-                                    at_limit, SATURATED_SIDE))
-                continue
-        checks.append(_pile_up(name, distance, values, mask, centre, core_px, quantum, noise_free,
-                               peak=name == "peak"))
+        low, high = limits
+        at_limit = float(np.mean((values[mask] <= low) | (values[mask] >= high)))
+        checks.append(Check("saturated", at_limit <= SATURATED_SIDE,
+                            f"the {name} side is saturated ({100 * at_limit:.0f} % of its samples at {low:g} "
+                            f"or {high:g} DN): its true level is unknown", at_limit, SATURATED_SIDE))
+    if noise_free and monotone:
+        halves = (distance < centre, distance > centre)      # the sides are listed left, right
+        reach = [_first_reach(distance, values, half, centre) for half in halves]
+        for (name, _, _), this, other in zip(sides, reach, reach[::-1]):
+            clipped = this < CLIP_REACH * other and this < rise_px
+            checks.append(Check("saturated", not clipped,
+                                f"the {name} side reaches its exact extreme {this:.2f} px from the target's "
+                                f"centre, the other side only at {other:.2f} px: clipped", this, CLIP_REACH * other))
+    elif not noise_free:
+        for name, mask, _ in sides:
+            if mask.sum() >= 5:
+                checks.append(_pile_up(name, values, mask, quantum))
+    if bright_core is not None and bright_core.sum() >= 5:
+        v = values[bright_core]
+        outward = 1.0 if v.mean() >= np.median(values[~bright_core]) else -1.0
+        extreme = v.max() if outward > 0 else v.min()
+        if limits is not None and (extreme <= limits[0] or extreme >= limits[1]):
+            checks.append(Check("saturated", False, f"the bar's peak reaches the saturation limit {extreme:g} DN: "
+                                "its true height is unknown", extreme, None))
+        elif noise_free:
+            flat = float(np.mean(v == extreme))
+            checks.append(Check("saturated", flat <= FLAT_PEAK, f"{100 * flat:.0f} % of the bar's peak sits at "
+                                f"exactly {extreme:g} DN: its top is clipped flat", flat, FLAT_PEAK))
+        else:
+            checks.append(_pile_up("peak", values, bright_core, quantum))
     return checks or [Check("saturated", True, "no side reaches a saturation limit")]
 
 
-def _pile_up(name, distance, values, mask, centre, core_px, quantum, noise_free, peak=False) -> Check:
-    """Clipping that no limit declares (float data, 12 bits in 16): with
-    noise, many samples at exactly the side's extreme value and few just
-    inside it; without noise, the extreme value reached inside the
-    transition, where an unclipped profile is still changing, or a bar's
-    peak flattened over much of its width."""
+def _first_reach(distance, values, mask, centre) -> float:
+    """How far from the centre a side first holds its own extreme value
+    (px): an unclipped noise-free profile gets there only as its tail
+    flattens out; a clipped one as soon as it meets the clip."""
     v = values[mask]
-    side_mean = v.mean()
-    others = values[~mask]
-    outward = 1.0 if side_mean >= np.median(others) else -1.0
+    outward = 1.0 if v.mean() >= np.median(values) else -1.0
+    extreme = v.max() if outward > 0 else v.min()
+    reach = np.abs(distance[mask][v == extreme] - centre)
+    return float(reach.min()) if reach.size else math.inf
+
+
+def _pile_up(name, values, mask, quantum) -> Check:
+    """With noise, clipping piles samples up at exactly the extreme value:
+    many there, few one quantum inside it (for unquantised data, at the
+    nearest distinct value); a natural noise tail thins out instead."""
+    v = values[mask]
+    outward = 1.0 if v.mean() >= np.median(values[~mask]) else -1.0
     extreme = v.max() if outward > 0 else v.min()
     at_extreme = v == extreme
-    if noise_free and peak:
-        flat = float(at_extreme.mean())
-        return Check("saturated", flat <= 0.3, f"{100 * flat:.0f} % of the bar's peak sits at exactly "
-                     f"{extreme:g} DN: its top is clipped flat", flat, 0.3)
-    if noise_free:
-        reach = np.abs(distance[mask][at_extreme] - centre)
-        first = float(reach.min()) if reach.size else math.inf
-        clipped = first < 0.5 * core_px and at_extreme.mean() > 0.02
-        return Check("saturated", not clipped,
-                     f"the {name} side reaches its extreme {extreme:g} DN already {first:.2f} px from the "
-                     f"target's centre, inside the transition: clipped", first, 0.5 * core_px)
     inside = outward * (extreme - v)
-    # the next value inward: one quantum in (for unquantised data, the
-    # nearest distinct value): a natural noise tail thins out towards the
-    # extreme, a clip piles up on it
     q = quantum if quantum > 0 else (float(inside[inside > 0].min()) if (inside > 0).any() else 1.0)
     just_inside = np.count_nonzero((inside > 0) & (inside <= 1.5 * q))
     ratio = at_extreme.sum() / max(just_inside, 1)

@@ -367,7 +367,8 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     except ImgmtfError:
         # what the gate already knows (fill, a second target) explains more
         # than the failure it caused further on
-        gate.enforce(checks, force=False)
+        if not settings.force:
+            gate.enforce(checks, force=False)
         raise
     rows_used = int(geometry.kept.sum())
     checks += gate.line_checks(geometry, geometry.location_sd_px, kind.name)
@@ -445,8 +446,8 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
                   for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
     checks += gate.saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
-                                     bright_core=kind.peak_mask(s, shape))
-    checks += gate.side_checks(d, raw, row.astype(float), c, max(core, shape.plateau_px), contrast,
+                                     bright_core=kind.peak_mask(s, shape), monotone=kind.monotone)
+    checks += gate.side_checks(d, raw, row.astype(float), c, shape.plateau_px, contrast,
                                robust_noise(data), kind.tail_power)
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
     checks += snr_failures
