@@ -69,3 +69,33 @@ def gaussian_sensor():
     """Gaussian optics (0.5 px) and a square pixel only."""
     return im.Sensor(optics_sigma_x_m=0.5, optics_sigma_y_m=0.5, motion_m=0.0,
                      electronics_cutoff_cy_m=0.0)
+
+
+def diffraction_transfer(cutoff_cy_px):
+    """A circular aperture's incoherent MTF, cut-off ``cutoff_cy_px``:
+    (2/pi)(acos v - v sqrt(1 - v^2)), v = f / cut-off."""
+    def transfer(f):
+        v = np.clip(np.abs(f) / cutoff_cy_px, 0.0, 1.0)
+        return (2 / np.pi) * (np.arccos(v) - v * np.sqrt(1.0 - v * v))
+    return transfer
+
+
+def defocus_transfer(radius_px):
+    """A uniform defocus disk of ``radius_px``: 2 J1(2 pi r f) / (2 pi r f)."""
+    from scipy.special import j1
+
+    def transfer(f):
+        z = np.maximum(2 * np.pi * radius_px * np.abs(f), 1e-12)
+        return np.where(z > 1e-9, 2 * j1(z) / z, 1.0)
+    return transfer
+
+
+def olpf_transfer(split_px, angle_deg):
+    """A 4-dot birefringent low-pass filter of split ``split_px`` along the
+    normal of an edge tilted ``angle_deg``: cos(pi d fx) cos(pi d fy)."""
+    a = math.radians(angle_deg)
+    return lambda f: np.cos(np.pi * split_px * f * math.cos(a)) * np.cos(np.pi * split_px * f * math.sin(a))
+
+
+def product(*transfers):
+    return lambda f: np.prod([t(f) for t in transfers], axis=0)

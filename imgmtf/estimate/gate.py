@@ -94,12 +94,19 @@ def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
 # -- before the profile ---------------------------------------------------------
 def fill_check(image: np.ndarray, dtype) -> Check:
     """Fill or nodata that no tag declared: a sizeable region at exactly one
-    value, 0 or the image's extreme, whose boundary is hard (its neighbours
-    differ from it by a large part of the contrast, where a blurred or
-    clipped plateau meets values close to it); a value other than 0 must
-    also lie well outside the rest's range (a sentinel such as 65535 or
-    -9999, not a clipped target's level)."""
-    for value in sorted({0.0, float(image.min()), float(image.max())}):
+    fill value whose boundary is hard (its neighbours differ from it by a
+    large part of the contrast, where a blurred or clipped plateau meets
+    values close to it).  Fill values: 0, an integer type's limits, and a
+    negative minimum where the rest is not negative (-9999); all but 0
+    must also lie well outside the rest's range (a sentinel, not a clipped
+    target's level)."""
+    candidates = {0.0}
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        info = np.iinfo(np.dtype(dtype))
+        candidates |= {float(info.min), float(info.max)}
+    if image.min() < 0 <= np.partition(image.ravel(), min(image.size - 1, image.size // 2))[image.size // 2]:
+        candidates.add(float(image.min()))
+    for value in sorted(candidates):
         mask = image == value
         count = int(mask.sum())
         if count < 8 or count < MIN_FILL_FRACTION * image.size or count == image.size:

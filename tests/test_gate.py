@@ -1,0 +1,145 @@
+"""The quality gate: for every check, a chip that trips it and one that
+passes; forced measurements carry every failed check as a warning."""
+import math
+
+import numpy as np
+import pytest
+from scipy.ndimage import gaussian_filter
+from scipy.special import erf
+
+import imgmtf as im
+from imgmtf.errors import ImgmtfError, MultipleTargetsError, TargetNotFoundError
+from imgmtf.estimate import gate
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
+
+H = gaussian_pixel_transfer(0.5, 6.0)
+
+
+def edge(noise=5.0, seed=1, angle=6.0, shape=(100, 100), **kw):
+    h = gaussian_pixel_transfer(0.5, angle)
+    return exact_edge_chip(h, angle, shape=shape, noise_std=noise, seed=seed, offset=0.2, **kw)
+
+
+def refused(image, reason, measure=im.measure_edge, **kw):
+    with pytest.raises(ImgmtfError) as info:
+        measure(image, **kw)
+    assert info.value.reason == reason, str(info.value)
+    assert "\n" not in str(info.value)
+    return info.value
+
+
+def test_a_clean_edge_passes_every_check():
+    r = im.measure_edge(edge())
+    assert all(c.passed for c in r.checks) and not r.warnings
+    assert {c.reason for c in r.checks} >= {"fill", "not-straight", "too-short", "saturated", "non-uniform",
+                                           "two-targets", "snr", "mtf-above-one"}
+
+
+def test_fill_with_a_hard_boundary_is_refused_and_a_dark_plateau_is_not():
+    chip = edge().astype(float)
+    chip[:, :18] = 0
+    refused(chip, "fill")
+    # a 0 DN side blurred into the edge is a level (clipped or not), not fill
+    dark = edge(noise=0.0, low=0, high=1000, dtype=np.float64)
+    assert im.measure_edge(dark).mtf_nyquist == pytest.approx(H(0.5), abs=0.003)
+    # a sentinel far outside the data: a type's limit, or a negative value among positive ones
+    sentinel = edge().astype(float)
+    sentinel[:20] = 65535
+    assert not gate.fill_check(sentinel, np.uint16).passed
+    sentinel[:20] = -9999
+    assert not gate.fill_check(sentinel, np.float32).passed
+    # a second, unblurred step to a level inside the data's range is not fill
+    step = edge().astype(float) + np.where(np.arange(100) > 80, 300.0, 0.0)[None, :]
+    assert gate.fill_check(step, np.uint16).passed
+
+
+def test_saturation_by_type_limit_by_given_range_and_by_a_clip_no_one_declared():
+    refused(edge(noise=3.0, low=40, high=400, dtype=np.uint8), "saturated")
+    ok = edge(noise=3.0)
+    refused(ok, "saturated", saturation=(0, 1000))
+    assert im.measure_edge(ok, saturation=(0, 4095)).mtf_nyquist > 0
+    clipped = np.minimum(edge(noise=0.0).astype(float), 255.0)          # float, noise-free
+    refused(clipped, "saturated")
+    noisy_clip = np.minimum(edge(noise=5.0).astype(float), 700.0)       # a pile-up at 700
+    refused(noisy_clip, "saturated")
+
+
+def test_a_bent_edge_and_scattered_rows_are_not_straight():
+    y, x = np.mgrid[0:100, 0:100].astype(float)
+    r = np.hypot(x - 200, y - 50)
+    bent = 200 + 1000 * 0.5 * (1 + erf((150 - r) / (0.6 * math.sqrt(2))))
+    refused(bent + np.random.default_rng(0).normal(0, 5, bent.shape), "not-straight")
+    wobbly = np.array([np.interp(np.arange(100.0), np.arange(100.0) + 3 * math.sin(i / 3.0),
+                                 row) for i, row in enumerate(edge(noise=2.0).astype(float))])
+    refused(wobbly, "not-straight")
+
+
+def test_two_parallel_edges_and_two_bars():
+    h = H
+    first = exact_edge_chip(h, 6.0, offset=-7.5, low=200, high=700)
+    second = exact_edge_chip(h, 6.0, offset=7.5, low=0, high=500)
+    with pytest.raises(MultipleTargetsError) as info:
+        im.measure_edge(first.astype(float) + second)
+    assert info.value.reason == "two-targets"
+    bars = (im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, -8.5, 1.5), 100).image.astype(float)
+            + im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, 8.5, 1.5), 100).image - 200)
+    refused(bars, "two-targets", measure=im.measure_pulse, width_px=1.5)
+
+
+def test_a_level_that_drifts_or_carries_texture_is_non_uniform():
+    chip = edge().astype(float)
+    x = np.arange(100.0)
+    refused(chip + np.where(x > 55, 4.0 * (x - 55), 0.0)[None, :], "non-uniform")
+    texture = 150 * gaussian_filter(np.random.default_rng(3).normal(size=chip.shape), 2.0) / 0.14
+    refused(chip + np.where(x > 56, 1.0, 0.0)[None, :] * texture, "non-uniform")
+
+
+def test_too_few_rows_and_too_little_snr():
+    refused(edge(shape=(16, 100)), "too-short")
+    refused(edge(noise=150.0, seed=4, dtype=np.float64), "snr")
+    warned = im.measure_edge(edge(noise=50.0, seed=4))          # SNR 20: measured, with a warning
+    assert warned.snr == pytest.approx(20, rel=0.25) and any("SNR" in w for w in warned.warnings)
+
+
+def test_a_sharpened_edge_reads_above_one_and_is_refused():
+    chip = edge(noise=1.0).astype(float)
+    sharpened = chip + 2.5 * (chip - gaussian_filter(chip, 2.0))
+    refused(sharpened, "mtf-above-one")
+
+
+def test_edge_and_bar_are_one_classification():
+    bar = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, 0.1, 2.0), 100).image
+    refused(bar, "not-an-edge")
+    refused(edge(), "not-a-bar", measure=im.measure_pulse)
+    grid = np.linspace(-10, 10, 401)
+    assert gate.classify_profile(0.5 * (1 + erf(grid))) == "edge"
+    assert gate.classify_profile(np.exp(-grid ** 2)) == "bar"
+
+
+def test_no_target_in_noise():
+    with pytest.raises(TargetNotFoundError):
+        im.measure_edge(np.random.default_rng(0).normal(500, 20, (80, 80)))
+
+
+def test_force_measures_anyway_with_every_failed_check_as_a_warning():
+    chip = edge().astype(float)
+    chip[:, :18] = 0
+    x = np.arange(100.0)
+    chip += np.where(x > 55, 4.0 * (x - 55), 0.0)[None, :]
+    error = refused(chip, "fill")
+    assert "non-uniform" in str(error).split("also failed:")[1] and "force" in str(error)
+    r = im.measure_edge(chip, force=True)
+    assert {w.split(":")[0] for w in r.warnings} >= {"fill", "non-uniform"}
+    assert r.to_dict()["checks"]
+
+
+def test_direction_is_labelled_only_near_the_track():
+    assert im.measure_edge(edge(angle=6.0)).direction == "across-track"
+    assert im.measure_edge(edge(angle=84.0)).direction == "along-track"
+    oblique = im.measure_edge(edge(angle=30.0))
+    assert oblique.direction == "oblique" and oblique.tilt_deg == pytest.approx(30.0, abs=0.05)
+    # the same edge in a scene whose track runs 30 deg clockwise from the image's up
+    assert im.measure_edge(edge(angle=30.0), track_azimuth_deg=30.0).direction == "across-track"
+    unknown = im.measure_edge(edge(), track_azimuth_deg=None)
+    assert unknown.direction == "unknown" and any("map-projected" in w for w in unknown.warnings)

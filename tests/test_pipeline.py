@@ -1,0 +1,118 @@
+"""The shared pipeline: long-tailed blurs against their closed forms, the
+settings' validation, and the linearised intervals."""
+import math
+
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.errors import ParameterError
+from imgmtf.estimate.pipeline import direction_label, make_settings
+
+from conftest import (defocus_transfer, diffraction_transfer, exact_edge_chip, gaussian_pixel_transfer,
+                      olpf_transfer, product, true_fwhm, true_mtf50)
+
+
+def pixel(angle):
+    a = math.radians(angle)
+    return lambda f: np.sinc(f * math.cos(a)) * np.sinc(f * math.sin(a))
+
+
+LONG_TAILED = {
+    "diffraction f/8": lambda a: product(diffraction_transfer(4.73 / (0.55 * 8)), pixel(a)),
+    "diffraction f/22": lambda a: product(diffraction_transfer(4.73 / (0.55 * 22)), pixel(a)),
+    "diffraction + Gaussian": lambda a: product(diffraction_transfer(4.73 / (0.55 * 11)),
+                                                gaussian_pixel_transfer(0.4, a)),
+    "defocus r 1.5": lambda a: product(defocus_transfer(1.5), gaussian_pixel_transfer(0.3, a)),
+    "OLPF": lambda a: product(olpf_transfer(0.75, a), diffraction_transfer(4.73 / (0.55 * 5.6)), pixel(a)),
+}
+
+
+@pytest.mark.parametrize("name", list(LONG_TAILED))
+def test_long_tailed_blurs_keep_their_tails(name):
+    angle = 5.0
+    h = LONG_TAILED[name](angle)
+    r = im.measure_edge(exact_edge_chip(h, angle, shape=(100, 200), offset=0.3))
+    assert abs(r.mtf_nyquist - abs(h(0.5))) <= 0.002      # a defocus disk's transfer turns negative
+    assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.003)
+    assert r.fwhm_px == pytest.approx(true_fwhm(h), rel=0.005)
+
+
+def test_a_short_window_without_the_tail_model_would_read_high():
+    """What the tails are worth: cut at the core, diffraction reads MTF50 3 % high."""
+    angle = 5.0
+    h = LONG_TAILED["diffraction f/8"](angle)
+    chip = exact_edge_chip(h, angle, shape=(100, 200), offset=0.3)
+    kept = im.measure_edge(chip)
+    assert kept.tail_fraction > 0.01
+    profile = kept.lsf
+    assert profile.sum() > 0
+    assert true_mtf50(h) * 1.02 < _truncated_mtf50(kept)
+
+
+def _truncated_mtf50(result):
+    """MTF50 of the result's own LSF cut to its core and renormalised."""
+    x, lsf = result.lsf_x_px, result.lsf
+    core = np.abs(x - x[np.argmax(lsf)]) <= result.lsf_half_width_px
+    f = np.linspace(0, 1, 2001)
+    spectrum = np.abs(np.exp(-2j * np.pi * f[:, None] * x[None, core]) @ lsf[core])
+    mtf = spectrum / spectrum[0]
+    i = np.nonzero(mtf < 0.5)[0][0]
+    return f[i]
+
+
+def test_settings_are_validated_by_name():
+    for bad, words in [(dict(step_px=1e-7), "step_px"), (dict(step_px=5), "step_px"),
+                       (dict(lsf_half_width_px=-1), "lsf_half_width_px"),
+                       (dict(lsf_window_factor=1e-9), "lsf_window_factor"),
+                       (dict(bootstrap=5), "replicates"), (dict(bootstrap=10 ** 6), "replicates"),
+                       (dict(colour="red"), "unknown option"), (dict(method="lanczos"), "unknown method"),
+                       (dict(method_options={"window_px": 0}), "window_px"),
+                       (dict(frequencies_cy_px=[0.1, np.nan]), "frequencies"), (dict(force="yes"), "force")]:
+        with pytest.raises(ParameterError, match=words):
+            make_settings(**bad)
+    assert make_settings(bootstrap=200).intervals.replicates == 200
+    assert make_settings(bootstrap=0).intervals.method == "none"
+    assert make_settings(step_px=np.float32(0.05)).step_px == pytest.approx(0.05)
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0)
+    for gsd in (-1, float("nan"), "abc"):
+        with pytest.raises(ParameterError, match="gsd_m"):
+            im.measure_edge(chip, gsd_m=gsd)
+    for saturation in ("x", (5, 1), (0, float("inf"))):
+        with pytest.raises(ParameterError, match="saturation"):
+            im.measure_edge(chip, saturation=saturation)
+    assert im.measure_edge(chip, gsd_m=np.int64(2)).mtf50_cy_m == pytest.approx(
+        im.measure_edge(chip).mtf50_cy_px / 2)
+
+
+def test_intervals_switch_off_and_the_bootstrap_agrees_with_the_linearised_one():
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=10.0, seed=3)
+    none = im.measure_edge(chip, bootstrap=0)
+    assert math.isnan(none.mtf_nyquist_ci.low)
+    linear = im.measure_edge(chip)
+    boot = im.measure_edge(chip, bootstrap=200)
+    assert boot.mtf_nyquist == linear.mtf_nyquist
+    assert boot.mtf_nyquist_ci.width == pytest.approx(linear.mtf_nyquist_ci.width, rel=0.35)
+    assert boot.mtf50_ci_cy_px.width == pytest.approx(linear.mtf50_ci_cy_px.width, rel=0.35)
+
+
+def test_linearised_standard_error_matches_the_spread_of_repeated_chips():
+    """40 chips of one edge under fresh noise: the spread of their MTF at
+    Nyquist against the mean standard error the intervals imply."""
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    estimates, widths = [], []
+    for seed in range(40):
+        r = im.measure_edge(exact_edge_chip(h, 6.0, shape=(60, 60), noise_std=20.0, seed=seed))
+        estimates.append(r.mtf_nyquist)
+        widths.append(r.mtf_nyquist_ci.width)
+    from scipy.special import stdtrit
+    implied = np.mean(widths) / (2 * stdtrit(59, 0.975))
+    assert np.std(estimates) == pytest.approx(implied, rel=0.3)
+
+
+@pytest.mark.parametrize("normal, track, label", [(5.0, 0.0, "across-track"), (-8.0, 0.0, "across-track"),
+                                                  (84.0, 0.0, "along-track"), (-89.0, 0.0, "along-track"),
+                                                  (30.0, 0.0, "oblique"), (30.0, 30.0, "across-track"),
+                                                  (0.0, None, "unknown")])
+def test_direction_label(normal, track, label):
+    assert direction_label(normal, track) == label

@@ -1,0 +1,37 @@
+"""De-quantising a noise-free staircase: the ESF rebuilt through its level
+crossings, against the exact edge response."""
+import numpy as np
+import pytest
+from scipy.special import ndtr
+
+import imgmtf as im
+from imgmtf.estimate.quantisation import dequantise
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
+
+
+def test_the_staircase_of_a_gaussian_edge_is_rebuilt():
+    d = np.random.default_rng(0).uniform(-6, 6, 5000)
+    exact = 100 + 12 * ndtr(d / 0.6)
+    rebuilt = dequantise(d, np.round(exact), 1.0)
+    assert np.abs(rebuilt - exact).max() < 0.05            # 0.4 % of the 12 DN step
+    assert np.abs(np.round(exact) - exact).max() > 0.45     # the staircase itself is off by half a step
+
+
+def test_nothing_to_undo_with_noise_unquantised_values_or_many_levels():
+    d = np.random.default_rng(1).uniform(-6, 6, 5000)
+    exact = 100 + 12 * ndtr(d / 0.6)
+    noisy = np.round(exact + np.random.default_rng(2).normal(0, 1.0, d.size))
+    assert dequantise(d, noisy, 1.0) is None
+    assert dequantise(d, exact, 0.0) is None
+    assert dequantise(d, np.round(100 + 5000 * ndtr(d / 0.6)), 1.0) is None
+
+
+@pytest.mark.parametrize("step, angle", [(12, 5.0), (18, 8.0), (30, 11.0)])
+def test_low_contrast_8_bit_edges_read_true(step, angle):
+    h = gaussian_pixel_transfer(0.5, angle)
+    chip = exact_edge_chip(h, angle, offset=0.3, low=100, high=100 + step, dtype=np.uint8)
+    r = im.measure_edge(chip)
+    assert abs(r.mtf_nyquist - h(0.5)) <= 0.012
+    assert np.isfinite(r.snr) and r.snr == pytest.approx(step * np.sqrt(12), rel=0.01)
+    assert r.params["dequantised"]
