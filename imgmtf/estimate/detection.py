@@ -85,7 +85,8 @@ def _peaks(acc, thetas, rhos, max_lines, min_distance_px=5, min_angle_deg=8.0) -
     return lines
 
 
-def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0) -> tuple[Line, Line | None]:
+def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0,
+              noise: float | None = None) -> tuple[Line, Line | None]:
     """The strongest straight edge of a chip, and a competitor if there is
     one.
 
@@ -94,13 +95,14 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0)
     the image noise.  The competitor is a second such line with at least
     half the support of the first lying more than 3 px away from it inside
     the chip: another edge, or the far side of a bar (the quality gate
-    tells them apart, :mod:`.gate`).
+    tells them apart, :mod:`.gate`).  ``noise`` is the image's pixel noise
+    (DN), measured by :func:`robust_noise` when not given.
 
     Raises
     ------
     TargetNotFoundError : no such line.
     """
-    noise = robust_noise(image)
+    noise = robust_noise(image) if noise is None else noise
     lines = [ln for ln in find_lines(image)
              if ln.votes >= min_votes and step_contrast(image, ln) >= min_contrast * noise]
     if not lines:

@@ -67,8 +67,8 @@ class EdgeKind(TargetKind):
     subtracts_background = False
     restore_min_divisor = MIN_TRANSFER
 
-    def seed(self, data):
-        line, rival = find_edge(data)
+    def seed(self, data, noise):
+        line, rival = find_edge(data, noise=noise)
         checks = []
         if rival is None or parallel_within(line, rival, data.shape, BAR_MAX_SEPARATION_PX):
             return line, checks      # one edge, or a bar's two sides (the profile tells)

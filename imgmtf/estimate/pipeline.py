@@ -204,8 +204,9 @@ class TargetKind:
     profile: ClassVar[str]
     tail_power: ClassVar[int]
 
-    def seed(self, data: np.ndarray):
-        """(line, list of gate checks) for the chip."""
+    def seed(self, data: np.ndarray, noise: float):
+        """(line, list of gate checks) for the chip, whose pixel noise is
+        ``noise`` (DN)."""
         raise NotImplementedError
 
     def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
@@ -270,7 +271,7 @@ def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> Side
     u = x ** -float(power)
     if x.size >= MIN_TAIL_SAMPLES and np.std(u) > 1e-3 * np.mean(u):
         design = np.column_stack([np.ones_like(u), u])
-        operator = np.linalg.pinv(design)
+        operator = np.linalg.solve(design.T @ design, design.T)
     else:
         design = np.ones((x.size, 1))
         operator = np.vstack([np.full(x.size, 1.0 / x.size), np.zeros(x.size)])
@@ -356,9 +357,10 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
     q = quantum(data, stored)
     checks = [gate.fill_check(data, stored)]
+    pixel_noise = robust_noise(data)
 
     try:
-        line, seed_checks = kind.seed(data)
+        line, seed_checks = kind.seed(data, pixel_noise)
         checks += seed_checks
         work, seed_x, transposed = vertical_frame(data, line)
         geometry = kind.locate(work, seed_x, transposed)
@@ -448,7 +450,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
                                      bright_core=kind.peak_mask(s, shape), monotone=kind.monotone)
     checks += gate.side_checks(d, raw, row.astype(float), c, shape.plateau_px, contrast,
-                               robust_noise(data), kind.tail_power)
+                               pixel_noise, kind.tail_power)
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
     checks += snr_failures
     checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))

@@ -22,7 +22,7 @@ from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import check_number
 from ..metrics import fwhm
 from . import gate
-from .detection import bar_contrast, describe, find_lines, parallel_within, robust_noise
+from .detection import bar_contrast, describe, find_lines, parallel_within
 from .geometry import fit_line, row_windows
 from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, run
 from .results import MTFResult, finite
@@ -79,11 +79,10 @@ class PulseKind(TargetKind):
     def __init__(self, width_px: float | None = None):
         self.width_px = None if width_px is None else check_width(width_px)
 
-    def seed(self, data):
+    def seed(self, data, noise):
         lines = find_lines(data)
         if not lines:
             raise TargetNotFoundError("no bar found: no straight line of strong contrast")
-        noise = robust_noise(data)
         lines = [ln for ln in lines if bar_contrast(data, ln) >= 3.0 * noise]
         if not lines:
             raise TargetNotFoundError("no bar found: no straight line stands out of the noise")

@@ -153,9 +153,10 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         a = full[..., None, :] * coef.T                          # (..., order + 1, n_grid)
         # sum over the windows holding a sample's bin of a_k^(j) (u0 + offset)^j,
         # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
-        conv = [correlate1d(a, (-1.0) ** p * offsets ** p, axis=-1, mode="constant")
+        # power p of the offset only meets the coefficients j >= p
+        conv = [correlate1d(a[..., p:, :], (-1.0) ** p * offsets ** p, axis=-1, mode="constant")
                 for p in range(order + 1)]
-        g = np.stack([sum(math.comb(j, m_) * conv[j - m_][..., j, :] for j in range(m_, order + 1))
+        g = np.stack([sum(math.comb(j, m_) * conv[j - m_][..., m_, :] for j in range(m_, order + 1))
                       for m_ in range(order + 1)], axis=-2)      # (..., order + 1, n_grid)
         kept = np.einsum("...mi,im->...i", g[..., bins], u0) * w
         result = np.zeros((*h.shape[:-1], distance.size))

@@ -32,6 +32,7 @@ from ..metrics import first_crossing
 
 MIN_TRANSFER = 0.1
 NYQUIST = 0.5
+MAX_MTF_FREQUENCY = 4.0       # cy/px: an MTF is reported and searched no further
 
 
 def central_difference(grid: np.ndarray, esf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -132,13 +133,17 @@ def corrected_mtf(profile: np.ndarray, step: float,
     if support.size:
         profile = profile[support[0]: support[-1] + 1]
     freqs, modulus = spectrum(profile, step)
-    modulus = modulus / modulus[0]
+    # the correction on the transform's own bins, once (frequencies beyond
+    # MAX_MTF_FREQUENCY are of no use and cost the divisor's evaluation)
+    kept = freqs <= MAX_MTF_FREQUENCY
+    freqs = freqs[kept]
+    div = np.abs(divisor(freqs) / divisor(np.zeros(1)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        corrected = np.where(div >= MIN_TRANSFER, modulus[kept] / modulus[0] / div, np.nan)
 
     def mtf(f):
         f = np.atleast_1d(np.asarray(f, float))
-        div = np.abs(divisor(f) / divisor(np.zeros(1)))
-        value = np.interp(f, freqs, modulus, right=np.nan)
-        return np.where(div >= MIN_TRANSFER, value / np.where(div > 0, div, 1), np.nan)
+        return np.interp(f, freqs, corrected, right=np.nan)
     return mtf
 
 
