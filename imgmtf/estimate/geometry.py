@@ -21,7 +21,7 @@ from .resampling import sample_gap
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
 MAX_SAMPLE_GAP_PX = 0.25       # at least 4 sample positions per pixel
-MAX_HALF_RANGE_PX = 64.0       # profile samples kept within this distance (a long tail's reach)
+MAX_HALF_RANGE_PX = 96.0       # profile samples kept within this distance (a long tail's reach)
 MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
 
 

@@ -21,7 +21,9 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator, make_smoothing_spline
 from scipy.special import ndtr, ndtri
 
-MAX_LEVELS = 256          # with more steps the staircase's own error is below 0.001
+MAX_LEVELS = 256          # with more steps the staircase's own error is below 0.001 at Nyquist
+MAX_CROSSINGS_PER_PX = 100  # denser steps (a sharp edge of many DN) read true as they are, and
+                            # rebuilding them costs the FWHM more than it gains
 MAX_NOISE_QUANTA = 0.5    # noise above half a step dithers the rounding away
 MIN_CROSSINGS = 3
 SMOOTH_ABOVE = 40           # more crossings than this are smoothed, fewer interpolated
@@ -31,8 +33,9 @@ Z_RANGE = 8.0             # the rebuilt ESF is tabulated for |z| <= this
 def dequantise(distance: np.ndarray, values: np.ndarray, quantum: float):
     """Sample values read off the ESF rebuilt through its level crossings,
     or None where the staircase needs no undoing (unquantised data, noise
-    of ``MAX_NOISE_QUANTA`` steps or more, more than ``MAX_LEVELS`` steps,
-    or too few crossings).
+    of ``MAX_NOISE_QUANTA`` steps or more, more than ``MAX_LEVELS`` steps
+    or more than ``MAX_CROSSINGS_PER_PX`` within the 10-90 % rise, or too
+    few crossings).
 
     Parameters
     ----------
@@ -88,6 +91,10 @@ def dequantise(distance: np.ndarray, values: np.ndarray, quantum: float):
     increasing = np.r_[True, np.diff(crossing) > 1e-9]
     crossing, thresholds = crossing[increasing], thresholds[increasing]
     if crossing.size < MIN_CROSSINGS:
+        return None
+    fraction = (thresholds - low) / (high - low)
+    rise = np.interp(0.9, fraction, crossing) - np.interp(0.1, fraction, crossing)
+    if rise > 0 and 0.8 * (high - low) / quantum / rise > MAX_CROSSINGS_PER_PX:
         return None
     z = ndtri((thresholds - low) / (high - low))
     if z.size > SMOOTH_ABOVE:
