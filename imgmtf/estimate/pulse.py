@@ -35,6 +35,7 @@ MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
+OUTER_PX = 5                    # a row window's pixels this far from the centre are background
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
@@ -319,7 +320,13 @@ def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_wi
                 f"fewer than 5 rows hold the bar with {half_window} px of background on both "
                 "sides: the chip is too narrow, or the bar too wide or too close to its border")
         centres = (weight * cols).sum(axis=1)[usable] / total[usable]
-        geometry = fit_line(rows[usable], centres, transposed)
+        # a centroid's noise: the pixel noise (the window's outer pixels'
+        # scatter) times the root-sum-square of the offsets it weighs
+        offsets = cols[usable] - centres[:, None]
+        outer = np.abs(offsets) >= OUTER_PX
+        noise = float(np.std(excess[usable][outer])) if outer.any() else 0.0
+        expected = float(np.median(noise * np.sqrt((offsets ** 2).sum(axis=1)) / total[usable]))
+        geometry = fit_line(rows[usable], centres, transposed, expected)
         centre_x = geometry.slope * rows + geometry.intercept
     return geometry
 
