@@ -159,25 +159,46 @@ def plot_fit(fit, max_edges: int = 6):
 
 
 # -- a measurement (edge or pulse) ---------------------------------------------
+def _title(ax, text: str) -> None:
+    """Title the axes unless the caller already has."""
+    if not ax.get_title():
+        ax.set_title(text)
+
+
+def _view_px(result) -> float:
+    """Half-width (px) of a profile view that shows the LSF's core and the
+    start of its tails."""
+    return float(min(max(6.0, 2.5 * result.lsf_half_width_px), np.abs(result.samples_x_px).max()))
+
+
 def plot_locations(result, ax=None):
-    """Per-row sub-pixel target locations and the fitted line (paper Fig. 5a)."""
+    """Per-row sub-pixel target locations and the fitted line (paper Fig.
+    5a), at equal scale in both axes so that the tilt looks as it is; the
+    rows' RMS scatter about the line is in the legend."""
     fig, ax = _axes(ax)
     g = result.geometry
-    ax.plot(g.locations[g.kept], g.rows[g.kept], "o", ms=3, mfc="none", label=f"row {result.target} location")
-    if (~g.kept).any():
-        ax.plot(g.locations[~g.kept], g.rows[~g.kept], "x", color="C3", label="rejected")
-    ax.plot(g.slope * g.rows + g.intercept, g.rows, "-", color="C1", label="least-squares line")
+    kept = g.kept
+    fitted = g.slope * g.rows + g.intercept
+    rms = float(np.sqrt(np.mean((g.locations[kept] - fitted[kept]) ** 2)))
+    ax.plot(g.locations[kept], g.rows[kept], "o", ms=3, mfc="none",
+            label=f"row {result.target} location (scatter {rms:.3f} px RMS)")
+    if (~kept).any():
+        ax.plot(g.locations[~kept], g.rows[~kept], "x", color="C3", label=f"rejected ({(~kept).sum()})")
+    ax.plot(fitted, g.rows, "-", color="C1", label="least-squares line")
+    ax.set_aspect("equal", adjustable="datalim")
     ax.invert_yaxis()
-    frame = "columns" if not g.transposed else "rows"
-    ax.set(title=f"{result.target.capitalize()} at {result.normal_angle_deg:.2f} deg normal", xlabel=f"position ({frame}, px)",
-           ylabel="row" if not g.transposed else "column")
+    frame = "column" if not g.transposed else "row"
+    ax.set(xlabel=f"{frame} (px)", ylabel="row (px)" if not g.transposed else "column (px)")
+    _title(ax, f"{result.target.capitalize()}: normal at {result.normal_angle_deg:.2f} deg, "
+               f"tilt {result.tilt_deg:.2f} deg")
     ax.legend(fontsize="small")
     return fig
 
 
 def plot_profile(result, ax=None):
     """Over-sampled profile samples and the resampled profile: the ESF of an
-    edge (paper Fig. 5b) or the PRF of a pulse, normalised."""
+    edge (paper Fig. 5b) or the PRF of a pulse, normalised; the LSF window's
+    flat core is shaded, its taper lighter."""
     fig, ax = _axes(ax)
     if result.target == "edge":
         lo, hi = result.levels_dn
@@ -188,49 +209,90 @@ def plot_profile(result, ax=None):
     ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
             color="0.6", label="pixels")
     ax.plot(x, profile, "-", color="C0", label=f"{result.method} profile")
-    ax.set(xlim=(-6, 6), title=f"{name} (SNR {result.snr:.0f})", xlabel="distance from line (px)",
-           ylabel="normalised DN")
-    ax.legend(fontsize="small")
+    _window_bands(ax, result)
+    view = _view_px(result)
+    ax.set(xlim=(-view, view), xlabel="distance from the line along the normal (px)", ylabel="normalised DN")
+    _title(ax, f"{name} (SNR {result.snr:.0f})")
+    ax.legend(fontsize="small", loc="best")
     return fig
+
+
+def _window_bands(ax, result):
+    centre = 0.0
+    core, taper = result.lsf_half_width_px, result.params.get("lsf_taper_px", 0.0)
+    ax.axvspan(centre - core, centre + core, color="C2", alpha=0.08, lw=0, label="LSF window core (data)")
+    for sign in (-1, 1):
+        ax.axvspan(centre + sign * core, centre + sign * (core + taper), color="C2", alpha=0.04, lw=0,
+                   label="taper to the tail model" if sign > 0 else None)
 
 
 def plot_lsf(result, ax=None):
-    """The windowed LSF with its FWHM."""
+    """The recovered LSF with its full width at half maximum marked."""
     fig, ax = _axes(ax)
-    ax.plot(result.lsf_x_px, result.lsf, color="C0")
-    ax.set(xlim=(-6, 6), title=f"LSF, FWHM {result.fwhm_px:.3f} px",
-           xlabel="distance from line (px)", ylabel="LSF (1/px)")
-    return fig
-
-
-def plot_mtf(result, ax=None, truth=None):
-    """The MTF with Nyquist and MTF50 marked; ``truth(f)`` overlays a known
-    MTF (cycles/pixel)."""
-    fig, ax = _axes(ax)
-    f = result.frequencies_cy_px
-    ax.plot(f, result.mtf, color="C0", label="measured")
-    if truth is not None:
-        ax.plot(f, truth(f), "--", color="C2", label="true")
-    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
-    ax.plot([NYQUIST], [result.mtf_nyquist], "o", color="C1",
-            label=f"MTF@Nyquist {result.mtf_nyquist:.4f}")
-    ax.plot([result.mtf50_cy_px], [0.5], "s", color="C3",
-            label=f"MTF50 {result.mtf50_cy_px:.4f} cy/px")
-    ax.set(title="MTF", xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF",
-           ylim=(0, 1.05))
+    x, lsf = result.lsf_x_px, result.lsf
+    ax.plot(x, lsf, color="C0", label="LSF")
+    peak = float(lsf.max())
+    centre = float(x[np.argmax(lsf)])
+    ax.hlines(peak / 2, centre - result.fwhm_px / 2, centre + result.fwhm_px / 2, color="C3",
+              label=f"FWHM {result.fwhm_px:.3f} px" + (f" ({result.fwhm_m:.3g} m)" if result.gsd_m else ""))
+    view = max(4.0, 2.5 * result.fwhm_px)
+    ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
+    _title(ax, "Line spread function")
     ax.legend(fontsize="small")
     return fig
 
 
-def plot_measurement(result, truth=None):
+def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str | None = None):
+    """The MTF along the normal with MTF at Nyquist and MTF50 marked with
+    their confidence intervals, the frequencies beyond the noise limit
+    shaded, and ``truth(f)`` (cycles/pixel) overlaid when known."""
+    fig, ax = _axes(ax)
+    f = result.frequencies_cy_px
+    line, = ax.plot(f, result.mtf, color=color, label=label or "measured")
+    c = line.get_color()
+    if truth is not None:
+        ax.plot(f, truth(f), "--", color="0.2", lw=1.0, label="true")
+    if np.isfinite(result.noise_limit_cy_px) and result.noise_limit_cy_px < f.max():
+        ax.axvspan(result.noise_limit_cy_px, f.max(), color="0.5", alpha=0.1, lw=0,
+                   label=f"below 3 x its noise (from {result.noise_limit_cy_px:.2f} cy/px)")
+    ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8, label="Nyquist, 0.5 cy/px")
+    ci = result.mtf_nyquist_ci
+    yerr = ([[result.mtf_nyquist - ci.low], [ci.high - result.mtf_nyquist]] if np.isfinite(ci.low) else None)
+    ax.errorbar([NYQUIST], [result.mtf_nyquist], yerr=yerr, fmt="o", color=c, capsize=3, ms=4,
+                label=f"MTF@Nyquist {result.mtf_nyquist:.4f}" + (f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""))
+    ci50 = result.mtf50_ci_cy_px
+    xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
+    ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
+                label=f"MTF50 {result.mtf50_cy_px:.4f} cy/px" + (f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""))
+    top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
+    ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
+    if result.gsd_m:
+        gsd = result.gsd_m
+        ax.secondary_xaxis("top", functions=(lambda x: x / gsd, lambda x: x * gsd)).set_xlabel(
+            "frequency (cy/m)")
+    _title(ax, "MTF")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_measurement(result, truth=None, title: str | None = None):
     """Target locations, profile (ESF or PRF), LSF and MTF of one
-    measurement."""
-    fig = Figure(figsize=(11, 8), layout="constrained")
+    measurement, headed by ``title`` (the file) and the figures a report
+    quotes; ``truth(f)`` overlays a known MTF."""
+    fig = Figure(figsize=(12, 8.5), layout="constrained")
     axes = fig.subplots(2, 2)
     plot_locations(result, axes[0, 0])
     plot_profile(result, axes[0, 1])
     plot_lsf(result, axes[1, 0])
     plot_mtf(result, axes[1, 1], truth=truth)
+    ci = result.mtf_nyquist_ci
+    interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if np.isfinite(ci.low) else ""
+    summary = (f"MTF at Nyquist {result.mtf_nyquist:.4f}{interval}, MTF50 {result.mtf50_cy_px:.4f} cy/px, "
+               f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
+               f"{result.rows_used} rows, method {result.method}")
+    if result.warnings:
+        summary += f"\n{len(result.warnings)} warning(s): " + "; ".join(w[:90] for w in result.warnings[:2])
+    fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
     return fig
 
 

@@ -31,7 +31,7 @@ from .sensor.rendering import Renderer
 from .estimate.resampling import METHODS
 from .sensor.model import Sensor
 from .sensor.targets import Target
-from .estimate.intervals import NO_BOOTSTRAP
+from .estimate.intervals import NO_INTERVALS
 
 CHIP_PX = 40
 ANGLE_DEG = 6.0
@@ -69,7 +69,7 @@ def _measure_all(image, methods) -> dict:
     out = {}
     for method in methods:
         try:
-            r = EdgeEstimator(method, correct=True, bootstrap=NO_BOOTSTRAP)(image)
+            r = EdgeEstimator(method, correct=True, intervals=NO_INTERVALS, force=True)(image)
             out[method] = (r.mtf_nyquist, r.snr)
         except ImgmtfError:
             out[method] = (float("nan"), float("nan"))
@@ -118,10 +118,10 @@ def estimator_tables(methods) -> list[dict]:
         for correct in (False, True):
             for method in methods:
                 if kind == "edge":
-                    r = EdgeEstimator(method, correct=correct, bootstrap=NO_BOOTSTRAP)(chip.image)
+                    r = EdgeEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(chip.image)
                     fw = r.fwhm_px
                 else:
-                    r = PulseEstimator(method, correct=correct, bootstrap=NO_BOOTSTRAP)(
+                    r = PulseEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(
                         chip.image, width_px=width)
                     fw = r.prf_fwhm_px
                 paper = PAPER_TABLE[kind].get(method, ("", "")) if not correct else ("", "")

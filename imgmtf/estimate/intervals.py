@@ -120,7 +120,6 @@ def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) ->
     return Intervals("bootstrap", confidence, replicates, seed)
 
 
-NO_BOOTSTRAP = NO_INTERVALS
 
 
 def as_intervals(value) -> Intervals:
