@@ -40,36 +40,55 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     return int(number) if integer else number
 
 
-def prepare_image(image, roi=None) -> tuple[np.ndarray, tuple[int, int]]:
+def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, int]]:
     """Validate a 2-D image and crop it to ``roi`` = (x, y, width, height).
 
-    Returns the float64 crop and the (x, y) of its top-left pixel in the
-    image.  Raises :class:`ParameterError` for a bad ROI and
-    :class:`ImageContentError` for an image that cannot be measured.
+    ``mask`` (a boolean array of the image's shape, True where a pixel
+    belongs to the chip) leaves the other pixels out: they come back as NaN,
+    which every stage skips.  Returns the float64 crop and the (x, y) of its
+    top-left pixel in the image.
+
+    Raises
+    ------
+    ParameterError
+        A bad ROI or mask.
+    ImageContentError
+        An image that cannot be measured (NaN or nodata among the pixels
+        used, too small, flat, values no sensor records).
     """
     array = np.asarray(image)
     if array.ndim != 2:
         raise ImageContentError(f"expected a 2-D image, got an array of shape {array.shape}")
     if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):
         raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
+    if mask is not None:
+        mask = np.asarray(mask)
+        if mask.shape != array.shape or mask.dtype != bool:
+            raise ParameterError(f"the mask must be a boolean array of the image's shape {array.shape}, "
+                                 f"got {mask.dtype} {mask.shape}")
     x0, y0 = 0, 0
     if roi is not None:
         x0, y0, w, h = check_roi(roi, array.shape)
         array = array[y0:y0 + h, x0:x0 + w]
+        mask = None if mask is None else mask[y0:y0 + h, x0:x0 + w]
     data = array.astype(np.float64)
-    bad = ~np.isfinite(data)
-    if bad.all():
+    used = np.ones(data.shape, bool) if mask is None else mask
+    bad = ~np.isfinite(data) & used
+    if bad.all() or not used.any():
         raise ImageContentError("every pixel is NaN or nodata: nothing to measure")
     if bad.any():
         raise ImageContentError(f"{int(bad.sum())} pixel(s) are NaN, infinite or nodata")
     if min(data.shape) < MIN_SIZE_PX:
         raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
-    if np.abs(data).max() > MAX_ABS_DN:
-        raise ImageContentError(f"pixel values reach {np.abs(data).max():.3g}: beyond {MAX_ABS_DN:g} "
+    values = data[used]
+    if np.abs(values).max() > MAX_ABS_DN:
+        raise ImageContentError(f"pixel values reach {np.abs(values).max():.3g}: beyond {MAX_ABS_DN:g} "
                                 "they are not DN an imaging sensor records; rescale the image")
-    if data.max() == data.min():
+    if values.max() == values.min():
         raise ImageContentError("the image is flat: no contrast to measure")
+    if mask is not None:
+        data[~mask] = np.nan
     return data, (x0, y0)
 
 
@@ -77,7 +96,8 @@ def quantum(data: np.ndarray, dtype) -> float:
     """The DN step of the recorded values: 1 for integer types and for
     floats that hold only whole numbers, else 0 (not quantised).  Its
     rounding noise, quantum / sqrt(12), is the floor of any noise estimate."""
-    if np.issubdtype(np.dtype(dtype), np.integer) or np.allclose(data, np.round(data), rtol=0, atol=1e-6):
+    values = data[np.isfinite(data)]
+    if np.issubdtype(np.dtype(dtype), np.integer) or np.allclose(values, np.round(values), rtol=0, atol=1e-6):
         return 1.0
     return 0.0
 

@@ -116,3 +116,22 @@ def test_linearised_standard_error_matches_the_spread_of_repeated_chips():
                                                   (0.0, None, "unknown")])
 def test_direction_label(normal, track, label):
     assert direction_label(normal, track) == label
+
+
+def test_a_mask_leaves_the_fill_around_a_tilted_target_out():
+    """A 16.8 deg edge cut out of a 0 fill (as a calibration chip is): refused
+    whole, measured true inside a tilted mask that stops short of the fill."""
+    angle = 16.8
+    h = gaussian_pixel_transfer(0.5, angle)
+    chip = exact_edge_chip(h, angle, offset=0.2, noise_std=5.0, seed=2).astype(float)
+    y, x = np.mgrid[0:100, 0:100].astype(float)
+    a = math.radians(angle)
+    across = (x - 49.5) * math.cos(a) + (y - 49.5) * math.sin(a)
+    along = -(x - 49.5) * math.sin(a) + (y - 49.5) * math.cos(a)
+    chip[(np.abs(across) >= 30) | (np.abs(along) >= 25)] = 0
+    with pytest.raises(im.ImgmtfError, match="fill"):
+        im.measure_edge(chip.astype(np.uint16))
+    r = im.measure_edge(chip.astype(np.uint16), mask=(np.abs(across) < 28) & (np.abs(along) < 23))
+    assert abs(r.mtf_nyquist - h(0.5)) < 0.02 and r.normal_angle_deg == pytest.approx(angle, abs=0.1)
+    with pytest.raises(ParameterError, match="mask"):
+        im.measure_edge(chip, mask=np.ones((3, 3), bool))

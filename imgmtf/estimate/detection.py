@@ -54,14 +54,16 @@ def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> lis
                                                     + math.sin(math.radians(ln.theta_deg))),
                      ln.votes)
                 for ln in find_lines(small, max_lines, sigma)]
-    lo, hi = np.percentile(image, [1, 99])
+    valid = np.isfinite(image)
+    lo, hi = np.percentile(image[valid], [1, 99])
     if not hi > lo:
         raise ImageContentError("the image is flat: no contrast to measure")
-    norm = (image - lo) / (hi - lo)
-    edges = canny(norm, sigma=sigma, low_threshold=0.1, high_threshold=0.2)
+    norm = (fill_nearest(image, valid) - lo) / (hi - lo)
+    mask = None if valid.all() else valid
+    edges = canny(norm, sigma=sigma, low_threshold=0.1, high_threshold=0.2, mask=mask)
     if edges.sum() < 5:
         edges = canny(norm, sigma=sigma, low_threshold=0.5, high_threshold=0.8,
-                      use_quantiles=True)
+                      use_quantiles=True, mask=mask)
     if edges.sum() < 5:
         return []
     acc, thetas, rhos = hough_line(edges, theta=_THETAS)
@@ -148,10 +150,23 @@ def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
     return x * math.cos(t) + y * math.sin(t) - line.rho_px
 
 
+def fill_nearest(image: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """``image`` with every pixel outside ``valid`` set to its nearest valid
+    pixel's value: left-out pixels continue the chip instead of cutting a
+    false edge into it."""
+    if valid.all():
+        return image
+    from scipy.ndimage import distance_transform_edt
+    index = distance_transform_edt(~valid, return_distances=False, return_indices=True)
+    return image[tuple(index)]
+
+
 def robust_noise(image: np.ndarray) -> float:
     """Noise standard deviation (DN) from the median absolute difference of
-    horizontally adjacent pixels, which an edge barely affects."""
+    horizontally adjacent pixels, which an edge barely affects (pairs with a
+    left-out, NaN, pixel skipped)."""
     diff = np.diff(image, axis=1)
+    diff = diff[np.isfinite(diff)]
     mad = np.median(np.abs(diff - np.median(diff)))
     # a noise-free (or coarsely quantised) image has MAD 0: its noise is nil
     return max(float(1.4826 * mad / np.sqrt(2.0)), 1e-12)
@@ -160,7 +175,8 @@ def robust_noise(image: np.ndarray) -> float:
 def step_contrast(image: np.ndarray, line: Line) -> float:
     """|mean level 1-5 px on one side of ``line`` - on the other| (DN)."""
     d = line_distance(image.shape, line)
-    near, far = (d > 1) & (d < 5), (d < -1) & (d > -5)
+    valid = np.isfinite(image)
+    near, far = (d > 1) & (d < 5) & valid, (d < -1) & (d > -5) & valid
     if not near.any() or not far.any():
         return 0.0
     return float(abs(image[near].mean() - image[far].mean()))
@@ -171,13 +187,14 @@ def bar_contrast(image: np.ndarray, line: Line, reach_px: float = 8.0) -> float:
     median| within ``reach_px`` of the line (DN): large for a bar along it,
     wherever across the strips the seed line fell; small for noise."""
     d = line_distance(image.shape, line)
-    near = np.abs(d) < reach_px
+    valid = np.isfinite(image)
+    near = (np.abs(d) < reach_px) & valid
     if not near.any():
         return 0.0
     strips = np.floor(d[near] + reach_px).astype(int)
     counts = np.bincount(strips)
     means = np.bincount(strips, weights=image[near])[counts > 0] / counts[counts > 0]
-    return float(np.max(np.abs(means - np.median(image))))
+    return float(np.max(np.abs(means - np.median(image[valid]))))
 
 
 def _separation(a: Line, b: Line, shape) -> float:

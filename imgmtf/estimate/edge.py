@@ -164,11 +164,11 @@ class EdgeEstimator:
     def method(self) -> str:
         return self.settings.method
 
-    def __call__(self, image, *, roi=None, gsd_m: float | None = None,
+    def __call__(self, image, *, roi=None, mask=None, gsd_m: float | None = None,
                  saturation: tuple[float, float] | None = None, dtype=None,
                  track_azimuth_deg: float | None = 0.0) -> EdgeResult:
         """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
-        m = run(EdgeKind(), image, self.settings, roi=roi, gsd_m=gsd_m, saturation=saturation,
+        m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
                 dtype=dtype, track_azimuth_deg=track_azimuth_deg)
         f, a = m.figures, m.arrays
         left, right = f["side_levels"]
@@ -188,7 +188,7 @@ class EdgeEstimator:
             esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
 
 
-def measure_edge(image, *, roi=None, method: str = "msg", gsd_m: float | None = None,
+def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: float | None = None,
                  saturation: tuple[float, float] | None = None, force: bool = False,
                  track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> EdgeResult:
     """Measure the MTF of the straight edge in ``image``.
@@ -200,6 +200,9 @@ def measure_edge(image, *, roi=None, method: str = "msg", gsd_m: float | None = 
         least.
     roi : (int, int, int, int), optional
         (x, y, width, height) crop, px.
+    mask : ndarray of bool, optional
+        Of the image's shape: True for the pixels that belong to the chip
+        (a tilted ROI, a target cut out of its fill), the others left out.
     method : str
         "msg" (default), "sliding", "spline" or "iso".
     gsd_m : float, optional
@@ -240,7 +243,8 @@ def measure_edge(image, *, roi=None, method: str = "msg", gsd_m: float | None = 
     True
     """
     return EdgeEstimator(method, force=force, **options)(
-        image, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        image, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+        track_azimuth_deg=track_azimuth_deg)
 
 
 def _bright_side(rising: bool, transposed: bool) -> str:

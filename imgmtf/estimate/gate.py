@@ -100,18 +100,22 @@ def fill_check(image: np.ndarray, dtype) -> Check:
     negative minimum where the rest is not negative (-9999); all but 0
     must also lie well outside the rest's range (a sentinel, not a clipped
     target's level)."""
+    used = np.isfinite(image)          # left-out pixels (NaN) are not part of the chip
+    if not used.all():
+        image = np.where(used, image, np.nan)
+    values = image[used]
     candidates = {0.0}
     if np.issubdtype(np.dtype(dtype), np.integer):
         info = np.iinfo(np.dtype(dtype))
         candidates |= {float(info.min), float(info.max)}
-    if image.min() < 0 <= np.partition(image.ravel(), min(image.size - 1, image.size // 2))[image.size // 2]:
-        candidates.add(float(image.min()))
+    if values.min() < 0 <= np.median(values):
+        candidates.add(float(values.min()))
     for value in sorted(candidates):
         mask = image == value
         count = int(mask.sum())
-        if count < 8 or count < MIN_FILL_FRACTION * image.size or count == image.size:
+        if count < 8 or count < MIN_FILL_FRACTION * values.size or count == values.size:
             continue
-        rest = image[~mask]
+        rest = image[~mask & used]
         lo, hi = float(rest.min()), float(rest.max())
         contrast = hi - lo
         if contrast <= 0 or (value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast):
@@ -121,12 +125,12 @@ def fill_check(image: np.ndarray, dtype) -> Check:
         border[:-1, :] |= mask[1:, :]
         border[:, 1:] |= mask[:, :-1]
         border[:, :-1] |= mask[:, 1:]
-        border &= ~mask
+        border &= ~mask & used
         if not border.any():
             continue
         jump = float(np.median(np.abs(image[border] - value))) / contrast
         if jump > FILL_BOUNDARY:
-            return Check("fill", False, f"{100 * count / image.size:.1f} % of the chip is fill at "
+            return Check("fill", False, f"{100 * count / values.size:.1f} % of the chip is fill at "
                          f"{value:g} DN with a hard boundary (no nodata tag declares it): crop the "
                          "ROI away from it", jump, FILL_BOUNDARY)
     return Check("fill", True, "no fill in the chip")

@@ -113,12 +113,14 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,
 def row_windows(image: np.ndarray, centre_x: np.ndarray, half_window: int):
     """Each row's pixels within ``half_window`` of ``centre_x``: (cols,
     values, inside), arrays of n_rows x (2 half_window + 1), ``inside``
-    False where the window leaves the image."""
+    False where the window leaves the image or meets a left-out (NaN)
+    pixel, whose value is then 0."""
     rows_n, cols_n = image.shape
     cols = np.rint(centre_x).astype(int)[:, None] + np.arange(-half_window, half_window + 1)[None, :]
     inside = (cols >= 0) & (cols < cols_n)
     values = image[np.arange(rows_n)[:, None], np.clip(cols, 0, cols_n - 1)]
-    return cols, values, inside
+    inside &= np.isfinite(values)
+    return cols, np.where(inside, values, 0.0), inside
 
 
 def vertical_frame(image: np.ndarray, line: Line) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -160,13 +162,15 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
     d = geometry.distance(cols[None, :], rows[:, None].astype(float))
     v = work[rows]
     row = np.broadcast_to(rows[:, None], d.shape)
-    reach = np.minimum(-d[:, 0], d[:, -1])
+    valid = np.isfinite(v)
+    # how far each row's data reach on either side of the line (left-out pixels skipped)
+    reach = np.minimum(-np.where(valid, d, np.inf).min(axis=1), np.where(valid, d, -np.inf).max(axis=1))
     half_range = min(float(np.quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
     if half_range < MIN_HALF_RANGE_PX:
         raise UnsuitableTargetError(
             f"the {name} is {max(half_range, 0):.1f} px from the image border; at least "
             f"{MIN_HALF_RANGE_PX:g} px of flat level are needed on each side", reason="border")
-    inside = np.abs(d) <= half_range
+    inside = (np.abs(d) <= half_range) & valid
     d, v, row = d[inside], v[inside], row[inside]
     if np.count_nonzero(np.abs(d) < 2.0) < 20:
         raise UnsuitableTargetError(f"too few samples near the {name}")

@@ -327,13 +327,16 @@ class Measurement:
     params: dict
 
 
-def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, saturation=None,
+def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd_m=None, saturation=None,
         dtype=None, track_azimuth_deg: float | None = 0.0) -> Measurement:
     """Measure the target of ``kind`` in ``image`` (2-D array, DN).
 
     Parameters
     ----------
     roi : (x, y, width, height) crop, px, or None.
+    mask : boolean array of the image's shape, True for the pixels that
+        belong to the chip (a tilted ROI, a target cut out of its fill);
+        None for all.
     gsd_m : ground sample distance (m) or None.
     saturation : (low, high) DN the sensor records, or None for an
         integer image's type range (floats: none declared).
@@ -350,7 +353,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     """
     array = np.asarray(image)
     stored = np.dtype(dtype) if dtype is not None else array.dtype
-    data, (x0, y0) = prepare_image(array, roi)
+    data, (x0, y0) = prepare_image(array, roi, mask)
     gsd_m = None if gsd_m is None else check_number("gsd_m", gsd_m, positive=True)
     if track_azimuth_deg is not None:
         track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
@@ -383,9 +386,11 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, gsd_m=None, sa
     resampled = resample_profile(d, v, method=settings.method, step=settings.step_px,
                                  half_range=half_range - 0.6, **settings.method_options)
     grid, values, span = _central_run(resampled.grid, resampled.values, kind.name)
-    if not gate.kind_check(gate.classify_profile(values), kind.profile).passed:
-        failed = gate.kind_check(gate.classify_profile(values), kind.profile)
-        raise UnsuitableTargetError(failed.message, reason=failed.reason)
+    kind_check = gate.kind_check(gate.classify_profile(values), kind.profile)
+    if not kind_check.passed:
+        if not settings.force:       # fill or a second target explain the profile's shape
+            gate.enforce([c for c in checks if c.reason in ("fill", "two-targets")], force=False)
+        raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
     shape = kind.shape(grid, values, d, v, half_range)
     c = shape.centre
     s = d - c

@@ -180,11 +180,11 @@ class PulseEstimator:
     def method(self) -> str:
         return self.settings.method
 
-    def __call__(self, image, *, width_px: float | None = None, roi=None, gsd_m: float | None = None,
+    def __call__(self, image, *, width_px: float | None = None, roi=None, mask=None, gsd_m: float | None = None,
                  saturation=None, dtype=None, track_azimuth_deg: float | None = 0.0) -> PulseResult:
         """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
         (estimated from the profile when None); see :func:`measure_pulse`."""
-        m = run(PulseKind(width_px), image, self.settings, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+        m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
                 track_azimuth_deg=track_azimuth_deg)
         f, a = m.figures, m.arrays
         width = f["width_px"]
@@ -211,7 +211,7 @@ class PulseEstimator:
             peak_dn=float(peak))
 
 
-def measure_pulse(image, *, width_px: float | None = None, roi=None, method: str = "msg",
+def measure_pulse(image, *, width_px: float | None = None, roi=None, mask=None, method: str = "msg",
                   gsd_m: float | None = None, saturation=None, force: bool = False,
                   track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> PulseResult:
     """Measure the MTF from the bar (pulse) in ``image``.
@@ -223,7 +223,7 @@ def measure_pulse(image, *, width_px: float | None = None, roi=None, method: str
     width_px : float, optional
         The bar's width along its normal (px); estimated from the first
         zero of the PRF's spectrum when None.
-    roi, method, gsd_m, saturation, force, track_azimuth_deg, dtype, **options
+    roi, mask, method, gsd_m, saturation, force, track_azimuth_deg, dtype, **options
         As for :func:`imgmtf.measure_edge`.
 
     Returns
@@ -246,7 +246,7 @@ def measure_pulse(image, *, width_px: float | None = None, roi=None, method: str
     True
     """
     return PulseEstimator(method, force=force, **options)(
-        image, width_px=width_px, roi=roi, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+        image, width_px=width_px, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
         track_azimuth_deg=track_azimuth_deg)
 
 
@@ -305,7 +305,7 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
 def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_window: int = 12):
     """Per-row bar centres (centroids of the background-subtracted profile
     within ``half_window`` px), re-centred twice on the fitted line."""
-    background = np.median(work, axis=1)
+    background = np.nanmedian(work, axis=1)
     rows = np.arange(work.shape[0])
     centre_x = seed_x
     for _ in range(3):
