@@ -105,9 +105,9 @@ def test_rgb_photo_is_luminance_by_default_and_per_channel_with_band_all(tmp_pat
                                                         rasterio.enums.ColorInterp.green,
                                                         rasterio.enums.ColorInterp.blue])
     settings = MeasureSettings()
-    (lum,) = measure_file(str(path), settings)
+    (lum,) = (r.to_dict() for r in measure_file(str(path), settings))
     assert lum["band"] == "luminance" and lum["status"] == "ok"
-    per_band = measure_file(str(path), MeasureSettings(band="all"))
+    per_band = [r.to_dict() for r in measure_file(str(path), MeasureSettings(band="all"))]
     assert [r["band"] for r in per_band] == [1, 2, 3]
     # the same edge in every channel: the same MTF (to quantisation of the dimmer channels)
     for r in per_band:
@@ -119,8 +119,8 @@ def test_float_image_with_negative_values_measures_like_its_offset_copy(tmp_path
                            dtype=np.float32)
     negative = write(tmp_path / "negative.tif", edge)
     shifted = write(tmp_path / "shifted.tif", edge + 1000.0)
-    a, = measure_file(str(negative), MeasureSettings())
-    b, = measure_file(str(shifted), MeasureSettings())
+    a, = (r.to_dict() for r in measure_file(str(negative), MeasureSettings()))
+    b, = (r.to_dict() for r in measure_file(str(shifted), MeasureSettings()))
     assert a["status"] == "ok" and a["levels_dn"][0] < 0
     assert a["mtf_nyquist"] == pytest.approx(b["mtf_nyquist"], abs=2e-4)
 
@@ -155,6 +155,6 @@ def test_windowed_read_reports_roi_in_file_coordinates(tmp_path):
     path = write(tmp_path / "scene.tif", scene.astype(np.uint16))
     raster = im.read_raster(path, window=(100, 60, 64, 64))
     assert raster.data.shape == (64, 64) and raster.origin == (100, 60)
-    record, = measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64)))
+    record, = (r.to_dict() for r in measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64))))
     assert record["roi"] == [100, 60, 64, 64]
     assert record["normal_angle_deg"] == pytest.approx(6.0, abs=0.05)

@@ -26,7 +26,7 @@ def tile_of(record):
 
 @pytest.fixture(scope="module")
 def edge_scan():
-    return scan_scene(str(SCENE))
+    return [r.to_dict() for r in scan_scene(str(SCENE))]
 
 
 def test_scan_accepts_the_good_edges_with_true_mtf_in_their_intervals(edge_scan):
@@ -55,7 +55,7 @@ def test_scan_rejects_the_mosaic_seams_as_axis_aligned(edge_scan):
 
 
 def test_scan_measures_the_bar_as_a_pulse_target():
-    records = scan_scene(str(SCENE), ScanSettings(target="pulse", pulse_width=(3.0, "px")))
+    records = [r.to_dict() for r in scan_scene(str(SCENE), ScanSettings(target="pulse", pulse_width=(3.0, "px")))]
     accepted = [r for r in records if r["status"] == "accepted"]
     assert len(accepted) == 1 and tile_of(accepted[0])["verdict"] == "bar"
     assert accepted[0]["bar_width_px"] == pytest.approx(3.0, abs=0.6)
