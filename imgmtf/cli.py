@@ -219,8 +219,12 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
         if kind == "pulse":
             value, unit = pulse_width
             width_px = value if unit == "px" else value / gsd_m
-            if not 0 < width_px <= size:
-                raise ParameterError(f"the pulse width must be > 0 and at most the chip ({size} px), "
+            from .estimate.pulse import MIN_WIDTH_PX
+            if not width_px >= MIN_WIDTH_PX:
+                raise ParameterError(f"a {width_px:g} px wide pulse is narrower than the {MIN_WIDTH_PX} px "
+                                     "imgmtf can measure (is the unit right?)")
+            if width_px > size:
+                raise ParameterError(f"the pulse width must be at most the chip ({size} px), "
                                      f"got {width_px:g} px")
         target = Target(kind, angle, low, high, offset, width_px)
         chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),

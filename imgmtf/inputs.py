@@ -124,3 +124,4 @@ def saturation_levels(dtype) -> tuple[float, float] | None:
         info = np.iinfo(dtype)
         return float(info.min), float(info.max)
     return None
+

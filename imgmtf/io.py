@@ -306,5 +306,9 @@ def _gsd_m(src) -> float | None:
 
 
 def _reason(exc: Exception) -> str:
+    """GDAL's own first line; rasterio sometimes wraps it in "see previous
+    exception", whose text is the cause's."""
     text = str(exc).strip() or type(exc).__name__
+    if "previous exception" in text and exc.__cause__ is not None:
+        text = str(exc.__cause__).strip() or text
     return text.splitlines()[0]
