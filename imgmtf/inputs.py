@@ -124,4 +124,3 @@ def saturation_levels(dtype) -> tuple[float, float] | None:
         info = np.iinfo(dtype)
         return float(info.min), float(info.max)
     return None
-

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import rasterio
-from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
+from rasterio.errors import NotGeoreferencedWarning, RasterioError
 from rasterio.transform import Affine
 from rasterio.windows import Window
 
@@ -29,6 +29,12 @@ from .inputs import check_roi
 
 # Rec. 709 luma weights, applied to the stored (encoded) values of RGB input
 LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+
+try:     # GDAL's own errors, which rasterio raises as they are from some calls
+    from rasterio._err import CPLE_BaseError
+except ImportError:       # pragma: no cover - a rasterio without the private module
+    CPLE_BaseError = RasterioError
+GDAL_ERRORS = (RasterioError, CPLE_BaseError)
 
 # The most pixels one read returns: 16 Mpx (4096 x 4096) is 128 MiB as
 # float64, far more than any edge or bar needs, and few enough that the
@@ -101,7 +107,7 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                 with rasterio.open(partial, "w", **profile) as dst:
                     dst.write(bands)
                     dst.update_tags(**tags)
-        except (RasterioIOError, OSError) as exc:
+        except (*GDAL_ERRORS, OSError) as exc:
             raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
 
 
@@ -254,7 +260,7 @@ def _opened(path):
                                          "an MTF needs real DN: convert the band you want first "
                                          "(e.g. its magnitude)", reason="unsupported-type")
                 yield src
-    except RasterioIOError as exc:
+    except GDAL_ERRORS as exc:
         kind = _image_kind(path)
         if kind:
             raise ImageReadError(f"{path}: a {kind} file that is damaged or truncated "
@@ -284,7 +290,7 @@ def _band(src, index: int, window: Window, out_shape=None) -> np.ndarray:
     """Band ``index`` as float64 with nodata (mask) set to NaN."""
     try:
         values = src.read(index, window=window, masked=True, out_shape=out_shape)
-    except RasterioIOError as exc:
+    except GDAL_ERRORS as exc:
         raise ImageReadError(f"{src.name}: the file is damaged or truncated ({_reason(exc)})") from None
     data = values.data.astype(np.float64)
     data[np.ma.getmaskarray(values)] = np.nan

@@ -158,3 +158,50 @@ def test_windowed_read_reports_roi_in_file_coordinates(tmp_path):
     record, = (r.to_dict() for r in measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64))))
     assert record["roi"] == [100, 60, 64, 64]
     assert record["normal_angle_deg"] == pytest.approx(6.0, abs=0.05)
+
+
+def test_fifo_and_complex_pixels_are_refused_by_name_and_the_batch_goes_on(tmp_path, good):
+    fifo = tmp_path / "pipe.tif"
+    os.mkfifo(fifo)
+    complex_tif = write(tmp_path / "complex.tif", np.ones((32, 32), np.complex64))
+    result = CliRunner().invoke(main, ["measure", "--format", "json", str(fifo), str(complex_tif),
+                                       str(good)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert result.exit_code == 1 and [r["status"] for r in rows] == ["error", "error", "ok"]
+    assert rows[0]["error"] == f"{fifo}: is a FIFO (named pipe), not an image file; imgmtf reads regular files only"
+    assert rows[1]["reason"] == "unsupported-type" and "complex64" in rows[1]["error"]
+
+
+def test_a_fifo_in_a_folder_is_reported_not_skipped(tmp_path, good):
+    os.mkfifo(tmp_path / "pipe.tif")
+    assert str(tmp_path / "pipe.tif") in expand_inputs([tmp_path])
+
+
+def test_an_unexpected_failure_is_an_internal_error_record_for_that_file_only(tmp_path, good, monkeypatch):
+    import imgmtf.batch as batch
+    real = batch.measure_raster
+
+    def fails_on_one(raster, settings):
+        if raster.path.endswith("boom.tif"):
+            raise TypeError("unsupported operand")
+        return real(raster, settings)
+    monkeypatch.setattr(batch, "measure_raster", fails_on_one)
+    boom = write(tmp_path / "boom.tif", exact_edge_chip(TRANSFER, 6.0, (64, 64)))
+    result = CliRunner().invoke(main, ["measure", "--format", "json", str(boom), str(good)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert rows[0]["reason"] == "internal"
+    assert rows[0]["error"] == f"{boom}: internal error: TypeError: unsupported operand"
+    assert rows[1]["status"] == "ok"
+
+
+def test_mixed_batch_keeps_every_row_in_input_order_with_workers(tmp_path, good):
+    cases = bad_inputs(tmp_path)
+    paths = [str(p) for p, _ in cases.values()] * 2 + [str(good)] * 3
+    out_csv = tmp_path / "rows.csv"
+    result = CliRunner().invoke(main, ["measure", "--format", "json", "--workers", "2", "--bootstrap", "0",
+                                       "--csv", str(out_csv), *paths])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [r["path"] for r in rows] == paths
+    assert [r["path"] for r in csv.DictReader(out_csv.open())] == paths
+    assert all(r["reason"] and r["error"] for r in rows if r["status"] == "error")

@@ -67,7 +67,7 @@ def test_roi_and_band(run, chip):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["simulate", "--target", "pulse", "--pulse-width", "-2", "--out", "{tmp}/a.tif"], "pulse width must be > 0"),
+    (["simulate", "--target", "pulse", "--pulse-width", "-2", "--out", "{tmp}/a.tif"], "a pulse width of -2 px"),
     (["simulate", "--out", "{tmp}/no/such/dir/a.tif"], "cannot write"),
     (["simulate", "--sensor", "{tmp}/bad.toml", "--out", "{tmp}/a.tif"], "malformed TOML"),
     (["sensor", "--sensor", "{tmp}/missing.toml"], "cannot read"),
@@ -149,3 +149,60 @@ def test_pulse_width_errors(run, chip, tmp_path):
             dst.write(np.full((1, 40, 40), 9, np.uint8))
     r = run("measure", "--target", "pulse", "--pulse-width", "2m", "--format", "json", png)
     assert r.exit_code == 1 and "needs a georeferenced image" in json.loads(r.stdout)["error"]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["measure", "--bootstrap", "100000", "x.tif"], "0<=x<=2000"),
+    (["simulate", "--size", "100000", "--out", "a.tif"], "2<=x<=8192"),
+    (["simulate", "--oversampling", "100000", "--out", "a.tif"], "1<=x<=100"),
+    (["simulate", "--seed", "-1", "--out", "a.tif"], "x>=0"),
+    (["simulate", "--angle", "120", "--out", "a.tif"], "-90<x<=90"),
+    (["simulate", "--gsd", "-1", "--out", "a.tif"], "x>0"),
+    (["simulate", "--noise-std", "nan", "--out", "a.tif"], "not a finite number"),
+    (["measure", "--roi", "0,0,0,5", "x.tif"], "W, H > 0"),
+    (["measure", "--band", "0", "x.tif"], "numbered from 1"),
+    (["scan", "--margin", "2", "x.tif"], "6<=x<=1000"),
+])
+def test_out_of_range_options_are_usage_errors_naming_the_limit(run, args, words):
+    result = run(*args)
+    assert result.exit_code == 2 and words in result.output and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--size", "5000"], "sub-pixel scene"),
+    (["--gsd", "1e-9"], "raise --gsd"),
+    (["--target", "pulse", "--pulse-width", "1e-300px"], "below the 0.1 px"),
+])
+def test_simulate_refuses_what_would_not_fit_before_allocating(run, tmp_path, args, words):
+    result = run("simulate", *args, "--out", tmp_path / "a.tif")
+    assert result.exit_code == 1 and words in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and not (tmp_path / "a.tif").exists()
+
+
+def test_unwritable_outputs_are_named_before_any_work(run, chip, tmp_path):
+    blocker = tmp_path / "afile.txt"
+    blocker.write_text("x")
+    for args in (["--plot-dir", blocker / "sub"], ["--csv", blocker / "sub" / "out.csv"],
+                 ["--plot", blocker / "p.png"]):
+        result = run("measure", *args, chip)
+        assert result.exit_code == 1, args
+        assert str(args[1]) in result.stderr and "Traceback" not in result.output
+        assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_binary_sensor_file_is_one_line(run, tmp_path):
+    toml = tmp_path / "bin.toml"
+    toml.write_bytes(bytes(range(256)))
+    result = run("simulate", "--sensor", toml, "--out", tmp_path / "a.tif")
+    assert result.exit_code == 1 and str(toml) in result.stderr and "Traceback" not in result.output
+
+
+def test_help_imports_no_numerical_library():
+    import subprocess
+    import sys
+    code = ("import sys; from click.testing import CliRunner; from imgmtf.cli import main; "
+            "assert CliRunner().invoke(main, ['--help']).exit_code == 0; "
+            "print(sorted(m for m in ('numpy', 'scipy', 'skimage', 'cv2', 'rasterio', 'matplotlib', "
+            "'dask', 'tqdm') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

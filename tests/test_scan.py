@@ -94,3 +94,34 @@ def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
     im.write_geotiff(flat, (1000 + rng.normal(0, 5, (128, 128))).astype(np.uint16))
     result = CliRunner().invoke(main, ["scan", str(flat)])
     assert result.exit_code == 1 and f"{flat}: no usable edge found" in result.output
+
+
+def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--target", "pulse", "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    assert "1 accepted" in result.stdout and "Traceback" not in result.output
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--target", "pulse", "--bootstrap", "0",
+                                       "--format", "json", "--out", str(tmp_path)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    accepted = [r for r in rows if r["status"] == "accepted"]
+    assert len(accepted) == 1 and accepted[0]["mtf50_cy_px"] is None and accepted[0]["rank"] == 1
+    header = (tmp_path / "targets.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["id", "rank", "path"] and "bar_width_px" in header and "run_utc" in header
+
+
+def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
+    import imgmtf.scan as scan_module
+    calls = []
+
+    def breaks_once(raster, settings):
+        calls.append(raster.origin)
+        if len(calls) == 1:
+            raise ZeroDivisionError("float division by zero")
+        return real(raster, settings)
+    real = scan_module.measure_raster
+    monkeypatch.setattr(scan_module, "measure_raster", breaks_once)
+    records = scan_scene(str(SCENE), ScanSettings(bootstrap=im.Bootstrap(0)))
+    internal = [r for r in records if r.reason == "internal"]
+    assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error
+    assert internal[0].error.startswith(str(SCENE))
+    assert sum(r.ok for r in records) >= 1
