@@ -31,7 +31,7 @@ from datetime import datetime, timezone
 from typing import IO, Any
 
 from .atomic import atomic_output
-from .errors import FileWriteError
+from .errors import FileWriteError, ImgmtfError
 from .version import __version__
 
 OK_STATUSES = ("ok", "accepted")
@@ -102,9 +102,10 @@ class Record:
         """A record of a target that could not be measured: the reason code
         of an imgmtf error, ``internal`` for any other exception; the
         message names the file (prefixed when it does not)."""
-        reason = getattr(exc, "reason", None)
         message = " ".join(str(exc).split())
-        if not isinstance(reason, str):
+        if isinstance(exc, ImgmtfError):
+            reason = exc.reason
+        else:
             reason = INTERNAL
             message = f"internal error: {type(exc).__name__}: {message or 'no message'}"
         if not message.startswith(str(path)):

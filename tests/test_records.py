@@ -33,6 +33,8 @@ def test_failed_record_has_a_reason_and_a_message_naming_the_file():
     assert (record.reason, record.error) == ("unreadable", "b.tif: no such file")
     other = Record.failed("c.tif", 2, "edge", "msg", KeyError("mtf50"), params={}, run_utc="")
     assert other.reason == "internal" and other.error == "c.tif: band 2: internal error: KeyError: 'mtf50'"
+    decode = UnicodeDecodeError("utf-8", b"\x80", 0, 1, "invalid start byte")   # has a .reason of its own
+    assert Record.failed("d.tif", None, "edge", "msg", decode, params={}, run_utc="").reason == "internal"
 
 
 def test_csv_schema_names_units_and_scan_extends_it():
