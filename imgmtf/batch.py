@@ -13,7 +13,7 @@ from pathlib import Path
 from .atomic import atomic_output, ensure_folder
 from .errors import FileWriteError, ImgmtfError, ParameterError
 from .estimate.edge import EdgeEstimator
-from .estimate.intervals import Bootstrap
+from .estimate.intervals import Intervals
 from .estimate.pulse import PulseEstimator, check_width
 from .inputs import saturation_levels
 from .io import raster_info, read_raster
@@ -34,7 +34,7 @@ class MeasureSettings:
         RGB luminance.
     roi : (x, y, width, height) window read from every file (px).
     pulse_width : (value, "px" or "m"), or None to estimate it.
-    bootstrap : confidence-interval settings.
+    intervals : confidence-interval settings (linearised by default).
     """
 
     target: str = "edge"
@@ -42,7 +42,7 @@ class MeasureSettings:
     band: int | str | None = None
     roi: tuple[int, int, int, int] | None = None
     pulse_width: tuple[float, str] | None = None
-    bootstrap: Bootstrap = field(default_factory=Bootstrap)
+    intervals: Intervals = field(default_factory=Intervals)
 
     def __post_init__(self):
         if self.target not in ("edge", "pulse"):
@@ -55,11 +55,11 @@ class MeasureSettings:
 
     def estimator(self):
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
-        return kind(self.method, bootstrap=self.bootstrap)
+        return kind(self.method, intervals=self.intervals)
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
-        return {"bootstrap": self.bootstrap.as_dict(), "roi": list(self.roi) if self.roi else None,
+        return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
                 "band": self.band,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None}
 

@@ -25,7 +25,6 @@ from .errors import FileWriteError, ImgmtfError, ParameterError
 from .version import __version__
 
 # Bounds of the size-like options (see docs): what a run may allocate.
-MAX_REPLICATES = 2000               # --bootstrap: replicates x samples of every chip in memory
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
 
@@ -377,18 +376,26 @@ def _parallel_options(command):
                         help="parallel worker processes, each on one thread (at most 64)")(command)
 
 
-def _bootstrap_options(command):
+def _interval_options(command):
+    """--intervals, --bootstrap and --confidence, shared by measure and scan."""
     command = click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True),
                            default=0.95, show_default=True, help="confidence of the intervals")(command)
-    return click.option("--bootstrap", "replicates", type=click.IntRange(0, MAX_REPLICATES), default=200,
-                        show_default=True,
-                        help=f"bootstrap replicates for the confidence intervals (0: none; at most "
-                             f"{MAX_REPLICATES})")(command)
+    command = click.option("--bootstrap", "replicates", type=click.IntRange(min=0), metavar="N",
+                           help="intervals from a bootstrap of N row resamplings (20 to 5000; slower); "
+                                "0: no intervals")(command)
+    return click.option("--intervals", "interval_method", type=click.Choice(["influence", "bootstrap", "none"]),
+                        default="influence", show_default=True,
+                        help="confidence intervals: linearised row influence (about the cost of one fit), "
+                             "a bootstrap over rows, or none")(command)
 
 
-def _bootstrap(replicates: int, confidence: float):
-    from .estimate.intervals import Bootstrap
-    return Bootstrap(replicates, confidence)
+def _intervals(method: str, replicates: int | None, confidence: float):
+    """The interval settings the options ask for: --bootstrap N means a
+    bootstrap of N replicates (0: none), whatever --intervals says."""
+    from .estimate.intervals import Intervals
+    if replicates is not None:
+        method = "bootstrap" if replicates else "none"
+    return Intervals(method, confidence, **({"replicates": replicates} if replicates else {}))
 
 
 @main.command()
@@ -411,10 +418,10 @@ def _bootstrap(replicates: int, confidence: float):
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
-@_bootstrap_options
+@_interval_options
 @_parallel_options
 def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
-            progress, replicates, confidence, workers, scheduler):
+            progress, interval_method, replicates, confidence, workers, scheduler):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
@@ -429,7 +436,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         from .batch import MeasureSettings, expand_inputs, measure_files
         from .parallel import InputOrder
         from .records import CsvWriter, JsonLinesWriter, utc_now
-        settings = MeasureSettings(kind, method, band, roi, pulse_width, _bootstrap(replicates, confidence))
+        settings = MeasureSettings(kind, method, band, roi, pulse_width,
+                                   _intervals(interval_method, replicates, confidence))
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
@@ -549,10 +557,10 @@ def _num(value, width: int, decimals: int) -> str:
               help="write targets.csv, targets.geojson and overview.png here")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
-@_bootstrap_options
+@_interval_options
 @_parallel_options
 def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, out_dir, fmt, progress,
-         replicates, confidence, workers, scheduler):
+         interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in SCENE, measure the usable ones
     and say why the others were rejected.  Exit status 1 when none is
     usable; on Ctrl-C or SIGTERM the candidates measured so far are
@@ -565,7 +573,8 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
         from .io import raster_info
         from .scan import ScanSettings, scan_scene, write_outputs
         settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
-                                pulse_width=pulse_width, bootstrap=_bootstrap(replicates, confidence))
+                                pulse_width=pulse_width,
+                                intervals=_intervals(interval_method, replicates, confidence))
         if out_dir:
             ensure_folder(out_dir)
         info = raster_info(scene)

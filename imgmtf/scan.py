@@ -38,7 +38,7 @@ from .atomic import atomic_output, ensure_folder
 from .batch import MeasureSettings, measure_raster, save_figure
 from .errors import FileWriteError, ImgmtfError, ParameterError
 from .estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
-from .estimate.intervals import Bootstrap
+from .estimate.intervals import Intervals
 from .inputs import saturation_levels
 from .io import RasterInfo, raster_info, read_raster
 from .parallel import run_tasks
@@ -103,7 +103,7 @@ class ScanSettings:
     max_line_rms_px : largest RMS scatter of the per-row target locations
         about their line (px) for a straight target.
     tile_px : side of the tiles read for detection (px).
-    method, band, pulse_width, bootstrap : as in
+    method, band, pulse_width, intervals : as in
         :class:`imgmtf.batch.MeasureSettings`.
     """
 
@@ -117,7 +117,7 @@ class ScanSettings:
     method: str = "msg"
     band: int | None = None
     pulse_width: tuple[float, str] | None = None
-    bootstrap: Bootstrap = field(default_factory=Bootstrap)
+    intervals: Intervals = field(default_factory=Intervals)
 
     def __post_init__(self):
         if not self.min_length_px >= 16:
@@ -129,7 +129,7 @@ class ScanSettings:
         self.measure_settings()
 
     def measure_settings(self) -> MeasureSettings:
-        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.bootstrap)
+        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.intervals)
 
 
 # -- detection -----------------------------------------------------------------
@@ -445,7 +445,7 @@ def _segment_record(path, segment: Segment, roi, info: RasterInfo, settings: Sca
         (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
                                   for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
         site.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
-    params = {"scan": _scan_params(settings), "bootstrap": settings.bootstrap.as_dict()}
+    params = {"scan": _scan_params(settings), "intervals": settings.intervals.as_dict()}
     return Record(path, settings.band, settings.target, settings.method, "candidate", site=site,
                   params=params, run_utc=run_utc)
 

@@ -152,7 +152,6 @@ def test_pulse_width_errors(run, chip, tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["measure", "--bootstrap", "100000", "x.tif"], "0<=x<=2000"),
     (["simulate", "--size", "100000", "--out", "a.tif"], "2<=x<=4096"),
     (["simulate", "--oversampling", "100000", "--out", "a.tif"], "1<=x<=100"),
     (["simulate", "--seed", "-1", "--out", "a.tif"], "x>=0"),
@@ -187,6 +186,16 @@ def test_unwritable_outputs_are_named_before_any_work(run, chip, tmp_path):
         assert result.exit_code == 1, args
         assert str(args[1]) in result.stderr and "Traceback" not in result.output
         assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
+    result = run("measure", "--bootstrap", "100000", chip)
+    assert result.exit_code == 1 and "from 20 to 5000, got 100000" in result.stderr
+    for args, method in ((), "influence"), (("--intervals", "none"), "none"), (("--bootstrap", "50"), "bootstrap"):
+        result = run("measure", "--format", "json", *args, chip)
+        row = json.loads(result.stdout)
+        assert result.exit_code == 0 and row["params"]["intervals"]["method"] == method
+        assert (row["mtf_nyquist_ci"][0] is None) == (method == "none")
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):

@@ -120,7 +120,7 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
         return real(raster, settings)
     real = scan_module.measure_raster
     monkeypatch.setattr(scan_module, "measure_raster", breaks_once)
-    records = scan_scene(str(SCENE), ScanSettings(bootstrap=im.Bootstrap(0)))
+    records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
     internal = [r for r in records if r.reason == "internal"]
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error
     assert internal[0].error.startswith(str(SCENE))
