@@ -433,8 +433,10 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     with _reported_errors():
+        from .parallel import InputOrder, prestart_workers
+        if scheduler is None and not plot_path:
+            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap ours
         from .batch import MeasureSettings, expand_inputs, measure_files
-        from .parallel import InputOrder
         from .records import CsvWriter, JsonLinesWriter, utc_now
         settings = MeasureSettings(kind, method, band, roi, pulse_width,
                                    _intervals(interval_method, replicates, confidence))
@@ -569,6 +571,9 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
         raise click.UsageError("--pulse-width applies to --target pulse only")
     interrupted = None
     with _reported_errors():
+        from .parallel import prestart_workers
+        if scheduler is None:
+            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap detection
         from .atomic import ensure_folder
         from .io import raster_info
         from .scan import ScanSettings, scan_scene, write_outputs

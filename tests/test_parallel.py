@@ -45,3 +45,13 @@ def test_measure_and_scan_on_a_local_dask_cluster(tmp_path):
     assert scan.exit_code == 0
     accepted = [r for r in map(json.loads, scan.stdout.splitlines()) if r["status"] == "accepted"]
     assert len(accepted) == 2
+
+
+def test_prestarted_workers_are_used_once_and_never_left_behind():
+    from imgmtf import parallel
+    parallel.prestart_workers(2, ["json"])
+    assert list(run_tasks(math.sqrt, [9, 4, 1], workers=2)) == [3, 2, 1]
+    assert not parallel._prestarted
+    parallel.prestart_workers(2, ["json"])
+    assert list(run_tasks(math.sqrt, [9], workers=2)) == [3]     # one task runs here: the pool goes
+    assert not parallel._prestarted
