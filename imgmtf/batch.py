@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .atomic import atomic_output, ensure_folder
-from .errors import FileWriteError, ImgmtfError, ParameterError
+from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.edge import EdgeEstimator
 from .estimate.intervals import Intervals
 from .estimate.pulse import PulseEstimator, check_width
@@ -74,14 +74,18 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
     sorted; with ``recursive`` also in their sub-folders.  Paths that do not
     exist are kept, to be reported as errors."""
     out = []
-    for path in map(Path, paths):
-        if path.is_dir():
-            found = path.rglob("*") if recursive else path.iterdir()
+    for raw in map(str, paths):
+        path = Path(raw)
+        if raw and path.is_dir():          # Path("") is the current folder: "" is no file
+            try:
+                found = list(path.rglob("*") if recursive else path.iterdir())
+            except OSError as exc:
+                raise ImageReadError(f"{raw}: cannot list the folder: {exc.strerror or exc}") from None
             # not only regular files: a FIFO named x.tif is reported, not skipped
             out.extend(sorted(str(p) for p in found
                               if p.suffix.lower() in IMAGE_SUFFIXES and not p.is_dir()))
         else:
-            out.append(str(path))
+            out.append(raw)
     return out
 
 

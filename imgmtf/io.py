@@ -230,6 +230,8 @@ def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) ->
 def check_regular_file(path: str) -> None:
     """Refuse anything but a regular file (following links) before GDAL
     sees it: GDAL blocks forever reading a FIFO and reads a device whole."""
+    if not path:
+        raise ImageReadError("'': an empty path names no file")
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:

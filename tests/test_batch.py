@@ -205,3 +205,11 @@ def test_mixed_batch_keeps_every_row_in_input_order_with_workers(tmp_path, good)
     assert [r["path"] for r in rows] == paths
     assert [r["path"] for r in csv.DictReader(out_csv.open())] == paths
     assert all(r["reason"] and r["error"] for r in rows if r["status"] == "error")
+
+
+def test_an_empty_path_is_an_error_row_not_the_current_folder(tmp_path, good, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert expand_inputs(["", str(good)]) == ["", str(good)]
+    rows = [json.loads(line) for line in
+            CliRunner().invoke(main, ["measure", "--format", "json", "", str(good)]).stdout.splitlines()]
+    assert [r["status"] for r in rows] == ["error", "ok"] and "empty path" in rows[0]["error"]
