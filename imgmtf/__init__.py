@@ -25,7 +25,7 @@ _LAZY = {
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
-    "Raster": "io", "read_raster": "io", "write_geotiff": "io",
+    "Raster": "io", "read_raster": "io", "write_geotiff": "io", "Record": "records",
     "run_selftest": "selftest",
 }
 

@@ -1,36 +1,27 @@
 """Measure many image files: folders expanded, every file (and band) one
 task, tasks run in parallel (:mod:`imgmtf.parallel`), every outcome a
-record, failures included, so that one bad file never loses the others.
-
-A record is a flat, JSON-ready dict: the measurement's figures (see
-:meth:`imgmtf.results.MTFResult.to_dict`) or an ``error``, always with its
-provenance: ``path``, ``band``, ``target``, ``method``, ``params`` and
-``imgmtf_version``.
+:class:`imgmtf.records.Record`, failures included, so that one bad file
+never loses the others: an unexpected exception inside one file's
+measurement becomes an error record of reason ``internal`` for that file.
 """
 from __future__ import annotations
 
-import csv
-import json
+import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .version import __version__
+from .atomic import atomic_output, ensure_folder
+from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.edge import EdgeEstimator
-from .errors import FileWriteError, ImgmtfError, ParameterError
+from .estimate.intervals import Intervals
+from .estimate.pulse import PulseEstimator, check_width
 from .inputs import saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
-from .estimate.pulse import PulseEstimator, check_width
-from .estimate.intervals import Bootstrap
+from .records import Record, utc_now
 
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
-
-CSV_COLUMNS = ("path", "band", "target", "method", "status", "error", "normal_angle_deg", "tilt_deg", "direction",
-               "polarity", "rows_used", "snr", "mtf_nyquist", "mtf_nyquist_ci_low",
-               "mtf_nyquist_ci_high", "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
-               "fwhm_px", "mtfa", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "rer",
-               "pulse_width_px", "roi", "warnings", "plot", "params", "imgmtf_version")
 
 
 @dataclass(frozen=True)
@@ -43,7 +34,7 @@ class MeasureSettings:
         RGB luminance.
     roi : (x, y, width, height) window read from every file (px).
     pulse_width : (value, "px" or "m"), or None to estimate it.
-    bootstrap : confidence-interval settings.
+    intervals : confidence-interval settings (linearised by default).
     """
 
     target: str = "edge"
@@ -51,7 +42,7 @@ class MeasureSettings:
     band: int | str | None = None
     roi: tuple[int, int, int, int] | None = None
     pulse_width: tuple[float, str] | None = None
-    bootstrap: Bootstrap = field(default_factory=Bootstrap)
+    intervals: Intervals = field(default_factory=Intervals)
 
     def __post_init__(self):
         if self.target not in ("edge", "pulse"):
@@ -64,7 +55,18 @@ class MeasureSettings:
 
     def estimator(self):
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
-        return kind(self.method, bootstrap=self.bootstrap)
+        return kind(self.method, intervals=self.intervals)
+
+    def params(self) -> dict:
+        """The run's settings, as records carry them."""
+        return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
+                "band": self.band,
+                "pulse_width": list(self.pulse_width) if self.pulse_width else None}
+
+    def failed(self, path: str, band, exc: BaseException, run_utc: str) -> Record:
+        """The error record of a file (or band) that could not be measured."""
+        return Record.failed(path, band, self.target, self.method, exc, params=self.params(),
+                             run_utc=run_utc)
 
 
 def expand_inputs(paths, recursive: bool = False) -> list[str]:
@@ -72,38 +74,51 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
     sorted; with ``recursive`` also in their sub-folders.  Paths that do not
     exist are kept, to be reported as errors."""
     out = []
-    for path in map(Path, paths):
-        if path.is_dir():
-            found = path.rglob("*") if recursive else path.iterdir()
-            out.extend(sorted(str(p) for p in found if p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES))
+    for raw in map(str, paths):
+        path = Path(raw)
+        if raw and path.is_dir():          # Path("") is the current folder: "" is no file
+            try:
+                found = list(path.rglob("*") if recursive else path.iterdir())
+            except OSError as exc:
+                raise ImageReadError(f"{raw}: cannot list the folder: {exc.strerror or exc}") from None
+            # not only regular files: a FIFO named x.tif is reported, not skipped
+            out.extend(sorted(str(p) for p in found
+                              if p.suffix.lower() in IMAGE_SUFFIXES and not p.is_dir()))
         else:
-            out.append(str(path))
+            out.append(raw)
     return out
 
 
-def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = None) -> list[dict]:
+def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = None, *,
+                 run_utc: str | None = None) -> list[Record]:
     """Every requested band of one file measured: one record each (an error
-    record when the file or a band cannot be measured)."""
+    record when the file or a band cannot be measured, whatever the
+    failure).  ``run_utc`` stamps the records (default: now)."""
+    run_utc = run_utc or utc_now()
     try:
         bands = raster_info(path).bands(settings.band)
-    except ImgmtfError as exc:
-        return [error_record(path, settings.band, settings, exc)]
+    except Exception as exc:               # the safety net: a record, never an abort
+        return [settings.failed(path, settings.band, exc, run_utc)]
     records = []
     for band in bands:
         try:
             raster = read_raster(path, band, window=settings.roi)
             result = measure_raster(raster, settings)
-        except ImgmtfError as exc:
-            records.append(error_record(path, band, settings, exc))
+            summary = result.to_dict(curves=True)
+        except Exception as exc:
+            records.append(settings.failed(path, band, exc, run_utc))
             continue
-        record = {"path": path, "band": raster.band, "status": "ok", **result.to_dict(curves=True)}
+        record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         if plot_path:
             target = _band_plot_path(plot_path, band, len(bands))
             try:
-                _save_plot(result, target)
-                record["plot"] = target
-            except ImgmtfError as exc:
-                record["warnings"] = [*record["warnings"], str(exc)]
+                save_figure(lambda: _measurement_figure(result), target)
+                record = record.with_(plot=target)
+            except Exception as exc:
+                message = str(exc) if isinstance(exc, ImgmtfError) else (
+                    f"{target}: the figure failed: {type(exc).__name__}: {exc}")
+                warnings = [*record.figures.get("warnings", []), message]
+                record = record.with_(figures={"warnings": warnings})
         records.append(record)
     return records
 
@@ -137,46 +152,42 @@ def pulse_width_px(width, raster) -> float | None:
     return value / raster.gsd_m
 
 
-def error_record(path, band, settings: MeasureSettings, exc: Exception) -> dict:
-    """A record for a file (or band) that could not be measured.  Messages
-    name the file; a message that does not gets it prefixed."""
-    message = str(exc)
-    if not message.startswith(str(path)):
-        where = f"{path}: band {band}" if isinstance(band, int) else str(path)
-        message = f"{where}: {message}"
-    return {"path": str(path), "band": band, "status": "error", "error": message,
-            "target": settings.target, "method": settings.method,
-            "params": {"bootstrap": settings.bootstrap.as_dict(), "roi": settings.roi},
-            "imgmtf_version": __version__}
-
-
 def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, scheduler: str | None = None,
-                  plot_dir: str | None = None, progress: bool | None = None):
+                  plot_dir: str | None = None, progress: bool | None = None,
+                  run_utc: str | None = None, ordered: bool = True):
     """Measure every file (expand folders first with :func:`expand_inputs`);
-    yields each file's list of records, in input order."""
+    yields each file's list of records, in input order (with ``ordered``
+    false: ``(index, records)`` pairs as files complete).  A task that dies
+    with its worker process still gives its file an error record."""
     paths = list(paths)
+    run_utc = run_utc or utc_now()
     plots = plot_paths(paths, plot_dir) if plot_dir else [None] * len(paths)
-    tasks = [(path, settings, plot) for path, plot in zip(paths, plots)]
-    yield from run_tasks(_measure_task, tasks, workers=workers, scheduler=scheduler,
-                         progress=progress, description="measuring")
+    tasks = [(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
+
+    def lost(task, exc):
+        return [settings.failed(task[0], settings.band, exc, run_utc)]
+    yield from run_tasks(_measure_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                         description="measuring", on_error=lost, ordered=ordered)
 
 
-def _measure_task(task) -> list[dict]:
-    path, settings, plot = task
-    return measure_file(path, settings, plot)
+def _measure_task(task) -> list[Record]:
+    path, settings, plot, run_utc = task
+    return measure_file(path, settings, plot, run_utc=run_utc)
 
 
 def plot_paths(paths, plot_dir: str) -> list[str]:
-    """One figure path per input in ``plot_dir``, named after the input's
-    stem (``_2``, ``_3``... for inputs that share a stem)."""
-    Path(plot_dir).mkdir(parents=True, exist_ok=True)
+    """One figure path per input in ``plot_dir`` (created), named after
+    the input's stem (``_2``, ``_3``... for inputs that share a stem)."""
+    folder = ensure_folder(plot_dir)
+    if not os.access(folder, os.W_OK):
+        raise FileWriteError(f"{plot_dir}: cannot write figures there: permission denied")
     seen: dict[str, int] = {}
     out = []
     for path in paths:
         stem = Path(path).stem
         seen[stem] = seen.get(stem, 0) + 1
         suffix = f"_{seen[stem]}" if seen[stem] > 1 else ""
-        out.append(str(Path(plot_dir) / f"{stem}{suffix}_mtf.png"))
+        out.append(str(folder / f"{stem}{suffix}_mtf.png"))
     return out
 
 
@@ -187,34 +198,16 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _save_plot(result, path: str) -> None:
+def _measurement_figure(result):
     from .plot import plot_measurement
-    try:
-        plot_measurement(result).savefig(path, dpi=110)
-    except OSError as exc:
-        raise FileWriteError(f"{path}: cannot write the figure: {exc.strerror or exc}") from None
+    return plot_measurement(result)
 
 
-def csv_row(record: dict) -> dict:
-    """A record flattened to :data:`CSV_COLUMNS` (lists and dicts as JSON)."""
-    row = {k: record.get(k) for k in CSV_COLUMNS}
-    for name, key in (("mtf_nyquist_ci", "mtf_nyquist_ci"), ("mtf50_ci", "mtf50_ci_cy_px")):
-        low, high = record.get(key) or (None, None)
-        unit = "_cy_px" if name == "mtf50_ci" else ""
-        row[f"{name}_low{unit}"], row[f"{name}_high{unit}"] = low, high
-    for key in ("roi", "warnings", "params"):
-        if row[key] is not None:
-            row[key] = json.dumps(row[key], sort_keys=True)
-    return {k: ("" if v is None else v) for k, v in row.items()}
-
-
-def write_csv(records, path: str, columns=CSV_COLUMNS, flatten=csv_row) -> None:
-    """Write records as CSV with a header of ``columns``."""
-    try:
-        with open(path, "w", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(columns), extrasaction="ignore")
-            writer.writeheader()
-            for record in records:
-                writer.writerow(flatten(record))
-    except OSError as exc:
-        raise FileWriteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+def save_figure(make_figure, path: str, dpi: int = 110) -> None:
+    """Save the matplotlib figure ``make_figure()`` builds to ``path``
+    (atomically; the format from the extension, Agg backend)."""
+    with atomic_output(path) as partial:
+        try:
+            make_figure().savefig(partial, dpi=dpi, format=Path(path).suffix.lstrip(".") or "png")
+        except OSError as exc:
+            raise FileWriteError(f"{path}: cannot write the figure: {exc.strerror or exc}") from None

@@ -1,54 +1,140 @@
 """Command-line interface: a thin shell over the public API.
 
-Exit codes: 0 success, 1 a problem with the input (one line on stderr, or
-an ``error`` field per file in JSON), 2 a usage error.
+Exit codes: 0 success; 1 a problem with the input (one line on stderr, or
+an error record per file: ``error`` and ``reason`` in JSON and CSV); 2 a
+usage error (a bad option); 130 interrupted by Ctrl-C and 143 by SIGTERM
+(what was measured is kept: CSV rows are written as each file completes).
+
+Start-up stays cheap: this module imports only click; each command imports
+the libraries it needs when it runs, so ``imgmtf --help`` loads no
+numerical library.  Set ``IMGMTF_DEBUG=1`` to see the traceback of an
+internal error instead of its one-line report.
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 import click
 
-from .version import __version__
-from .batch import MeasureSettings, expand_inputs, measure_file, measure_files, write_csv
 from .errors import FileWriteError, ImgmtfError, ParameterError
-from .io import write_geotiff
-from .sensor.noise import GroundNoise
-from .sensor.rendering import render
-from .estimate.resampling import METHODS
-from .selftest import run_selftest
-from .sensor.model import DIRECTIONS, Sensor
-from .sensor.targets import Target
-from .estimate.intervals import Bootstrap
+from .version import __version__
+
+# Bounds of the size-like options (see docs): what a run may allocate.
+MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
+MAX_OVERSAMPLING = 100              # simulate --oversampling
 
 
 @contextmanager
 def _reported_errors():
-    """Turn a deliberate imgmtf error into one line on stderr and exit 1."""
+    """Turn a deliberate imgmtf error into one line on stderr and exit 1; an
+    interrupt into one line and exit 130 (Ctrl-C) or 143 (SIGTERM); any
+    other exception into a one-line internal error and exit 1 (its
+    traceback with IMGMTF_DEBUG=1)."""
     try:
         yield
     except ImgmtfError as exc:
-        click.echo(f"imgmtf: error: {exc}", err=True)
+        click.echo(f"imgmtf: error: {_one_line(exc)}", err=True)
+        sys.exit(1)
+    except KeyboardInterrupt as exc:
+        click.echo("imgmtf: interrupted", err=True)
+        sys.exit(_interrupt_code(exc))
+    except BrokenPipeError:
+        raise                     # click exits quietly when stdout's reader has gone (| head)
+    except Exception as exc:
+        if os.environ.get("IMGMTF_DEBUG"):
+            raise
+        click.echo(f"imgmtf: internal error: {type(exc).__name__}: {_one_line(exc)} "
+                   "(please report it; IMGMTF_DEBUG=1 shows where)", err=True)
         sys.exit(1)
 
 
-def _load_sensor(path: str | None) -> Sensor:
-    return Sensor.from_toml(path) if path else Sensor()
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def _interrupt_code(exc: BaseException) -> int:
+    return getattr(exc, "exit_code", 130)
+
+
+def _load_sensor(path: str | None):
+    from .sensor.model import Sensor
+    if not path:
+        return Sensor()
+    try:
+        return Sensor.from_toml(path)
+    except ImgmtfError:
+        raise
+    except (UnicodeDecodeError, ValueError, TypeError) as exc:  # what a model check may miss
+        from .errors import ConfigError
+        raise ConfigError(f"{path}: not a readable sensor TOML file ({type(exc).__name__}: "
+                          f"{_one_line(exc)})") from None
 
 
 def _save_figure(fig, path: str | Path) -> None:
-    try:
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise FileWriteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    from .batch import save_figure
+    save_figure(lambda: fig, str(path))
+
+
+def check_output_file(path: str) -> None:
+    """Refuse an output path that cannot be written, before any work: its
+    folder missing, not a folder or not writable, or the path a folder."""
+    target = Path(path)
+    folder = target.parent
+    if target.is_dir():
+        raise FileWriteError(f"{path}: is a folder; give a file name")
+    if not folder.is_dir():
+        what = "does not exist" if not folder.exists() else "is not a folder"
+        raise FileWriteError(f"{path}: cannot write: {folder} {what}")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise FileWriteError(f"{path}: cannot write: permission denied in {folder}")
+
+
+class FiniteFloat(click.FloatRange):
+    """A float option that refuses NaN and infinities (FloatRange lets NaN
+    through every bound)."""
+
+    name = "number"
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number
+
+
+class MethodName(click.ParamType):
+    """A resampling method name, checked against the method registry when
+    the option is used (the registry imports SciPy: ``imgmtf --help`` does
+    not pay for it)."""
+
+    name = "method"
+
+    @staticmethod
+    def names() -> list[str]:
+        from .estimate.resampling import METHODS
+        return list(METHODS)
+
+    def get_metavar(self, param, ctx=None) -> str:
+        return "[" + "|".join(self.names()) + "]"
+
+    def convert(self, value, param, ctx):
+        if value in self.names():
+            return value
+        self.fail(f"{value!r} is not one of {', '.join(map(repr, self.names()))}", param, ctx)
+
+    def shell_complete(self, ctx, param, incomplete):
+        from click.shell_completion import CompletionItem
+        return [CompletionItem(n) for n in self.names() if n.startswith(incomplete)]
 
 
 def _length_option(default_unit: str):
-    """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit)."""
+    """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit), the value
+    finite and > 0."""
     def parse(ctx, param, value):
         if value is None:
             return None
@@ -56,9 +142,12 @@ def _length_option(default_unit: str):
         unit = next((u for u in ("px", "m") if text.endswith(u)), None)
         number = text[: -len(unit)] if unit else text
         try:
-            return float(number), unit or default_unit
+            length = float(number)
         except ValueError:
             raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}")
+        if not math.isfinite(length):
+            raise click.BadParameter(f"expected a finite width, got {value!r}")
+        return length, unit or default_unit
     return parse
 
 
@@ -71,61 +160,80 @@ def _parse_roi(ctx, param, value):
         parts = ()
     if len(parts) != 4:
         raise click.BadParameter(f"expected X,Y,W,H (four integers), got {value!r}")
+    if parts[2] <= 0 or parts[3] <= 0 or parts[0] < 0 or parts[1] < 0:
+        raise click.BadParameter(f"expected X, Y >= 0 and W, H > 0 px, got {value!r}")
     return parts
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="imgmtf")
-def main():
+@click.pass_context
+def main(ctx):
     """Measure the MTF of imaging sensors from edge and pulse targets, and
     render exact synthetic chips with the generic pushbroom sensor."""
+    from .parallel import terminate_raises
+    ctx.with_resource(terminate_raises())
 
 
 # -- simulate -----------------------------------------------------------------
 @main.command()
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
-@click.option("--angle", type=float, default=6.0, show_default=True,
+@click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
               help="tilt of the edge from the column axis, degrees in (-90, 90]; near 90 for along track")
-@click.option("--low", type=float, default=200.0, show_default=True, help="DN on the dark side (outside a pulse)")
-@click.option("--high", type=float, default=1200.0, show_default=True, help="DN on the bright side (inside a pulse)")
+@click.option("--low", type=FiniteFloat(), default=200.0, show_default=True,
+              help="DN on the dark side (outside a pulse)")
+@click.option("--high", type=FiniteFloat(), default=1200.0, show_default=True,
+              help="DN on the bright side (inside a pulse)")
 @click.option("--pulse-width", callback=_length_option("m"),
               help="pulse width: 18.3 or 18.3m (metres), 1.4px (pixels); pulse targets")
-@click.option("--offset", type=float, default=0.0, show_default=True,
+@click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
-@click.option("--size", type=int, default=50, show_default=True, help="chip side, pixels")
-@click.option("--gsd", type=float, help="output GSD in metres (default: the sensor's)")
+@click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default=True,
+              help="chip side, pixels")
+@click.option("--gsd", type=FiniteFloat(0, min_open=True), help="output GSD in metres (default: the sensor's)")
 @click.option("--bits", type=click.Choice(["8", "16"]), default="16", show_default=True)
-@click.option("--noise-std", type=float, default=0.0, show_default=True, help="system noise std, DN")
+@click.option("--noise-std", type=FiniteFloat(0), default=0.0, show_default=True, help="system noise std, DN")
 @click.option("--ground-noise", is_flag=True, help="add the paper's 20-layer ground noise (2000 DN^2)")
-@click.option("--oversampling", type=int, default=20, show_default=True, help="sub-pixels per pixel")
+@click.option("--oversampling", type=click.IntRange(1, MAX_OVERSAMPLING), default=20, show_default=True,
+              help="sub-pixels per pixel")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False), help="sensor TOML file")
-@click.option("--seed", type=int, help="random seed for the noise")
+@click.option("--seed", type=click.IntRange(min=0), help="random seed for the noise (an integer >= 0)")
 @click.option("--out", required=True, type=click.Path(dir_okay=False), help="output GeoTIFF")
 def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF."""
     with _reported_errors():
+        from .io import write_geotiff
+        from .sensor.noise import GroundNoise
+        from .sensor.rendering import render
+        from .sensor.targets import Target
+        check_output_file(out)
         sensor = _load_sensor(sensor_path)
         gsd_m = sensor.gsd_m if gsd is None else gsd
-        if gsd_m <= 0:
-            raise ImgmtfError(f"--gsd must be > 0 m, got {gsd_m}")
         if kind == "pulse" and pulse_width is None:
-            raise ImgmtfError("a pulse target needs --pulse-width (metres)")
+            raise ParameterError("a pulse target needs --pulse-width (metres)")
         if kind == "edge" and pulse_width is not None:
-            raise ImgmtfError("--pulse-width applies to --target pulse only")
+            raise ParameterError("--pulse-width applies to --target pulse only")
         width_px = 0.0
         if kind == "pulse":
             value, unit = pulse_width
             width_px = value if unit == "px" else value / gsd_m
+            from .estimate.pulse import MIN_WIDTH_PX
+            if not width_px >= MIN_WIDTH_PX:
+                raise ParameterError(f"a {width_px:g} px wide pulse is narrower than the {MIN_WIDTH_PX} px "
+                                     "imgmtf can measure (is the unit right?)")
+            if width_px > size:
+                raise ParameterError(f"the pulse width must be at most the chip ({size} px), "
+                                     f"got {width_px:g} px")
         target = Target(kind, angle, low, high, offset, width_px)
         chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
                       noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
                       seed=seed)
         write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
-    clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
-    click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind} at {angle:g} deg, "
-               f"GSD {chip.gsd_m:g} m; true MTF at Nyquist along the normal "
-               f"{float(chip.true_mtf(0.5)):.4f}{clipped}")
+        clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
+        click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind} at {angle:g} deg, "
+                   f"GSD {chip.gsd_m:g} m; true MTF at Nyquist along the normal "
+                   f"{float(chip.true_mtf(0.5)):.4f}{clipped}")
 
 
 # -- sensor -------------------------------------------------------------------
@@ -138,6 +246,7 @@ def sensor_command(sensor_path, plot_path, save_path):
     """Print the sensor's stages, and each stage's and the system's FWHM and
     MTF at Nyquist across and along track."""
     with _reported_errors():
+        from .sensor.model import DIRECTIONS, Sensor
         sensor = _load_sensor(sensor_path)
         click.echo(f"sensor, GSD {sensor.gsd_m:g} m "
                    f"({'the paper' + chr(39) + 's generic sensor' if sensor == Sensor() else sensor_path})")
@@ -250,9 +359,12 @@ def _parse_band(ctx, param, value):
     if value is None or value.lower() == "all":
         return value and "all"
     try:
-        return int(value)
+        band = int(value)
     except ValueError:
         raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}")
+    if band < 1:
+        raise click.BadParameter(f"bands are numbered from 1, got {value!r}")
+    return band
 
 
 def _parallel_options(command):
@@ -261,15 +373,29 @@ def _parallel_options(command):
                            help="run on a Dask distributed cluster (tcp://host:8786), or 'local' "
                                 "for a local Dask cluster of --workers processes; needs imgmtf[dask]")(command)
     return click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
-                        help="parallel worker processes")(command)
+                        help="parallel worker processes, each on one thread (at most 64)")(command)
 
 
-def _bootstrap_options(command):
-    command = click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True),
+def _interval_options(command):
+    """--intervals, --bootstrap and --confidence, shared by measure and scan."""
+    command = click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True),
                            default=0.95, show_default=True, help="confidence of the intervals")(command)
-    return click.option("--bootstrap", "replicates", type=click.IntRange(min=0), default=200,
-                        show_default=True,
-                        help="bootstrap replicates for the confidence intervals (0: none)")(command)
+    command = click.option("--bootstrap", "replicates", type=click.IntRange(min=0), metavar="N",
+                           help="intervals from a bootstrap of N row resamplings (20 to 5000; slower); "
+                                "0: no intervals")(command)
+    return click.option("--intervals", "interval_method", type=click.Choice(["influence", "bootstrap", "none"]),
+                        default="influence", show_default=True,
+                        help="confidence intervals: linearised row influence (about the cost of one fit), "
+                             "a bootstrap over rows, or none")(command)
+
+
+def _intervals(method: str, replicates: int | None, confidence: float):
+    """The interval settings the options ask for: --bootstrap N means a
+    bootstrap of N replicates (0: none), whatever --intervals says."""
+    from .estimate.intervals import Intervals
+    if replicates is not None:
+        method = "bootstrap" if replicates else "none"
+    return Intervals(method, confidence, **({"replicates": replicates} if replicates else {}))
 
 
 @main.command()
@@ -278,59 +404,120 @@ def _bootstrap_options(command):
 @click.option("--pulse-width", callback=_length_option("px"),
               help="bar width: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
                    "estimated from the profile when omitted")
-@click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True,
+@click.option("--method", type=MethodName(), default="msg", show_default=True,
               help="profile smoothing/resampling method")
-@click.option("--roi", callback=_parse_roi, help="X,Y,W,H window in pixels (only it is read)")
+@click.option("--roi", callback=_parse_roi,
+              help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
 @click.option("--band", callback=_parse_band,
               help="1-based band, or 'all' for one result per band "
                    "(default: the only band, or the luminance of RGB)")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), help="also write a CSV summary")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False),
+              help="also write a CSV summary (each row as its file completes)")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
-@_bootstrap_options
+@_interval_options
 @_parallel_options
 def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
-            progress, replicates, confidence, workers, scheduler):
+            progress, interval_method, replicates, confidence, workers, scheduler):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
-    line and the rest go on (exit status 1 if any failed)."""
+    line and the rest go on (exit status 1 if any failed).  Rows are printed
+    and written to the CSV as each file completes; on Ctrl-C or SIGTERM the
+    rows measured so far are kept (exit status 130 or 143)."""
     if plot_path and plot_dir:
         raise click.UsageError("give --plot or --plot-dir, not both")
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     with _reported_errors():
-        settings = MeasureSettings(kind, method, band, roi, pulse_width, Bootstrap(replicates, confidence))
+        from .parallel import InputOrder, prestart_workers
+        if scheduler is None and not plot_path:
+            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap ours
+        from .batch import MeasureSettings, expand_inputs, measure_files
+        from .records import CsvWriter, JsonLinesWriter, utc_now
+        settings = MeasureSettings(kind, method, band, roi, pulse_width,
+                                   _intervals(interval_method, replicates, confidence))
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
         if plot_path and len(files) > 1:
             raise ParameterError("--plot takes a single input; use --plot-dir for several")
+        for output in filter(None, (plot_path, csv_path)):
+            check_output_file(output)
+        run_utc = utc_now()
         if plot_path:
-            batches = [measure_file(files[0], settings, plot_path)]
+            from .batch import measure_file
+            completed = iter([(0, measure_file(files[0], settings, plot_path, run_utc=run_utc))])
         else:
-            batches = measure_files(files, settings, workers=workers, scheduler=scheduler,
-                                    plot_dir=plot_dir, progress=progress)
-        records = []
-        if fmt == "text":
-            last = "RER" if kind == "edge" else "W px"
-            click.echo(f"{'path':<32} {'band':>4} {'angle':>7} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
-                       f"{'95% interval':>15} {'MTF50':>7} {'FWHM':>6} {last:>6}".replace(
-                           "95%", f"{100 * confidence:g}%"))
-        for batch in batches:
-            for record in batch:
-                records.append(record)
-                click.echo(json.dumps(record) if fmt == "json" else _text_row(record, kind))
-        if csv_path:
-            write_csv(records, csv_path)
-    failures = sum(r["status"] == "error" for r in records)
-    if len(records) > 1 and fmt == "text":
-        click.echo(f"{len(records) - failures} measured, {failures} failed"
+            completed = measure_files(files, settings, workers=workers, scheduler=scheduler,
+                                      plot_dir=plot_dir, progress=progress, run_utc=run_utc,
+                                      ordered=False)
+        stdout = JsonLinesWriter(sys.stdout) if fmt == "json" else _TextRows(kind)
+        order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
+        with ExitStack() as outputs:
+            writers = [stdout]
+            if csv_path:
+                writers.append(outputs.enter_context(CsvWriter(csv_path)))
+            if fmt == "text":
+                stdout.header(confidence)
+
+            def emit(batches):
+                for batch in batches:
+                    for record in batch:
+                        for writer in writers:
+                            writer.write(record)
+                        counts["ok" if record.ok else "error"] += 1
+            try:
+                with _closing(completed):
+                    for index, batch in completed:
+                        emit(order.push(index, batch))
+            except KeyboardInterrupt as exc:
+                emit(order.pending())            # measured, though after a file still running
+                interrupted = exc
+    total = counts["ok"] + counts["error"]
+    if interrupted is not None:
+        kept = f"; rows kept in {csv_path}" if csv_path else ""
+        click.echo(f"imgmtf: interrupted ({_signal_name(interrupted)}): {total} result(s) of "
+                   f"{len(files)} file(s) reported{kept}", err=True)
+        sys.exit(_interrupt_code(interrupted))
+    if total > 1 and fmt == "text":
+        click.echo(f"{counts['ok']} measured, {counts['error']} failed"
                    + (f"; summary in {csv_path}" if csv_path else ""), err=True)
-    sys.exit(1 if failures else 0)
+    sys.exit(1 if counts["error"] else 0)
+
+
+@contextmanager
+def _closing(generator):
+    """Close a task generator when its loop ends, however: an interrupt
+    then stops the workers at once rather than when they are collected."""
+    try:
+        yield generator
+    finally:
+        close = getattr(generator, "close", None)
+        if close:
+            close()
+
+
+def _signal_name(exc: BaseException) -> str:
+    return str(exc) if getattr(exc, "signum", None) else "SIGINT"
+
+
+class _TextRows:
+    """The text table of ``measure``, one row per record as it comes."""
+
+    def __init__(self, kind: str):
+        self.kind = kind
+
+    def header(self, confidence: float) -> None:
+        last = "RER" if self.kind == "edge" else "W px"
+        click.echo(f"{'path':<32} {'band':>4} {'angle':>7} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+                   f"{f'{100 * confidence:g}% interval':>15} {'MTF50':>7} {'FWHM':>6} {last:>6}")
+
+    def write(self, record) -> None:
+        click.echo(_text_row(record.to_dict(), self.kind))
 
 
 def _text_row(record: dict, kind: str) -> str:
@@ -338,13 +525,14 @@ def _text_row(record: dict, kind: str) -> str:
     band = "" if record["band"] in (None, 1, "luminance") else str(record["band"])
     if record["status"] == "error":
         return f"{path:<32} {band:>4} error: {record['error']}"
-    last = record["rer"] if kind == "edge" else record["pulse_width_px"]
-    lo, hi = record["mtf_nyquist_ci"]
-    interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None else "-"
-    cells = [f"{path:<32} {band:>4} {record['normal_angle_deg']:7.2f} {record['direction'].split('-')[0]:>6} "
-             f"{_num(record['snr'], 6, 0)} {_num(record['mtf_nyquist'], 7, 4)} {interval:>15} "
-             f"{_num(record['mtf50_cy_px'], 7, 4)} {_num(record['fwhm_px'], 6, 3)} {_num(last, 6, 3)}"]
-    cells += [f"{'':<32} warning: {w}" for w in record["warnings"]]
+    last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
+    lo, hi = record.get("mtf_nyquist_ci") or (None, None)
+    interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
+    direction = (record.get("direction") or "-").split("-")[0]
+    cells = [f"{path:<32} {band:>4} {_num(record.get('normal_angle_deg'), 7, 2)} {direction:>6} "
+             f"{_num(record.get('snr'), 6, 0)} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>15} "
+             f"{_num(record.get('mtf50_cy_px'), 7, 4)} {_num(record.get('fwhm_px'), 6, 3)} {_num(last, 6, 3)}"]
+    cells += [f"{'':<32} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
 
 
@@ -356,71 +544,99 @@ def _num(value, width: int, decimals: int) -> str:
 @main.command()
 @click.argument("scene", type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
-@click.option("--min-length", type=float, default=40.0, show_default=True,
+@click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
               help="shortest usable target, px along it")
-@click.option("--max-length", type=float, default=300.0, show_default=True,
+@click.option("--max-length", type=FiniteFloat(16), default=300.0, show_default=True,
               help="longer targets are measured over their central part, px")
-@click.option("--margin", type=int, default=12, show_default=True, help="ROI extent beyond the target, px")
+@click.option("--margin", type=click.IntRange(6, 1000), default=12, show_default=True,
+              help="ROI extent beyond the target, px")
 @click.option("--pulse-width", callback=_length_option("px"),
               help="bar width (px or m) for every bar; estimated per bar when omitted")
-@click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True)
-@click.option("--band", type=int, help="1-based band (default: the only band, or the luminance of RGB)")
+@click.option("--method", type=MethodName(), default="msg", show_default=True)
+@click.option("--band", type=click.IntRange(min=1),
+              help="1-based band (default: the only band, or the luminance of RGB)")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
               help="write targets.csv, targets.geojson and overview.png here")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
-@_bootstrap_options
+@_interval_options
 @_parallel_options
 def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, out_dir, fmt, progress,
-         replicates, confidence, workers, scheduler):
+         interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in SCENE, measure the usable ones
     and say why the others were rejected.  Exit status 1 when none is
-    usable."""
-    from .io import raster_info
-    from .scan import ScanSettings, scan_scene, write_outputs
+    usable; on Ctrl-C or SIGTERM the candidates measured so far are
+    reported and written (130 or 143)."""
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
+    interrupted = None
     with _reported_errors():
+        from .parallel import prestart_workers
+        if scheduler is None:
+            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap detection
+        from .atomic import ensure_folder
+        from .io import raster_info
+        from .scan import ScanSettings, scan_scene, write_outputs
         settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
-                                pulse_width=pulse_width, bootstrap=Bootstrap(replicates, confidence))
+                                pulse_width=pulse_width,
+                                intervals=_intervals(interval_method, replicates, confidence))
+        if out_dir:
+            ensure_folder(out_dir)
         info = raster_info(scene)
-        records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress)
+        try:
+            records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress)
+        except KeyboardInterrupt as exc:
+            records, interrupted = getattr(exc, "records", None), exc
+            if records is None:
+                raise
         written = write_outputs(records, info, out_dir, band) if out_dir else []
-    accepted = [r for r in records if r["status"] == "accepted"]
-    if fmt == "json":
-        for r in records:
-            click.echo(json.dumps(r))
-    else:
-        click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
-                   f"{kind}s, {len(accepted)} accepted")
-        click.echo(f"{'id':>3} {'rank':>4} {'dir':>6} {'len px':>6} {'tilt':>6} {'SNR':>6} {'MTF@Nyq':>7} "
-                   f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
-        for r in records:
-            roi = ",".join(str(v) for v in r["roi"])
-            head = (f"{r['id']:>3} {r.get('rank', ''):>4} {r['direction'].split('-')[0]:>6} "
-                    f"{r['length_px']:6.0f} {r['tilt_deg']:6.2f}")
-            if r["status"] == "accepted":
-                lo, hi = r["mtf_nyquist_ci"]
-                interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None else "-"
-                click.echo(f"{head} {_num(r['snr'], 6, 0)} {_num(r['mtf_nyquist'], 7, 4)} {interval:>15} "
-                           f"{_num(r['mtf50_cy_px'], 7, 4)}  {roi}")
-            else:
-                click.echo(f"{head} {'rejected':>38}  {r['reason']}: {r['error']}")
-        for path in written:
-            click.echo(f"wrote {path}")
-    if not accepted:
+        _print_scan(scene, info, kind, records, written, fmt)
+    if interrupted is not None:
+        measured = sum(r.reason != "interrupted" for r in records)
+        click.echo(f"imgmtf: interrupted ({_signal_name(interrupted)}): {measured} of {len(records)} "
+                   "candidates screened or measured, the rest marked interrupted"
+                   + (f"; written to {out_dir}" if out_dir else ""), err=True)
+        sys.exit(_interrupt_code(interrupted))
+    if not any(r.ok for r in records):
         click.echo(f"imgmtf: error: {scene}: no usable {kind} found "
                    f"({len(records)} candidates, all rejected)", err=True)
         sys.exit(1)
+
+
+def _print_scan(scene, info, kind, records, written, fmt) -> None:
+    if fmt == "json":
+        from .records import to_json
+        for r in records:
+            click.echo(to_json(r))
+        return
+    accepted = sum(r.ok for r in records)
+    click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
+               f"{kind}s, {accepted} accepted")
+    click.echo(f"{'id':>3} {'rank':>4} {'dir':>6} {'len px':>6} {'tilt':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+               f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
+    for record in records:
+        r = record.to_dict()
+        roi = ",".join(str(v) for v in r["roi"])
+        head = (f"{r['id']:>3} {r.get('rank') or '':>4} {r['direction'].split('-')[0]:>6} "
+                f"{r['length_px']:6.0f} {r['tilt_deg']:6.2f}")
+        if record.ok:
+            lo, hi = r.get("mtf_nyquist_ci") or (None, None)
+            interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
+            click.echo(f"{head} {_num(r.get('snr'), 6, 0)} {_num(r.get('mtf_nyquist'), 7, 4)} "
+                       f"{interval:>15} {_num(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
+        else:
+            click.echo(f"{head} {'rejected':>38}  {r['reason']}: {r['error']}")
+    for path in written:
+        click.echo(f"wrote {path}")
 
 
 # -- reproduce ----------------------------------------------------------------
 @main.command()
 @click.option("--out", required=True, type=click.Path(file_okay=False), help="output folder")
 @click.option("--quick", is_flag=True, help="few realisations (under a minute)")
-@click.option("--workers", type=click.IntRange(min=1), default=os.cpu_count() or 1,
+@click.option("--workers", type=click.IntRange(1, 64), default=os.cpu_count() or 1,
               show_default="all cores", help="worker processes")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
 def reproduce(out, quick, workers, seed):
     """Rerun the paper's study (Tables 1-2, Figs. 2-3 and 12-14) and find the
     lowest SNR at which each method is trustworthy; writes OUT/report.md."""
@@ -434,31 +650,34 @@ def reproduce(out, quick, workers, seed):
 
 # -- selftest -----------------------------------------------------------------
 @main.command()
-@click.option("--method", type=click.Choice(list(METHODS)), default="msg", show_default=True)
+@click.option("--method", type=MethodName(), default="msg", show_default=True)
 def selftest(method):
     """Render generic-sensor chips with known MTF, measure them, and compare
     measured with true; exit 1 if any estimate is out of tolerance."""
-    sensor = Sensor()
-    click.echo(f"imgmtf {__version__} self-test: generic sensor (Choi & Helder), GSD {sensor.gsd_m:g} m")
-    for d in DIRECTIONS:
-        click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
-                   f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
-    click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
-               "(! marks a figure out of tolerance):")
-    click.echo(f"{'case':<28} {'':>5} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM px':>8}")
-    rows = run_selftest(sensor, method=method)
-    for row in rows:
-        click.echo(f"{row.name:<28} {'true':>5} {row.true['mtf_nyquist']:8.4f} "
-                   f"{row.true['mtf50']:8.4f} {row.true['fwhm']:8.4f}")
-        marks = {k: ("" if v else "!") for k, v in row.passed.items()}
-        click.echo(f"{'':<28} {'got':>5} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
-                   f"{row.measured['mtf50']:8.4f}{marks['mtf50']:1}{row.measured['fwhm']:8.4f}{marks['fwhm']:1}"
-                   f"  {'PASS' if row.ok else 'FAIL'}  (SNR {row.snr:.0f})")
-    failed = [r.name for r in rows if not r.ok]
-    if failed:
-        click.echo(f"FAILED: {len(failed)} of {len(rows)} cases out of tolerance (marked !)", err=True)
-        sys.exit(1)
-    click.echo(f"all {len(rows)} cases within tolerance")
+    with _reported_errors():
+        from .selftest import run_selftest
+        from .sensor.model import DIRECTIONS, Sensor
+        sensor = Sensor()
+        click.echo(f"imgmtf {__version__} self-test: generic sensor (Choi & Helder), GSD {sensor.gsd_m:g} m")
+        for d in DIRECTIONS:
+            click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
+                       f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
+        click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
+                   "(! marks a figure out of tolerance):")
+        click.echo(f"{'case':<28} {'':>5} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM px':>8}")
+        rows = run_selftest(sensor, method=method)
+        for row in rows:
+            click.echo(f"{row.name:<28} {'true':>5} {row.true['mtf_nyquist']:8.4f} "
+                       f"{row.true['mtf50']:8.4f} {row.true['fwhm']:8.4f}")
+            marks = {k: ("" if v else "!") for k, v in row.passed.items()}
+            click.echo(f"{'':<28} {'got':>5} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
+                       f"{row.measured['mtf50']:8.4f}{marks['mtf50']:1}{row.measured['fwhm']:8.4f}{marks['fwhm']:1}"
+                       f"  {'PASS' if row.ok else 'FAIL'}  (SNR {row.snr:.0f})")
+        failed = [r.name for r in rows if not r.ok]
+        if failed:
+            click.echo(f"FAILED: {len(failed)} of {len(rows)} cases out of tolerance (marked !)", err=True)
+            sys.exit(1)
+        click.echo(f"all {len(rows)} cases within tolerance")
 
 
 if __name__ == "__main__":

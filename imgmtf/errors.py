@@ -21,17 +21,27 @@ class ImgmtfError(Exception):
 class ParameterError(ImgmtfError, ValueError):
     """A parameter is out of its valid range or of the wrong kind."""
 
+    reason = "parameter"
+
 
 class ConfigError(ImgmtfError):
     """A configuration file (sensor TOML) cannot be read or is malformed."""
+
+    reason = "config"
 
 
 class FileWriteError(ImgmtfError):
     """An output file cannot be written."""
 
+    reason = "write"
+
 
 class ImageReadError(ImgmtfError):
-    """An image file cannot be opened or decoded."""
+    """An image file cannot be opened or decoded (``reason`` ``unreadable``;
+    ``too-large`` for an image above the read limit, ``unsupported-type``
+    for complex pixels)."""
+
+    reason = "unreadable"
 
 
 class ImageContentError(ImgmtfError):

@@ -10,6 +10,8 @@ the main figures also as plain tags for ``gdalinfo``.
 from __future__ import annotations
 
 import json
+import os
+import stat
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -17,15 +19,29 @@ from pathlib import Path
 
 import numpy as np
 import rasterio
-from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
+from rasterio.errors import NotGeoreferencedWarning, RasterioError
 from rasterio.transform import Affine
 from rasterio.windows import Window
 
+from .atomic import atomic_output
 from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
 from .inputs import check_roi
 
 # Rec. 709 luma weights, applied to the stored (encoded) values of RGB input
 LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+
+try:     # GDAL's own errors, which rasterio raises as they are from some calls
+    from rasterio._err import CPLE_BaseError
+except ImportError:       # pragma: no cover - a rasterio without the private module
+    CPLE_BaseError = RasterioError
+GDAL_ERRORS = (RasterioError, CPLE_BaseError)
+
+# The most pixels one read returns: 16 Mpx (4096 x 4096) is 128 MiB as
+# float64, far more than any edge or bar needs, and few enough that the
+# estimators' working copies fit in memory.  A larger image is measured
+# through a window (``window=``, ``--roi``); scan reads tiles and decimated
+# overviews, each far below it.
+MAX_READ_PIXELS = 16 * 1024 * 1024
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,14 +100,15 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
     profile = dict(driver="GTiff", width=bands.shape[2], height=bands.shape[1],
                    count=bands.shape[0], dtype=bands.dtype.name,
                    transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", NotGeoreferencedWarning)
-            with rasterio.open(path, "w", **profile) as dst:
-                dst.write(bands)
-                dst.update_tags(**tags)
-    except (RasterioIOError, OSError) as exc:
-        raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
+    with atomic_output(path) as partial:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", NotGeoreferencedWarning)
+                with rasterio.open(partial, "w", **profile) as dst:
+                    dst.write(bands)
+                    dst.update_tags(**tags)
+        except (*GDAL_ERRORS, OSError) as exc:
+            raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
 
 
 @dataclass(frozen=True)
@@ -150,6 +167,22 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     (``Raster.origin`` is its top-left pixel), so a large scene is never
     loaded whole for a small ROI.  ``out_shape`` = (rows, cols) reads the
     window decimated (nearest), for overviews.
+
+    Raises
+    ------
+    ImageReadError
+        The file is missing, not a regular file (a FIFO or a device is
+        never opened), not an image, damaged, of a complex pixel type, or
+        larger than :data:`MAX_READ_PIXELS` for one read (reason
+        ``too-large``: read a window of it).
+    ParameterError
+        A bad ``band`` or ``window``.
+
+    Example
+    -------
+    >>> raster = read_raster("chip.tif", window=(100, 60, 64, 64))  # doctest: +SKIP
+    >>> raster.data.shape, raster.origin                              # doctest: +SKIP
+    ((64, 64), (100, 60))
     """
     path = str(path)
     with _opened(path) as src:
@@ -158,6 +191,8 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
         info = RasterInfo(path, src.width, src.height, count, tuple(colours), src.dtypes[0],
                           _gsd_m(src), src.transform, None)
         x, y, w, h = info.check_window(window) if window is not None else (0, 0, src.width, src.height)
+        check_read_size(path, (w, h) if out_shape is None else (out_shape[1], out_shape[0]),
+                        windowed=window is not None)
         region = Window(x, y, w, h)
         if band is not None:
             if not (isinstance(band, (int, np.integer)) and 1 <= band <= count):
@@ -178,20 +213,56 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y))
 
 
+def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) -> None:
+    """Refuse to read ``size`` = (width, height) px at once when it is more
+    than :data:`MAX_READ_PIXELS`: the header's word is taken before a byte
+    of pixels is read, so a small file declaring a huge image costs
+    nothing."""
+    width, height = size
+    if width * height > MAX_READ_PIXELS:
+        what = "the window" if windowed else "the image"
+        raise ImageReadError(
+            f"{path}: {what} is {width} x {height} px ({width * height / 2**20:.1f} Mpx), more than "
+            f"the {MAX_READ_PIXELS // 2**20} Mpx read at once; measure a part of it "
+            f"(--roi X,Y,W,H)", reason="too-large")
+
+
+def check_regular_file(path: str) -> None:
+    """Refuse anything but a regular file (following links) before GDAL
+    sees it: GDAL blocks forever reading a FIFO and reads a device whole."""
+    if not path:
+        raise ImageReadError("'': an empty path names no file")
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise ImageReadError(f"{path}: no such file") from None
+    except (OSError, ValueError) as exc:      # ValueError: a NUL byte in the path
+        raise ImageReadError(f"{path!r}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise ImageReadError(f"{path}: is a folder, not an image")
+    if not stat.S_ISREG(mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode)
+                or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        raise ImageReadError(f"{path}: is {kind}, not an image file; imgmtf reads regular files only")
+
+
 @contextmanager
 def _opened(path):
-    """An open rasterio dataset, GDAL's failures turned into ImageReadError."""
+    """An open rasterio dataset of a regular file with real pixels, GDAL's
+    failures turned into ImageReadError."""
     path = str(path)
-    if Path(path).is_dir():
-        raise ImageReadError(f"{path}: is a folder, not an image")
-    if not Path(path).exists():
-        raise ImageReadError(f"{path}: no such file")
+    check_regular_file(path)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as src:
+                complex_types = sorted({t for t in src.dtypes if "complex" in t})
+                if complex_types:
+                    raise ImageReadError(f"{path}: has complex pixels ({', '.join(complex_types)}); "
+                                         "an MTF needs real DN: convert the band you want first "
+                                         "(e.g. its magnitude)", reason="unsupported-type")
                 yield src
-    except RasterioIOError as exc:
+    except GDAL_ERRORS as exc:
         kind = _image_kind(path)
         if kind:
             raise ImageReadError(f"{path}: a {kind} file that is damaged or truncated "
@@ -221,7 +292,7 @@ def _band(src, index: int, window: Window, out_shape=None) -> np.ndarray:
     """Band ``index`` as float64 with nodata (mask) set to NaN."""
     try:
         values = src.read(index, window=window, masked=True, out_shape=out_shape)
-    except RasterioIOError as exc:
+    except GDAL_ERRORS as exc:
         raise ImageReadError(f"{src.name}: the file is damaged or truncated ({_reason(exc)})") from None
     data = values.data.astype(np.float64)
     data[np.ma.getmaskarray(values)] = np.nan
@@ -243,5 +314,9 @@ def _gsd_m(src) -> float | None:
 
 
 def _reason(exc: Exception) -> str:
+    """GDAL's own first line; rasterio sometimes wraps it in "see previous
+    exception", whose text is the cause's."""
     text = str(exc).strip() or type(exc).__name__
+    if "previous exception" in text and exc.__cause__ is not None:
+        text = str(exc.__cause__).strip() or text
     return text.splitlines()[0]

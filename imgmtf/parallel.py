@@ -2,68 +2,311 @@
 processes, or on a Dask distributed cluster, with one progress bar.
 
 Tasks are module-level functions of picklable arguments that return plain
-data (dicts, lists), so they can travel to any worker.  Results come back
-in the order of the inputs, whatever order the workers finish in.
+data, so they can travel to any worker.  :func:`run_tasks` yields results
+in the order of the inputs, whatever order the workers finish in (or as
+they complete, with their index).
+
+Local workers scale: each runs its numerical libraries (BLAS, OpenMP,
+OpenCV) on one thread, so ``workers`` is what parallelises rather than
+every worker fighting for every core.  They ignore Ctrl-C (the parent
+handles it), and end when their parent does, even if it was killed.
+
+Interrupts: an interrupt (Ctrl-C, or SIGTERM under :func:`terminate_raises`)
+while tasks run cancels the pending ones and terminates the workers at
+once before it propagates; the caller keeps what had completed.
 """
 from __future__ import annotations
 
+import multiprocessing
 import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
-
-from tqdm import tqdm
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 
 from .errors import ParameterError
 
 LOCAL_CLUSTER = "local"
+_prestarted: list = []      # at most one pool started ahead by prestart_workers
+MAX_WORKERS = 64
+WATCHDOG_PERIOD_S = 0.5
+# what numerical libraries read, at load time, for their thread count
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
+                    "OPENCV_FOR_THREADS_NUM")
+
+
+class Interrupted(KeyboardInterrupt):
+    """The run was stopped by a signal; ``signum`` says which (SIGINT for
+    Ctrl-C), and ``exit_code`` is the shell's convention, 128 + signum."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+    @property
+    def exit_code(self) -> int:
+        return 128 + self.signum
+
+
+@contextmanager
+def terminate_raises():
+    """While active (in the main thread), SIGTERM raises
+    :class:`Interrupted` like Ctrl-C raises KeyboardInterrupt, so that a
+    terminated run stops its workers and keeps what it measured."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def raise_interrupted(signum, frame):
+        raise Interrupted(signum)
+    previous = signal.signal(signal.SIGTERM, raise_interrupted)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, scheduler: str | None = None,
-              progress: bool | None = None, description: str = "measuring") -> Iterator:
+              progress: bool | None = None, description: str = "measuring",
+              on_error: Callable | None = None, ordered: bool = True) -> Iterator:
     """``function(item)`` for every item, yielded in input order.
 
     Parameters
     ----------
-    workers : local worker processes (1: run here, no processes).
+    workers : local worker processes (1: run here, no processes), at most
+        :data:`MAX_WORKERS`.
     scheduler : a Dask distributed scheduler address (``tcp://host:8786``)
         to run on that cluster, or ``"local"`` for a local Dask cluster of
         ``workers`` processes; None for local processes.  The workers must
         see the same files at the same paths (a shared file system).
     progress : show a progress bar (on stderr); None shows it when stderr
         is a terminal and there is more than one item.
+    on_error : ``on_error(item, exception)`` gives the result of a task
+        that raised or whose worker died; None lets the exception through.
+    ordered : False yields ``(index, result)`` pairs as tasks complete.
+
+    Example
+    -------
+    >>> list(run_tasks(abs, [-2, 1, -3], workers=2))
+    [2, 1, 3]
     """
     items = list(items)
+    if not (isinstance(workers, int) and 1 <= workers <= MAX_WORKERS):
+        raise ParameterError(f"workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}")
     if progress is None:
         progress = len(items) > 1 and _stderr_is_terminal()
-    bar = tqdm(total=len(items), desc=description, unit="task", disable=not progress, leave=False)
-    done: dict[int, object] = {}
-    next_index = 0
-    with bar:
-        for index, result in _completed(function, items, workers, scheduler):
-            done[index] = result
-            bar.update(1)
-            while next_index in done:
-                yield done.pop(next_index)
-                next_index += 1
+    completed = _completed(function, items, workers, scheduler, on_error)
+    if progress:
+        completed = _with_progress(completed, len(items), description)
+    try:
+        if ordered:
+            reorder = InputOrder()
+            for index, result in completed:
+                yield from reorder.push(index, result)
+        else:
+            yield from completed
+    finally:
+        completed.close()       # on an interrupt or an early stop: workers stopped now
 
 
-def _completed(function, items, workers, scheduler):
+def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
+    """Start ``workers`` local worker processes now, each importing
+    ``modules``, for the next :func:`run_tasks` of as many workers to use:
+    their start-up (the numerical libraries' imports, about half a second)
+    then overlaps the caller's own instead of following it."""
+    if workers < 2 or _prestarted or not 1 <= workers <= MAX_WORKERS:
+        return
+    pool = _new_pool(workers)
+    for _ in range(workers):
+        pool.submit(_import_modules, tuple(modules))
+    _prestarted.append((workers, pool))
+
+
+def _import_modules(modules: tuple[str, ...]) -> None:
+    import importlib
+    for name in modules:
+        importlib.import_module(name)
+
+
+def _take_prestarted(workers: int):
+    """The prestarted pool if it has ``workers`` processes, else None; any
+    other prestarted pool is shut down."""
+    if not _prestarted:
+        return None
+    size, pool = _prestarted.pop()
+    if size == workers:
+        return pool
+    pool.shutdown(wait=False, cancel_futures=True)
+    return None
+
+
+def _new_pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(workers, mp_context=_fresh_processes(), initializer=_init_worker,
+                               initargs=(os.getpid(),))
+
+
+class InputOrder:
+    """Reorder ``(index, value)`` pairs that arrive in any order: ``push``
+    returns the values now ready in index order; ``pending`` those still
+    waiting for an earlier one (what an interrupt would otherwise lose)."""
+
+    def __init__(self):
+        self._waiting: dict[int, object] = {}
+        self._next = 0
+
+    def push(self, index: int, value) -> list:
+        self._waiting[index] = value
+        ready = []
+        while self._next in self._waiting:
+            ready.append(self._waiting.pop(self._next))
+            self._next += 1
+        return ready
+
+    def pending(self) -> list:
+        return [self._waiting.pop(i) for i in sorted(self._waiting)]
+
+
+def _with_progress(completed, total: int, description: str):
+    from tqdm import tqdm
+    with tqdm(total=total, desc=description, unit="task", leave=False) as bar:
+        try:
+            for pair in completed:
+                bar.update(1)
+                yield pair
+        finally:
+            completed.close()
+
+
+def _completed(function, items, workers, scheduler, on_error):
     """(index, result) pairs as tasks complete."""
-    if workers < 1:
-        raise ParameterError(f"workers must be >= 1, got {workers}")
     if scheduler is not None:
-        yield from _dask_completed(function, items, workers, scheduler)
+        yield from _dask_completed(function, items, workers, scheduler, on_error)
     elif workers == 1 or len(items) <= 1:
+        _take_prestarted(0)
         for index, item in enumerate(items):
-            yield index, function(item)
+            yield index, _call(function, item, on_error)
     else:
-        with ProcessPoolExecutor(min(workers, len(items))) as pool:
-            futures = {pool.submit(function, item): i for i, item in enumerate(items)}
-            for future in as_completed(futures):
-                yield futures[future], future.result()
+        yield from _pool_completed(function, items, workers, on_error)
 
 
-def _dask_completed(function, items, workers, scheduler):
+def _call(function, item, on_error):
+    if on_error is None:
+        return function(item)
+    try:
+        return function(item)
+    except Exception as exc:
+        return on_error(item, exc)
+
+
+def _pool_completed(function, items, workers, on_error):
+    pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
+    futures = {}
+    finished = False
+    try:
+        futures = {pool.submit(function, item): i for i, item in enumerate(items)}
+        waiting = set(futures)
+        while waiting:
+            done, waiting = wait(waiting, return_when=FIRST_COMPLETED)
+            for future in done:
+                index = futures[future]
+                try:
+                    result = future.result()
+                except BrokenProcessPool as exc:
+                    if on_error is None:
+                        raise
+                    result = on_error(items[index], RuntimeError(
+                        f"its worker process died ({exc}); a crash in a library, or out of memory"))
+                except Exception as exc:
+                    if on_error is None:
+                        raise
+                    result = on_error(items[index], exc)
+                yield index, result
+        finished = True
+    finally:
+        if finished:
+            pool.shutdown()
+        else:
+            _stop(pool, futures)
+
+
+def _stop(pool: ProcessPoolExecutor, futures) -> None:
+    """Cancel what has not started and terminate the workers now (not after
+    their current task), then reap them."""
+    for future in futures:
+        future.cancel()
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.join(timeout=2)
+        if process.is_alive():
+            process.kill()
+            process.join(timeout=1)
+
+
+def _fresh_processes():
+    """Workers started without a copy of this process: a fork of a process
+    whose OpenCV or BLAS thread pools have run can deadlock in them, and a
+    fresh worker loads its libraries after :func:`limit_threads` has set
+    their thread counts."""
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def _init_worker(parent_pid: int) -> None:
+    """Set up a local worker process: a watchdog that ends the worker when
+    the parent is gone, Ctrl-C left to the parent, one numerical-library
+    thread."""
+    threading.Thread(target=_watch_parent, args=(parent_pid, os.getppid()), daemon=True,
+                     name="imgmtf-parent-watchdog").start()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    limit_threads()
+
+
+def limit_threads() -> None:
+    """One thread for every numerical library of this process: the loaded
+    ones now (threadpoolctl, OpenCV), those loaded later through the
+    environment they read when they load."""
+    for name in THREAD_VARIABLES:
+        os.environ[name] = "1"
+    try:
+        from threadpoolctl import threadpool_limits
+        threadpool_limits(limits=1)
+    except ImportError:          # an optional speed-up: without it the environment still applies
+        pass
+    if "cv2" in sys.modules:
+        sys.modules["cv2"].setNumThreads(1)
+
+
+def _watch_parent(parent_pid: int, first_ppid: int) -> None:
+    """Exit when the parent has gone: this process was re-parented (the
+    parent, or the fork server between us, died), even by SIGKILL."""
+    while True:
+        time.sleep(WATCHDOG_PERIOD_S)
+        ppid = os.getppid()
+        if ppid != first_ppid or (ppid != parent_pid and not _alive(parent_pid)):
+            os._exit(1)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _dask_completed(function, items, workers, scheduler, on_error):
     try:
         from distributed import Client, LocalCluster
         from distributed import as_completed as dask_as_completed
@@ -81,12 +324,22 @@ def _dask_completed(function, items, workers, scheduler):
         if cluster is not None:
             cluster.close()
         raise ParameterError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    futures = []
     try:
         futures = client.map(function, items, pure=False)
         index = {future.key: i for i, future in enumerate(futures)}
         for future in dask_as_completed(futures):
-            yield index[future.key], future.result()
+            i = index[future.key]
+            try:
+                result = future.result()
+            except Exception as exc:
+                if on_error is None:
+                    raise
+                result = on_error(items[i], exc)
+            yield i, result
     finally:
+        if futures:
+            client.cancel(futures)
         client.close()
         if cluster is not None:
             cluster.close()

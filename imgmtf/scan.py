@@ -18,29 +18,36 @@
 5. rank: accepted targets by the width of their MTF-at-Nyquist confidence
    interval, which grows as SNR, length or straightness fall.
 
-Every candidate becomes a record (see :mod:`imgmtf.batch`) with ``id``,
-``status`` (accepted/rejected), ``reason``, the segment in pixels
-(``x0_px``...) and, when georeferenced, in map coordinates.
+Every candidate becomes a :class:`imgmtf.records.Record` with ``status``
+(accepted/rejected), ``reason`` and, in its ``site``, ``id``, ``rank``,
+the segment in pixels (``x0_px``...) and, when georeferenced, in map
+coordinates.  An unexpected failure on one candidate rejects it (reason
+``internal``), never the scan.
 """
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from .version import __version__
-from .batch import MeasureSettings, measure_raster, write_csv
-from .batch import csv_row as batch_csv_row
+from .atomic import atomic_output, ensure_folder
+from .batch import MeasureSettings, measure_raster, save_figure
 from .errors import FileWriteError, ImgmtfError, ParameterError
+from .estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
+from .estimate.intervals import Intervals
 from .inputs import saturation_levels
 from .io import RasterInfo, raster_info, read_raster
 from .parallel import run_tasks
-from .estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
-from .estimate.intervals import Bootstrap
+from .records import SCAN_CSV_COLUMNS, Record, json_safe, utc_now, write_csv
+from .version import __version__
+
+# Scenes larger than this are refused: detection reads every tile, and 1 Gpx
+# (32768 x 32768) is already minutes of it.  Crop a part to scan it.
+MAX_SCAN_PIXELS = 2 ** 30
 
 MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
 MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line
@@ -96,7 +103,7 @@ class ScanSettings:
     max_line_rms_px : largest RMS scatter of the per-row target locations
         about their line (px) for a straight target.
     tile_px : side of the tiles read for detection (px).
-    method, band, pulse_width, bootstrap : as in
+    method, band, pulse_width, intervals : as in
         :class:`imgmtf.batch.MeasureSettings`.
     """
 
@@ -110,7 +117,7 @@ class ScanSettings:
     method: str = "msg"
     band: int | None = None
     pulse_width: tuple[float, str] | None = None
-    bootstrap: Bootstrap = field(default_factory=Bootstrap)
+    intervals: Intervals = field(default_factory=Intervals)
 
     def __post_init__(self):
         if not self.min_length_px >= 16:
@@ -122,7 +129,7 @@ class ScanSettings:
         self.measure_settings()
 
     def measure_settings(self) -> MeasureSettings:
-        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.bootstrap)
+        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.intervals)
 
 
 # -- detection -----------------------------------------------------------------
@@ -130,6 +137,7 @@ def detect_segments(path: str, settings: ScanSettings = ScanSettings()) -> list[
     """Straight segments of the scene at least half ``min_length_px`` long
     (shorter ones are texture, not worth reporting), merged across tiles."""
     info = raster_info(path)
+    check_scene_size(info)
     lo, hi = _display_levels(path, settings.band, info)
     detector = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
     pieces = []
@@ -143,6 +151,16 @@ def detect_segments(path: str, settings: ScanSettings = ScanSettings()) -> list[
                 pieces.extend(found.reshape(-1, 4).astype(float) + (x, y, x, y))
     merged = merge_segments(np.array(pieces, float).reshape(-1, 4))
     return [s for s in merged if s.length_px >= settings.min_length_px / 2]
+
+
+def check_scene_size(info: RasterInfo) -> None:
+    """Refuse a scene above :data:`MAX_SCAN_PIXELS` (its header's word)."""
+    if info.width * info.height > MAX_SCAN_PIXELS:
+        raise ImgmtfError(
+            f"{info.path}: the scene is {info.width} x {info.height} px "
+            f"({info.width * info.height / 2**30:.1f} Gpx), more than the {MAX_SCAN_PIXELS // 2**30} Gpx "
+            "a scan reads; scan a part of it (crop it, e.g. gdal_translate -srcwin X Y W H)",
+            reason="too-large")
 
 
 def _display_levels(path, band, info: RasterInfo) -> tuple[float, float]:
@@ -293,30 +311,31 @@ def screen(segment: Segment, settings: ScanSettings) -> tuple[str, str] | None:
 
 
 # -- measurement ------------------------------------------------------------------
-def measure_candidate(task) -> dict:
+def measure_candidate(task) -> Record:
     """Measure one candidate ROI (a task of :func:`scan_scene`): a record
-    with ``status`` accepted or rejected."""
-    path, roi, settings = task
-    record = {"status": "rejected", "reason": None, "error": None}
+    with ``status`` accepted or rejected, whatever goes wrong."""
+    path, roi, settings, run_utc = task
+    measure = settings.measure_settings()
+    params = measure.params()
     try:
         raster = read_raster(path, settings.band, window=roi)
-        result = measure_raster(raster, settings.measure_settings())
-        line_rms = _line_rms(result.geometry)
-        variation = side_variation(result)
-        record.update(result.to_dict(curves=False), line_rms_px=line_rms, side_variation=variation,
-                      band=raster.band)
-        if variation > settings.max_side_variation:
-            record.update(reason="non-uniform", error=(
-                f"a side of the target varies by {100 * variation:.0f} % of its contrast (at most "
-                f"{100 * settings.max_side_variation:g} % allowed): not a uniform field"))
-        elif line_rms > settings.max_line_rms_px:
-            record.update(reason="not-straight", error=(
-                f"the per-row locations scatter {line_rms:.2f} px about the fitted line (at most "
-                f"{settings.max_line_rms_px:g} px allowed): not a straight target"))
-        else:
-            record["status"] = "accepted"
-    except ImgmtfError as exc:
-        record.update(reason=exc.reason, error=str(exc))
+        result = measure_raster(raster, measure)
+        figures = {**result.to_dict(curves=False), "line_rms_px": _line_rms(result.geometry),
+                   "side_variation": side_variation(result)}
+    except Exception as exc:        # an estimator's refusal, or the safety net
+        return Record.failed(path, settings.band, settings.target, settings.method, exc, params=params,
+                             run_utc=run_utc, status="rejected")
+    record = Record.measured(path, raster.band, figures, params=params, run_utc=run_utc,
+                             status="accepted")
+    variation, line_rms = figures["side_variation"], figures["line_rms_px"]
+    if variation > settings.max_side_variation:
+        return record.with_(status="rejected", reason="non-uniform", error=(
+            f"{path}: a side of the target varies by {100 * variation:.0f} % of its contrast (at most "
+            f"{100 * settings.max_side_variation:g} % allowed): not a uniform field"))
+    if line_rms > settings.max_line_rms_px:
+        return record.with_(status="rejected", reason="not-straight", error=(
+            f"{path}: the per-row locations scatter {line_rms:.2f} px about the fitted line (at most "
+            f"{settings.max_line_rms_px:g} px allowed): not a straight target"))
     return record
 
 
@@ -351,10 +370,17 @@ def side_variation(result) -> float:
 
 
 def scan_scene(path: str, settings: ScanSettings = ScanSettings(), *, workers: int = 1,
-               scheduler: str | None = None, progress: bool | None = None) -> list[dict]:
+               scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
     """Every candidate target of the scene as a record, accepted ones first
-    in rank order, then rejected ones by length."""
+    in rank order, then rejected ones by length.
+
+    An interrupt (KeyboardInterrupt, or SIGTERM under
+    :func:`imgmtf.parallel.terminate_raises`) propagates with the records
+    so far as its ``records`` attribute: candidates not yet measured are
+    rejected with reason ``interrupted``.
+    """
     path = str(path)
+    run_utc = utc_now()
     info = raster_info(path)
     segments = detect_segments(path, settings)
     lone, bars = pair_bars(segments)
@@ -370,39 +396,58 @@ def scan_scene(path: str, settings: ScanSettings = ScanSettings(), *, workers: i
     for segment, verdict in candidates:
         verdict = verdict or screen(segment, settings)
         roi = segment_roi(segment, info, settings)
-        record = _segment_record(path, segment, roi, info, settings)
+        record = _segment_record(path, segment, roi, info, settings, run_utc)
         if verdict:
-            record.update(status="rejected", reason=verdict[0], error=verdict[1])
+            record = record.with_(status="rejected", reason=verdict[0], error=f"{path}: {verdict[1]}")
         else:
-            tasks.append((len(records), (path, roi, settings)))
+            tasks.append((len(records), (path, roi, settings, run_utc)))
         records.append(record)
-    measured = run_tasks(measure_candidate, [t for _, t in tasks], workers=workers, scheduler=scheduler,
-                         progress=progress, description="measuring targets")
-    for (index, _), outcome in zip(tasks, measured):
-        scan_params = records[index]["params"]
-        records[index].update({k: v for k, v in outcome.items() if v is not None or k == "reason"})
-        records[index]["params"] = {**outcome.get("params", {}), **scan_params}
+
+    def lost(task, exc):
+        return Record.failed(path, settings.band, settings.target, settings.method, exc,
+                             params=settings.measure_settings().params(), run_utc=run_utc,
+                             status="rejected")
+    try:
+        for task_index, outcome in run_tasks(measure_candidate, [t for _, t in tasks], workers=workers,
+                                             scheduler=scheduler, progress=progress,
+                                             description="measuring targets", on_error=lost,
+                                             ordered=False):
+            index = tasks[task_index][0]
+            records[index] = _measured(records[index], outcome)
+    except KeyboardInterrupt as exc:
+        stopped = [i for i, _ in tasks if records[i].status == "candidate"]
+        for i in stopped:
+            records[i] = records[i].with_(status="rejected", reason="interrupted",
+                                          error=f"{path}: not measured: the scan was interrupted")
+        exc.records = _ranked(records)
+        raise
     return _ranked(records)
 
 
-def _segment_record(path, segment: Segment, roi, info: RasterInfo, settings: ScanSettings) -> dict:
-    record = {
-        "path": path, "band": settings.band, "target": settings.target, "method": settings.method,
-        "status": "candidate", "reason": None, "error": None,
+def _measured(candidate: Record, outcome: Record) -> Record:
+    """A candidate with its measurement's outcome, figures and settings."""
+    return candidate.with_(status=outcome.status, reason=outcome.reason, error=outcome.error,
+                           band=outcome.band if outcome.band is not None else candidate.band,
+                           figures=outcome.figures, params={**outcome.params, **candidate.params})
+
+
+def _segment_record(path, segment: Segment, roi, info: RasterInfo, settings: ScanSettings,
+                    run_utc: str) -> Record:
+    site = {
         "x0_px": round(segment.x0, 2), "y0_px": round(segment.y0, 2),
         "x1_px": round(segment.x1, 2), "y1_px": round(segment.y1, 2),
         "length_px": round(segment.length_px, 1), "tilt_deg": round(segment.tilt_deg, 2),
         "direction": segment.direction, "roi": list(roi),
-        "params": {"scan": _scan_params(settings), "bootstrap": settings.bootstrap.as_dict()},
-        "imgmtf_version": __version__,
     }
     if settings.target == "pulse":
-        record["bar_width_px"] = round(segment.width_px, 2)
+        site["bar_width_px"] = round(segment.width_px, 2)
     if not info.transform.is_identity:
         (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
                                   for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
-        record.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
-    return record
+        site.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
+    params = {"scan": _scan_params(settings), "intervals": settings.intervals.as_dict()}
+    return Record(path, settings.band, settings.target, settings.method, "candidate", site=site,
+                  params=params, run_utc=run_utc)
 
 
 def _scan_params(settings: ScanSettings) -> dict:
@@ -410,43 +455,23 @@ def _scan_params(settings: ScanSettings) -> dict:
                                              "max_side_variation", "max_line_rms_px", "tile_px")}
 
 
-def _ranked(records: list[dict]) -> list[dict]:
-    accepted = [r for r in records if r["status"] == "accepted"]
-    rejected = [r for r in records if r["status"] != "accepted"]
+def _ranked(records: list[Record]) -> list[Record]:
+    """Accepted records by interval width (then SNR), rejected ones by
+    length; ``id`` (and ``rank`` for accepted ones) first in their site."""
+    accepted = [r for r in records if r.ok]
+    rejected = [r for r in records if not r.ok]
 
     def interval_width(r):
-        low, high = r.get("mtf_nyquist_ci") or (None, None)
+        low, high = r.figures.get("mtf_nyquist_ci") or (None, None)
         return (high - low) if low is not None and high is not None else math.inf
-    accepted.sort(key=lambda r: (interval_width(r), -(r.get("snr") or math.inf)))
-    rejected.sort(key=lambda r: -r["length_px"])
-    for rank, r in enumerate(accepted, 1):
-        r["rank"] = rank
-    for i, r in enumerate(accepted + rejected, 1):
-        r["id"] = i
-    return [{"id": r.pop("id"), **r} for r in accepted + rejected]
+    accepted.sort(key=lambda r: (interval_width(r), -(r.figures.get("snr") or math.inf)))
+    rejected.sort(key=lambda r: -r.site["length_px"])
+    ranked = [(r, rank) for rank, r in enumerate(accepted, 1)] + [(r, None) for r in rejected]
+    return [replace(r, site={"id": i, "rank": rank, **r.site}) for i, (r, rank) in enumerate(ranked, 1)]
 
 
 # -- outputs ------------------------------------------------------------------------
-CSV_COLUMNS = ("id", "rank", "status", "reason", "error", "path", "band", "target", "method",
-               "direction", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "tilt_deg",
-               "map_x0", "map_y0", "map_x1", "map_y1", "roi", "normal_angle_deg", "snr",
-               "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high", "mtf50_cy_px",
-               "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px", "fwhm_px", "gsd_m", "mtf50_cy_m",
-               "fwhm_m", "rows_used", "line_rms_px", "side_variation", "bar_width_px",
-               "pulse_width_px", "warnings", "params", "imgmtf_version")
-
-
-def csv_row(record: dict) -> dict:
-    """A scan record flattened to :data:`CSV_COLUMNS`."""
-    row = batch_csv_row(record)
-    row.update({k: ("" if record.get(k) is None else record[k]) for k in CSV_COLUMNS if k not in row})
-    for key in ("roi", "warnings", "params"):
-        if record.get(key) is not None:
-            row[key] = json.dumps(record[key], sort_keys=True)
-    return row
-
-
-def to_geojson(records: list[dict], info: RasterInfo) -> dict:
+def to_geojson(records: list[Record], info: RasterInfo) -> dict:
     """The candidates as a GeoJSON FeatureCollection of LineStrings.
 
     Georeferenced scenes (a CRS): geometry in longitude/latitude (WGS 84,
@@ -455,44 +480,41 @@ def to_geojson(records: list[dict], info: RasterInfo) -> dict:
     coordinates (x right, y down; the ``imgmtf_coordinates`` member says
     so).  Every feature's properties carry the pixel coordinates and the
     record's figures."""
+    rows = [r.to_dict() for r in records]
     if info.crs:
         from rasterio.warp import transform as warp
-        xs = [v for r in records for v in (r["map_x0"], r["map_x1"])]
-        ys = [v for r in records for v in (r["map_y0"], r["map_y1"])]
+        xs = [v for r in rows for v in (r["map_x0"], r["map_x1"])]
+        ys = [v for r in rows for v in (r["map_y0"], r["map_y1"])]
         lon, lat = warp(info.crs, "EPSG:4326", xs, ys) if xs else ([], [])
-        lines = [[[lon[2 * i], lat[2 * i]], [lon[2 * i + 1], lat[2 * i + 1]]] for i in range(len(records))]
+        lines = [[[lon[2 * i], lat[2 * i]], [lon[2 * i + 1], lat[2 * i + 1]]] for i in range(len(rows))]
         coordinates = "longitude/latitude (EPSG:4326)"
     else:
-        lines = [[[r["x0_px"], r["y0_px"]], [r["x1_px"], r["y1_px"]]] for r in records]
+        lines = [[[r["x0_px"], r["y0_px"]], [r["x1_px"], r["y1_px"]]] for r in rows]
         coordinates = "pixel (x right, y down, pixel centres at integers)"
     features = [{"type": "Feature", "id": r["id"],
                  "geometry": {"type": "LineString", "coordinates": line},
                  "properties": {k: v for k, v in r.items() if k not in ("frequencies_cy_px", "mtf")}}
-                for r, line in zip(records, lines)]
+                for r, line in zip(rows, lines)]
     return {"type": "FeatureCollection", "imgmtf_coordinates": coordinates,
             "imgmtf_source": info.path, "imgmtf_version": __version__, "features": features}
 
 
-def write_outputs(records: list[dict], info: RasterInfo, out_dir: str, overview_band=None) -> list[str]:
-    """CSV, GeoJSON and overview PNG of a scan in ``out_dir``; their paths."""
+def write_outputs(records: list[Record], info: RasterInfo, out_dir: str, overview_band=None) -> list[str]:
+    """CSV, GeoJSON and overview PNG of a scan in ``out_dir`` (each written
+    atomically); their paths."""
     from .plot import plot_scan
-    out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FileWriteError(f"{out_dir}: cannot create the folder: {exc.strerror or exc}") from None
+    out = ensure_folder(out_dir)
     csv_path, json_path, png_path = (str(out / n) for n in ("targets.csv", "targets.geojson", "overview.png"))
-    write_csv(records, csv_path, CSV_COLUMNS, csv_row)
-    try:
-        Path(json_path).write_text(json.dumps(to_geojson(records, info), indent=1))
-    except OSError as exc:
-        raise FileWriteError(f"{json_path}: cannot write: {exc.strerror or exc}") from None
+    write_csv(records, csv_path, SCAN_CSV_COLUMNS)
+    with atomic_output(json_path) as partial:
+        try:
+            Path(partial).write_text(json.dumps(json_safe(to_geojson(records, info)), indent=1))
+        except OSError as exc:
+            raise FileWriteError(f"{json_path}: cannot write: {exc.strerror or exc}") from None
     scale = max(max(info.width, info.height) / 1500, 1.0)
     shape = (max(int(info.height / scale), 1), max(int(info.width / scale), 1))
     overview = read_raster(info.path, overview_band, out_shape=shape).data
-    try:
-        levels = _display_levels(info.path, overview_band, info)
-        plot_scan(overview, info.width / shape[1], records, levels).savefig(png_path, dpi=110)
-    except OSError as exc:
-        raise FileWriteError(f"{png_path}: cannot write: {exc.strerror or exc}") from None
+    levels = _display_levels(info.path, overview_band, info)
+    rows = [r.to_dict() for r in records]
+    save_figure(lambda: plot_scan(overview, info.width / shape[1], rows, levels), png_path)
     return [csv_path, json_path, png_path]

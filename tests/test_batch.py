@@ -105,9 +105,9 @@ def test_rgb_photo_is_luminance_by_default_and_per_channel_with_band_all(tmp_pat
                                                         rasterio.enums.ColorInterp.green,
                                                         rasterio.enums.ColorInterp.blue])
     settings = MeasureSettings()
-    (lum,) = measure_file(str(path), settings)
+    (lum,) = (r.to_dict() for r in measure_file(str(path), settings))
     assert lum["band"] == "luminance" and lum["status"] == "ok"
-    per_band = measure_file(str(path), MeasureSettings(band="all"))
+    per_band = [r.to_dict() for r in measure_file(str(path), MeasureSettings(band="all"))]
     assert [r["band"] for r in per_band] == [1, 2, 3]
     # the same edge in every channel: the same MTF (to quantisation of the dimmer channels)
     for r in per_band:
@@ -119,8 +119,8 @@ def test_float_image_with_negative_values_measures_like_its_offset_copy(tmp_path
                            dtype=np.float32)
     negative = write(tmp_path / "negative.tif", edge)
     shifted = write(tmp_path / "shifted.tif", edge + 1000.0)
-    a, = measure_file(str(negative), MeasureSettings())
-    b, = measure_file(str(shifted), MeasureSettings())
+    a, = (r.to_dict() for r in measure_file(str(negative), MeasureSettings()))
+    b, = (r.to_dict() for r in measure_file(str(shifted), MeasureSettings()))
     assert a["status"] == "ok" and a["levels_dn"][0] < 0
     assert a["mtf_nyquist"] == pytest.approx(b["mtf_nyquist"], abs=2e-4)
 
@@ -155,6 +155,61 @@ def test_windowed_read_reports_roi_in_file_coordinates(tmp_path):
     path = write(tmp_path / "scene.tif", scene.astype(np.uint16))
     raster = im.read_raster(path, window=(100, 60, 64, 64))
     assert raster.data.shape == (64, 64) and raster.origin == (100, 60)
-    record, = measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64)))
+    record, = (r.to_dict() for r in measure_file(str(path), MeasureSettings(roi=(100, 60, 64, 64))))
     assert record["roi"] == [100, 60, 64, 64]
     assert record["normal_angle_deg"] == pytest.approx(6.0, abs=0.05)
+
+
+def test_fifo_and_complex_pixels_are_refused_by_name_and_the_batch_goes_on(tmp_path, good):
+    fifo = tmp_path / "pipe.tif"
+    os.mkfifo(fifo)
+    complex_tif = write(tmp_path / "complex.tif", np.ones((32, 32), np.complex64))
+    result = CliRunner().invoke(main, ["measure", "--format", "json", str(fifo), str(complex_tif),
+                                       str(good)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert result.exit_code == 1 and [r["status"] for r in rows] == ["error", "error", "ok"]
+    assert rows[0]["error"] == f"{fifo}: is a FIFO (named pipe), not an image file; imgmtf reads regular files only"
+    assert rows[1]["reason"] == "unsupported-type" and "complex64" in rows[1]["error"]
+
+
+def test_a_fifo_in_a_folder_is_reported_not_skipped(tmp_path, good):
+    os.mkfifo(tmp_path / "pipe.tif")
+    assert str(tmp_path / "pipe.tif") in expand_inputs([tmp_path])
+
+
+def test_an_unexpected_failure_is_an_internal_error_record_for_that_file_only(tmp_path, good, monkeypatch):
+    import imgmtf.batch as batch
+    real = batch.measure_raster
+
+    def fails_on_one(raster, settings):
+        if raster.path.endswith("boom.tif"):
+            raise TypeError("unsupported operand")
+        return real(raster, settings)
+    monkeypatch.setattr(batch, "measure_raster", fails_on_one)
+    boom = write(tmp_path / "boom.tif", exact_edge_chip(TRANSFER, 6.0, (64, 64)))
+    result = CliRunner().invoke(main, ["measure", "--format", "json", str(boom), str(good)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert rows[0]["reason"] == "internal"
+    assert rows[0]["error"] == f"{boom}: internal error: TypeError: unsupported operand"
+    assert rows[1]["status"] == "ok"
+
+
+def test_mixed_batch_keeps_every_row_in_input_order_with_workers(tmp_path, good):
+    cases = bad_inputs(tmp_path)
+    paths = [str(p) for p, _ in cases.values()] * 2 + [str(good)] * 3
+    out_csv = tmp_path / "rows.csv"
+    result = CliRunner().invoke(main, ["measure", "--format", "json", "--workers", "2", "--bootstrap", "0",
+                                       "--csv", str(out_csv), *paths])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [r["path"] for r in rows] == paths
+    assert [r["path"] for r in csv.DictReader(out_csv.open())] == paths
+    assert all(r["reason"] and r["error"] for r in rows if r["status"] == "error")
+
+
+def test_an_empty_path_is_an_error_row_not_the_current_folder(tmp_path, good, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert expand_inputs(["", str(good)]) == ["", str(good)]
+    rows = [json.loads(line) for line in
+            CliRunner().invoke(main, ["measure", "--format", "json", "", str(good)]).stdout.splitlines()]
+    assert [r["status"] for r in rows] == ["error", "ok"] and "empty path" in rows[0]["error"]

@@ -26,7 +26,7 @@ def tile_of(record):
 
 @pytest.fixture(scope="module")
 def edge_scan():
-    return scan_scene(str(SCENE))
+    return [r.to_dict() for r in scan_scene(str(SCENE))]
 
 
 def test_scan_accepts_the_good_edges_with_true_mtf_in_their_intervals(edge_scan):
@@ -55,7 +55,7 @@ def test_scan_rejects_the_mosaic_seams_as_axis_aligned(edge_scan):
 
 
 def test_scan_measures_the_bar_as_a_pulse_target():
-    records = scan_scene(str(SCENE), ScanSettings(target="pulse", pulse_width=(3.0, "px")))
+    records = [r.to_dict() for r in scan_scene(str(SCENE), ScanSettings(target="pulse", pulse_width=(3.0, "px")))]
     accepted = [r for r in records if r["status"] == "accepted"]
     assert len(accepted) == 1 and tile_of(accepted[0])["verdict"] == "bar"
     assert accepted[0]["bar_width_px"] == pytest.approx(3.0, abs=0.6)
@@ -94,3 +94,34 @@ def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
     im.write_geotiff(flat, (1000 + rng.normal(0, 5, (128, 128))).astype(np.uint16))
     result = CliRunner().invoke(main, ["scan", str(flat)])
     assert result.exit_code == 1 and f"{flat}: no usable edge found" in result.output
+
+
+def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--target", "pulse", "--bootstrap", "0"])
+    assert result.exit_code == 0, result.output
+    assert "1 accepted" in result.stdout and "Traceback" not in result.output
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--target", "pulse", "--bootstrap", "0",
+                                       "--format", "json", "--out", str(tmp_path)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    accepted = [r for r in rows if r["status"] == "accepted"]
+    assert len(accepted) == 1 and accepted[0]["mtf50_cy_px"] is None and accepted[0]["rank"] == 1
+    header = (tmp_path / "targets.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["id", "rank", "path"] and "bar_width_px" in header and "run_utc" in header
+
+
+def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
+    import imgmtf.scan as scan_module
+    calls = []
+
+    def breaks_once(raster, settings):
+        calls.append(raster.origin)
+        if len(calls) == 1:
+            raise ZeroDivisionError("float division by zero")
+        return real(raster, settings)
+    real = scan_module.measure_raster
+    monkeypatch.setattr(scan_module, "measure_raster", breaks_once)
+    records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
+    internal = [r for r in records if r.reason == "internal"]
+    assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error
+    assert internal[0].error.startswith(str(SCENE))
+    assert sum(r.ok for r in records) >= 1

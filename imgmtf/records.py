@@ -1,0 +1,273 @@
+"""One typed row for every outcome of ``measure``, batches and ``scan``, its
+CSV schema, and writers that stream rows to disk as they come.
+
+A :class:`Record` is what one target gave: the figures of an estimate
+(``status`` ``ok``, or ``accepted`` in a scan), or why there are none
+(``error``/``rejected``, with a machine-readable ``reason`` and a one-line
+message naming the file).  Every record carries its provenance: the input
+``path`` and ``band``, ``target`` and ``method``, ``params`` (the
+estimator's settings with the run's: bootstrap, ROI, scan thresholds...),
+``imgmtf_version`` and ``run_utc``, the start of the run in UTC (ISO 8601).
+
+The JSON form (:meth:`Record.to_dict`) is flat: the estimate's own keys
+(:meth:`imgmtf.estimate.results.MTFResult.to_dict`, units in the names)
+beside the provenance.  The CSV schema is :data:`CSV_COLUMNS`; a scan's CSV
+adds the columns of :data:`SCAN_COLUMNS` (where the target lies).
+
+Reason codes of failed records: those of :mod:`imgmtf.errors`
+(``unreadable``, ``too-large``, ``unsupported-type``, ``image``,
+``no-target``, ``two-targets``, ``unsuitable``, ``parameter``...), the
+scan's screening codes (``angle``, ``too-short``, ``non-uniform``...), and
+``internal`` for an unexpected failure of the software on that input.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from datetime import datetime, timezone
+from typing import IO, Any
+
+from .atomic import atomic_output
+from .errors import FileWriteError, ImgmtfError
+from .version import __version__
+
+OK_STATUSES = ("ok", "accepted")
+FAILED_STATUSES = ("error", "rejected")
+INTERNAL = "internal"
+
+# keys of an estimate's dict that are the record's own fields
+_OWN_KEYS = frozenset({"path", "band", "target", "method", "status", "reason", "error", "plot",
+                       "params", "imgmtf_version", "run_utc"})
+
+
+def utc_now() -> str:
+    """The current time in UTC, ISO 8601 to the second (``2024-05-01T09:30:00Z``)."""
+    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+@dataclass(frozen=True)
+class Record:
+    """The outcome of measuring one target: a file (or one of its bands), or
+    a scan candidate.
+
+    Attributes
+    ----------
+    path : the input file.
+    band : 1-based band, ``"luminance"`` for RGB, None when not known.
+    target : ``"edge"`` or ``"pulse"``.
+    method : the resampling method.
+    status : ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
+    reason : machine-readable code of a failure (None when ok).
+    error : one-line message naming the file (None when ok).
+    figures : the estimate's JSON summary (units in the names:
+        ``mtf50_cy_px``, ``fwhm_px``...), empty for a failure.
+    site : where a scan candidate lies (``id``, ``rank``, ``x0_px``...);
+        empty for ``measure``.
+    plot : the figure written for this record, if any.
+    params : settings of the estimate and of the run.
+    run_utc : start of the run, UTC, ISO 8601.
+    imgmtf_version : the version that made the record.
+    """
+
+    path: str
+    band: int | str | None
+    target: str
+    method: str
+    status: str
+    reason: str | None = None
+    error: str | None = None
+    figures: Mapping[str, Any] = field(default_factory=dict)
+    site: Mapping[str, Any] = field(default_factory=dict)
+    plot: str | None = None
+    params: Mapping[str, Any] = field(default_factory=dict)
+    run_utc: str = ""
+    imgmtf_version: str = __version__
+
+    @classmethod
+    def measured(cls, path: str, band, summary: Mapping[str, Any], *, params: Mapping[str, Any],
+                 run_utc: str, status: str = "ok", **fields) -> "Record":
+        """A record of an estimate whose JSON summary is ``summary``; the
+        run's ``params`` are merged with the estimator's own."""
+        figures = {k: v for k, v in summary.items() if k not in _OWN_KEYS}
+        return cls(str(path), band, summary.get("target", ""), summary.get("method", ""), status,
+                   figures=figures, params={**params, **(summary.get("params") or {})},
+                   run_utc=run_utc, **fields)
+
+    @classmethod
+    def failed(cls, path: str, band, target: str, method: str, exc: BaseException, *,
+               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> "Record":
+        """A record of a target that could not be measured: the reason code
+        of an imgmtf error, ``internal`` for any other exception; the
+        message names the file (prefixed when it does not)."""
+        message = " ".join(str(exc).split())
+        if isinstance(exc, ImgmtfError):
+            reason = exc.reason
+        else:
+            reason = INTERNAL
+            message = f"internal error: {type(exc).__name__}: {message or 'no message'}"
+        if not message.startswith(str(path)):
+            where = f"{path}: band {band}" if isinstance(band, int) else str(path)
+            message = f"{where}: {message}"
+        return cls(str(path), band, target, method, status, reason, message, params=params,
+                   run_utc=run_utc, **fields)
+
+    @property
+    def ok(self) -> bool:
+        return self.status in OK_STATUSES
+
+    def get(self, key: str, default=None):
+        """A value of the flat JSON form (a field, a figure or a site key)."""
+        return self.to_dict().get(key, default)
+
+    def with_(self, **changes) -> "Record":
+        """A copy with fields changed (``figures``/``site`` given as
+        mappings are merged into the current ones)."""
+        for name in ("figures", "site"):
+            if name in changes:
+                changes[name] = {**getattr(self, name), **changes[name]}
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        """The flat, JSON-ready form (one JSON Lines line)."""
+        return {**self.site, "path": self.path, "band": self.band, "target": self.target,
+                "method": self.method, "status": self.status, "reason": self.reason,
+                "error": self.error, **self.figures, "plot": self.plot, "params": dict(self.params),
+                "imgmtf_version": self.imgmtf_version, "run_utc": self.run_utc}
+
+    def csv_row(self, columns=None) -> dict:
+        """The record flattened to ``columns`` (default :data:`CSV_COLUMNS`):
+        intervals split into their bounds, lists and mappings as JSON,
+        missing values empty."""
+        flat = self.to_dict()
+        row = {}
+        for column in columns or CSV_COLUMNS:
+            source = _CSV_SOURCES.get(column, column)
+            if isinstance(source, tuple):
+                pair = flat.get(source[0]) or (None, None)
+                value = pair[source[1]]
+            else:
+                value = flat.get(source)
+            if isinstance(value, (list, tuple, dict)):
+                value = json.dumps(value, sort_keys=True, default=_json_default)
+            elif isinstance(value, float) and not math.isfinite(value):
+                value = None
+            row[column] = "" if value is None else value
+        return row
+
+
+# The CSV schema of measure and batch rows: provenance, outcome, figures
+# (units in the names; MTF values are dimensionless, 1 at zero frequency).
+CSV_COLUMNS = (
+    "path", "band", "target", "method", "status", "reason", "error",
+    "direction", "normal_angle_deg", "tilt_deg", "polarity", "rows_used", "snr",
+    "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high",
+    "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
+    "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px",
+    "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
+)
+# what a scan adds: the candidate's rank and where it lies in the scene
+# (pixel coordinates, x right, y down; map coordinates in the scene's CRS
+# units), and its screening figures
+SCAN_COLUMNS = (
+    "id", "rank", "x0_px", "y0_px", "x1_px", "y1_px", "length_px",
+    "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation",
+)
+
+# a scan's CSV: id and rank first, then the common columns, then the site's
+SCAN_CSV_COLUMNS = SCAN_COLUMNS[:2] + CSV_COLUMNS + SCAN_COLUMNS[2:]
+
+# CSV columns that are not a key of the flat record: (key, index) of a pair, or the key
+_CSV_SOURCES = {
+    "mtf_nyquist_ci_low": ("mtf_nyquist_ci", 0), "mtf_nyquist_ci_high": ("mtf_nyquist_ci", 1),
+    "mtf50_ci_low_cy_px": ("mtf50_ci_cy_px", 0), "mtf50_ci_high_cy_px": ("mtf50_ci_cy_px", 1),
+    "roi_px": "roi",
+}
+
+
+def _json_default(value):
+    """NumPy scalars and arrays, which records may hold, as plain JSON."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def to_json(record: Record) -> str:
+    """One JSON Lines line (no newline); NaN and infinities as null."""
+    return json.dumps(json_safe(record.to_dict()), default=_json_default)
+
+
+def json_safe(value):
+    """``value`` with NaN and infinities (at any depth) as None, for JSON."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    return value
+
+
+class CsvWriter:
+    """Write records as CSV rows as they come, each flushed to disk, into a
+    file that appears in place atomically when closed.  An interrupt (Ctrl-C,
+    SIGTERM) keeps the rows written so far (see
+    :func:`imgmtf.atomic.atomic_output`).
+
+    Example
+    -------
+    >>> with CsvWriter("summary.csv") as out:        # doctest: +SKIP
+    ...     for record in records:
+    ...         out.write(record)
+    """
+
+    def __init__(self, path: str, columns=CSV_COLUMNS):
+        self.path, self.columns, self.rows = str(path), tuple(columns), 0
+        self._output = atomic_output(self.path, keep_partial=True)
+
+    def __enter__(self) -> "CsvWriter":
+        partial = self._output.__enter__()
+        try:
+            self._file = open(partial, "w", newline="", encoding="utf-8")
+        except OSError as exc:
+            self._output.__exit__(type(exc), exc, exc.__traceback__)
+            raise FileWriteError(f"{self.path}: cannot write: {exc.strerror or exc}") from None
+        self._writer = csv.DictWriter(self._file, fieldnames=list(self.columns))
+        self._guarded(self._writer.writeheader)
+        return self
+
+    def write(self, record: Record) -> None:
+        self._guarded(self._writer.writerow, record.csv_row(self.columns))
+        self.rows += 1
+
+    def _guarded(self, action, *args) -> None:
+        try:
+            action(*args)
+            self._file.flush()
+        except OSError as exc:
+            raise FileWriteError(f"{self.path}: cannot write: {exc.strerror or exc}") from None
+
+    def __exit__(self, kind, exc, tb):
+        self._file.close()
+        return self._output.__exit__(kind, exc, tb)
+
+
+class JsonLinesWriter:
+    """Write records as JSON Lines to an open text stream (stdout), one
+    line per record, flushed at once."""
+
+    def __init__(self, stream: IO[str]):
+        self.stream = stream
+
+    def write(self, record: Record) -> None:
+        self.stream.write(to_json(record) + "\n")
+        self.stream.flush()
+
+
+def write_csv(records, path: str, columns=CSV_COLUMNS) -> None:
+    """All ``records`` as one CSV file (atomically)."""
+    with CsvWriter(path, columns) as out:
+        for record in records:
+            out.write(record)

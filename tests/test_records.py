@@ -1,0 +1,86 @@
+"""Records: one typed row, its JSON and CSV forms, provenance, and the
+streaming CSV writer that keeps rows on an interrupt."""
+import csv
+import json
+import math
+import re
+
+import pytest
+
+import imgmtf as im
+from imgmtf.errors import FileWriteError, ImageReadError
+from imgmtf.records import CSV_COLUMNS, SCAN_CSV_COLUMNS, CsvWriter, Record, to_json, utc_now
+
+SUMMARY = {"target": "edge", "method": "msg", "angle_deg": 6.0, "snr": 120.0, "mtf_nyquist": 0.27,
+           "mtf_nyquist_ci": [0.26, 0.28], "mtf50_cy_px": 0.36, "mtf50_ci_cy_px": [0.35, 0.37],
+           "fwhm_px": 1.2, "roi": [0, 0, 64, 64], "warnings": ["a warning"], "noise_limit_cy_px": math.inf,
+           "params": {"order": 4}, "imgmtf_version": "x"}
+
+
+def test_measured_record_is_flat_json_with_provenance():
+    record = Record.measured("a.tif", 1, SUMMARY, params={"bootstrap": {"replicates": 200}},
+                             run_utc="2024-05-01T09:30:00Z")
+    row = json.loads(to_json(record))
+    assert row["status"] == "ok" and row["reason"] is None and row["error"] is None
+    assert row["mtf50_cy_px"] == 0.36 and row["noise_limit_cy_px"] is None      # inf is not JSON
+    assert row["params"] == {"bootstrap": {"replicates": 200}, "order": 4}
+    assert row["imgmtf_version"] == im.__version__ and row["run_utc"] == "2024-05-01T09:30:00Z"
+
+
+def test_failed_record_has_a_reason_and_a_message_naming_the_file():
+    exc = ImageReadError("b.tif: no such file")
+    record = Record.failed("b.tif", None, "edge", "msg", exc, params={}, run_utc=utc_now())
+    assert (record.reason, record.error) == ("unreadable", "b.tif: no such file")
+    other = Record.failed("c.tif", 2, "edge", "msg", KeyError("mtf50"), params={}, run_utc="")
+    assert other.reason == "internal" and other.error == "c.tif: band 2: internal error: KeyError: 'mtf50'"
+    decode = UnicodeDecodeError("utf-8", b"\x80", 0, 1, "invalid start byte")   # has a .reason of its own
+    assert Record.failed("d.tif", None, "edge", "msg", decode, params={}, run_utc="").reason == "internal"
+
+
+def test_csv_schema_names_units_and_scan_extends_it():
+    assert CSV_COLUMNS[:7] == ("path", "band", "target", "method", "status", "reason", "error")
+    assert set(CSV_COLUMNS) < set(SCAN_CSV_COLUMNS) and SCAN_CSV_COLUMNS[:2] == ("id", "rank")
+    record = Record.measured("a.tif", 1, SUMMARY, params={}, run_utc="t")
+    row = record.csv_row()
+    assert row["mtf_nyquist_ci_low"] == 0.26 and row["mtf50_ci_high_cy_px"] == 0.37
+    assert row["roi_px"] == "[0, 0, 64, 64]" and json.loads(row["warnings"]) == ["a warning"]
+    assert row["noise_limit_cy_px"] == "" and row["rer"] == ""
+
+
+def test_utc_timestamp_is_iso_8601():
+    assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", utc_now())
+
+
+def test_csv_rows_are_on_disk_as_written_and_the_file_appears_whole(tmp_path):
+    path = tmp_path / "out.csv"
+    record = Record.measured("a.tif", 1, SUMMARY, params={}, run_utc="t")
+    with CsvWriter(path) as out:
+        out.write(record)
+        assert not path.exists()                       # in place only when complete
+        partial, = tmp_path.glob(".out.csv.*")
+        assert len(list(csv.DictReader(partial.open()))) == 1
+    assert [r["path"] for r in csv.DictReader(path.open())] == ["a.tif"]
+    assert not list(tmp_path.glob(".out.csv.*"))
+
+
+def test_an_interrupt_keeps_the_rows_and_an_error_keeps_the_old_file(tmp_path):
+    path = tmp_path / "out.csv"
+    record = Record.measured("a.tif", 1, SUMMARY, params={}, run_utc="t")
+    with pytest.raises(KeyboardInterrupt):
+        with CsvWriter(path) as out:
+            out.write(record)
+            raise KeyboardInterrupt
+    assert len(list(csv.DictReader(path.open()))) == 1
+    with pytest.raises(ValueError):
+        with CsvWriter(path) as out:
+            raise ValueError("a bug")
+    assert len(list(csv.DictReader(path.open()))) == 1  # the earlier complete file is untouched
+    assert not list(tmp_path.glob(".out.csv.*"))
+
+
+def test_unwritable_csv_is_named(tmp_path):
+    blocker = tmp_path / "afile.txt"
+    blocker.write_text("x")
+    with pytest.raises(FileWriteError, match="afile.txt/sub/out.csv: cannot write"):
+        with CsvWriter(blocker / "sub" / "out.csv"):
+            pass
