@@ -35,6 +35,12 @@ class MeasureSettings:
     roi : (x, y, width, height) window read from every file (px).
     pulse_width : (value, "px" or "m"), or None to estimate it.
     intervals : confidence-interval settings (linearised by default).
+    force : measure even where a quality check fails (each a warning).
+    saturation : (low, high) DN the sensor records; None for an integer
+        file's type range (floats: none declared).
+    track_azimuth_deg : the ground track's direction in the image, degrees
+        clockwise from up; None: rows along track for images in sensor
+        geometry, unknown for map-projected ones.
     """
 
     target: str = "edge"
@@ -43,6 +49,9 @@ class MeasureSettings:
     roi: tuple[int, int, int, int] | None = None
     pulse_width: tuple[float, str] | None = None
     intervals: Intervals = field(default_factory=Intervals)
+    force: bool = False
+    saturation: tuple[float, float] | None = None
+    track_azimuth_deg: float | None = None
 
     def __post_init__(self):
         if self.target not in ("edge", "pulse"):
@@ -55,12 +64,14 @@ class MeasureSettings:
 
     def estimator(self):
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
-        return kind(self.method, intervals=self.intervals)
+        return kind(self.method, intervals=self.intervals, force=self.force)
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
         return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
-                "band": self.band,
+                "band": self.band, "force": self.force,
+                "saturation": list(self.saturation) if self.saturation else None,
+                "track_azimuth_deg": self.track_azimuth_deg,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None}
 
     def failed(self, path: str, band, exc: BaseException, run_utc: str) -> Record:
@@ -127,11 +138,15 @@ def measure_raster(raster, settings: MeasureSettings):
     """The estimate of one raster (a window of the file when ``roi`` is
     set), its ROI reported in the file's pixel coordinates."""
     estimator = settings.estimator()
+    track = settings.track_azimuth_deg
+    if track is None and not raster.map_projected:
+        track = 0.0                          # sensor geometry: rows along track
+    common = dict(gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
+                  saturation=settings.saturation or saturation_levels(raster.dtype))
     if settings.target == "edge":
-        result = estimator(raster.data, gsd_m=raster.gsd_m, saturation=saturation_levels(raster.dtype))
+        result = estimator(raster.data, **common)
     else:
-        result = estimator(raster.data, width_px=pulse_width_px(settings.pulse_width, raster),
-                           gsd_m=raster.gsd_m)
+        result = estimator(raster.data, width_px=pulse_width_px(settings.pulse_width, raster), **common)
     x0, y0 = raster.origin
     x, y, w, h = result.roi
     return replace(result, roi=(x + x0, y + y0, w, h))

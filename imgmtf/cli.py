@@ -151,6 +151,19 @@ def _length_option(default_unit: str):
     return parse
 
 
+def _parse_pair(ctx, param, value):
+    """Click callback: "LO,HI" -> (lo, hi), two finite numbers, lo < hi."""
+    if value is None:
+        return None
+    try:
+        low, high = (float(v) for v in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"expected LO,HI (two numbers), got {value!r}") from None
+    if not (math.isfinite(low) and math.isfinite(high) and low < high):
+        raise click.BadParameter(f"expected finite LO < HI, got {value!r}")
+    return low, high
+
+
 def _parse_roi(ctx, param, value):
     if value is None:
         return None
@@ -417,11 +430,21 @@ def _intervals(method: str, replicates: int | None, confidence: float):
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--force", is_flag=True,
+              help="measure even where a quality check fails (fill, saturation, a second target, "
+                   "non-uniform sides...): every failed check becomes a warning")
+@click.option("--saturation", callback=_parse_pair, metavar="LO,HI",
+              help="DN range the sensor records (default: an integer file's type range); "
+                   "sides at or beyond it are saturated")
+@click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
+              help="the ground track's direction in the image, degrees clockwise from up (default: "
+                   "rows along track, as in L0/L1 products; unknown for map-projected files)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @_interval_options
 @_parallel_options
 def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
-            progress, interval_method, replicates, confidence, workers, scheduler):
+            force, saturation, track_azimuth, progress, interval_method, replicates, confidence, workers,
+            scheduler):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
@@ -439,7 +462,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         from .batch import MeasureSettings, expand_inputs, measure_files
         from .records import CsvWriter, JsonLinesWriter, utc_now
         settings = MeasureSettings(kind, method, band, roi, pulse_width,
-                                   _intervals(interval_method, replicates, confidence))
+                                   _intervals(interval_method, replicates, confidence), force=force,
+                                   saturation=saturation, track_azimuth_deg=track_azimuth)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
@@ -513,14 +537,18 @@ class _TextRows:
 
     def header(self, confidence: float) -> None:
         last = "RER" if self.kind == "edge" else "W px"
-        click.echo(f"{'path':<32} {'band':>4} {'angle':>7} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+        click.echo(f"{'path':<32} {'band':>4} {'normal':>7} {'tilt':>5} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
                    f"{f'{100 * confidence:g}% interval':>15} {'MTF50':>7} {'FWHM':>6} {last:>6}")
+        click.echo(f"{'':<32} {'':>4} {'deg':>7} {'deg':>5} {'':>6} {'':>6} {'':>7} {'':>15} "
+                   f"{'cy/px':>7} {'px':>6} {'':>6}")
 
     def write(self, record) -> None:
         click.echo(_text_row(record.to_dict(), self.kind))
 
 
 def _text_row(record: dict, kind: str) -> str:
+    """One record as rows of the text table: figures in px units, a
+    ground line in metres when the GSD is known, then its warnings."""
     path = record["path"]
     band = "" if record["band"] in (None, 1, "luminance") else str(record["band"])
     if record["status"] == "error":
@@ -528,10 +556,15 @@ def _text_row(record: dict, kind: str) -> str:
     last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
-    direction = (record.get("direction") or "-").split("-")[0]
-    cells = [f"{path:<32} {band:>4} {_num(record.get('normal_angle_deg'), 7, 2)} {direction:>6} "
+    direction = {"across-track": "across", "along-track": "along"}.get(record.get("direction"),
+                                                                      record.get("direction") or "-")
+    cells = [f"{path:<32} {band:>4} {_num(record.get('normal_angle_deg'), 7, 2)} "
+             f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>6} "
              f"{_num(record.get('snr'), 6, 0)} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>15} "
              f"{_num(record.get('mtf50_cy_px'), 7, 4)} {_num(record.get('fwhm_px'), 6, 3)} {_num(last, 6, 3)}"]
+    if record.get("gsd_m"):
+        cells.append(f"{'':<32} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
+                     f"{record['mtf50_cy_m']:.4g} cy/m, FWHM {record['fwhm_m']:.4g} m")
     cells += [f"{'':<32} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
 

@@ -57,6 +57,9 @@ class Raster:
     tags : the file's metadata tags.
     dtype : the stored sample type (e.g. "uint16").
     origin : (x, y) of ``data``'s top-left pixel in the file (a window's).
+    map_projected : True when the file has a coordinate reference system:
+        a map-projected (or geographic) product, whose rows are not along
+        the sensor's track.
     """
 
     data: np.ndarray
@@ -66,6 +69,7 @@ class Raster:
     tags: dict = field(default_factory=dict)
     dtype: str = "float64"
     origin: tuple[int, int] = (0, 0)
+    map_projected: bool = False
 
     @property
     def provenance(self) -> dict | None:
@@ -190,6 +194,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
         colours = [c.name for c in src.colorinterp]
         info = RasterInfo(path, src.width, src.height, count, tuple(colours), src.dtypes[0],
                           _gsd_m(src), src.transform, None)
+        map_projected = src.crs is not None
         x, y, w, h = info.check_window(window) if window is not None else (0, 0, src.width, src.height)
         check_read_size(path, (w, h) if out_shape is None else (out_shape[1], out_shape[0]),
                         windowed=window is not None)
@@ -210,7 +215,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
         tags = src.tags()
     if data.size == 0:
         raise ImageContentError(f"{path}: the image is empty")
-    return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y))
+    return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y), map_projected)
 
 
 def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) -> None:

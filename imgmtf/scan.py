@@ -103,7 +103,7 @@ class ScanSettings:
     max_line_rms_px : largest RMS scatter of the per-row target locations
         about their line (px) for a straight target.
     tile_px : side of the tiles read for detection (px).
-    method, band, pulse_width, intervals : as in
+    method, band, pulse_width, intervals, track_azimuth_deg : as in
         :class:`imgmtf.batch.MeasureSettings`.
     """
 
@@ -118,6 +118,7 @@ class ScanSettings:
     band: int | None = None
     pulse_width: tuple[float, str] | None = None
     intervals: Intervals = field(default_factory=Intervals)
+    track_azimuth_deg: float | None = None
 
     def __post_init__(self):
         if not self.min_length_px >= 16:
@@ -129,7 +130,8 @@ class ScanSettings:
         self.measure_settings()
 
     def measure_settings(self) -> MeasureSettings:
-        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.intervals)
+        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.intervals,
+                               track_azimuth_deg=self.track_azimuth_deg)
 
 
 # -- detection -----------------------------------------------------------------
