@@ -19,7 +19,7 @@ import numpy as np
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import TargetGeometry, locate_edge
-from .pipeline import Settings, Shape, TargetKind, make_settings, run
+from .pipeline import Settings, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, edge_divisor, relative_edge_response, rise_distance
 
@@ -84,8 +84,8 @@ class EdgeKind(TargetKind):
         return locate_edge(work, seed_x, transposed=transposed)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
-        n_side = max(len(values) // 8, 2)
-        left, right = float(values[:n_side].mean()), float(values[-n_side:].mean())
+        # the levels: the samples in the outer eighth of the range each side
+        left, right = (float(v[side].mean()) for side in outer_samples(d, half_range, 0.75))
         if left == right:
             raise gate.UnsuitableTargetError("the two sides of the edge have the same level", reason="not-an-edge")
         esf01 = (values - left) / (right - left)

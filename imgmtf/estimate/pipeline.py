@@ -56,6 +56,7 @@ MAX_FREQUENCY_CY_PX = 4.0
 TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
 TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
 MIN_TAIL_SAMPLES = 12
+INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
 CORE_STEP_PX = 0.5                # the core grows in these steps while the tail model misfits
 MODEL_CHECK_PX = 3.0              # the model must explain this much of the profile past the core
 MODEL_BIN_PX = 0.5
@@ -260,6 +261,15 @@ class SideFit:
     sd: float
 
 
+def outer_samples(d: np.ndarray, half_range: float, fraction: float) -> tuple[np.ndarray, np.ndarray]:
+    """Masks of the samples beyond ``fraction`` of the range on the left
+    and on the right (at least the three outermost pixels' worth each)."""
+    order = np.sort(d)
+    left = min(-fraction * half_range, order[min(order.size - 1, 3 * MIN_TAIL_SAMPLES)])
+    right = max(fraction * half_range, order[max(0, order.size - 1 - 3 * MIN_TAIL_SAMPLES)])
+    return d <= left, d >= right
+
+
 def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> SideFit:
     """Least-squares level and tail of the samples selected by ``mask``
     (``s``: distance from the target's centre).  Too few samples, or too
@@ -383,15 +393,31 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     # staircase rebuilt as the smooth ESF it samples; the gate reads the raw ones
     rebuilt = dequantise(d, v, q) if kind.monotone else None
     raw, v = v, (v if rebuilt is None else rebuilt)
-    resampled = resample_profile(d, v, method=settings.method, step=settings.step_px,
-                                 half_range=half_range - 0.6, **settings.method_options)
-    grid, values, span = _central_run(resampled.grid, resampled.values, kind.name)
-    kind_check = gate.kind_check(gate.classify_profile(values), kind.profile)
-    if not kind_check.passed:
+    # the profile is resampled where the LSF window needs data: a central
+    # span first, widened below if the window's core and taper reach past it
+    reach = half_range - 0.6
+
+    def resample(span_px):
+        r = resample_profile(d, v, method=settings.method, step=settings.step_px, half_range=span_px,
+                             **settings.method_options)
+        return (r, *_central_run(r.grid, r.values, kind.name))
+    try:
+        resampled, grid, values, span = resample(min(reach, INITIAL_SPAN_PX))
+        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile)
+        if not kind_check.passed:
+            raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
+        try:
+            shape = kind.shape(grid, values, d, v, half_range)
+        except UnsuitableTargetError:
+            if grid[-1] >= reach - settings.step_px:
+                raise
+            # a profile still rising at the span's end (a drifting level): all of it
+            resampled, grid, values, span = resample(reach)
+            shape = kind.shape(grid, values, d, v, half_range)
+    except ImgmtfError:
         if not settings.force:       # fill or a second target explain the profile's shape
             gate.enforce([c for c in checks if c.reason in ("fill", "two-targets")], force=False)
-        raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
-    shape = kind.shape(grid, values, d, v, half_range)
+        raise
     c = shape.centre
     s = d - c
 
@@ -415,16 +441,27 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         core = max(core, max(model_reach(s, v, side, core, kind.tail_power, CORE_STEP_PX, floor)
                              for side in (-1, 1)))
     taper = kind.taper_factor(snr) * core if settings.lsf_half_width_px is None else TAPER_FACTOR * core
-    start = [min(core, TAIL_FIT_MAX_START * abs(grid[0] - c)), min(core, TAIL_FIT_MAX_START * abs(grid[-1] - c))]
+    window_end = abs(c) + core + taper + 3.0 * settings.step_px
+    if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
+        resampled, grid, values, span = resample(min(reach, window_end + 1.0))
+    start = [min(core, TAIL_FIT_MAX_START * (half_range + c)), min(core, TAIL_FIT_MAX_START * (half_range - c))]
     sides = [fit_side(s, v, (s <= -start[0]), kind.tail_power), fit_side(s, v, (s >= start[1]), kind.tail_power)]
     if any(not np.isfinite(sf.coef).all() for sf in sides):
         raise UnsuitableTargetError(f"a side of the {kind.name} holds too few samples for its level")
     background = 0.5 * (sides[0].coef[0] + sides[1].coef[0])
-    x, lsf, lsf_adjoint = kind.lsf(grid, values, background)
+    x_data, lsf_data, lsf_adjoint = kind.lsf(grid, values, background)
     step = float(grid[1] - grid[0])
+    # the LSF-like profile out to the data's reach: measured within the
+    # window, the tail model beyond it (the same lattice as the grid)
+    x = np.arange(-np.floor(reach / step), np.floor(reach / step) + 1) * step
+    data_at = slice(int(round((x_data[0] - x[0]) / step)), int(round((x_data[0] - x[0]) / step)) + x_data.size)
+    lsf = np.zeros_like(x)
+    lsf[data_at] = lsf_data
+    in_data = np.zeros(x.size, bool)
+    in_data[data_at] = True
     to_amplitude = kind.lsf_tail_amplitudes()
     amplitudes = [float(to_amplitude[i] @ sides[i].coef) for i in range(2)]
-    w = flat_top_window(x, c, core, taper)
+    w = flat_top_window(x, c, core, taper) * in_data
     sx = x - c
     tail_shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
     model = np.where(sx < 0, amplitudes[0], amplitudes[1]) * tail_shape
@@ -465,11 +502,11 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     nyquist_ci = mtf50_ci = Interval.none()
     if settings.intervals.method == "influence":
         nyquist_ci, mtf50_ci = _influence_intervals(
-            settings.intervals, mtf, mtf_nyquist, f50, resampled, grid, span, x, c, w, lsf_adjoint,
-            tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, background, tail_share)
+            settings.intervals, mtf, mtf_nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
+            tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share)
     elif settings.intervals.method == "bootstrap":
         nyquist_ci, mtf50_ci = _bootstrap_intervals(
-            settings, kind, d, v, row, c, core, taper, start, divisor, step, grid)
+            settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
 
     figures = dict(
         normal_angle_deg=_normal_angle(geometry), tilt_deg=geometry.tilt_deg,
@@ -556,26 +593,26 @@ def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) ->
     return "oblique"
 
 
-def _influence_intervals(intervals, mtf, nyquist, f50, resampled, grid, span, x, c, w, lsf_adjoint,
-                         tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, background, tail_share):
+def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
+                         tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share):
     """Linearised intervals for MTF at Nyquist and MTF50 (see
     :mod:`.intervals`).
 
     The transform F(f) = sum_k e_k(f) [w_k lsf_k + (1 - w_k) model_k] is
     linear in the samples: through the LSF operator and the resampling
-    (their adjoints), through each side's tail amplitude (its least-squares
-    operator), and for a bar through the background under the window.
-    Each figure is |F(f)| / |F(0)| divided by the corrections, so its
-    gradient follows, and with each sample's residual (scaled up by its
-    leverage) gives the row influences."""
-    step = float(grid[1] - grid[0])
+    (their adjoints) where the window holds data, through each side's tail
+    amplitude (its least-squares operator), and for a bar through the
+    background under the window.  Each figure is |F(f)| / |F(0)| divided by
+    the corrections, so its gradient follows, and with each sample's
+    residual (scaled up by its leverage) gives the row influences."""
+    step = float(x[1] - x[0])
     freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
     e = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                   # (n_f, n_x)
     left = x < c
     model = np.where(left, amplitudes[0], amplitudes[1]) * tail_shape
-    _, lsf, _ = kind.lsf(grid, resampled.values[span[0]: span[1]], background)
     transform = e @ (w * lsf + (1.0 - w) * model)
-    on_grid = lsf_adjoint(np.concatenate([(e * w).real, (e * w).imag]))
+    weighted = (e * w)[:, data_at]
+    on_grid = lsf_adjoint(np.concatenate([weighted.real, weighted.imag]))
     full = np.zeros((on_grid.shape[0], resampled.grid.size))
     full[:, span[0]: span[1]] = on_grid
     through = resampled.adjoint(full)
@@ -590,7 +627,12 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, grid, span, x,
             grad_f[:, idx] -= 0.5 * (e @ w)[:, None] * side.operator[0][None, :]
     f0 = transform[0].real
     run_grid, run_values = resampled.grid[span[0]: span[1]], resampled.values[span[0]: span[1]]
-    residual = v - np.interp(d, run_grid, run_values)
+    # each sample's residual from the profile: the resampled one where it
+    # was resampled, the side's model beyond
+    far = np.abs(d - c) ** -float(kind.tail_power)
+    model_dn = np.where(d < c, sides[0].coef[0] + sides[0].coef[1] * far, sides[1].coef[0] + sides[1].coef[1] * far)
+    inside = (d >= run_grid[0]) & (d <= run_grid[-1])
+    residual = v - np.where(inside, np.interp(d, run_grid, run_values), model_dn)
     if resampled.leverage is not None:
         residual = residual / np.sqrt(1.0 - np.minimum(resampled.leverage, LEVERAGE_CAP))
     out = []
@@ -615,12 +657,16 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, grid, span, x,
     return out[0], out[1]
 
 
-def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, step, grid):
-    """Bootstrap intervals: every replicate re-resamples the rows it drew,
-    refits its sides' levels and tails, and is windowed as the estimate."""
+def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, x, span_px):
+    """Bootstrap intervals: every replicate re-resamples the rows it drew
+    (within ``span_px`` of the line), refits its sides' levels and tails,
+    and is windowed onto the lattice ``x`` as the estimate is."""
     s = d - c
     masks = [s <= -start[0], s >= start[1]]
     to_amplitude = kind.lsf_tail_amplitudes()
+    step = float(x[1] - x[0])
+    sx = x - c
+    shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
 
     def resample(keep, weights, span):
         return resample_profile(d[keep], v[keep], method=settings.method, step=settings.step_px,
@@ -636,12 +682,14 @@ def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divis
             rhs = np.einsum("ri,ij,i->rj", wts, design, v[mask])
             coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
         background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
-        x, lsf, _ = kind.lsf(grid_b, values_b, background[:, None])
+        x_data, lsf_data, _ = kind.lsf(grid_b, values_b, background[:, None])
+        first = int(round((x_data[0] - x[0]) / step))
+        lsf = np.zeros((lsf_data.shape[0], x.size))
+        lsf[:, first: first + x_data.size] = lsf_data
+        in_data = np.zeros(x.size, bool)
+        in_data[first: first + x_data.size] = True
         amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
-        w = flat_top_window(x, c, core, taper)
-        sx = x - c
-        shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
+        w = flat_top_window(x, c, core, taper) * in_data
         model = np.where(sx < 0, amp[0][:, None], amp[1][:, None]) * shape
         return w * lsf + (1.0 - w) * model
-    span = max(abs(grid[0]), abs(grid[-1]))
-    return bootstrap_figures(settings.intervals, d, row, span, resample, windowed, step, divisor)
+    return bootstrap_figures(settings.intervals, d, row, span_px, resample, windowed, step, divisor)

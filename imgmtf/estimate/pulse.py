@@ -24,7 +24,7 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, parallel_within
 from .geometry import fit_line, row_windows
-from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, run
+from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 
@@ -100,8 +100,7 @@ class PulseKind(TargetKind):
         return locate_pulse(work, seed_x, transposed)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
-        n_side = max(len(values) // 6, 2)
-        left, right = values[:n_side].mean(), values[-n_side:].mean()
+        left, right = (float(v[side].mean()) for side in outer_samples(d, half_range, 2.0 / 3.0))
         background = (left + right) / 2
         centre = int(np.argmin(np.abs(grid)))
         sign = 1.0 if values[centre] >= background else -1.0

@@ -210,19 +210,40 @@ def _local_polynomial_transfer(order: int, width: float) -> Callable:
     """Transfer function of a centred local polynomial fit over a window of
     ``width`` px with uniform sample density: the Fourier transform of its
     equivalent kernel K(u) = e0' M^-1 phi(u) / width, with phi the monomials
-    and M their Gram matrix over the window."""
-    # Gauss-Legendre nodes on [-1/2, 1/2]: exact for the polynomial part,
-    # and accurate for the cosine up to several cycles across the window
+    and M their Gram matrix over the window.  It depends on f * width only,
+    so it is read off one table per order (:func:`_equivalent_kernel_table`)."""
+    scaled, table = _equivalent_kernel_table(order)
+
+    def transfer(f):
+        x = np.abs(np.atleast_1d(np.asarray(f, float))) * width
+        out = np.interp(x, scaled, table)
+        beyond = x > scaled[-1]
+        if beyond.any():
+            out[beyond] = _equivalent_kernel_transfer(order, x[beyond])
+        return out
+    return transfer
+
+
+TABLE_STEP = 1e-3          # in f * width: interpolation error below 2e-6
+TABLE_END = 40.0           # beyond, a local polynomial passes less than 1e-4
+
+
+@functools.lru_cache(maxsize=16)
+def _equivalent_kernel_table(order: int) -> tuple[np.ndarray, np.ndarray]:
+    scaled = np.arange(0.0, TABLE_END + TABLE_STEP / 2, TABLE_STEP)
+    return scaled, _equivalent_kernel_transfer(order, scaled)
+
+
+def _equivalent_kernel_transfer(order: int, scaled: np.ndarray) -> np.ndarray:
+    """sum_u K(u) cos(2 pi x u) over Gauss-Legendre nodes on [-1/2, 1/2]:
+    exact for the polynomial part, accurate for the cosine up to several
+    cycles across the window; ``scaled`` x = f * width."""
     nodes, weights = np.polynomial.legendre.leggauss(64)
     u, weights = nodes / 2, weights / 2
     phi = u[None, :] ** np.arange(order + 1)[:, None]
     gram = (phi * weights) @ phi.T
     kernel = np.linalg.solve(gram, np.eye(order + 1)[:, 0]) @ phi * weights
-
-    def transfer(f):
-        f = np.atleast_1d(np.asarray(f, float))
-        return np.cos(2 * np.pi * f[:, None] * u[None, :] * width) @ kernel
-    return transfer
+    return np.cos(2 * np.pi * scaled[:, None] * u[None, :]) @ kernel
 
 
 def smoothing_spline(distance, values, step: float, half_range: float, *,
