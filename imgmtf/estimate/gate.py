@@ -18,6 +18,7 @@ warnings.  Reasons:
 ``non-uniform``           a side with a level trend or texture
 ``too-short``             too few rows for a stable estimate
 ``mtf-above-one``         the MTF rises above 1 by more than its noise
+``mtf-undefined``         MTF50, MTF at Nyquist or FWHM cannot be read off
 ``snr``                   noise too strong to measure anything
 ``not-an-edge``,          the profile is a bar where an edge was asked for,
 ``not-a-bar``             or a step where a bar was
@@ -338,3 +339,14 @@ def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
     return Check("mtf-above-one", over <= MAX_MTF_EXCESS,
                  f"the MTF reaches {float(mtf(f[worst:worst + 1])[0]):.2f} at {f[worst]:.2f} cy/px, above 1 "
                  "beyond its noise: a sharpened image or not a clean target", over, MAX_MTF_EXCESS)
+
+
+def figures_check(mtf_nyquist: float, mtf50: float, fwhm_px: float) -> Check:
+    """The figures a report quotes must exist: an MTF that never falls to
+    0.5 below 2 cy/px, or an LSF without a half maximum, is not an imaging
+    system's."""
+    missing = [name for name, value in (("MTF at Nyquist", mtf_nyquist), ("MTF50", mtf50), ("FWHM", fwhm_px))
+               if not (math.isfinite(value) and value >= 0)]
+    return Check("mtf-undefined", not missing,
+                 f"{', '.join(missing) or 'no figure'} cannot be read off this profile (the MTF never "
+                 "falls to 0.5 below 2 cy/px, or the LSF has no half maximum): not a clean target")

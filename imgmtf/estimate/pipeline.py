@@ -441,6 +441,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         core = max(core, max(model_reach(s, v, side, core, kind.tail_power, CORE_STEP_PX, floor)
                              for side in (-1, 1)))
     taper = kind.taper_factor(snr) * core if settings.lsf_half_width_px is None else TAPER_FACTOR * core
+    cut = settings.lsf_half_width_px is not None and settings.lsf_half_width_px < shape.scale_px
     window_end = abs(c) + core + taper + 3.0 * settings.step_px
     if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
         resampled, grid, values, span = resample(min(reach, window_end + 1.0))
@@ -496,7 +497,12 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
     checks += snr_failures
     checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
+    fwhm_px = fwhm(x_c, lsf_c)
+    checks.append(gate.figures_check(mtf_nyquist, f50, fwhm_px))
     warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
+    if cut:
+        warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
+                        f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
 
     # intervals
     nyquist_ci = mtf50_ci = Interval.none()
@@ -514,7 +520,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         orientation="horizontal" if transposed else "vertical",
         rows_used=rows_used, rows_total=int(work.shape[0]), snr=snr, noise_dn=noise,
         mtf_nyquist=mtf_nyquist, mtf50_cy_px=f50, mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
-        fwhm_px=fwhm(x_c, lsf_c), mtfa=mtf_area(mtf), gsd_m=gsd_m, noise_limit_cy_px=noise_limit,
+        fwhm_px=fwhm_px, mtfa=mtf_area(mtf), gsd_m=gsd_m, noise_limit_cy_px=noise_limit,
         lsf_half_width_px=core, tail_fraction=tail_share, roi=(x0, y0, data.shape[1], data.shape[0]),
         centre_px=c, levels=(shape.low, shape.high), side_levels=(sides[0].coef[0], sides[1].coef[0]),
         scale_px=shape.scale_px, transposed=transposed, **shape.extra)
