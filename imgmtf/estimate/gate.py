@@ -341,12 +341,15 @@ def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
                  "beyond its noise: a sharpened image or not a clean target", over, MAX_MTF_EXCESS)
 
 
-def figures_check(mtf_nyquist: float, mtf50: float, fwhm_px: float) -> Check:
+def figures_check(mtf_nyquist: float, mtf50: float, fwhm_px: float, nyquist_masked: bool = False,
+                  mtf50_masked: bool = False) -> Check:
     """The figures a report quotes must exist: an MTF that never falls to
     0.5 below 2 cy/px, or an LSF without a half maximum, is not an imaging
-    system's."""
-    missing = [name for name, value in (("MTF at Nyquist", mtf_nyquist), ("MTF50", mtf50), ("FWHM", fwhm_px))
-               if not (math.isfinite(value) and value >= 0)]
+    system's.  ``nyquist_masked``, ``mtf50_masked``: a bar's sinc hides
+    that figure (said in the warnings), so its NaN is expected."""
+    figures = ([("FWHM", fwhm_px)] + ([] if mtf50_masked else [("MTF50", mtf50)])
+               + ([] if nyquist_masked else [("MTF at Nyquist", mtf_nyquist)]))
+    missing = [name for name, value in figures if not (math.isfinite(value) and value >= 0)]
     return Check("mtf-undefined", not missing,
                  f"{', '.join(missing) or 'no figure'} cannot be read off this profile (the MTF never "
                  "falls to 0.5 below 2 cy/px, or the LSF has no half maximum): not a clean target")

@@ -498,7 +498,13 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks += snr_failures
     checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
     fwhm_px = fwhm(x_c, lsf_c)
-    checks.append(gate.figures_check(mtf_nyquist, f50, fwhm_px))
+    # where a divisor's zeros hide the MTF (a bar's sinc), a figure there is rightly missing
+    f_check = np.arange(0.0, 2.0, 0.005)
+    hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
+    first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
+    checks.append(gate.figures_check(
+        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / 0.005))]),
+        mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
     warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
     if cut:
         warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
