@@ -82,8 +82,8 @@ def test_noise_gives_a_finite_snr_and_a_warning_below_threshold():
 
 def test_window_factor_adapts_to_snr():
     assert window_factor(float("inf")) == window_factor(1e4) == 1.35
-    assert window_factor(20.0) == 1.0
-    assert 1.0 < window_factor(50.0) < 1.35
+    assert window_factor(20.0) == 0.9
+    assert 0.9 < window_factor(50.0) < 1.35
 
 
 def test_roi_selects_one_edge_of_two():
