@@ -31,6 +31,7 @@ from contextlib import contextmanager
 from .errors import ParameterError
 
 LOCAL_CLUSTER = "local"
+SCHEDULER_TIMEOUT_S = 10        # how long to keep trying a remote Dask scheduler
 _prestarted: list = []      # at most one pool started ahead by prestart_workers
 MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
@@ -319,7 +320,7 @@ def _dask_completed(function, items, workers, scheduler, on_error):
                                    dashboard_address=None)
             client = Client(cluster)
         else:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
     except (OSError, TimeoutError, ValueError) as exc:
         if cluster is not None:
             cluster.close()

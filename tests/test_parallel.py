@@ -18,10 +18,12 @@ def test_processes_keep_input_order():
     assert list(run_tasks(math.sqrt, [16, 9, 4, 1, 0], workers=2)) == [4, 3, 2, 1, 0]
 
 
-def test_bad_worker_count_and_unreachable_scheduler():
+def test_bad_worker_count_and_unreachable_scheduler(monkeypatch):
     with pytest.raises(ParameterError):
         list(run_tasks(math.sqrt, [1, 4], workers=0))
     pytest.importorskip("distributed")
+    import imgmtf.parallel
+    monkeypatch.setattr(imgmtf.parallel, "SCHEDULER_TIMEOUT_S", 1)
     with pytest.raises(ParameterError, match="cannot reach the Dask scheduler"):
         list(run_tasks(math.sqrt, [1, 4], scheduler="tcp://127.0.0.1:9"))
 
