@@ -35,3 +35,10 @@ def test_low_contrast_8_bit_edges_read_true(step, angle):
     assert abs(r.mtf_nyquist - h(0.5)) <= 0.012
     assert np.isfinite(r.snr) and r.snr == pytest.approx(step * np.sqrt(12), rel=0.01)
     assert r.params["dequantised"]
+
+
+def test_a_rebuilt_staircase_still_has_an_honest_interval():
+    h = gaussian_pixel_transfer(0.5, 7.0)
+    r = im.measure_edge(exact_edge_chip(h, 7.0, offset=0.1, low=100, high=118, dtype=np.uint8))
+    assert r.params["dequantised"] and h(0.5) in r.mtf_nyquist_ci
+    assert r.mtf_nyquist_ci.width > 0.015            # the rebuild's own error, not noise, sets it

