@@ -13,7 +13,6 @@ import importlib
 
 from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadError, ImgmtfError,
                      MultipleTargetsError, ParameterError, TargetNotFoundError, UnsuitableTargetError)
-from .version import __version__
 
 # public name -> the module that defines it
 _LAZY = {
@@ -37,6 +36,9 @@ __all__ = [
 
 
 def __getattr__(name: str):
+    if name == "__version__":         # reading the package metadata costs a tenth of a second
+        from .version import __version__
+        return __version__
     if name not in _LAZY:
         raise AttributeError(f"module 'imgmtf' has no attribute {name!r}")
     value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)

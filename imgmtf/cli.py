@@ -22,7 +22,6 @@ from pathlib import Path
 import click
 
 from .errors import FileWriteError, ImgmtfError, ParameterError
-from .version import __version__
 
 # Bounds of the size-like options (see docs): what a run may allocate.
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
@@ -179,7 +178,7 @@ def _parse_roi(ctx, param, value):
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="imgmtf")
+@click.version_option(package_name="imgmtf", prog_name="imgmtf")   # read only when asked
 @click.pass_context
 def main(ctx):
     """Measure the MTF of imaging sensors from edge and pulse targets, and
@@ -324,6 +323,7 @@ def fit(paths, stages, sensor_path, hold, gsd, band, recursive, confidence, out_
                             confidence=confidence)
         written = []
         if out_path:
+            from .version import __version__
             result.sensor.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(files)} edge(s): "
                                                      f"{', '.join(e.source for e in result.edges)}")
             written.append(out_path)
@@ -691,6 +691,7 @@ def selftest(method):
         from .selftest import run_selftest
         from .sensor.model import DIRECTIONS, Sensor
         sensor = Sensor()
+        from .version import __version__
         click.echo(f"imgmtf {__version__} self-test: generic sensor (Choi & Helder), GSD {sensor.gsd_m:g} m")
         for d in DIRECTIONS:
             click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
