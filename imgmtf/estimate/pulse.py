@@ -22,7 +22,7 @@ from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import check_number
 from ..metrics import fwhm
 from . import gate
-from .detection import bar_contrast, describe, find_lines, parallel_within
+from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
 from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
@@ -89,8 +89,10 @@ class PulseKind(TargetKind):
             raise TargetNotFoundError("no bar found: no straight line stands out of the noise")
         best = lines[0]
         reach = BAR_SIDES_PX + (self.width_px or 0.0)
+        # a second target lies beside the bar, apart from it and not crossing it
+        # (pieces of one line meet inside the chip: the profile judges those)
         others = [ln for ln in lines[1:] if not parallel_within(best, ln, data.shape, reach, angle_deg=8.0)
-                  and ln.votes >= 0.5 * best.votes]
+                  and not meet_inside(best, ln, data.shape) and ln.votes >= 0.5 * best.votes]
         checks = [gate.Check("two-targets", False, f"another line of strong contrast at {describe(others[0])} "
                              f"besides the bar at {describe(best)}: crop the image to one bar with --roi")
                   ] if others else []
