@@ -24,7 +24,8 @@ _LAZY = {
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
-    "Raster": "io", "read_raster": "io", "write_geotiff": "io", "Record": "records",
+    "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
+    "Record": "records",
     "run_selftest": "selftest",
 }
 

@@ -25,10 +25,7 @@ from rasterio.windows import Window
 
 from .atomic import atomic_output
 from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
-from .inputs import check_roi
-
-# Rec. 709 luma weights, applied to the stored (encoded) values of RGB input
-LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+from .inputs import check_roi, luminance
 
 try:     # GDAL's own errors, which rasterio raises as they are from some calls
     from rasterio._err import CPLE_BaseError
@@ -84,14 +81,50 @@ class Raster:
 def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                   provenance: dict | None = None, crs: str | None = None,
                   origin_m: tuple[float, float] = (0.0, 0.0)) -> None:
-    """Write a uint8/uint16 chip (rows x cols, or bands x rows x cols) as a
-    GeoTIFF whose geotransform carries ``gsd_m`` and whose tags carry
-    ``provenance``; ``crs`` (e.g. "EPSG:32633") and ``origin_m`` (map x, y
-    of the top-left corner) place it on the map."""
-    image = np.asarray(image)
-    if image.dtype not in (np.uint8, np.uint16):
-        raise ParameterError(f"{path}: GeoTIFF chips are 8 or 16 bit, got {image.dtype}")
-    bands = image[None] if image.ndim == 2 else image
+    """Write an 8/16-bit chip as a GeoTIFF that carries its GSD and how it
+    was made.
+
+    Without ``crs`` the chip is in a local metric frame: the geotransform
+    is (``gsd_m``, 0, 0, 0, -``gsd_m``, 0), which :func:`read_raster` reads
+    back as the GSD.  The file appears whole or not at all (written under a
+    temporary name, then renamed).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The GeoTIFF to write (replaced if it exists).
+    image : numpy.ndarray of uint8 or uint16, shape (rows, cols) or (bands, rows, cols)
+        The pixels, DN.
+    gsd_m : float, optional
+        Ground sample distance, m (default 1).
+    provenance : dict, optional
+        How the chip was made (:meth:`imgmtf.Chip.provenance`), stored as
+        JSON in the ``IMGMTF`` tag and read back by
+        :attr:`Raster.provenance`; its main items also as plain tags for
+        ``gdalinfo``.
+    crs : str, optional
+        A coordinate reference system (``"EPSG:32633"``) placing the chip on
+        a map.
+    origin_m : (float, float), optional
+        Map x, y of the top-left corner, m (with ``crs``).
+
+    Raises
+    ------
+    ParameterError
+        The image is not uint8 or uint16.
+    FileWriteError
+        The file cannot be written (no such folder, no permission, disk
+        full...).
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, gsd_m=0.5)
+    >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
+    >>> raster = imgmtf.read_raster("chip.tif")
+    >>> raster.gsd_m, raster.provenance["target"]["angle_deg"]
+    (0.5, 6.0)
+    """
     tags = {}
     if provenance:
         tags["IMGMTF"] = json.dumps(provenance, sort_keys=True)
@@ -101,16 +134,64 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                 tags[f"TARGET_{key.upper()}"] = str(target[key])
         for key in ("noise_std_dn", "seed", "imgmtf_version"):
             tags[key.upper()] = str(provenance.get(key))
-    profile = dict(driver="GTiff", width=bands.shape[2], height=bands.shape[1],
-                   count=bands.shape[0], dtype=bands.dtype.name,
-                   transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
+    _write_image(path, image, "GTiff", tags,
+                 transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
+
+
+def write_png(path: str | Path, image: np.ndarray) -> None:
+    """Write an 8/16-bit image as a grey (or RGB) PNG, for viewers and
+    tools that read no TIFF.
+
+    A PNG keeps the pixels only: no GSD and no provenance (use
+    :func:`write_geotiff` for those), so :func:`read_raster` gives it
+    ``gsd_m`` None and figures in pixel units.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The PNG to write (replaced if it exists), atomically.
+    image : numpy.ndarray of uint8 or uint16, shape (rows, cols) or (bands, rows, cols)
+        The pixels, DN (1 band: grey; 3: RGB; 4: RGBA).
+
+    Raises
+    ------
+    ParameterError
+        The image is not uint8 or uint16.
+    FileWriteError
+        The file cannot be written.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, bits=8)
+    >>> imgmtf.write_png("chip.png", chip.image)
+    >>> raster = imgmtf.read_raster("chip.png")
+    >>> raster.dtype, raster.gsd_m
+    ('uint8', None)
+    """
+    _write_image(path, image, "PNG", {})
+
+
+def _write_image(path: str | Path, image: np.ndarray, driver: str, tags: dict, **georeference) -> None:
+    """Write uint8/uint16 pixels with a GDAL ``driver``, atomically."""
+    image = np.asarray(image)
+    kind = {"GTiff": "GeoTIFF chips", "PNG": "PNG images"}[driver]
+    if image.dtype not in (np.uint8, np.uint16):
+        raise ParameterError(f"{path}: {kind} are 8 or 16 bit, got {image.dtype}")
+    if image.ndim not in (2, 3):
+        raise ParameterError(f"{path}: expected (rows, cols) or (bands, rows, cols) pixels, "
+                             f"got shape {image.shape}")
+    bands = image[None] if image.ndim == 2 else image
+    profile = dict(driver=driver, width=bands.shape[2], height=bands.shape[1], count=bands.shape[0],
+                   dtype=bands.dtype.name, **georeference)
     with atomic_output(path) as partial:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", NotGeoreferencedWarning)
                 with rasterio.open(partial, "w", **profile) as dst:
                     dst.write(bands)
-                    dst.update_tags(**tags)
+                    if tags:
+                        dst.update_tags(**tags)
         except (*GDAL_ERRORS, OSError) as exc:
             raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
 
@@ -138,11 +219,17 @@ class RasterInfo:
     def is_rgb(self) -> bool:
         return self.count in (3, 4) and list(self.colours[:3]) == ["red", "green", "blue"]
 
-    def bands(self, band: int | str | None) -> list[int | None]:
-        """The band selections ``band`` stands for: ``"all"`` every band,
-        otherwise just ``band`` (None: the single band or RGB luminance)."""
+    @property
+    def alpha_bands(self) -> list[int]:
+        """1-based numbers of the bands that hold transparency, not DN."""
+        return [i + 1 for i, colour in enumerate(self.colours) if colour == "alpha"]
+
+    def bands(self, band: int | str | None) -> list[int | str | None]:
+        """The band selections ``band`` stands for: ``"all"`` every band but
+        alpha, otherwise just ``band`` (None: the single band or RGB
+        luminance)."""
         if band == "all":
-            return list(range(1, self.count + 1))
+            return [i for i in range(1, self.count + 1) if i not in self.alpha_bands]
         return [band]
 
     def check_window(self, window) -> tuple[int, int, int, int]:
@@ -208,7 +295,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
             chosen, data = 1, _band(src, 1, region, out_shape)
         elif info.is_rgb:
             chosen = "luminance"
-            data = sum(w_ * _band(src, i + 1, region, out_shape) for i, w_ in enumerate(LUMA_WEIGHTS))
+            data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
         else:
             raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
                                  "choose one with --band N, or --band all")
