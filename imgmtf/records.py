@@ -30,6 +30,8 @@ from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from typing import IO, Any
 
+import numpy as np
+
 from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
 from .version import __version__
@@ -142,8 +144,11 @@ class Record:
         intervals split into their bounds, lists and mappings as JSON,
         missing values empty."""
         flat = self.to_dict()
+        columns = columns or CSV_COLUMNS
+        if any(c in _CURVE_COLUMN_FREQUENCY for c in columns):
+            flat.update(curve_values(flat.get("frequencies_cy_px"), flat.get("mtf")))
         row = {}
-        for column in columns or CSV_COLUMNS:
+        for column in columns:
             source = _CSV_SOURCES.get(column, column)
             if isinstance(source, tuple):
                 pair = flat.get(source[0]) or (None, None)
@@ -158,9 +163,10 @@ class Record:
         return row
 
 
-# The CSV schema of measure and batch rows: provenance, outcome, figures
-# (units in the names; MTF values are dimensionless, 1 at zero frequency).
-CSV_COLUMNS = (
+# The summary columns of measure and batch rows: provenance, outcome,
+# figures (units in the names; MTF values are dimensionless, 1 at zero
+# frequency).
+SUMMARY_COLUMNS = (
     "path", "band", "target", "method", "status", "reason", "error",
     "direction", "normal_angle_deg", "tilt_deg", "polarity", "rows_used", "snr",
     "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high",
@@ -168,6 +174,13 @@ CSV_COLUMNS = (
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px",
     "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
+# The MTF curve, one column per frequency along the normal: 0 to 1 cy/px
+# in steps of 0.05 (0.25 and 0.5 cy/px among them), so that a spreadsheet
+# can plot and compare the rows; JSON Lines carry the whole curve (0.01 cy/px).
+CURVE_FREQUENCIES_CY_PX = tuple(round(0.05 * i, 2) for i in range(21))
+CURVE_COLUMNS = tuple(f"mtf_at_{f:.2f}_cy_px" for f in CURVE_FREQUENCIES_CY_PX)
+# The CSV schema of measure and batch rows
+CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # what a scan adds: the candidate's rank and where it lies in the scene
 # (pixel coordinates, x right, y down; map coordinates in the scene's CRS
 # units), and its screening figures
@@ -176,8 +189,8 @@ SCAN_COLUMNS = (
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation",
 )
 
-# a scan's CSV: id and rank first, then the common columns, then the site's
-SCAN_CSV_COLUMNS = SCAN_COLUMNS[:2] + CSV_COLUMNS + SCAN_COLUMNS[2:]
+# a scan's CSV: id and rank first, then the summary, the site's columns, the curve
+SCAN_CSV_COLUMNS = SCAN_COLUMNS[:2] + SUMMARY_COLUMNS + SCAN_COLUMNS[2:] + CURVE_COLUMNS
 
 # CSV columns that are not a key of the flat record: (key, index) of a pair, or the key
 _CSV_SOURCES = {
@@ -185,6 +198,20 @@ _CSV_SOURCES = {
     "mtf50_ci_low_cy_px": ("mtf50_ci_cy_px", 0), "mtf50_ci_high_cy_px": ("mtf50_ci_cy_px", 1),
     "roi_px": "roi",
 }
+_CURVE_COLUMN_FREQUENCY = dict(zip(CURVE_COLUMNS, CURVE_FREQUENCIES_CY_PX))
+
+
+def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
+    """The MTF curve at :data:`CURVE_FREQUENCIES_CY_PX`, keyed by CSV
+    column (linear between the curve's samples; None outside the curve or
+    where it is undefined, e.g. at a bar's sinc zeros)."""
+    if not frequencies_cy_px or not mtf:
+        return dict.fromkeys(CURVE_COLUMNS)
+    f = np.asarray(frequencies_cy_px, float)
+    m = np.array([np.nan if v is None else v for v in mtf], float)
+    wanted = np.asarray(CURVE_FREQUENCIES_CY_PX)
+    values = np.where((wanted >= f[0] - 1e-9) & (wanted <= f[-1] + 1e-9), np.interp(wanted, f, m), np.nan)
+    return {c: round(float(v), 6) if math.isfinite(v) else None for c, v in zip(CURVE_COLUMNS, values)}
 
 
 def _json_default(value):
