@@ -11,8 +11,17 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadError, ImgmtfError,
-                     MultipleTargetsError, ParameterError, TargetNotFoundError, UnsuitableTargetError)
+from .errors import (
+    ConfigError,
+    FileWriteError,
+    ImageContentError,
+    ImageReadError,
+    ImgmtfError,
+    MultipleTargetsError,
+    ParameterError,
+    TargetNotFoundError,
+    UnsuitableTargetError,
+)
 
 # public name -> the module that defines it
 _LAZY = {

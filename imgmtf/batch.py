@@ -6,6 +6,7 @@ measurement becomes an error record of reason ``internal`` for that file.
 """
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -127,7 +128,7 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
         if plot_path:
             target = _band_plot_path(plot_path, band, len(bands))
             try:
-                save_figure(lambda: _measurement_figure(result, raster), target)
+                save_figure(functools.partial(_measurement_figure, result, raster), target)
                 record = record.with_(plot=target)
             except Exception as exc:
                 message = str(exc) if isinstance(exc, ImgmtfError) else (

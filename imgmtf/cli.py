@@ -161,7 +161,7 @@ def _length_option(default_unit: str):
         try:
             length = float(number)
         except ValueError:
-            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}")
+            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}") from None
         if not math.isfinite(length):
             raise click.BadParameter(f"expected a finite width, got {value!r}")
         return length, unit or default_unit
@@ -410,7 +410,7 @@ def _parse_band(ctx, param, value):
     try:
         band = int(value)
     except ValueError:
-        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}")
+        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}") from None
     if band < 1:
         raise click.BadParameter(f"bands are numbered from 1, got {value!r}")
     return band
@@ -600,8 +600,8 @@ def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False
     last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
-    direction = {"across-track": "across", "along-track": "along"}.get(record.get("direction"),
-                                                                      record.get("direction") or "-")
+    direction = record.get("direction") or "-"
+    direction = {"across-track": "across", "along-track": "along"}.get(direction, direction)
     cells = [f"{first} {_num(record.get('normal_angle_deg'), 7, 2)} "
              f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>7} "
              f"{_num(record.get('snr'), 5, 0)} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
@@ -724,7 +724,8 @@ def reproduce(out, quick, workers, seed, progress):
     with _reported_errors():
         result = run_study(out, quick=quick, workers=workers, seed=seed, progress=progress)
     for method, snr in result["thresholds"].items():
-        found = f"trustworthy from SNR {snr:g}" if math.isfinite(snr) else f"not trustworthy up to SNR {max(THRESHOLD_SNRS)}"
+        found = (f"trustworthy from SNR {snr:g}" if math.isfinite(snr)
+                 else f"not trustworthy up to SNR {max(THRESHOLD_SNRS)}")
         click.echo(f"{method:8s} {found}")
     if quick:
         click.echo(f"(a quick run: {result['chips_per_level']} chips per SNR level are too few for a "

@@ -43,20 +43,38 @@ MAX_READ_PIXELS = 16 * 1024 * 1024
 
 @dataclass(frozen=True, eq=False)
 class Raster:
-    """One band (or the luminance) of an image file.
+    """One band (or the luminance) of an image file, as :func:`read_raster`
+    returns it.
 
     Attributes
     ----------
-    data : 2-D float64 array (DN), NaN where the file marks nodata.
-    path : the file it came from.
-    band : 1-based band number, or "luminance" for RGB(A) input.
-    gsd_m : pixel size in metres when the file is georeferenced, else None.
-    tags : the file's metadata tags.
-    dtype : the stored sample type (e.g. "uint16").
-    origin : (x, y) of ``data``'s top-left pixel in the file (a window's).
-    map_projected : True when the file has a coordinate reference system:
-        a map-projected (or geographic) product, whose rows are not along
+    data : numpy.ndarray of float64, shape (rows, cols)
+        The pixels, DN; NaN where the file marks nodata.
+    path : str
+        The file it came from.
+    band : int or str
+        1-based band number, or ``"luminance"`` for RGB(A) input.
+    gsd_m : float or None
+        Pixel size in metres when the file is georeferenced, else None.
+    tags : dict
+        The file's metadata tags.
+    dtype : str
+        The stored sample type (``"uint16"``...): integer types set the
+        saturation limits.
+    origin : (int, int)
+        (x, y) of ``data``'s top-left pixel in the file (a window's).
+    map_projected : bool
+        True when the file has a coordinate reference system: a
+        map-projected (or geographic) product, whose rows are not along
         the sensor's track.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> imgmtf.write_geotiff("edge.tif", imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100).image)
+    >>> raster = imgmtf.read_raster("edge.tif")
+    >>> raster.band, raster.gsd_m, raster.dtype, raster.data.shape
+    (1, 1.0, 'uint16', (100, 100))
     """
 
     data: np.ndarray
@@ -70,7 +88,8 @@ class Raster:
 
     @property
     def provenance(self) -> dict | None:
-        """The imgmtf provenance record of a chip imgmtf wrote, else None."""
+        """How imgmtf made the chip (:meth:`imgmtf.Chip.provenance`: sensor,
+        target, GSD, noise, seed) when imgmtf wrote it, else None."""
         text = self.tags.get("IMGMTF")
         try:
             return json.loads(text) if text else None
@@ -224,12 +243,14 @@ class RasterInfo:
         """1-based numbers of the bands that hold transparency, not DN."""
         return [i + 1 for i, colour in enumerate(self.colours) if colour == "alpha"]
 
-    def bands(self, band: int | str | None) -> list[int | str | None]:
+    def bands(self, band: int | str | None) -> list[int | None]:
         """The band selections ``band`` stands for: ``"all"`` every band but
         alpha, otherwise just ``band`` (None: the single band or RGB
         luminance)."""
         if band == "all":
             return [i for i in range(1, self.count + 1) if i not in self.alpha_bands]
+        if isinstance(band, str):
+            raise ParameterError(f"band must be a 1-based number or 'all', got {band!r}")
         return [band]
 
     def check_window(self, window) -> tuple[int, int, int, int]:
@@ -247,7 +268,24 @@ def raster_info(path: str | Path) -> RasterInfo:
 
 def read_raster(path: str | Path, band: int | None = None, window=None,
                 out_shape: tuple[int, int] | None = None) -> Raster:
-    """Read one band of an image file as float64 DN.
+    """Read one band of an image file (anything GDAL reads: GeoTIFF, PNG,
+    JPEG, JP2, NITF...) as float64 DN.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The image file (a regular file).
+    band : int, optional
+        1-based band to read.
+    window : (int, int, int, int), optional
+        (x, y, width, height) in pixels: read only this part.
+    out_shape : (int, int), optional
+        (rows, cols) to read the window decimated to (nearest).
+
+    Returns
+    -------
+    Raster
+        The pixels with the file's GSD, tags, type and provenance.
 
     With ``band=None`` a single-band file gives its band and an RGB or RGBA
     file (8/16-bit, colour-interpreted as such) gives the Rec. 709 luminance
@@ -271,9 +309,12 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
 
     Example
     -------
-    >>> raster = read_raster("chip.tif", window=(100, 60, 64, 64))  # doctest: +SKIP
-    >>> raster.data.shape, raster.origin                              # doctest: +SKIP
-    ((64, 64), (100, 60))
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 200)
+    >>> imgmtf.write_geotiff("scene.tif", chip.image, gsd_m=2.0)
+    >>> raster = imgmtf.read_raster("scene.tif", window=(100, 60, 64, 64))
+    >>> raster.data.shape, raster.origin, raster.gsd_m
+    ((64, 64), (100, 60), 2.0)
     """
     path = str(path)
     with _opened(path) as src:
@@ -290,7 +331,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
             if not (isinstance(band, (int, np.integer)) and 1 <= band <= count):
                 raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
             chosen: int | str = int(band)
-            data = _band(src, chosen, region, out_shape)
+            data = _band(src, int(band), region, out_shape)
         elif count == 1:
             chosen, data = 1, _band(src, 1, region, out_shape)
         elif info.is_rgb:

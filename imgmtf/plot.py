@@ -3,6 +3,8 @@ returns the figure; nothing here touches pyplot's global state, so the
 figures render with the Agg canvas whatever the session's backend."""
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -291,8 +293,9 @@ def plot_measurement(result, truth=None, title: str | None = None):
     summary = (f"MTF at Nyquist {result.mtf_nyquist:.4f}{interval}, MTF50 {result.mtf50_cy_px:.4f} cy/px, "
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
-    if result.warnings:
-        summary += f"\n{len(result.warnings)} warning(s): " + "; ".join(w[:90] for w in result.warnings[:2])
+    for i, warning in enumerate(result.warnings[:2]):
+        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(result.warnings)}: {warning}", 170,
+                                           placeholder=" [...]")
     fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
     return fig
 

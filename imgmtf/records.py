@@ -27,7 +27,7 @@ import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import IO, Any
 
 import numpy as np
@@ -47,31 +47,62 @@ _OWN_KEYS = frozenset({"path", "band", "target", "method", "status", "reason", "
 
 def utc_now() -> str:
     """The current time in UTC, ISO 8601 to the second (``2024-05-01T09:30:00Z``)."""
-    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    return datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 @dataclass(frozen=True)
 class Record:
     """The outcome of measuring one target: a file (or one of its bands), or
-    a scan candidate.
+    a scan candidate; one JSON Lines line or CSV row of ``measure``.
 
     Attributes
     ----------
-    path : the input file.
-    band : 1-based band, ``"luminance"`` for RGB, None when not known.
-    target : ``"edge"`` or ``"pulse"``.
-    method : the resampling method.
-    status : ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
-    reason : machine-readable code of a failure (None when ok).
-    error : one-line message naming the file (None when ok).
-    figures : the estimate's JSON summary (units in the names:
-        ``mtf50_cy_px``, ``fwhm_px``...), empty for a failure.
-    site : where a scan candidate lies (``id``, ``rank``, ``x0_px``...);
-        empty for ``measure``.
-    plot : the figure written for this record, if any.
-    params : settings of the estimate and of the run.
-    run_utc : start of the run, UTC, ISO 8601.
-    imgmtf_version : the version that made the record.
+    path : str
+        The input file.
+    band : int, str or None
+        1-based band, ``"luminance"`` for RGB, None when not known.
+    target : str
+        ``"edge"`` or ``"pulse"``.
+    method : str
+        The resampling method.
+    status : str
+        ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
+    reason : str or None
+        Machine-readable code of a failure (``unreadable``, ``two-targets``,
+        ``saturated``...; None when ok).
+    error : str or None
+        One-line message naming the file (None when ok).
+    figures : mapping
+        The estimate's JSON summary (units in the names: ``mtf50_cy_px``,
+        ``fwhm_px``...), empty for a failure.
+    site : mapping
+        Where a scan candidate lies (``id``, ``rank``, ``x0_px``...); empty
+        for ``measure``.
+    plot : str or None
+        The figure written for this record, if any.
+    params : mapping
+        Settings of the estimate and of the run.
+    run_utc : str
+        Start of the run, UTC, ISO 8601.
+    imgmtf_version : str
+        The version that made the record.
+
+    Raises
+    ------
+    TypeError
+        A missing field (the constructors :meth:`measured` and
+        :meth:`failed` fill them).
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> from imgmtf.errors import ImageReadError
+    >>> record = imgmtf.Record.failed("a.tif", None, "edge", "msg", ImageReadError("a.tif: no such file"),
+    ...                               params={}, run_utc="2024-05-01T09:30:00Z")
+    >>> record
+    Record('a.tif', error, unreadable: a.tif: no such file)
+    >>> record.csv_row()["reason"], record.ok
+    ('unreadable', False)
     """
 
     path: str
@@ -90,7 +121,7 @@ class Record:
 
     @classmethod
     def measured(cls, path: str, band, summary: Mapping[str, Any], *, params: Mapping[str, Any],
-                 run_utc: str, status: str = "ok", **fields) -> "Record":
+                 run_utc: str, status: str = "ok", **fields) -> Record:
         """A record of an estimate whose JSON summary is ``summary``; the
         run's ``params`` are merged with the estimator's own."""
         figures = {k: v for k, v in summary.items() if k not in _OWN_KEYS}
@@ -100,7 +131,7 @@ class Record:
 
     @classmethod
     def failed(cls, path: str, band, target: str, method: str, exc: BaseException, *,
-               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> "Record":
+               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> Record:
         """A record of a target that could not be measured: the reason code
         of an imgmtf error, ``internal`` for any other exception; the
         message names the file (prefixed when it does not)."""
@@ -116,15 +147,26 @@ class Record:
         return cls(str(path), band, target, method, status, reason, message, params=params,
                    run_utc=run_utc, **fields)
 
+    def __repr__(self) -> str:
+        band = "" if self.band in (None, 1, "luminance") else f", band {self.band}"
+        if self.ok:
+            figures = self.figures
+            outcome = (f"MTF@Nyquist {figures.get('mtf_nyquist')}, MTF50 {figures.get('mtf50_cy_px')} cy/px"
+                       if figures else "no figures")
+        else:
+            outcome = f"{self.reason}: {self.error}"
+        return f"Record({self.path!r}{band}, {self.status}, {outcome})"
+
     @property
     def ok(self) -> bool:
+        """True for a measured (``ok``) or accepted record."""
         return self.status in OK_STATUSES
 
     def get(self, key: str, default=None):
         """A value of the flat JSON form (a field, a figure or a site key)."""
         return self.to_dict().get(key, default)
 
-    def with_(self, **changes) -> "Record":
+    def with_(self, **changes) -> Record:
         """A copy with fields changed (``figures``/``site`` given as
         mappings are merged into the current ones)."""
         for name in ("figures", "site"):
@@ -254,7 +296,7 @@ class CsvWriter:
         self.path, self.columns, self.rows = str(path), tuple(columns), 0
         self._output = atomic_output(self.path, keep_partial=True)
 
-    def __enter__(self) -> "CsvWriter":
+    def __enter__(self) -> CsvWriter:
         partial = self._output.__enter__()
         try:
             self._file = open(partial, "w", newline="", encoding="utf-8")

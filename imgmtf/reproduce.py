@@ -21,17 +21,18 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .version import __version__
-from .estimate.edge import EdgeEstimator
 from .errors import FileWriteError, ImgmtfError
-from .metrics import fwhm
-from .sensor.noise import GroundNoise
-from .estimate.pulse import PulseEstimator
-from .sensor.rendering import Renderer
-from .estimate.resampling import METHODS
-from .sensor.model import Sensor
-from .sensor.targets import Target
+from .estimate.edge import EdgeEstimator
 from .estimate.intervals import NO_INTERVALS
+from .estimate.pulse import PulseEstimator
+from .estimate.resampling import METHODS
+from .estimate.results import MTFResult
+from .metrics import fwhm
+from .sensor.model import Sensor
+from .sensor.noise import GroundNoise
+from .sensor.rendering import Renderer
+from .sensor.targets import Target
+from .version import __version__
 
 CHIP_PX = 40
 ANGLE_DEG = 6.0
@@ -124,6 +125,7 @@ def estimator_tables(methods) -> tuple[list[dict], dict]:
                      "paper_fwhm_diff_pct": "", "paper_mtf_diff_pct": ""})
         for correct in (False, True):
             for method in methods:
+                r: MTFResult
                 if kind == "edge":
                     r = EdgeEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(chip.image)
                     fw = r.fwhm_px

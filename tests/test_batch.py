@@ -7,14 +7,15 @@ import os
 import numpy as np
 import pytest
 import rasterio
-from rasterio.errors import NotGeoreferencedWarning
 from click.testing import CliRunner
-from conftest import exact_edge_chip, gaussian_pixel_transfer
+from rasterio.errors import NotGeoreferencedWarning
 
 import imgmtf as im
 from imgmtf.batch import MeasureSettings, expand_inputs, measure_file
-from imgmtf.io import read_raster, write_geotiff
 from imgmtf.cli import main
+from imgmtf.io import read_raster, write_geotiff
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 TRANSFER = gaussian_pixel_transfer(0.5, 6.0)
 pytestmark = pytest.mark.filterwarnings(f"ignore::{NotGeoreferencedWarning.__module__}.NotGeoreferencedWarning")

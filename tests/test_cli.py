@@ -142,8 +142,9 @@ def test_pulse_width_errors(run, chip, tmp_path):
     assert run("measure", "--target", "pulse", "--pulse-width", "wide", chip).exit_code == 2
     assert run("measure", "--pulse-width", "2", chip).exit_code == 2          # edge target
     png = tmp_path / "plain.png"
-    import rasterio
     import warnings
+
+    import rasterio
     from rasterio.errors import NotGeoreferencedWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
