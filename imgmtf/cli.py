@@ -387,7 +387,7 @@ def _fit_report(result) -> None:
         click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
                    "better than each")
     pct = f"{100 * result.confidence:g}%"
-    click.echo(f"{'edge':<32} {'angle':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
@@ -740,7 +740,7 @@ def selftest(method):
     """Render generic-sensor chips with known MTF, measure them, and compare
     measured with true; exit 1 if any estimate is out of tolerance."""
     with _reported_errors():
-        from .selftest import run_selftest
+        from .selftest import CASES, run_selftest
         from .sensor.model import DIRECTIONS, Sensor
         sensor = Sensor()
         from .version import __version__
@@ -750,13 +750,15 @@ def selftest(method):
                        f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
         click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
                    "(! marks a figure out of tolerance):")
-        click.echo(f"{'case':<28} {'':>5} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM px':>8}")
+        width = max(len(case.name) for case in CASES)
+        click.echo(f"{'case':<{width}} {'':>4} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM':>8}")
+        click.echo(f"{'':<{width}} {'':>4} {'':>8} {'cy/px':>8} {'px':>8}")
         rows = run_selftest(sensor, method=method)
         for row in rows:
-            click.echo(f"{row.name:<28} {'true':>5} {row.true['mtf_nyquist']:8.4f} "
+            click.echo(f"{row.name:<{width}} {'true':>4} {row.true['mtf_nyquist']:8.4f} "
                        f"{row.true['mtf50']:8.4f} {row.true['fwhm']:8.4f}")
             marks = {k: ("" if v else "!") for k, v in row.passed.items()}
-            click.echo(f"{'':<28} {'got':>5} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
+            click.echo(f"{'':<{width}} {'got':>4} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
                        f"{row.measured['mtf50']:8.4f}{marks['mtf50']:1}{row.measured['fwhm']:8.4f}{marks['fwhm']:1}"
                        f"  {'PASS' if row.ok else 'FAIL'}  (SNR {row.snr:.0f})")
         failed = [r.name for r in rows if not r.ok]

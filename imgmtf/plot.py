@@ -104,7 +104,7 @@ def plot_fit_edge(fit, index: int, ax=None):
             label=f"measured: {edge.measured_mtf_nyquist:.4f}")
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
     name = edge.source if len(edge.source) <= 32 else "..." + edge.source[-29:]
-    ax.set(title=f"{name}: {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
+    ax.set(title=f"{name}: normal {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
            xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF")
     ax.legend(fontsize="small", title=f"at Nyquist ({100 * fit.confidence:g} % interval)",
               title_fontsize="small")
