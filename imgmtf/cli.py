@@ -99,6 +99,11 @@ class FiniteFloat(click.FloatRange):
 
     name = "number"
 
+    def _describe_range(self) -> str:
+        """The bounds for the help ("finite" when there are none, rather
+        than click's "x<=None")."""
+        return "finite" if self.min is None and self.max is None else super()._describe_range()
+
     def convert(self, value, param, ctx):
         number = super().convert(value, param, ctx)
         if not math.isfinite(number):
@@ -604,13 +609,21 @@ def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False
     direction = {"across-track": "across", "along-track": "along"}.get(direction, direction)
     cells = [f"{first} {_num(record.get('normal_angle_deg'), 7, 2)} "
              f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>7} "
-             f"{_num(record.get('snr'), 5, 0)} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
+             f"{_snr(record.get('snr'))} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
              f"{_num(record.get('mtf50_cy_px'), 7, 4)} {_num(record.get('fwhm_px'), 6, 3)} {_num(last, 6, 3)}"]
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{record['mtf50_cy_m']:.4g} cy/m, FWHM {record['fwhm_m']:.4g} m")
     cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def _snr(value) -> str:
+    """The SNR in the table's 5 characters: to the unit up to 99999, then
+    in thousands (a noise-free chip's can reach millions)."""
+    if value is None:
+        return f"{'-':>5}"
+    return f"{value:5.0f}" if value < 99999.5 else f"{value / 1000:4.0f}k"
 
 
 def _num(value, width: int, decimals: int) -> str:

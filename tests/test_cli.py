@@ -253,6 +253,8 @@ def test_text_table_names_units_and_fits_long_paths(run, chip, tmp_path):
     assert "cy/px" in units and "deg" in units and "px" in units
     assert header.index("normal") == first.index("6.00") + len("6.00") - len("normal")   # columns line up
     assert "band" not in header                                   # no band asked for: no band column
+    from imgmtf.cli import _snr
+    assert [_snr(v) for v in (199.4, 99999.0, 136212.0, None)] == ["  199", "99999", " 136k", "    -"]
 
 
 def test_help_explains_methods_and_lists_every_command_in_full(run):
@@ -260,6 +262,7 @@ def test_help_explains_methods_and_lists_every_command_in_full(run):
     text = "".join(run("measure", "--help").stdout.split())          # wrapped anywhere, even at hyphens
     for method in METHODS.values():
         assert "".join(f"{method.name}: {method.description}".split()) in text
+    assert "None" not in run("simulate", "--help").stdout          # an unbounded number says "finite"
     listing = run("--help").stdout
     assert "Rerun the paper's study and find each method's SNR threshold." in listing
     assert "Figs.\n" not in listing
