@@ -320,7 +320,7 @@ def _report(tables, found, heights, ground_sd, size, quick, seed, workers, elaps
               + (f"This quick run's {n} chips per level are too few to find a threshold: a level meets "
                  f"the criterion only when {math.ceil(CRITERION_FRACTION * n)} of its {n} chips pass, so "
                  "one unlucky chip moves the threshold. Read it from the full run (100 chips per "
-                 "level), which takes about a minute on 2 cores."
+                 "level), which takes one to two minutes on 2 cores."
                  if quick else "A level whose fraction dips below the criterion after an earlier one "
                  "met it is within that noise; more chips per level would smooth the curves."), "",
               "The paper's threshold for its MSG was SNR 100. The noise of an MTF estimate falls "
