@@ -8,6 +8,10 @@
   output has its output unchecked), ``python`` blocks as doctests sharing
   the document's names, ``toml`` blocks read as sensor files.
 * The package's docstring examples, module by module, as doctests.
+
+When a change moves what a command prints, ``python tests/test_docs.py
+--update`` rewrites the console outputs the documents show (lines with
+``...`` kept where they still match); read the diff before committing it.
 """
 import doctest
 import importlib
@@ -52,20 +56,27 @@ def console_steps(body: str):
     return steps
 
 
+def run_command(command: str, where: str) -> list[str]:
+    """Run one ``$ imgmtf ...`` line, check its exit status, return its
+    output lines (stdout and stderr as a terminal shows them)."""
+    args = shlex.split(command, comments=True)
+    assert args[0] == "imgmtf", f"{where}: console blocks run imgmtf only, got {command!r}"
+    status = EXIT_STATUS.search(command)
+    result = CliRunner().invoke(main, args[1:])
+    assert result.exit_code == int(status[1] if status else 0), (
+        f"{where}: `{command}` exited {result.exit_code}:\n{result.output}")
+    return [line.rstrip() for line in result.output.strip("\n").splitlines()]
+
+
 def run_console(body: str, where: str) -> None:
     checker = doctest.OutputChecker()
     for command, expected in console_steps(body):
-        args = shlex.split(command, comments=True)
-        assert args[0] == "imgmtf", f"{where}: console blocks run imgmtf only, got {command!r}"
-        status = EXIT_STATUS.search(command)
-        result = CliRunner().invoke(main, args[1:])
-        assert result.exit_code == int(status[1] if status else 0), (
-            f"{where}: `{command}` exited {result.exit_code}:\n{result.output}")
+        got = run_command(command, where)
         if any(line.strip() for line in expected):
             want = "\n".join(line.rstrip() for line in expected).strip("\n") + "\n"
-            got = "\n".join(line.rstrip() for line in result.output.splitlines()).strip("\n") + "\n"
-            assert checker.check_output(want, got, doctest.ELLIPSIS), (
-                f"{where}: `{command}` printed\n{got}\nthe document shows\n{want}")
+            assert checker.check_output(want, "\n".join(got) + "\n", doctest.ELLIPSIS), (
+                f"{where}: `{command}` printed\n" + "\n".join(got) + f"\nthe document shows\n{want}"
+                + "(python tests/test_docs.py --update rewrites what the documents show)")
 
 
 def run_python(body: str, globs: dict, where: str) -> None:
@@ -138,3 +149,42 @@ def test_docstring_examples(name, tmp_path, monkeypatch):
     for test in doctest.DocTestFinder().find(module, name):
         runner.run(test, out=report.append)
     assert not runner.failures, "".join(report)
+
+
+def update_console_outputs(document: str) -> None:
+    """Rewrite the outputs a document's console blocks show with what the
+    commands print now, in a fresh folder as the test runs them; a shown
+    line that still matches (``...`` included) is kept as written."""
+    import os
+    import tempfile
+    text = (ROOT / document).read_text()
+    checker = doctest.OutputChecker()
+    with tempfile.TemporaryDirectory() as folder:
+        here = os.getcwd()
+        os.chdir(folder)
+        os.symlink(ROOT / "data", "data", target_is_directory=True)
+        try:
+            for language, body, line in list(fenced_blocks(text)):
+                if language != "console":
+                    continue
+                lines = []
+                for command, expected in console_steps(body):
+                    got = run_command(command, f"{document}:{line}")
+                    shown = [e.rstrip() for e in expected]
+                    if any(shown) and len(shown) == len(got):
+                        got = [e if checker.check_output(e + "\n", g + "\n", doctest.ELLIPSIS) else g
+                               for e, g in zip(shown, got)]
+                    lines += [f"$ {command}", *(got if any(shown) else shown)]
+                text = text.replace(body, "\n".join(lines) + "\n", 1)
+        finally:
+            os.chdir(here)
+    (ROOT / document).write_text(text)
+
+
+if __name__ == "__main__":
+    import sys
+    if sys.argv[1:] != ["--update"]:
+        raise SystemExit("usage: python tests/test_docs.py --update  (rewrites the console outputs the docs show)")
+    for name in DOCUMENTS:
+        update_console_outputs(name)
+        print(f"updated {name}")
