@@ -18,7 +18,7 @@ def quick_run(tmp_path_factory):
     figures, tables and report are all there; few chips)."""
     out = tmp_path_factory.mktemp("quick")
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr("imgmtf.reproduce.QUICK", StudySize(QUICK.system_stds[:3], 1, 2))
+        patch.setattr("imgmtf.reproduce.QUICK", StudySize(QUICK.system_stds[:2], 1, 1))
         result = CliRunner().invoke(main, ["reproduce", "--quick", "--workers", "1", "--no-progress",
                                            "--out", str(out)])
     return out, result
@@ -33,9 +33,9 @@ def test_results_do_not_depend_on_the_number_of_workers():
 def test_cli_quick_run_reports_and_says_it_is_quick(quick_run):
     out, r = quick_run
     assert r.exit_code == 0, r.output
-    assert "msg      " in r.stdout and "a quick run: 2 chips per SNR level are too few" in r.stdout
+    assert "msg      " in r.stdout and "a quick run: 1 chips per SNR level are too few" in r.stdout
     assert not r.stderr                                       # --no-progress: no bars
-    assert len(read(out / "system_noise.csv")) == 3 * 4       # 3 chips x every method
+    assert len(read(out / "system_noise.csv")) == 2 * 4       # 2 chips x every method
 
 
 def test_report_and_figures_are_written(quick_run):
