@@ -338,7 +338,8 @@ def sensor_command(sensor_path, plot_path, save_path):
 @click.option("--hold", metavar="PARAMS",
               help="comma-separated parameters held at their starting values: a stage (detector) or "
                    "stage.parameter (detector.width_x_m)")
-@click.option("--gsd", type=FiniteFloat(0, min_open=True), help="GSD in metres (default: the files', else 1: parameters in px)")
+@click.option("--gsd", type=FiniteFloat(0, min_open=True),
+              help="GSD in metres (default: the files', else 1: parameters in px)")
 @click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
@@ -755,8 +756,8 @@ def selftest(method):
     with _reported_errors():
         from .selftest import CASES, run_selftest
         from .sensor.model import DIRECTIONS, Sensor
-        sensor = Sensor()
         from .version import __version__
+        sensor = Sensor()
         click.echo(f"imgmtf {__version__} self-test: generic sensor (Choi & Helder), GSD {sensor.gsd_m:g} m")
         for d in DIRECTIONS:
             click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "

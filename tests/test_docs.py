@@ -130,14 +130,7 @@ def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
     assert '".[$extras]"' in ci and "run_suite .venv-ci test" in ci and "\n    pytest" in ci
 
 
-# examples known to be wrong, each with who fixes it; strict, so that a fix
-# that makes one pass says to remove it from here
-KNOWN_WRONG = {
-    "imgmtf.estimate.edge": "EdgeEstimator's example expects MTF at Nyquist 0.267, it gives 0.266 (estimate/)",
-}
-MODULES = [pytest.param(m.name, marks=pytest.mark.xfail(strict=True, reason=KNOWN_WRONG[m.name]))
-           if m.name in KNOWN_WRONG else m.name
-           for m in sorted(pkgutil.walk_packages(imgmtf.__path__, "imgmtf."), key=lambda m: m.name)]
+MODULES = sorted(m.name for m in pkgutil.walk_packages(imgmtf.__path__, "imgmtf."))
 
 
 @pytest.mark.parametrize("name", MODULES)
