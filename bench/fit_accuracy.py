@@ -56,8 +56,9 @@ def part_generic():
         for e in fit.edges:
             truth = true_nyquist(sensor, e.normal_angle_deg, e.gsd_m)
             worst = max(worst, abs(e.mtf_nyquist - truth))
-            print(f"{i + 1:>6} {e.normal_angle_deg:6.1f} {truth:7.4f} {e.mtf_nyquist:7.4f} {e.mtf_nyquist - truth:+8.4f} "
-                  f"{e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3f}  {held or '-'}")
+            print(f"{i + 1:>6} {e.normal_angle_deg:6.1f} {truth:7.4f} {e.mtf_nyquist:7.4f} "
+                  f"{e.mtf_nyquist - truth:+8.4f} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3f}  "
+                  f"{held or '-'}")
     print(f"worst |error| at Nyquist: {worst:.4f} (target 0.002)\n")
 
 
@@ -134,8 +135,8 @@ def part_misfit_rate(n: int):
             fit_err, warned = np.array(fit_err), np.array(warned)
             quiet = fit_err[~warned]
             rms_quiet = f"{np.sqrt(np.mean(quiet**2)):12.4f}" if quiet.size else f"{'-':>12}"
-            print(f"{name:>23} {stages or 'default':>20} {snr:5.0f} {np.sqrt(np.mean(fit_err**2)):8.4f} {warned.sum():>3}/{n:<3} {rms_quiet} "
-                  f"{np.sqrt(np.mean(np.square(np_err))):8.4f}")
+            print(f"{name:>23} {stages or 'default':>20} {snr:5.0f} {np.sqrt(np.mean(fit_err**2)):8.4f} "
+                  f"{warned.sum():>3}/{n:<3} {rms_quiet} {np.sqrt(np.mean(np.square(np_err))):8.4f}")
     print()
 
 

@@ -56,7 +56,7 @@ def main():
                 m50.append(r.mtf50_cy_px / chip.true_mtf50_cy_px() - 1)
                 fw.append(r.fwhm_px / chip.true_fwhm_px() - 1)
             nyq, m50, fw = (np.array(x) for x in (nyq, m50, fw))
-            print(f"{method:10s} {str(correct):>10s} {np.nanmax(np.abs(nyq)):9.4f} "
+            print(f"{method:10s} {correct!s:>10s} {np.nanmax(np.abs(nyq)):9.4f} "
                   f"{100 * np.nanmax(np.abs(m50)):8.2f} {100 * np.nanmax(np.abs(fw)):8.2f} "
                   f"{np.nanmean(nyq):+17.4f}")
     print(f"\nnoisy: 1.5 px bar, sigma 0.5 px + pixel, {a.realisations} chips per SNR (pulse definition), "

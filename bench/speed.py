@@ -105,8 +105,8 @@ def main():
     chip = im.Renderer(im.Sensor(), 100)(target, noise_std_dn=10.0, seed=1).image
     for method in ("msg", "sliding", "spline", "iso"):
         est, bare = EdgeEstimator(method), EdgeEstimator(method, bootstrap=im.Bootstrap(0))
-        t = median_time(lambda: est(chip), a.runs if method != "spline" else 5)
-        t0 = median_time(lambda: bare(chip), a.runs)
+        t = median_time(lambda est=est: est(chip), a.runs if method != "spline" else 5)
+        t0 = median_time(lambda bare=bare: bare(chip), a.runs)
         print(f"measure_edge 100 x 100 chip, method {method:8s}:        {1000 * t:7.1f} ms "
               f"({1000 * t0:.1f} ms without intervals)")
     with tempfile.TemporaryDirectory() as tmp:

@@ -11,8 +11,17 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (ConfigError, FileWriteError, ImageContentError, ImageReadError, ImgmtfError,
-                     MultipleTargetsError, ParameterError, TargetNotFoundError, UnsuitableTargetError)
+from .errors import (
+    ConfigError,
+    FileWriteError,
+    ImageContentError,
+    ImageReadError,
+    ImgmtfError,
+    MultipleTargetsError,
+    ParameterError,
+    TargetNotFoundError,
+    UnsuitableTargetError,
+)
 
 # public name -> the module that defines it
 _LAZY = {
@@ -24,7 +33,8 @@ _LAZY = {
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
-    "Raster": "io", "read_raster": "io", "write_geotiff": "io", "Record": "records",
+    "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
+    "Record": "records",
     "run_selftest": "selftest",
 }
 

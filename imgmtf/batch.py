@@ -6,9 +6,12 @@ measurement becomes an error record of reason ``internal`` for that file.
 """
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+import numpy as np
 
 from .atomic import atomic_output, ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
@@ -107,9 +110,11 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
     failure).  ``run_utc`` stamps the records (default: now)."""
     run_utc = run_utc or utc_now()
     try:
-        bands = raster_info(path).bands(settings.band)
+        info = raster_info(path)
+        bands = info.bands(settings.band)
     except Exception as exc:               # the safety net: a record, never an abort
         return [settings.failed(path, settings.band, exc, run_utc)]
+    skipped = info.alpha_bands if settings.band == "all" else []
     records = []
     for band in bands:
         try:
@@ -123,7 +128,7 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
         if plot_path:
             target = _band_plot_path(plot_path, band, len(bands))
             try:
-                save_figure(lambda: _measurement_figure(result), target)
+                save_figure(functools.partial(_measurement_figure, result, raster), target)
                 record = record.with_(plot=target)
             except Exception as exc:
                 message = str(exc) if isinstance(exc, ImgmtfError) else (
@@ -131,6 +136,9 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
                 warnings = [*record.figures.get("warnings", []), message]
                 record = record.with_(figures={"warnings": warnings})
         records.append(record)
+    if skipped and records:
+        note = (f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured")
+        records[0] = records[0].with_(figures={"warnings": [*records[0].get("warnings", []), note]})
     return records
 
 
@@ -213,9 +221,30 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result):
+def _measurement_figure(result, raster):
+    """The measurement figure, titled with the file (and band), with the
+    true MTF when the file is a chip imgmtf simulated."""
     from .plot import plot_measurement
-    return plot_measurement(result)
+    title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
+    return plot_measurement(result, truth=true_mtf(raster), title=title)
+
+
+def true_mtf(raster):
+    """The true MTF along the target's normal, a function of cy/px, of a
+    chip imgmtf simulated (its GeoTIFF records the sensor, the target's
+    angle and the GSD); None for any other file."""
+    provenance = raster.provenance
+    if not isinstance(provenance, dict):
+        return None
+    from .sensor.model import Sensor
+    try:
+        sensor = Sensor.from_dict(provenance["sensor"])
+        angle_deg = float(provenance["target"]["angle_deg"])
+        gsd_m = float(provenance["gsd_m"])
+        sensor.normal_transfer(0.5, angle_deg, gsd_m)           # a provenance it cannot use fails here
+    except (KeyError, TypeError, ValueError, ImgmtfError):
+        return None
+    return lambda f_cy_px: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
 
 
 def save_figure(make_figure, path: str, dpi: int = 110) -> None:

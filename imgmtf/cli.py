@@ -99,6 +99,11 @@ class FiniteFloat(click.FloatRange):
 
     name = "number"
 
+    def _describe_range(self) -> str:
+        """The bounds for the help ("finite" when there are none, rather
+        than click's "x<=None")."""
+        return "finite" if self.min is None and self.max is None else super()._describe_range()
+
     def convert(self, value, param, ctx):
         number = super().convert(value, param, ctx)
         if not math.isfinite(number):
@@ -131,6 +136,24 @@ class MethodName(click.ParamType):
         return [CompletionItem(n) for n in self.names() if n.startswith(incomplete)]
 
 
+class MethodOption(click.Option):
+    """``--method``: its help lists what each registered method does, read
+    from the registry when the help is shown (not at start-up)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("type", MethodName())
+        kwargs.setdefault("default", "msg")
+        kwargs.setdefault("show_default", True)
+        super().__init__(*args, **kwargs)
+
+    def get_help_record(self, ctx):
+        from .estimate.resampling import METHODS
+        self.help = ("how the profile's samples are smoothed and resampled before the MTF (each "
+                     "method's own blur is divided out): "
+                     + "; ".join(f"{m.name}: {m.description}" for m in METHODS.values()))
+        return super().get_help_record(ctx)
+
+
 def _length_option(default_unit: str):
     """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit), the value
     finite and > 0."""
@@ -143,7 +166,7 @@ def _length_option(default_unit: str):
         try:
             length = float(number)
         except ValueError:
-            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}")
+            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}") from None
         if not math.isfinite(length):
             raise click.BadParameter(f"expected a finite width, got {value!r}")
         return length, unit or default_unit
@@ -188,16 +211,18 @@ def main(ctx):
 
 
 # -- simulate -----------------------------------------------------------------
-@main.command()
+@main.command(short_help="Render an edge or bar chip through the sensor (GeoTIFF, PNG).")
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
-              help="tilt of the edge from the column axis, degrees in (-90, 90]; near 90 for along track")
+              help="angle of the edge's normal from the x (column) axis, degrees in (-90, 90], which "
+                   "is the edge's tilt from vertical: near 0 across track, near 90 along track "
+                   "(measure reports it as normal_angle_deg)")
 @click.option("--low", type=FiniteFloat(), default=200.0, show_default=True,
               help="DN on the dark side (outside a pulse)")
 @click.option("--high", type=FiniteFloat(), default=1200.0, show_default=True,
               help="DN on the bright side (inside a pulse)")
-@click.option("--pulse-width", callback=_length_option("m"),
-              help="pulse width: 18.3 or 18.3m (metres), 1.4px (pixels); pulse targets")
+@click.option("--pulse-width", callback=_length_option("px"),
+              help="bar width of a pulse target: 1.5 or 1.5px (pixels), 1.5m (metres on the ground)")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
 @click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default=True,
@@ -210,20 +235,28 @@ def main(ctx):
               help="sub-pixels per pixel")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False), help="sensor TOML file")
 @click.option("--seed", type=click.IntRange(min=0), help="random seed for the noise (an integer >= 0)")
-@click.option("--out", required=True, type=click.Path(dir_okay=False), help="output GeoTIFF")
+@click.option("--out", required=True, type=click.Path(dir_okay=False),
+              help="output file: .tif (a GeoTIFF that records the GSD and how the chip was made) "
+                   "or .png (pixels only)")
 def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out):
-    """Render an edge or pulse chip through the generic sensor to a GeoTIFF."""
+    """Render an edge or pulse chip through the generic sensor to a GeoTIFF
+    (or a PNG)."""
     with _reported_errors():
-        from .io import write_geotiff
+        from .io import write_geotiff, write_png
         from .sensor.noise import GroundNoise
         from .sensor.rendering import render
         from .sensor.targets import Target
+        suffix = Path(out).suffix.lower()
+        if suffix not in (".tif", ".tiff", ".png"):
+            raise ParameterError(f"{out}: simulate writes a GeoTIFF (.tif, .tiff), which records the GSD "
+                                 "and how the chip was made, or a PNG (.png, pixels only); "
+                                 f"got {suffix or 'no suffix'}")
         check_output_file(out)
         sensor = _load_sensor(sensor_path)
         gsd_m = sensor.gsd_m if gsd is None else gsd
         if kind == "pulse" and pulse_width is None:
-            raise ParameterError("a pulse target needs --pulse-width (metres)")
+            raise ParameterError("a pulse target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
         if kind == "edge" and pulse_width is not None:
             raise ParameterError("--pulse-width applies to --target pulse only")
         width_px = 0.0
@@ -241,15 +274,23 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
         chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
                       noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
                       seed=seed)
-        write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
+        if suffix == ".png":
+            write_png(out, chip.image)
+        else:
+            write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
         clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
-        click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind} at {angle:g} deg, "
+        width = f" {width_px:g} px wide" if kind == "pulse" else ""
+        click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind}{width} at {angle:g} deg, "
                    f"GSD {chip.gsd_m:g} m; true MTF at Nyquist along the normal "
                    f"{float(chip.true_mtf(0.5)):.4f}{clipped}")
+        if suffix == ".png":
+            click.echo(f"note: a PNG keeps the pixels only; the GSD and how the chip was made (which "
+                       f"`measure` uses to draw the true MTF) are kept in a GeoTIFF: --out "
+                       f"{Path(out).with_suffix('.tif')}")
 
 
 # -- sensor -------------------------------------------------------------------
-@main.command("sensor")
+@main.command("sensor", short_help="Print (and plot) the sensor model's stages, FWHM and MTF.")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False), help="sensor TOML file")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="save the PSF, LSFs and each stage's MTF beside the system's (PNG)")
@@ -287,7 +328,7 @@ def sensor_command(sensor_path, plot_path, save_path):
 
 
 # -- fit ----------------------------------------------------------------------
-@main.command()
+@main.command(short_help="Fit the sensor model to edges: its MTF in every direction.")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--stages", metavar="NAMES",
               help="comma-separated stages to fit: optics, detector, motion, electronics, diffraction, "
@@ -297,7 +338,8 @@ def sensor_command(sensor_path, plot_path, save_path):
 @click.option("--hold", metavar="PARAMS",
               help="comma-separated parameters held at their starting values: a stage (detector) or "
                    "stage.parameter (detector.width_x_m)")
-@click.option("--gsd", type=FiniteFloat(0, min_open=True), help="GSD in metres (default: the files', else 1: parameters in px)")
+@click.option("--gsd", type=FiniteFloat(0, min_open=True),
+              help="GSD in metres (default: the files', else 1: parameters in px)")
 @click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
@@ -351,7 +393,7 @@ def _fit_report(result) -> None:
         click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
                    "better than each")
     pct = f"{100 * result.confidence:g}%"
-    click.echo(f"{'edge':<32} {'angle':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
@@ -374,7 +416,7 @@ def _parse_band(ctx, param, value):
     try:
         band = int(value)
     except ValueError:
-        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}")
+        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}") from None
     if band < 1:
         raise click.BadParameter(f"bands are numbered from 1, got {value!r}")
     return band
@@ -411,14 +453,13 @@ def _intervals(method: str, replicates: int | None, confidence: float):
     return Intervals(method, confidence, **({"replicates": replicates} if replicates else {}))
 
 
-@main.command()
+@main.command(short_help="Measure the MTF of the edge or bar in image files or folders.")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--pulse-width", callback=_length_option("px"),
               help="bar width: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
                    "estimated from the profile when omitted")
-@click.option("--method", type=MethodName(), default="msg", show_default=True,
-              help="profile smoothing/resampling method")
+@click.option("--method", cls=MethodOption)
 @click.option("--roi", callback=_parse_roi,
               help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
 @click.option("--band", callback=_parse_band,
@@ -479,7 +520,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
             completed = measure_files(files, settings, workers=workers, scheduler=scheduler,
                                       plot_dir=plot_dir, progress=progress, run_utc=run_utc,
                                       ordered=False)
-        stdout = JsonLinesWriter(sys.stdout) if fmt == "json" else _TextRows(kind)
+        stdout = (JsonLinesWriter(sys.stdout) if fmt == "json"
+                  else _TextRows(kind, path_width=max(map(len, files)), bands=band is not None))
         order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
         with ExitStack() as outputs:
             writers = [stdout]
@@ -530,43 +572,59 @@ def _signal_name(exc: BaseException) -> str:
 
 
 class _TextRows:
-    """The text table of ``measure``, one row per record as it comes."""
+    """The text table of ``measure``, one row per record as it comes: the
+    path column as wide as the longest input, the band column when bands
+    were asked for."""
 
-    def __init__(self, kind: str):
-        self.kind = kind
+    def __init__(self, kind: str, path_width: int = 32, bands: bool = False):
+        self.kind, self.bands = kind, bands
+        self.path_width = max(path_width, 4)
 
     def header(self, confidence: float) -> None:
-        last = "RER" if self.kind == "edge" else "W px"
-        click.echo(f"{'path':<32} {'band':>4} {'normal':>7} {'tilt':>5} {'dir':>6} {'SNR':>6} {'MTF@Nyq':>7} "
-                   f"{f'{100 * confidence:g}% interval':>15} {'MTF50':>7} {'FWHM':>6} {last:>6}")
-        click.echo(f"{'':<32} {'':>4} {'deg':>7} {'deg':>5} {'':>6} {'':>6} {'':>7} {'':>15} "
-                   f"{'cy/px':>7} {'px':>6} {'':>6}")
+        last = "RER" if self.kind == "edge" else "W"
+        first = f"{'path':<{self.path_width}}" + (f" {'band':>4}" if self.bands else "")
+        blank = " " * len(first)
+        click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
+                   f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last:>6}")
+        click.echo(f"{blank} {'deg':>7} {'deg':>5} {'':>7} {'':>5} {'':>7} {'':>17} "
+                   f"{'cy/px':>7} {'px':>6} {'' if self.kind == 'edge' else 'px':>6}")
 
     def write(self, record) -> None:
-        click.echo(_text_row(record.to_dict(), self.kind))
+        click.echo(_text_row(record.to_dict(), self.kind, self.path_width, self.bands))
 
 
-def _text_row(record: dict, kind: str) -> str:
+def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False) -> str:
     """One record as rows of the text table: figures in px units, a
     ground line in metres when the GSD is known, then its warnings."""
-    path = record["path"]
-    band = "" if record["band"] in (None, 1, "luminance") else str(record["band"])
+    first = f"{record['path']:<{path_width}}"
+    if bands:
+        band = record["band"]
+        first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
+    indent = " " * len(first)
     if record["status"] == "error":
-        return f"{path:<32} {band:>4} error: {record['error']}"
+        return f"{first} error: {record['error']}"
     last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
-    direction = {"across-track": "across", "along-track": "along"}.get(record.get("direction"),
-                                                                      record.get("direction") or "-")
-    cells = [f"{path:<32} {band:>4} {_num(record.get('normal_angle_deg'), 7, 2)} "
-             f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>6} "
-             f"{_num(record.get('snr'), 6, 0)} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>15} "
+    direction = record.get("direction") or "-"
+    direction = {"across-track": "across", "along-track": "along"}.get(direction, direction)
+    cells = [f"{first} {_num(record.get('normal_angle_deg'), 7, 2)} "
+             f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>7} "
+             f"{_snr(record.get('snr'))} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
              f"{_num(record.get('mtf50_cy_px'), 7, 4)} {_num(record.get('fwhm_px'), 6, 3)} {_num(last, 6, 3)}"]
     if record.get("gsd_m"):
-        cells.append(f"{'':<32} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
+        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{record['mtf50_cy_m']:.4g} cy/m, FWHM {record['fwhm_m']:.4g} m")
-    cells += [f"{'':<32} warning: {w}" for w in record.get("warnings") or []]
+    cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def _snr(value) -> str:
+    """The SNR in the table's 5 characters: to the unit up to 99999, then
+    in thousands (a noise-free chip's can reach millions)."""
+    if value is None:
+        return f"{'-':>5}"
+    return f"{value:5.0f}" if value < 99999.5 else f"{value / 1000:4.0f}k"
 
 
 def _num(value, width: int, decimals: int) -> str:
@@ -664,47 +722,57 @@ def _print_scan(scene, info, kind, records, written, fmt) -> None:
 
 
 # -- reproduce ----------------------------------------------------------------
-@main.command()
+@main.command(short_help="Rerun the paper's study and find each method's SNR threshold.")
 @click.option("--out", required=True, type=click.Path(file_okay=False), help="output folder")
-@click.option("--quick", is_flag=True, help="few realisations (under a minute)")
+@click.option("--quick", is_flag=True,
+              help="few chips (8 per SNR level): a check that the study runs, too few for its thresholds")
 @click.option("--workers", type=click.IntRange(1, 64), default=os.cpu_count() or 1,
               show_default="all cores", help="worker processes")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-def reproduce(out, quick, workers, seed):
-    """Rerun the paper's study (Tables 1-2, Figs. 2-3 and 12-14) and find the
-    lowest SNR at which each method is trustworthy; writes OUT/report.md."""
-    from .reproduce import run_study
+@click.option("--progress/--no-progress", default=None, help="progress bars on stderr (default: on a terminal)")
+def reproduce(out, quick, workers, seed, progress):
+    """Rerun the paper's study: its Tables 1-2 and Figures 2-3, 9-10 and
+    12-14; find the lowest SNR at which each method is trustworthy; write
+    OUT/report.md with the figures and CSV data."""
+    from .reproduce import THRESHOLD_SNRS, run_study
     with _reported_errors():
-        result = run_study(out, quick=quick, workers=workers, seed=seed)
+        result = run_study(out, quick=quick, workers=workers, seed=seed, progress=progress)
     for method, snr in result["thresholds"].items():
-        click.echo(f"{method:8s} trustworthy from SNR {snr:g}")
+        found = (f"trustworthy from SNR {snr:g}" if math.isfinite(snr)
+                 else f"not trustworthy up to SNR {max(THRESHOLD_SNRS)}")
+        click.echo(f"{method:8s} {found}")
+    if quick:
+        click.echo(f"(a quick run: {result['chips_per_level']} chips per SNR level are too few for a "
+                   "threshold; run without --quick for one)")
     click.echo(f"wrote {Path(out) / 'report.md'} ({result['seconds']:.0f} s)")
 
 
 # -- selftest -----------------------------------------------------------------
-@main.command()
-@click.option("--method", type=MethodName(), default="msg", show_default=True)
+@main.command(short_help="Render chips of known MTF, measure them, compare (exit 1 if off).")
+@click.option("--method", cls=MethodOption)
 def selftest(method):
     """Render generic-sensor chips with known MTF, measure them, and compare
     measured with true; exit 1 if any estimate is out of tolerance."""
     with _reported_errors():
-        from .selftest import run_selftest
+        from .selftest import CASES, run_selftest
         from .sensor.model import DIRECTIONS, Sensor
-        sensor = Sensor()
         from .version import __version__
+        sensor = Sensor()
         click.echo(f"imgmtf {__version__} self-test: generic sensor (Choi & Helder), GSD {sensor.gsd_m:g} m")
         for d in DIRECTIONS:
             click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
                        f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
         click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
                    "(! marks a figure out of tolerance):")
-        click.echo(f"{'case':<28} {'':>5} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM px':>8}")
+        width = max(len(case.name) for case in CASES)
+        click.echo(f"{'case':<{width}} {'':>4} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM':>8}")
+        click.echo(f"{'':<{width}} {'':>4} {'':>8} {'cy/px':>8} {'px':>8}")
         rows = run_selftest(sensor, method=method)
         for row in rows:
-            click.echo(f"{row.name:<28} {'true':>5} {row.true['mtf_nyquist']:8.4f} "
+            click.echo(f"{row.name:<{width}} {'true':>4} {row.true['mtf_nyquist']:8.4f} "
                        f"{row.true['mtf50']:8.4f} {row.true['fwhm']:8.4f}")
             marks = {k: ("" if v else "!") for k, v in row.passed.items()}
-            click.echo(f"{'':<28} {'got':>5} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
+            click.echo(f"{'':<{width}} {'got':>4} {row.measured['mtf_nyquist']:8.4f}{marks['mtf_nyquist']:1}"
                        f"{row.measured['mtf50']:8.4f}{marks['mtf50']:1}{row.measured['fwhm']:8.4f}{marks['fwhm']:1}"
                        f"  {'PASS' if row.ok else 'FAIL'}  (SNR {row.snr:.0f})")
         failed = [r.name for r in rows if not r.ok]

@@ -10,6 +10,54 @@ from .errors import ImageContentError, ParameterError
 
 MIN_SIZE_PX = 16
 MAX_ABS_DN = 1e15                 # no sensor records more; beyond, squares overflow
+# Rec. 709 luma weights (red, green, blue), applied to the stored values
+LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+
+
+def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
+    """The Rec. 709 luminance of a colour image, as ``imgmtf measure``
+    computes it for an RGB(A) file: 0.2126 R + 0.7152 G + 0.0722 B of the
+    stored values (gamma-encoded values stay encoded: no linearisation),
+    alpha ignored.
+
+    Parameters
+    ----------
+    rgb : array_like, shape (H, W, 3) or (H, W, 4)
+        Red, green, blue (and alpha) along ``channel_axis``, any real dtype
+        (DN).
+    channel_axis : int, optional
+        The axis holding the channels (default the last; 0 for rasterio's
+        band-first arrays).
+
+    Returns
+    -------
+    numpy.ndarray, shape (H, W), float64
+        The luminance in the input's DN.
+
+    Raises
+    ------
+    ImageContentError
+        The array is not 3-D with 3 or 4 channels, or its values are not
+        real numbers.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> rgba = np.zeros((20, 30, 4), np.uint8)
+    >>> rgba[..., 1] = 100                       # green only
+    >>> gray = imgmtf.luminance(rgba)
+    >>> gray.shape, float(gray[0, 0])
+    ((20, 30), 71.52)
+    """
+    array = np.asarray(rgb)
+    if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):
+        raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
+    if array.ndim != 3 or array.shape[channel_axis] not in (3, 4):
+        raise ImageContentError(f"expected a colour image of shape (H, W, 3) or (H, W, 4) with the channels "
+                                f"on axis {channel_axis}, got an array of shape {array.shape}")
+    colours = np.moveaxis(array, channel_axis, 0)[:3].astype(np.float64)
+    return np.tensordot(np.asarray(LUMA_WEIGHTS), colours, axes=1)
 
 
 def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = False,
@@ -57,6 +105,10 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         used, too small, flat, values no sensor records).
     """
     array = np.asarray(image)
+    if array.ndim == 3 and array.shape[-1] in (3, 4):
+        raise ImageContentError(f"expected a 2-D image, got an array of shape {array.shape}: for a colour "
+                                "image measure its luminance, imgmtf.luminance(image) (what the CLI does "
+                                "for RGB files), or one channel, image[..., 1]")
     if array.ndim != 2:
         raise ImageContentError(f"expected a 2-D image, got an array of shape {array.shape}")
     if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):

@@ -25,10 +25,7 @@ from rasterio.windows import Window
 
 from .atomic import atomic_output
 from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
-from .inputs import check_roi
-
-# Rec. 709 luma weights, applied to the stored (encoded) values of RGB input
-LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+from .inputs import check_roi, luminance
 
 try:     # GDAL's own errors, which rasterio raises as they are from some calls
     from rasterio._err import CPLE_BaseError
@@ -46,20 +43,38 @@ MAX_READ_PIXELS = 16 * 1024 * 1024
 
 @dataclass(frozen=True, eq=False)
 class Raster:
-    """One band (or the luminance) of an image file.
+    """One band (or the luminance) of an image file, as :func:`read_raster`
+    returns it.
 
     Attributes
     ----------
-    data : 2-D float64 array (DN), NaN where the file marks nodata.
-    path : the file it came from.
-    band : 1-based band number, or "luminance" for RGB(A) input.
-    gsd_m : pixel size in metres when the file is georeferenced, else None.
-    tags : the file's metadata tags.
-    dtype : the stored sample type (e.g. "uint16").
-    origin : (x, y) of ``data``'s top-left pixel in the file (a window's).
-    map_projected : True when the file has a coordinate reference system:
-        a map-projected (or geographic) product, whose rows are not along
+    data : numpy.ndarray of float64, shape (rows, cols)
+        The pixels, DN; NaN where the file marks nodata.
+    path : str
+        The file it came from.
+    band : int or str
+        1-based band number, or ``"luminance"`` for RGB(A) input.
+    gsd_m : float or None
+        Pixel size in metres when the file is georeferenced, else None.
+    tags : dict
+        The file's metadata tags.
+    dtype : str
+        The stored sample type (``"uint16"``...): integer types set the
+        saturation limits.
+    origin : (int, int)
+        (x, y) of ``data``'s top-left pixel in the file (a window's).
+    map_projected : bool
+        True when the file has a coordinate reference system: a
+        map-projected (or geographic) product, whose rows are not along
         the sensor's track.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> imgmtf.write_geotiff("edge.tif", imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100).image)
+    >>> raster = imgmtf.read_raster("edge.tif")
+    >>> raster.band, raster.gsd_m, raster.dtype, raster.data.shape
+    (1, 1.0, 'uint16', (100, 100))
     """
 
     data: np.ndarray
@@ -73,7 +88,8 @@ class Raster:
 
     @property
     def provenance(self) -> dict | None:
-        """The imgmtf provenance record of a chip imgmtf wrote, else None."""
+        """How imgmtf made the chip (:meth:`imgmtf.Chip.provenance`: sensor,
+        target, GSD, noise, seed) when imgmtf wrote it, else None."""
         text = self.tags.get("IMGMTF")
         try:
             return json.loads(text) if text else None
@@ -84,14 +100,50 @@ class Raster:
 def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                   provenance: dict | None = None, crs: str | None = None,
                   origin_m: tuple[float, float] = (0.0, 0.0)) -> None:
-    """Write a uint8/uint16 chip (rows x cols, or bands x rows x cols) as a
-    GeoTIFF whose geotransform carries ``gsd_m`` and whose tags carry
-    ``provenance``; ``crs`` (e.g. "EPSG:32633") and ``origin_m`` (map x, y
-    of the top-left corner) place it on the map."""
-    image = np.asarray(image)
-    if image.dtype not in (np.uint8, np.uint16):
-        raise ParameterError(f"{path}: GeoTIFF chips are 8 or 16 bit, got {image.dtype}")
-    bands = image[None] if image.ndim == 2 else image
+    """Write an 8/16-bit chip as a GeoTIFF that carries its GSD and how it
+    was made.
+
+    Without ``crs`` the chip is in a local metric frame: the geotransform
+    is (``gsd_m``, 0, 0, 0, -``gsd_m``, 0), which :func:`read_raster` reads
+    back as the GSD.  The file appears whole or not at all (written under a
+    temporary name, then renamed).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The GeoTIFF to write (replaced if it exists).
+    image : numpy.ndarray of uint8 or uint16, shape (rows, cols) or (bands, rows, cols)
+        The pixels, DN.
+    gsd_m : float, optional
+        Ground sample distance, m (default 1).
+    provenance : dict, optional
+        How the chip was made (:meth:`imgmtf.Chip.provenance`), stored as
+        JSON in the ``IMGMTF`` tag and read back by
+        :attr:`Raster.provenance`; its main items also as plain tags for
+        ``gdalinfo``.
+    crs : str, optional
+        A coordinate reference system (``"EPSG:32633"``) placing the chip on
+        a map.
+    origin_m : (float, float), optional
+        Map x, y of the top-left corner, m (with ``crs``).
+
+    Raises
+    ------
+    ParameterError
+        The image is not uint8 or uint16.
+    FileWriteError
+        The file cannot be written (no such folder, no permission, disk
+        full...).
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, gsd_m=0.5)
+    >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
+    >>> raster = imgmtf.read_raster("chip.tif")
+    >>> raster.gsd_m, raster.provenance["target"]["angle_deg"]
+    (0.5, 6.0)
+    """
     tags = {}
     if provenance:
         tags["IMGMTF"] = json.dumps(provenance, sort_keys=True)
@@ -101,16 +153,64 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                 tags[f"TARGET_{key.upper()}"] = str(target[key])
         for key in ("noise_std_dn", "seed", "imgmtf_version"):
             tags[key.upper()] = str(provenance.get(key))
-    profile = dict(driver="GTiff", width=bands.shape[2], height=bands.shape[1],
-                   count=bands.shape[0], dtype=bands.dtype.name,
-                   transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
+    _write_image(path, image, "GTiff", tags,
+                 transform=Affine(gsd_m, 0.0, origin_m[0], 0.0, -gsd_m, origin_m[1]), crs=crs)
+
+
+def write_png(path: str | Path, image: np.ndarray) -> None:
+    """Write an 8/16-bit image as a grey (or RGB) PNG, for viewers and
+    tools that read no TIFF.
+
+    A PNG keeps the pixels only: no GSD and no provenance (use
+    :func:`write_geotiff` for those), so :func:`read_raster` gives it
+    ``gsd_m`` None and figures in pixel units.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The PNG to write (replaced if it exists), atomically.
+    image : numpy.ndarray of uint8 or uint16, shape (rows, cols) or (bands, rows, cols)
+        The pixels, DN (1 band: grey; 3: RGB; 4: RGBA).
+
+    Raises
+    ------
+    ParameterError
+        The image is not uint8 or uint16.
+    FileWriteError
+        The file cannot be written.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, bits=8)
+    >>> imgmtf.write_png("chip.png", chip.image)
+    >>> raster = imgmtf.read_raster("chip.png")
+    >>> raster.dtype, raster.gsd_m
+    ('uint8', None)
+    """
+    _write_image(path, image, "PNG", {})
+
+
+def _write_image(path: str | Path, image: np.ndarray, driver: str, tags: dict, **georeference) -> None:
+    """Write uint8/uint16 pixels with a GDAL ``driver``, atomically."""
+    image = np.asarray(image)
+    kind = {"GTiff": "GeoTIFF chips", "PNG": "PNG images"}[driver]
+    if image.dtype not in (np.uint8, np.uint16):
+        raise ParameterError(f"{path}: {kind} are 8 or 16 bit, got {image.dtype}")
+    if image.ndim not in (2, 3):
+        raise ParameterError(f"{path}: expected (rows, cols) or (bands, rows, cols) pixels, "
+                             f"got shape {image.shape}")
+    bands = image[None] if image.ndim == 2 else image
+    profile = dict(driver=driver, width=bands.shape[2], height=bands.shape[1], count=bands.shape[0],
+                   dtype=bands.dtype.name, **georeference)
     with atomic_output(path) as partial:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", NotGeoreferencedWarning)
                 with rasterio.open(partial, "w", **profile) as dst:
                     dst.write(bands)
-                    dst.update_tags(**tags)
+                    if tags:
+                        dst.update_tags(**tags)
         except (*GDAL_ERRORS, OSError) as exc:
             raise FileWriteError(f"{path}: cannot write: {_reason(exc)}") from None
 
@@ -138,11 +238,19 @@ class RasterInfo:
     def is_rgb(self) -> bool:
         return self.count in (3, 4) and list(self.colours[:3]) == ["red", "green", "blue"]
 
+    @property
+    def alpha_bands(self) -> list[int]:
+        """1-based numbers of the bands that hold transparency, not DN."""
+        return [i + 1 for i, colour in enumerate(self.colours) if colour == "alpha"]
+
     def bands(self, band: int | str | None) -> list[int | None]:
-        """The band selections ``band`` stands for: ``"all"`` every band,
-        otherwise just ``band`` (None: the single band or RGB luminance)."""
+        """The band selections ``band`` stands for: ``"all"`` every band but
+        alpha, otherwise just ``band`` (None: the single band or RGB
+        luminance)."""
         if band == "all":
-            return list(range(1, self.count + 1))
+            return [i for i in range(1, self.count + 1) if i not in self.alpha_bands]
+        if isinstance(band, str):
+            raise ParameterError(f"band must be a 1-based number or 'all', got {band!r}")
         return [band]
 
     def check_window(self, window) -> tuple[int, int, int, int]:
@@ -160,7 +268,24 @@ def raster_info(path: str | Path) -> RasterInfo:
 
 def read_raster(path: str | Path, band: int | None = None, window=None,
                 out_shape: tuple[int, int] | None = None) -> Raster:
-    """Read one band of an image file as float64 DN.
+    """Read one band of an image file (anything GDAL reads: GeoTIFF, PNG,
+    JPEG, JP2, NITF...) as float64 DN.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The image file (a regular file).
+    band : int, optional
+        1-based band to read.
+    window : (int, int, int, int), optional
+        (x, y, width, height) in pixels: read only this part.
+    out_shape : (int, int), optional
+        (rows, cols) to read the window decimated to (nearest).
+
+    Returns
+    -------
+    Raster
+        The pixels with the file's GSD, tags, type and provenance.
 
     With ``band=None`` a single-band file gives its band and an RGB or RGBA
     file (8/16-bit, colour-interpreted as such) gives the Rec. 709 luminance
@@ -184,9 +309,12 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
 
     Example
     -------
-    >>> raster = read_raster("chip.tif", window=(100, 60, 64, 64))  # doctest: +SKIP
-    >>> raster.data.shape, raster.origin                              # doctest: +SKIP
-    ((64, 64), (100, 60))
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 200)
+    >>> imgmtf.write_geotiff("scene.tif", chip.image, gsd_m=2.0)
+    >>> raster = imgmtf.read_raster("scene.tif", window=(100, 60, 64, 64))
+    >>> raster.data.shape, raster.origin, raster.gsd_m
+    ((64, 64), (100, 60), 2.0)
     """
     path = str(path)
     with _opened(path) as src:
@@ -203,12 +331,12 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
             if not (isinstance(band, (int, np.integer)) and 1 <= band <= count):
                 raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
             chosen: int | str = int(band)
-            data = _band(src, chosen, region, out_shape)
+            data = _band(src, int(band), region, out_shape)
         elif count == 1:
             chosen, data = 1, _band(src, 1, region, out_shape)
         elif info.is_rgb:
             chosen = "luminance"
-            data = sum(w_ * _band(src, i + 1, region, out_shape) for i, w_ in enumerate(LUMA_WEIGHTS))
+            data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
         else:
             raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
                                  "choose one with --band N, or --band all")

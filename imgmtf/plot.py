@@ -3,10 +3,13 @@ returns the figure; nothing here touches pyplot's global state, so the
 figures render with the Agg canvas whatever the session's backend."""
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from .estimate.spectrum import NYQUIST
+from .metrics import fwhm
 
 
 def _axes(ax, size=(5.0, 3.6)):
@@ -101,7 +104,7 @@ def plot_fit_edge(fit, index: int, ax=None):
             label=f"measured: {edge.measured_mtf_nyquist:.4f}")
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
     name = edge.source if len(edge.source) <= 32 else "..." + edge.source[-29:]
-    ax.set(title=f"{name}: {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
+    ax.set(title=f"{name}: normal {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
            xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF")
     ax.legend(fontsize="small", title=f"at Nyquist ({100 * fit.confidence:g} % interval)",
               title_fontsize="small")
@@ -290,8 +293,9 @@ def plot_measurement(result, truth=None, title: str | None = None):
     summary = (f"MTF at Nyquist {result.mtf_nyquist:.4f}{interval}, MTF50 {result.mtf50_cy_px:.4f} cy/px, "
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
-    if result.warnings:
-        summary += f"\n{len(result.warnings)} warning(s): " + "; ".join(w[:90] for w in result.warnings[:2])
+    for i, warning in enumerate(result.warnings[:2]):
+        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(result.warnings)}: {warning}", 170,
+                                           placeholder=" [...]")
     fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
     return fig
 
@@ -343,29 +347,94 @@ def plot_noise_sweep(rows, methods, true_nyquist, title):
     return fig
 
 
-def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20)):
-    """Example ground-noise layers and the composite (paper Fig. 13)."""
-    fig = Figure(figsize=(3.2 * (len(grains) + 1), 3.4), layout="constrained")
-    axes = fig.subplots(1, len(grains) + 1)
+def plot_estimates(kind: str, curves: dict, methods, width_px: float = 0.0):
+    """Each method's estimate of a noise-free chip against the truth (paper
+    Figs. 9 and 10): the LSF of an edge (or the pulse response of a bar
+    ``width_px`` wide), the MTF, and the MTF's error, as published (top) and
+    with each method's own blur divided out (bottom, imgmtf's default).
+    ``curves`` as :func:`imgmtf.reproduce.estimator_tables` returns it."""
+    fig = Figure(figsize=(15, 8.2), layout="constrained")
+    axes = fig.subplots(2, 3)
+    x_true, profile_true, f_true, mtf_true = curves["truth"]
+    name = "LSF (1/px)" if kind == "edge" else "pulse response (peak 1)"
+    view = 4.0 if kind == "edge" else 4.0 + width_px / 2
+    for row, variant in zip(axes, ("as published", "corrected")):
+        profile_ax, mtf_ax, error_ax = row
+        profile_ax.plot(x_true, profile_true, color="k", lw=2.4, alpha=0.35,
+                        label=f"true: FWHM {fwhm(x_true, profile_true):.3f} px")
+        mtf_ax.plot(f_true, mtf_true, color="k", lw=2.4, alpha=0.35,
+                    label=f"true: {float(np.interp(NYQUIST, f_true, mtf_true)):.4f}")
+        for i, method in enumerate(methods):
+            r = curves[variant][method]
+            x, profile = (r.lsf_x_px, r.lsf) if kind == "edge" else (r.prf_x_px, r.prf)
+            colour = f"C{i}"
+            profile_ax.plot(x, profile, color=colour, lw=1.0, label=f"{method}: FWHM {fwhm(x, profile):.3f} px")
+            mtf_ax.plot(r.frequencies_cy_px, r.mtf, color=colour, lw=1.0, label=f"{method}: {r.mtf_nyquist:.4f}")
+            error_ax.plot(r.frequencies_cy_px, r.mtf - np.interp(r.frequencies_cy_px, f_true, mtf_true),
+                          color=colour, lw=1.0, label=method)
+        profile_ax.set(xlim=(-view, view), xlabel="distance along the normal (px)", ylabel=name,
+                       title=f"{'LSF' if kind == 'edge' else 'pulse response'}, {variant}")
+        masked = np.isnan(curves[variant][methods[0]].mtf)
+        if kind == "pulse" and masked.any():
+            f_masked = curves[variant][methods[0]].frequencies_cy_px[masked]
+            for ax in (mtf_ax, error_ax):
+                ax.axvspan(f_masked.min(), f_masked.max(), color="0.5", alpha=0.12, lw=0,
+                           label="masked: the bar's sinc zero" if ax is mtf_ax else None)
+        mtf_ax.set(xlim=(0, 1), ylim=(0, 1.05), xlabel="frequency along the normal (cy/px)", ylabel="MTF",
+                   title=f"MTF, {variant}")
+        error_ax.axhline(0, color="k", lw=0.8)
+        error_ax.set(xlim=(0, 1), xlabel="frequency along the normal (cy/px)", ylabel="estimate - true MTF",
+                     title=f"MTF error, {variant}")
+        for ax in (mtf_ax, error_ax):
+            ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8)
+        profile_ax.legend(fontsize="small")
+        mtf_ax.legend(fontsize="small", title="MTF at Nyquist", title_fontsize="small")
+        error_ax.legend(fontsize="small")
+    target = "edge" if kind == "edge" else f"{width_px:g} px bar"
+    fig.suptitle(f"Estimates of a noise-free {target} (40 x 40 px, 6 deg, the paper's sensor) by each method "
+                 f"against the truth (paper Fig. {9 if kind == 'edge' else 10})\ntop: as published, each "
+                 "method's own blur left in; bottom: corrected, each method's blur divided out (imgmtf's default)")
+    return fig
+
+
+def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20), oversampling: int = 20):
+    """Example ground-noise layers and the composite (paper Fig. 13), on a
+    ``size`` x ``size`` grid of sub-pixel cells (``oversampling`` cells per
+    pixel)."""
+    panels = len(grains) + 1
+    fig = Figure(figsize=(3.1 * panels, 3.9), layout="constrained")
+    axes = fig.subplots(1, panels)
     rng = np.random.default_rng(seed)
     for ax, grain in zip(axes, grains):
         ax.imshow(ground_noise.layer(grain, (size, size), rng), cmap="gray")
         ax.set(title=f"{grain} x {grain} sub-pixel grains", xticks=[], yticks=[])
     axes[-1].imshow(ground_noise.sample((size, size), rng), cmap="gray")
-    axes[-1].set(title=f"composite of {ground_noise.layers} layers", xticks=[], yticks=[])
+    axes[-1].set(title=f"sum of {ground_noise.layers} layers", xticks=[], yticks=[])
+    fig.suptitle(f"Ground noise before the PSF: each layer {ground_noise.layer_variance_dn2:g} DN^2; "
+                 f"{size} x {size} sub-pixel cells = {size / oversampling:g} x {size / oversampling:g} px")
     return fig
 
 
-def plot_threshold(found, relative, fraction):
+def plot_threshold(found, relative, fraction, chips_per_level: int):
     """Fraction of estimates within +-``relative`` of the truth against SNR,
-    per method, with the ``fraction`` criterion."""
-    fig, ax = _axes(None, (6, 4))
-    for method, info in found.items():
-        snrs = sorted(info["fractions"])
-        ax.semilogx(snrs, [info["fractions"][s] for s in snrs], "o-", ms=3,
-                    label=f"{method}: threshold {info['threshold']:g}")
-    ax.axhline(fraction, color="0.5", ls="--", lw=0.8)
-    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist",
-           xlabel="SNR (step / noise std)", ylabel="fraction", ylim=(0, 1.02))
-    ax.legend(fontsize="small")
+    per method, with its 95 % binomial (Wilson) interval for
+    ``chips_per_level`` chips at each SNR, and the ``fraction`` criterion."""
+    fig, ax = _axes(None, (7, 4.4))
+    z = 1.96
+    for i, (method, info) in enumerate(found.items()):
+        snrs = np.array(sorted(info["fractions"]), float)
+        p = np.array([info["fractions"][s] for s in sorted(info["fractions"])])
+        n = chips_per_level
+        centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+        half = z / (1 + z * z / n) * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+        threshold = info["threshold"]
+        reached = f"threshold SNR {threshold:g}" if np.isfinite(threshold) else "never within the criterion"
+        ax.fill_between(snrs, centre - half, centre + half, color=f"C{i}", alpha=0.12, lw=0)
+        ax.semilogx(snrs, p, "o-", ms=3, color=f"C{i}", label=f"{method}: {reached}")
+    ax.axhline(fraction, color="0.5", ls="--", lw=0.8, label=f"criterion: {100 * fraction:g} %")
+    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist "
+                 f"({chips_per_level} chips per SNR; bands: 95 % intervals)",
+           xlabel="SNR (step / noise std)", ylabel="fraction of estimates", ylim=(0, 1.02))
+    ax.title.set_fontsize("medium")
+    ax.legend(fontsize="small", loc="lower right")
     return fig

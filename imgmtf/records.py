@@ -27,8 +27,10 @@ import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import IO, Any
+
+import numpy as np
 
 from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
@@ -45,31 +47,62 @@ _OWN_KEYS = frozenset({"path", "band", "target", "method", "status", "reason", "
 
 def utc_now() -> str:
     """The current time in UTC, ISO 8601 to the second (``2024-05-01T09:30:00Z``)."""
-    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    return datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 @dataclass(frozen=True)
 class Record:
     """The outcome of measuring one target: a file (or one of its bands), or
-    a scan candidate.
+    a scan candidate; one JSON Lines line or CSV row of ``measure``.
 
     Attributes
     ----------
-    path : the input file.
-    band : 1-based band, ``"luminance"`` for RGB, None when not known.
-    target : ``"edge"`` or ``"pulse"``.
-    method : the resampling method.
-    status : ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
-    reason : machine-readable code of a failure (None when ok).
-    error : one-line message naming the file (None when ok).
-    figures : the estimate's JSON summary (units in the names:
-        ``mtf50_cy_px``, ``fwhm_px``...), empty for a failure.
-    site : where a scan candidate lies (``id``, ``rank``, ``x0_px``...);
-        empty for ``measure``.
-    plot : the figure written for this record, if any.
-    params : settings of the estimate and of the run.
-    run_utc : start of the run, UTC, ISO 8601.
-    imgmtf_version : the version that made the record.
+    path : str
+        The input file.
+    band : int, str or None
+        1-based band, ``"luminance"`` for RGB, None when not known.
+    target : str
+        ``"edge"`` or ``"pulse"``.
+    method : str
+        The resampling method.
+    status : str
+        ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
+    reason : str or None
+        Machine-readable code of a failure (``unreadable``, ``two-targets``,
+        ``saturated``...; None when ok).
+    error : str or None
+        One-line message naming the file (None when ok).
+    figures : mapping
+        The estimate's JSON summary (units in the names: ``mtf50_cy_px``,
+        ``fwhm_px``...), empty for a failure.
+    site : mapping
+        Where a scan candidate lies (``id``, ``rank``, ``x0_px``...); empty
+        for ``measure``.
+    plot : str or None
+        The figure written for this record, if any.
+    params : mapping
+        Settings of the estimate and of the run.
+    run_utc : str
+        Start of the run, UTC, ISO 8601.
+    imgmtf_version : str
+        The version that made the record.
+
+    Raises
+    ------
+    TypeError
+        A missing field (the constructors :meth:`measured` and
+        :meth:`failed` fill them).
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> from imgmtf.errors import ImageReadError
+    >>> record = imgmtf.Record.failed("a.tif", None, "edge", "msg", ImageReadError("a.tif: no such file"),
+    ...                               params={}, run_utc="2024-05-01T09:30:00Z")
+    >>> record
+    Record('a.tif', error, unreadable: a.tif: no such file)
+    >>> record.csv_row()["reason"], record.ok
+    ('unreadable', False)
     """
 
     path: str
@@ -88,7 +121,7 @@ class Record:
 
     @classmethod
     def measured(cls, path: str, band, summary: Mapping[str, Any], *, params: Mapping[str, Any],
-                 run_utc: str, status: str = "ok", **fields) -> "Record":
+                 run_utc: str, status: str = "ok", **fields) -> Record:
         """A record of an estimate whose JSON summary is ``summary``; the
         run's ``params`` are merged with the estimator's own."""
         figures = {k: v for k, v in summary.items() if k not in _OWN_KEYS}
@@ -98,7 +131,7 @@ class Record:
 
     @classmethod
     def failed(cls, path: str, band, target: str, method: str, exc: BaseException, *,
-               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> "Record":
+               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> Record:
         """A record of a target that could not be measured: the reason code
         of an imgmtf error, ``internal`` for any other exception; the
         message names the file (prefixed when it does not)."""
@@ -114,15 +147,26 @@ class Record:
         return cls(str(path), band, target, method, status, reason, message, params=params,
                    run_utc=run_utc, **fields)
 
+    def __repr__(self) -> str:
+        band = "" if self.band in (None, 1, "luminance") else f", band {self.band}"
+        if self.ok:
+            figures = self.figures
+            outcome = (f"MTF@Nyquist {figures.get('mtf_nyquist')}, MTF50 {figures.get('mtf50_cy_px')} cy/px"
+                       if figures else "no figures")
+        else:
+            outcome = f"{self.reason}: {self.error}"
+        return f"Record({self.path!r}{band}, {self.status}, {outcome})"
+
     @property
     def ok(self) -> bool:
+        """True for a measured (``ok``) or accepted record."""
         return self.status in OK_STATUSES
 
     def get(self, key: str, default=None):
         """A value of the flat JSON form (a field, a figure or a site key)."""
         return self.to_dict().get(key, default)
 
-    def with_(self, **changes) -> "Record":
+    def with_(self, **changes) -> Record:
         """A copy with fields changed (``figures``/``site`` given as
         mappings are merged into the current ones)."""
         for name in ("figures", "site"):
@@ -142,8 +186,11 @@ class Record:
         intervals split into their bounds, lists and mappings as JSON,
         missing values empty."""
         flat = self.to_dict()
+        columns = columns or CSV_COLUMNS
+        if any(c in _CURVE_COLUMN_FREQUENCY for c in columns):
+            flat.update(curve_values(flat.get("frequencies_cy_px"), flat.get("mtf")))
         row = {}
-        for column in columns or CSV_COLUMNS:
+        for column in columns:
             source = _CSV_SOURCES.get(column, column)
             if isinstance(source, tuple):
                 pair = flat.get(source[0]) or (None, None)
@@ -158,9 +205,10 @@ class Record:
         return row
 
 
-# The CSV schema of measure and batch rows: provenance, outcome, figures
-# (units in the names; MTF values are dimensionless, 1 at zero frequency).
-CSV_COLUMNS = (
+# The summary columns of measure and batch rows: provenance, outcome,
+# figures (units in the names; MTF values are dimensionless, 1 at zero
+# frequency).
+SUMMARY_COLUMNS = (
     "path", "band", "target", "method", "status", "reason", "error",
     "direction", "normal_angle_deg", "tilt_deg", "polarity", "rows_used", "snr",
     "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high",
@@ -168,6 +216,13 @@ CSV_COLUMNS = (
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px",
     "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
+# The MTF curve, one column per frequency along the normal: 0 to 1 cy/px
+# in steps of 0.05 (0.25 and 0.5 cy/px among them), so that a spreadsheet
+# can plot and compare the rows; JSON Lines carry the whole curve (0.01 cy/px).
+CURVE_FREQUENCIES_CY_PX = tuple(round(0.05 * i, 2) for i in range(21))
+CURVE_COLUMNS = tuple(f"mtf_at_{f:.2f}_cy_px" for f in CURVE_FREQUENCIES_CY_PX)
+# The CSV schema of measure and batch rows
+CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # what a scan adds: the candidate's rank and where it lies in the scene
 # (pixel coordinates, x right, y down; map coordinates in the scene's CRS
 # units), and its screening figures
@@ -176,8 +231,8 @@ SCAN_COLUMNS = (
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation",
 )
 
-# a scan's CSV: id and rank first, then the common columns, then the site's
-SCAN_CSV_COLUMNS = SCAN_COLUMNS[:2] + CSV_COLUMNS + SCAN_COLUMNS[2:]
+# a scan's CSV: id and rank first, then the summary, the site's columns, the curve
+SCAN_CSV_COLUMNS = SCAN_COLUMNS[:2] + SUMMARY_COLUMNS + SCAN_COLUMNS[2:] + CURVE_COLUMNS
 
 # CSV columns that are not a key of the flat record: (key, index) of a pair, or the key
 _CSV_SOURCES = {
@@ -185,6 +240,20 @@ _CSV_SOURCES = {
     "mtf50_ci_low_cy_px": ("mtf50_ci_cy_px", 0), "mtf50_ci_high_cy_px": ("mtf50_ci_cy_px", 1),
     "roi_px": "roi",
 }
+_CURVE_COLUMN_FREQUENCY = dict(zip(CURVE_COLUMNS, CURVE_FREQUENCIES_CY_PX))
+
+
+def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
+    """The MTF curve at :data:`CURVE_FREQUENCIES_CY_PX`, keyed by CSV
+    column (linear between the curve's samples; None outside the curve or
+    where it is undefined, e.g. at a bar's sinc zeros)."""
+    if not frequencies_cy_px or not mtf:
+        return dict.fromkeys(CURVE_COLUMNS)
+    f = np.asarray(frequencies_cy_px, float)
+    m = np.array([np.nan if v is None else v for v in mtf], float)
+    wanted = np.asarray(CURVE_FREQUENCIES_CY_PX)
+    values = np.where((wanted >= f[0] - 1e-9) & (wanted <= f[-1] + 1e-9), np.interp(wanted, f, m), np.nan)
+    return {c: round(float(v), 6) if math.isfinite(v) else None for c, v in zip(CURVE_COLUMNS, values)}
 
 
 def _json_default(value):
@@ -227,7 +296,7 @@ class CsvWriter:
         self.path, self.columns, self.rows = str(path), tuple(columns), 0
         self._output = atomic_output(self.path, keep_partial=True)
 
-    def __enter__(self) -> "CsvWriter":
+    def __enter__(self) -> CsvWriter:
         partial = self._output.__enter__()
         try:
             self._file = open(partial, "w", newline="", encoding="utf-8")

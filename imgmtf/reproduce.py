@@ -21,17 +21,18 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .version import __version__
-from .estimate.edge import EdgeEstimator
 from .errors import FileWriteError, ImgmtfError
-from .metrics import fwhm
-from .sensor.noise import GroundNoise
-from .estimate.pulse import PulseEstimator
-from .sensor.rendering import Renderer
-from .estimate.resampling import METHODS
-from .sensor.model import Sensor
-from .sensor.targets import Target
+from .estimate.edge import EdgeEstimator
 from .estimate.intervals import NO_INTERVALS
+from .estimate.pulse import PulseEstimator
+from .estimate.resampling import METHODS
+from .estimate.results import MTFResult
+from .metrics import fwhm
+from .sensor.model import Sensor
+from .sensor.noise import GroundNoise
+from .sensor.rendering import Renderer
+from .sensor.targets import Target
+from .version import __version__
 
 CHIP_PX = 40
 ANGLE_DEG = 6.0
@@ -91,46 +92,55 @@ def _edge_task(task) -> dict:
             "results": _measure_all(chip.image, methods)}
 
 
-def run_tasks(tasks, workers: int, label: str) -> list[dict]:
+def run_tasks(tasks, workers: int, label: str, progress: bool | None = None) -> list[dict]:
     """Run tasks in ``workers`` processes (1: in this one), in order, with a
-    progress bar."""
+    progress bar on stderr (``progress`` None: only on a terminal)."""
+    bar = dict(desc=label, leave=False, disable=None if progress is None else not progress)
     if workers <= 1:
-        return [_edge_task(t) for t in tqdm(tasks, desc=label, leave=False)]
+        return [_edge_task(t) for t in tqdm(tasks, **bar)]
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(tqdm(pool.map(_edge_task, tasks, chunksize=4), total=len(tasks), desc=label,
-                         leave=False))
+        return list(tqdm(pool.map(_edge_task, tasks, chunksize=4), total=len(tasks), **bar))
 
 
-def estimator_tables(methods) -> list[dict]:
+def estimator_tables(methods) -> tuple[list[dict], dict]:
     """Model vs every method, corrected and as published, on noise-free edge
-    and pulse chips (the paper's Tables 1 and 2)."""
+    and pulse chips (the paper's Tables 1 and 2).  Returns the table rows
+    and, for Figs. 9-10, the estimates themselves with the truth:
+    ``curves[kind]`` = {"truth": (x_px, profile, f_cy_px, mtf), "as
+    published"/"corrected": {method: result}}."""
     sensor = Sensor()
     renderer = Renderer(sensor, CHIP_PX)
-    rows = []
+    rows: list[dict] = []
+    curves: dict = {}
     for kind in ("edge", "pulse"):
         width = PULSE_WIDTH_PX if kind == "pulse" else 0.0
         chip = renderer(Target(kind, ANGLE_DEG, 200.0, 1200.0, 0.0, width))
         true_nyq = float(chip.true_mtf(0.5))
-        true_fwhm = chip.true_fwhm_px() if kind == "edge" else _prf_fwhm(sensor, width)
-        rows.append({"target": kind, "method": "model", "corrected": "", "fwhm_m": true_fwhm,
+        x, profile = _true_profile(sensor, width)
+        true_fwhm = fwhm(x, profile)
+        f = np.linspace(0.0, 1.0, 201)
+        curves[kind] = {"truth": (x, profile, f, chip.true_mtf(f)), "as published": {}, "corrected": {}}
+        rows.append({"target": kind, "method": "model", "corrected": "", "fwhm_m": true_fwhm * chip.gsd_m,
                      "mtf_nyquist": true_nyq, "fwhm_diff_pct": 0.0, "mtf_diff_pct": 0.0,
                      "paper_fwhm_diff_pct": "", "paper_mtf_diff_pct": ""})
         for correct in (False, True):
             for method in methods:
+                r: MTFResult
                 if kind == "edge":
                     r = EdgeEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(chip.image)
                     fw = r.fwhm_px
                 else:
-                    r = PulseEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(
+                    pulse = PulseEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(
                         chip.image, width_px=width)
-                    fw = r.prf_fwhm_px
+                    r, fw = pulse, pulse.prf_fwhm_px
+                curves[kind]["corrected" if correct else "as published"][method] = r
                 paper = PAPER_TABLE[kind].get(method, ("", "")) if not correct else ("", "")
                 rows.append({"target": kind, "method": method, "corrected": "yes" if correct else "no",
                              "fwhm_m": fw * chip.gsd_m, "mtf_nyquist": r.mtf_nyquist,
                              "fwhm_diff_pct": 100 * (fw / true_fwhm - 1),
                              "mtf_diff_pct": 100 * (r.mtf_nyquist / true_nyq - 1),
                              "paper_fwhm_diff_pct": paper[0], "paper_mtf_diff_pct": paper[1]})
-    return rows
+    return rows, curves
 
 
 def thresholds(rows: list[dict], true_nyq: float, methods) -> dict:
@@ -149,18 +159,23 @@ def thresholds(rows: list[dict], true_nyq: float, methods) -> dict:
     return out
 
 
-def _prf_fwhm(sensor: Sensor, width_px: float) -> float:
-    """FWHM (px) of the exact pulse response of a bar ``width_px`` wide."""
+def _true_profile(sensor: Sensor, width_px: float) -> tuple[np.ndarray, np.ndarray]:
+    """(x_px, profile) along the normal: the exact LSF (1/px, area 1) of an
+    edge (``width_px`` 0), or the exact pulse response of a bar
+    ``width_px`` wide, peak 1."""
     x, lsf = sensor.normal_lsf(ANGLE_DEG)
+    if not width_px:
+        return x, lsf
     esf = np.cumsum(lsf) * (x[1] - x[0])
     prf = np.interp(x + width_px / 2, x, esf) - np.interp(x - width_px / 2, x, esf)
-    return fwhm(x, prf)
+    return x, prf / prf.max()
 
 
 def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: int = 0,
-              methods=tuple(METHODS)) -> dict:
-    """Run the whole study and write ``out``/report.md with figures and CSV.
-    Returns the thresholds and timings."""
+              methods=tuple(METHODS), progress: bool | None = None) -> dict:
+    """Run the whole study and write ``out``/report.md with figures and CSV
+    (progress bars on stderr: ``progress`` None shows them on a terminal).
+    Returns the thresholds, the chips per SNR level and the time taken (s)."""
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -170,27 +185,26 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
     sensor = Sensor()
     true_nyq = float(sensor.normal_transfer(0.5, ANGLE_DEG))
     started = time.perf_counter()
-    tables = estimator_tables(methods)
+    tables, curves = estimator_tables(methods)
     _write_csv(out / "tables_1_2.csv", tables)
 
     # Fig. 12: one chip per noise std, 1200 -> 200 DN (falling edge)
     system = run_tasks([("system", i, float(std), 1200.0, False, _seed(seed, 1, i), methods)
-                        for i, std in enumerate(size.system_stds)], workers, "system noise")
+                        for i, std in enumerate(size.system_stds)], workers, "system noise", progress)
     # ground noise: 11 transition heights x N realisations
     ground_sd = _ground_noise_output_std(seed)
     heights = [round(snr * ground_sd) for snr in GROUND_SNRS]
     ground = run_tasks([("ground", i * 1000 + k, 0.0, 200.0 + h, True, _seed(seed, 2, i, k), methods)
                         for i, h in enumerate(heights) for k in range(size.ground_realisations)],
-                       workers, "ground noise")
+                       workers, "ground noise", progress)
     # threshold: N chips per nominal SNR, 1000 DN step
     threshold_rows = run_tasks([("threshold", i * 1000 + k, 1000.0 / snr, 1200.0, False,
                                  _seed(seed, 3, i, k), methods)
                                 for i, snr in enumerate(THRESHOLD_SNRS)
-                                for k in range(size.threshold_realisations)], workers, "threshold")
+                                for k in range(size.threshold_realisations)], workers, "threshold", progress)
     for row in threshold_rows:
         row["snr_nominal"] = THRESHOLD_SNRS[row["index"] // 1000]
     found = thresholds(threshold_rows, true_nyq, methods)
-    elapsed = time.perf_counter() - started
 
     _write_sweep_csv(out / "system_noise.csv", system, methods)
     _write_sweep_csv(out / "ground_noise.csv", ground, methods)
@@ -199,16 +213,21 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
     from . import plot
     figures = {
         "fig02_03_sensor.png": plot.plot_sensor(sensor),
+        "fig09_edge_estimates.png": plot.plot_estimates("edge", curves["edge"], methods),
+        "fig10_pulse_estimates.png": plot.plot_estimates("pulse", curves["pulse"], methods, PULSE_WIDTH_PX),
         "fig12_system_noise.png": plot.plot_noise_sweep(system, methods, true_nyq, "System noise"),
         "fig13_ground_noise_layers.png": plot.plot_ground_noise_layers(GroundNoise(), seed),
         "fig14_ground_noise.png": plot.plot_noise_sweep(ground, methods, true_nyq, "Ground noise"),
-        "threshold.png": plot.plot_threshold(found, CRITERION_RELATIVE, CRITERION_FRACTION),
+        "threshold.png": plot.plot_threshold(found, CRITERION_RELATIVE, CRITERION_FRACTION,
+                                             size.threshold_realisations),
     }
     for name, fig in figures.items():
         fig.savefig(out / name, dpi=100)
+    elapsed = time.perf_counter() - started
     (out / "report.md").write_text(_report(tables, found, heights, ground_sd, size, quick, seed,
                                            workers, elapsed, methods, sensor))
-    return {"thresholds": {m: found[m]["threshold"] for m in methods}, "seconds": elapsed}
+    return {"thresholds": {m: found[m]["threshold"] for m in methods}, "seconds": elapsed,
+            "chips_per_level": size.threshold_realisations}
 
 
 def _ground_noise_output_std(seed: int) -> float:
@@ -261,7 +280,13 @@ def _report(tables, found, heights, ground_sd, size, quick, seed, workers, elaps
                      f"{cell(r['fwhm_diff_pct'], '{:+.2f}')} | {cell(r['paper_fwhm_diff_pct'])} | "
                      f"{r['mtf_nyquist']:.4f} | {cell(r['mtf_diff_pct'], '{:+.2f}')} | "
                      f"{cell(r['paper_mtf_diff_pct'])} |")
-    lines += ["", "## Figure 12: system noise", "",
+    lines += ["", "## Figures 9-10: each method's estimates against the truth", "",
+              "The LSF (edge) or pulse response (bar) and the MTF of each method on the same noise-free "
+              "chips, as published (top rows) and corrected (bottom rows), with the MTF's error. "
+              "The paper's figures show the as-published estimates.", "",
+              "![edge estimates](fig09_edge_estimates.png)", "",
+              "![pulse estimates](fig10_pulse_estimates.png)", "",
+              "## Figure 12: system noise", "",
               f"Edge 1200 -> 200 DN, white noise std {size.system_stds[0]} to {size.system_stds[-1]} DN "
               f"({len(size.system_stds)} chips), every method.", "",
               "![system noise](fig12_system_noise.png)", "",
@@ -282,9 +307,22 @@ def _report(tables, found, heights, ground_sd, size, quick, seed, workers, elaps
               "|---|---|" + "---|" * len(THRESHOLD_SNRS)]
     for m in methods:
         fr = found[m]["fractions"]
-        lines.append(f"| {m} | {cell(found[m]['threshold'], '{:g}')} | "
+        threshold = found[m]["threshold"]
+        reached = f"{threshold:g}" if math.isfinite(threshold) else f"not reached by {max(THRESHOLD_SNRS)}"
+        lines.append(f"| {m} | {reached} | "
                      + " | ".join(f"{100 * fr[s]:.0f} %" for s in THRESHOLD_SNRS) + " |")
+    n = size.threshold_realisations
+    spread = math.sqrt(0.25 / n)
     lines += ["", "![threshold](threshold.png)", "",
+              f"Each fraction comes from {n} chips, so it is a binomial estimate whose standard error "
+              f"is up to sqrt(0.25 / {n}) = {spread:.2f}; that is why the curves are jagged, and the shaded "
+              "bands are their 95 % intervals. "
+              + (f"This quick run's {n} chips per level are too few to find a threshold: a level meets "
+                 f"the criterion only when {math.ceil(CRITERION_FRACTION * n)} of its {n} chips pass, so "
+                 "one unlucky chip moves the threshold. Read it from the full run (100 chips per "
+                 "level), which takes one to two minutes on 2 cores."
+                 if quick else "A level whose fraction dips below the criterion after an earlier one "
+                 "met it is within that noise; more chips per level would smooth the curves."), "",
               "The paper's threshold for its MSG was SNR 100. The noise of an MTF estimate falls "
               "as 1 / (SNR sqrt(rows)), so a threshold found on 40-row chips scales as "
               "sqrt(40 / rows) for longer edges.", ""]

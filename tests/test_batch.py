@@ -7,13 +7,15 @@ import os
 import numpy as np
 import pytest
 import rasterio
-from rasterio.errors import NotGeoreferencedWarning
 from click.testing import CliRunner
-from conftest import exact_edge_chip, gaussian_pixel_transfer
+from rasterio.errors import NotGeoreferencedWarning
 
 import imgmtf as im
 from imgmtf.batch import MeasureSettings, expand_inputs, measure_file
 from imgmtf.cli import main
+from imgmtf.io import read_raster, write_geotiff
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 TRANSFER = gaussian_pixel_transfer(0.5, 6.0)
 pytestmark = pytest.mark.filterwarnings(f"ignore::{NotGeoreferencedWarning.__module__}.NotGeoreferencedWarning")
@@ -213,3 +215,16 @@ def test_an_empty_path_is_an_error_row_not_the_current_folder(tmp_path, good, mo
     rows = [json.loads(line) for line in
             CliRunner().invoke(main, ["measure", "--format", "json", "", str(good)]).stdout.splitlines()]
     assert [r["status"] for r in rows] == ["error", "ok"] and "empty path" in rows[0]["error"]
+
+
+def test_a_simulated_chip_knows_its_true_mtf_and_its_figure_shows_it(tmp_path):
+    from imgmtf.batch import true_mtf
+    chip = im.render(im.Sensor(), im.Target("edge", 8.0), 40, gsd_m=0.5)
+    write_geotiff(tmp_path / "c.tif", chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
+    truth = true_mtf(read_raster(tmp_path / "c.tif"))
+    f = np.linspace(0, 1, 11)
+    assert np.allclose(truth(f), chip.true_mtf(f))
+    im.write_png(tmp_path / "c.png", chip.image)
+    assert true_mtf(read_raster(tmp_path / "c.png")) is None
+    record, = measure_file(str(tmp_path / "c.tif"), MeasureSettings(), str(tmp_path / "c_mtf.png"))
+    assert record.plot and (tmp_path / "c_mtf.png").stat().st_size > 10_000

@@ -104,7 +104,7 @@ def test_selftest_passes(run):
 def test_simulated_chip_describes_itself(run, tmp_path):
     from imgmtf.io import read_raster
     path = tmp_path / "p.tif"
-    r = run("simulate", "--target", "pulse", "--pulse-width", "2.5", "--gsd", "0.5", "--bits", "8",
+    r = run("simulate", "--target", "pulse", "--pulse-width", "2.5m", "--gsd", "0.5", "--bits", "8",
             "--low", "20", "--high", "200", "--ground-noise", "--seed", "3", "--out", path)
     assert r.exit_code == 0, r.output
     raster = read_raster(path)
@@ -117,8 +117,8 @@ def test_simulated_chip_describes_itself(run, tmp_path):
 
 def test_pulse_measure_json_fields_and_width_units(run, tmp_path):
     path = tmp_path / "bar.tif"
-    assert run("simulate", "--target", "pulse", "--pulse-width", "1.5", "--gsd", "0.5", "--size", 80,
-               "--out", path).exit_code == 0              # 1.5 m = 3 px at 0.5 m GSD
+    assert run("simulate", "--target", "pulse", "--pulse-width", "3", "--gsd", "0.5", "--size", 80,
+               "--out", path).exit_code == 0              # a bare width is in px, as in measure
     for width in ("3px", "3", "1.5m"):
         r = run("measure", "--target", "pulse", "--pulse-width", width, "--format", "json", path)
         assert r.exit_code == 0, r.output
@@ -129,7 +129,9 @@ def test_pulse_measure_json_fields_and_width_units(run, tmp_path):
     r = run("measure", "--target", "pulse", "--format", "json", path)
     assert json.loads(r.stdout)["width_estimated"] is True
     r = run("measure", "--target", "pulse", "--plot", tmp_path / "bar.png", path)
-    assert r.exit_code == 0 and "W px" in r.stdout and (tmp_path / "bar.png").exists()
+    header, units = r.stdout.splitlines()[:2]
+    assert r.exit_code == 0 and header.split()[-1] == "W" and units.split()[-1] == "px"
+    assert (tmp_path / "bar.png").exists()
 
 
 def test_pulse_width_errors(run, chip, tmp_path):
@@ -140,8 +142,9 @@ def test_pulse_width_errors(run, chip, tmp_path):
     assert run("measure", "--target", "pulse", "--pulse-width", "wide", chip).exit_code == 2
     assert run("measure", "--pulse-width", "2", chip).exit_code == 2          # edge target
     png = tmp_path / "plain.png"
-    import rasterio
     import warnings
+
+    import rasterio
     from rasterio.errors import NotGeoreferencedWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -214,3 +217,52 @@ def test_help_imports_no_numerical_library():
             "'dask', 'tqdm') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_simulate_writes_png_or_refuses_other_formats(run, tmp_path):
+    from imgmtf.io import read_raster
+    for bits in ("8", "16"):
+        path = tmp_path / f"edge{bits}.png"
+        r = run("simulate", "--bits", bits, "--low", "20", "--high", "220", "--out", path)
+        assert r.exit_code == 0 and "a PNG keeps the pixels only" in r.stdout
+        assert path.read_bytes()[:4] == b"\x89PNG"
+        raster = read_raster(path)
+        assert raster.dtype == f"uint{bits}" and raster.gsd_m is None and raster.provenance is None
+    r = run("simulate", "--out", tmp_path / "edge.jpg")
+    assert r.exit_code == 1 and "GeoTIFF (.tif, .tiff)" in r.stderr and not (tmp_path / "edge.jpg").exists()
+
+
+def test_band_all_on_an_rgba_photo_measures_the_colours_and_skips_alpha(run, tmp_path):
+    import imgmtf as im
+    grey = im.render(im.Sensor(), im.Target("edge", 6.0, 30.0, 200.0), 48, bits=8, noise_std_dn=1.0, seed=2).image
+    rgba = np.stack([grey, grey, grey, np.full_like(grey, 255)])
+    im.write_png(tmp_path / "photo.png", rgba)
+    r = run("measure", "--band", "all", "--format", "json", tmp_path / "photo.png")
+    rows = [json.loads(line) for line in r.stdout.splitlines()]
+    assert r.exit_code == 0 and [row["band"] for row in rows] == [1, 2, 3]
+    assert any("band 4 is alpha" in w for w in rows[0]["warnings"])
+    text = run("measure", "--band", "all", tmp_path / "photo.png").stdout
+    assert "band" in text.splitlines()[0] and "band 4 is alpha" in text
+
+
+def test_text_table_names_units_and_fits_long_paths(run, chip, tmp_path):
+    long_name = tmp_path / ("a_rather_long_file_name_for_a_chip_" + "x" * 10 + ".tif")
+    long_name.write_bytes(chip.read_bytes())
+    lines = run("measure", chip, long_name).stdout.splitlines()
+    header, units, first = lines[0], lines[1], lines[2]
+    assert "cy/px" in units and "deg" in units and "px" in units
+    assert header.index("normal") == first.index("6.00") + len("6.00") - len("normal")   # columns line up
+    assert "band" not in header                                   # no band asked for: no band column
+    from imgmtf.cli import _snr
+    assert [_snr(v) for v in (199.4, 99999.0, 136212.0, None)] == ["  199", "99999", " 136k", "    -"]
+
+
+def test_help_explains_methods_and_lists_every_command_in_full(run):
+    from imgmtf.estimate.resampling import METHODS
+    text = "".join(run("measure", "--help").stdout.split())          # wrapped anywhere, even at hyphens
+    for method in METHODS.values():
+        assert "".join(f"{method.name}: {method.description}".split()) in text
+    assert "None" not in run("simulate", "--help").stdout          # an unbounded number says "finite"
+    listing = run("--help").stdout
+    assert "Rerun the paper's study and find each method's SNR threshold." in listing
+    assert "Figs.\n" not in listing

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.estimate.detection import find_edge, parallel_within
 from imgmtf.errors import ImageContentError, TargetNotFoundError
+from imgmtf.estimate.detection import find_edge, parallel_within
 
 
 @pytest.mark.parametrize("angle", [2.0, 6.0, -17.0, 38.0, 84.0, -70.0])

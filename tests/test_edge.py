@@ -4,9 +4,14 @@ import numpy as np
 import pytest
 
 import imgmtf as im
+from imgmtf.errors import (
+    ImageContentError,
+    MultipleTargetsError,
+    ParameterError,
+    TargetNotFoundError,
+    UnsuitableTargetError,
+)
 from imgmtf.estimate.edge import EdgeEstimator, measure_edge, window_factor
-from imgmtf.errors import (ImageContentError, MultipleTargetsError, ParameterError,
-                           TargetNotFoundError, UnsuitableTargetError)
 
 from conftest import exact_edge_chip, gaussian_pixel_transfer, true_fwhm, true_mtf50
 

@@ -10,9 +10,10 @@ import time
 
 import numpy as np
 import pytest
-from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 from imgmtf.io import write_geotiff
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 

@@ -4,12 +4,13 @@ import math
 
 import numpy as np
 import pytest
-from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.estimate.resampling import resample_profile
 from imgmtf.estimate.intervals import Bootstrap, percentile_interval, row_weights, spectral_figures
+from imgmtf.estimate.resampling import resample_profile
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
 
 
 def test_row_weights_resample_whole_rows():

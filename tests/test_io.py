@@ -75,3 +75,15 @@ def test_truncated_tiff(tmp_path):
     path.write_bytes(data[: len(data) // 2])
     with pytest.raises(ImageReadError, match="t.tif"):
         read_raster(path)
+
+
+def test_luminance_is_what_the_reader_computes_and_arrays_of_colour_are_pointed_to_it(tmp_path):
+    rgba = np.zeros((4, 20, 20), np.uint8)
+    rgba[0], rgba[1], rgba[2], rgba[3] = 100, 200, 50, 255
+    im.write_png(tmp_path / "c.png", rgba)
+    assert np.array_equal(read_raster(tmp_path / "c.png").data, im.luminance(np.moveaxis(rgba, 0, -1)))
+    assert np.array_equal(im.luminance(rgba, channel_axis=0), im.luminance(np.moveaxis(rgba, 0, -1)))
+    with pytest.raises(im.ImageContentError, match=r"imgmtf.luminance\(image\)"):
+        im.measure_edge(np.moveaxis(rgba, 0, -1))
+    with pytest.raises(im.ImageContentError, match="shape"):
+        im.luminance(np.zeros((20, 20)))

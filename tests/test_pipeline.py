@@ -9,8 +9,16 @@ import imgmtf as im
 from imgmtf.errors import ParameterError
 from imgmtf.estimate.pipeline import direction_label, make_settings
 
-from conftest import (defocus_transfer, diffraction_transfer, exact_edge_chip, gaussian_pixel_transfer,
-                      olpf_transfer, product, true_fwhm, true_mtf50)
+from conftest import (
+    defocus_transfer,
+    diffraction_transfer,
+    exact_edge_chip,
+    gaussian_pixel_transfer,
+    olpf_transfer,
+    product,
+    true_fwhm,
+    true_mtf50,
+)
 
 
 def pixel(angle):

@@ -84,3 +84,14 @@ def test_unwritable_csv_is_named(tmp_path):
     with pytest.raises(FileWriteError, match="afile.txt/sub/out.csv: cannot write"):
         with CsvWriter(blocker / "sub" / "out.csv"):
             pass
+
+
+def test_csv_rows_carry_the_mtf_curve_on_a_fixed_grid():
+    from imgmtf.records import CURVE_COLUMNS, curve_values
+    f = [i / 100 for i in range(101)]
+    summary = {**SUMMARY, "frequencies_cy_px": f, "mtf": [1 - x / 2 for x in f[:60]] + [None] * 41}
+    row = Record.measured("a.tif", 1, summary, params={}, run_utc="t").csv_row()
+    assert set(CURVE_COLUMNS) <= set(CSV_COLUMNS) and CURVE_COLUMNS[10] == "mtf_at_0.50_cy_px"
+    assert row["mtf_at_0.50_cy_px"] == 0.75 and row["mtf_at_0.25_cy_px"] == 0.875
+    assert row["mtf_at_0.70_cy_px"] == ""                  # undefined there (a bar's sinc zero)
+    assert all(v is None for v in curve_values(None, None).values())   # failures: empty cells

@@ -29,7 +29,7 @@ def exact_chip(sensor, target, shape):
     return target.low_dn + (target.high_dn - target.low_dn) * np.interp(d, x, esf)
 
 
-@pytest.mark.parametrize("sensor", [im.Sensor()] + GAUSSIAN_ONLY)
+@pytest.mark.parametrize("sensor", [im.Sensor(), *GAUSSIAN_ONLY])
 @pytest.mark.parametrize("angle", [6.0, 84.0, -23.0])
 def test_noise_free_edge_equals_exact_edge_response(sensor, angle):
     target = im.Target("edge", angle, 200.0, 1200.0, 0.37)

@@ -4,7 +4,7 @@ import pytest
 from click.testing import CliRunner
 
 from imgmtf.cli import main
-from imgmtf.reproduce import QUICK, StudySize, run_study, thresholds
+from imgmtf.reproduce import QUICK, StudySize, _seed, run_tasks, thresholds
 
 
 def read(path):
@@ -13,36 +13,40 @@ def read(path):
 
 
 @pytest.fixture(scope="module")
-def quick_runs(tmp_path_factory):
-    """The quick study with one method, in one process and in two."""
-    one = tmp_path_factory.mktemp("one")
-    two = tmp_path_factory.mktemp("two")
-    small = StudySize(QUICK.system_stds[:4], 2, 3)
-    import imgmtf.reproduce as r
-    old = r.QUICK
-    r.QUICK = small
-    try:
-        a = run_study(one, quick=True, workers=1, seed=3, methods=("msg",))
-        b = run_study(two, quick=True, workers=2, seed=3, methods=("msg",))
-    finally:
-        r.QUICK = old
-    return one, two, a, b
+def quick_run(tmp_path_factory):
+    """``imgmtf reproduce --quick`` on a study made smaller still (the
+    figures, tables and report are all there; few chips)."""
+    out = tmp_path_factory.mktemp("quick")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("imgmtf.reproduce.QUICK", StudySize(QUICK.system_stds[:2], 1, 1))
+        result = CliRunner().invoke(main, ["reproduce", "--quick", "--workers", "1", "--no-progress",
+                                           "--out", str(out)])
+    return out, result
 
 
-def test_results_do_not_depend_on_the_number_of_workers(quick_runs):
-    one, two, a, b = quick_runs
-    for name in ("system_noise.csv", "ground_noise.csv", "threshold.csv", "tables_1_2.csv"):
-        assert read(one / name) == read(two / name)
-    assert a["thresholds"] == b["thresholds"]
+def test_results_do_not_depend_on_the_number_of_workers():
+    tasks = [("system", i, float(std), 1200.0, False, _seed(3, 1, i), ("msg",)) for i, std in enumerate((2, 9))]
+    tasks.append(("ground", 0, 0.0, 1500.0, True, _seed(3, 2, 0, 0), ("msg",)))
+    assert run_tasks(tasks, 1, "one") == run_tasks(tasks, 2, "two")
 
 
-def test_report_and_figures_are_written(quick_runs):
-    one = quick_runs[0]
+def test_cli_quick_run_reports_and_says_it_is_quick(quick_run):
+    out, r = quick_run
+    assert r.exit_code == 0, r.output
+    assert "msg      " in r.stdout and "a quick run: 1 chips per SNR level are too few" in r.stdout
+    assert not r.stderr                                       # --no-progress: no bars
+    assert len(read(out / "system_noise.csv")) == 2 * 4       # 2 chips x every method
+
+
+def test_report_and_figures_are_written(quick_run):
+    one = quick_run[0]
     report = (one / "report.md").read_text()
-    for heading in ("Tables 1 and 2", "Figure 12", "Figures 13-14", "SNR threshold"):
+    for heading in ("Tables 1 and 2", "Figures 9-10", "Figure 12", "Figures 13-14", "SNR threshold",
+                    "too few to find a threshold"):
         assert heading in report
-    for png in ("fig02_03_sensor.png", "fig12_system_noise.png", "fig13_ground_noise_layers.png",
-                "fig14_ground_noise.png", "threshold.png"):
+    for png in ("fig02_03_sensor.png", "fig09_edge_estimates.png", "fig10_pulse_estimates.png",
+                "fig12_system_noise.png", "fig13_ground_noise_layers.png", "fig14_ground_noise.png",
+                "threshold.png"):
         assert (one / png).stat().st_size > 5000
     rows = read(one / "tables_1_2.csv")
     model = [r for r in rows if r["method"] == "model"]
@@ -69,10 +73,3 @@ def test_cli_reports_unwritable_folder(tmp_path):
     blocker.write_text("x")
     r = CliRunner().invoke(main, ["reproduce", "--quick", "--out", str(blocker / "sub")])
     assert r.exit_code == 1 and "cannot create" in r.stderr
-
-
-def test_cli_quick_run(tmp_path):
-    r = CliRunner().invoke(main, ["reproduce", "--quick", "--workers", "2", "--out", str(tmp_path)])
-    assert r.exit_code == 0, r.output
-    assert "msg      trustworthy from SNR" in r.stdout
-    assert (tmp_path / "report.md").exists() and len(read(tmp_path / "system_noise.csv")) == 8 * 4

@@ -2,9 +2,18 @@ import numpy as np
 import pytest
 from scipy.special import erf
 
+from imgmtf.estimate.spectrum import (
+    central_difference,
+    corrected_mtf,
+    edge_divisor,
+    flat_top_window,
+    mtf50,
+    mtf_area,
+    relative_edge_response,
+    restore_lsf,
+    rise_distance,
+)
 from imgmtf.metrics import first_crossing, fwhm
-from imgmtf.estimate.spectrum import (central_difference, corrected_mtf, edge_divisor, flat_top_window, mtf50, mtf_area,
-                        relative_edge_response, restore_lsf, rise_distance)
 
 
 def gaussian_edge(sigma=0.6, step=0.05, half=15.0):

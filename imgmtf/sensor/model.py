@@ -27,14 +27,14 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import ConfigError, FileWriteError, ParameterError
-from ..metrics import first_crossing, fwhm
 from ..inputs import check_number
+from ..metrics import first_crossing, fwhm
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 
 DIRECTIONS = ("across", "along")
@@ -154,7 +154,7 @@ class Sensor:
         return max(sum(stage.support_radius_m(self.gsd_m) for stage in self.stages), self.gsd_m)
 
     def line_response(self, angle_deg: float, gsd_m: float | None = None, *, reach_px: float = 0.0,
-                      step_px: float = 1.0 / 64.0) -> "LineResponse":
+                      step_px: float = 1.0 / 64.0) -> LineResponse:
         """Edge and line spread functions along the normal of an edge tilted
         ``angle_deg`` from the column axis, in pixels of ``gsd_m`` (default
         the sensor's), exact at any distance; the fine grid behind them
@@ -214,7 +214,7 @@ class Sensor:
         return fwhm(*self.lsf(direction))
 
     def psf(self, oversampling: int = 20, tolerance: float = 1e-7,
-            gsd_m: float | None = None, deconvolve_cell: bool = False) -> "SampledPSF":
+            gsd_m: float | None = None, deconvolve_cell: bool = False) -> SampledPSF:
         """System PSF sampled ``oversampling`` times per GSD (``gsd_m``, default
         the sensor's) in each axis.
 
@@ -260,7 +260,7 @@ class Sensor:
         data = grid[half - keep: half + keep + 1, half - keep: half + keep + 1]
         return SampledPSF(data / data.sum(), step)
 
-    def components(self) -> dict[str, "Sensor"]:
+    def components(self) -> dict[str, Sensor]:
         """Each stage alone, as a sensor of the same GSD, keyed by stage
         name (a repeated name gets " 2", " 3", ...)."""
         out: dict[str, Sensor] = {}
@@ -278,7 +278,7 @@ class Sensor:
         return {"gsd_m": self.gsd_m, "stages": [stage.to_dict() for stage in self.stages]}
 
     @classmethod
-    def from_dict(cls, values: dict) -> "Sensor":
+    def from_dict(cls, values: dict) -> Sensor:
         """The sensor from :meth:`to_dict`'s form, or from the generic
         sensor's keywords (the old ``[sensor]`` table); missing keywords take
         the paper's defaults.
@@ -314,7 +314,7 @@ class Sensor:
             raise FileWriteError(f"{path}: cannot write sensor file: {exc.strerror or exc}") from None
 
     @classmethod
-    def from_toml(cls, path: str | Path) -> "Sensor":
+    def from_toml(cls, path: str | Path) -> Sensor:
         """Read a sensor from TOML: ``gsd_m`` and ``[[stages]]`` tables as
         :meth:`to_toml` writes them, or the old form, the generic sensor's
         keywords at the top level or in a ``[sensor]`` table.
@@ -391,14 +391,29 @@ class LineResponse:
 
 @dataclass(frozen=True, eq=False)
 class SampledPSF:
-    """A PSF on a square grid: ``data`` sums to 1, ``step_m`` is the sample
-    spacing in metres, the centre sample is the PSF's origin."""
+    """A PSF on a square grid (what :meth:`Sensor.psf` returns).
+
+    Attributes
+    ----------
+    data : numpy.ndarray, shape (n, n), n odd
+        The PSF's samples, summing to 1; the centre sample is its origin.
+    step_m : float
+        The sample spacing, metres on the ground.
+
+    Example
+    -------
+    >>> from imgmtf import Sensor
+    >>> psf = Sensor().psf(oversampling=10)
+    >>> psf.step_m, round(float(psf.data.sum()), 6), psf.data.shape[0] % 2
+    (0.1, 1.0, 1)
+    """
 
     data: np.ndarray
     step_m: float
 
     @property
     def coordinates_m(self) -> np.ndarray:
+        """Positions of the samples along either axis, metres from the origin."""
         n = self.data.shape[0]
         return (np.arange(n) - n // 2) * self.step_m
 
@@ -426,7 +441,7 @@ def _paper_stages(keywords: dict) -> list[Stage]:
                              f"known: gsd_m, stages, {', '.join(_PAPER_KEYWORDS)}")
     values: dict[type, dict[str, float]] = {}
     for key, (cls, name) in _PAPER_KEYWORDS.items():
-        default = cls.__dataclass_fields__[name].default
+        default = {f.name: f.default for f in fields(cls)}[name]
         values.setdefault(cls, {})[name] = check_number(f"sensor parameter {key}", keywords.get(key, default))
     return [cls(**params) for cls, params in values.items() if any(params.values())]
 

@@ -12,10 +12,32 @@ from ..errors import ParameterError
 
 @dataclass(frozen=True)
 class GroundNoise:
-    """Multi-scale ground noise: ``layers`` white-Gaussian images made of
-    1x1, 2x2, ..., layers x layers sub-pixel squares, each with variance
-    ``layer_variance_dn2`` (DN^2) and a random grid offset; their sum has
-    variance layers * layer_variance_dn2 (the paper: 20 x 100 = 2000 DN^2)."""
+    """The paper's multi-scale ground noise, added to the scene before the
+    PSF: ``layers`` white-Gaussian images made of 1x1, 2x2, ..., layers x
+    layers sub-pixel squares, each with a random grid offset; their sum has
+    variance layers x layer_variance_dn2 (the paper: 20 x 100 = 2000 DN^2).
+
+    Parameters
+    ----------
+    layers : int
+        Number of layers, >= 1 (default 20).
+    layer_variance_dn2 : float
+        Variance of each layer, DN^2, >= 0 (default 100).
+
+    Raises
+    ------
+    ParameterError
+        ``layers`` not a positive integer, or a negative or non-finite
+        variance.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from imgmtf import GroundNoise
+    >>> field = GroundNoise().sample((400, 400), np.random.default_rng(0))   # sub-pixel cells
+    >>> 1500 < float(field.var()) < 2500                                    # about 2000 DN^2
+    True
+    """
 
     layers: int = 20
     layer_variance_dn2: float = 100.0

@@ -22,11 +22,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..version import __version__
 from ..errors import ParameterError
 from ..metrics import first_crossing, fwhm
-from .noise import GroundNoise, add_system_noise
+from ..version import __version__
 from .model import MAX_GRID_CELLS, SampledPSF, Sensor
+from .noise import GroundNoise, add_system_noise
 from .targets import Target
 
 BITS = (8, 16)
@@ -34,10 +34,38 @@ BITS = (8, 16)
 
 @dataclass(frozen=True, eq=False)
 class Chip:
-    """A rendered chip and everything needed to reproduce it.
+    """A rendered chip and everything needed to reproduce it (what
+    :func:`render` and :class:`Renderer` return).
 
-    ``image`` is uint8 or uint16, rows x cols; ``clipped_fraction`` is the
-    fraction of pixels that hit 0 or the top of the range.
+    Attributes
+    ----------
+    image : numpy.ndarray of uint8 or uint16, shape (rows, cols)
+        The chip, DN.
+    sensor : Sensor
+        The sensor it was rendered through.
+    target : Target
+        The edge or bar.
+    gsd_m : float
+        Its ground sample distance, m.
+    oversampling : int
+        Sub-pixel cells per pixel of the ground-noise field.
+    bits : int
+        8 or 16.
+    noise_std_dn : float
+        Standard deviation of the white system noise, DN.
+    ground_noise : GroundNoise or None
+        The ground noise added before the PSF, if any.
+    seed : int or None
+        The noise's random seed.
+    clipped_fraction : float
+        Fraction of pixels that hit 0 or the top of the range.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100)
+    >>> round(float(chip.true_mtf(0.5)), 4), round(chip.true_mtf50_cy_px(), 4), round(chip.true_fwhm_px(), 4)
+    (0.2667, 0.3644, 1.2392)
     """
 
     image: np.ndarray
@@ -52,7 +80,8 @@ class Chip:
     clipped_fraction: float
 
     def true_mtf(self, f_cy_px) -> np.ndarray:
-        """The sensor's MTF along the target's normal (cycles/pixel)."""
+        """The sensor's MTF along the target's normal at ``f_cy_px``
+        (cycles per pixel of this chip): what an ideal estimator returns."""
         return np.abs(self.sensor.normal_transfer(f_cy_px, self.target.angle_deg, self.gsd_m))
 
     def true_fwhm_px(self) -> float:
@@ -65,7 +94,10 @@ class Chip:
         return first_crossing(f, self.true_mtf(f), 0.5)
 
     def provenance(self) -> dict:
-        """JSON-ready description of how the chip was made."""
+        """JSON-ready description of how the chip was made: version,
+        sensor (GSD and stages), target, GSD, oversampling, bits, noise and
+        seed (what :func:`imgmtf.write_geotiff` stores in its ``IMGMTF``
+        tag)."""
         return {
             "imgmtf_version": __version__,
             "sensor": self.sensor.to_dict(),
@@ -80,16 +112,37 @@ class Chip:
 
 
 class Renderer:
-    """Set up once (sensor, chip size), render many targets.
+    """Set up once (sensor, chip size), render many targets: calling it
+    with a :class:`Target` returns a :class:`Chip`.
+
+    Each pixel is the sensor's exact edge response along the target's
+    normal at the pixel centre's distance from it (no scene grid, no
+    border), plus noise, rounded and clipped to ``bits``.
 
     Parameters
     ----------
-    sensor : the sensor.
-    shape : output chip size (rows, cols) in pixels, or one int for a square.
-    gsd_m : output ground sample distance (m); default the sensor's.
-    oversampling : sub-pixel cells per output pixel in each axis, for the
-        ground-noise field.
-    bits : 8 or 16, the output integer depth.
+    sensor : Sensor, optional
+        The sensor (default the paper's generic sensor).
+    shape : int or (int, int), optional
+        Chip size (rows, cols) in pixels, or one int for a square (default
+        50; at least 2, at most 16 Mpx).
+    gsd_m : float, optional
+        Output ground sample distance, m (default the sensor's).
+    oversampling : int, optional
+        Sub-pixel cells per output pixel in each axis, for the ground-noise
+        field (default 20).
+    bits : {8, 16}, optional
+        The output integer depth (default 16).
+
+    Calling it takes the target and, keyword-only, ``noise_std_dn``
+    (white system noise, DN), ``ground_noise`` (a :class:`GroundNoise`)
+    and ``seed`` (an integer >= 0, for reproducible noise).
+
+    Raises
+    ------
+    ParameterError
+        A bad size, depth, oversampling or GSD, or a sensor whose blur would
+        need more than 16 M grid cells at this GSD.
 
     Example
     -------
@@ -101,12 +154,13 @@ class Renderer:
 
     def __init__(self, sensor: Sensor = Sensor(), shape: int | tuple[int, int] = 50, *,
                  gsd_m: float | None = None, oversampling: int = 20, bits: int = 16):
-        shape = (shape, shape) if isinstance(shape, (int, np.integer)) else tuple(shape)
-        if len(shape) != 2 or any(isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer))
-                                  or n < 2 for n in shape):
+        size = (shape, shape) if isinstance(shape, (int, np.integer)) else tuple(shape)
+        if len(size) != 2 or any(isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer))
+                                 or n < 2 for n in size):
             raise ParameterError(f"chip size must be at least 2 x 2 pixels, got {shape}")
-        if shape[0] * shape[1] > MAX_GRID_CELLS:
-            raise ParameterError(f"a {shape[0]} x {shape[1]} px chip is over the {MAX_GRID_CELLS}-pixel limit")
+        rows, cols = (int(n) for n in size)
+        if rows * cols > MAX_GRID_CELLS:
+            raise ParameterError(f"a {rows} x {cols} px chip is over the {MAX_GRID_CELLS}-pixel limit")
         if bits not in BITS:
             raise ParameterError(f"bits must be 8 or 16, got {bits}")
         if isinstance(oversampling, (bool, np.bool_)) or not (
@@ -115,8 +169,8 @@ class Renderer:
         self.gsd_m = sensor.gsd_m if gsd_m is None else float(gsd_m)
         if not self.gsd_m > 0 or not math.isfinite(self.gsd_m):
             raise ParameterError(f"GSD must be > 0 m, got {gsd_m}")
-        self.sensor, self.shape, self.oversampling, self.bits = sensor, tuple(int(n) for n in shape), int(oversampling), bits
-        rows, cols = self.shape
+        self.sensor, self.oversampling, self.bits = sensor, int(oversampling), bits
+        self.shape: tuple[int, int] = (rows, cols)
         self._y, self._x = np.mgrid[0:rows, 0:cols].astype(float)
         self._responses: dict[float, object] = {}
 
@@ -172,6 +226,46 @@ def render(sensor: Sensor, target: Target, shape: int | tuple[int, int] = 50, *,
            gsd_m: float | None = None, oversampling: int = 20, bits: int = 16,
            noise_std_dn: float = 0.0, ground_noise: GroundNoise | None = None,
            seed: int | None = None) -> Chip:
-    """Render one target through ``sensor``; see :class:`Renderer`."""
+    """Render one target through a sensor into an 8/16-bit chip (one call
+    of a :class:`Renderer`; make one to render many chips of a sensor).
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor.
+    target : Target
+        The edge or bar.
+    shape : int or (int, int), optional
+        Chip size in pixels (default 50 x 50).
+    gsd_m : float, optional
+        Output GSD, m (default the sensor's).
+    oversampling : int, optional
+        Sub-pixel cells per pixel of the ground-noise field (default 20).
+    bits : {8, 16}, optional
+        Output depth (default 16).
+    noise_std_dn : float, optional
+        White system noise added after sampling, DN (default 0).
+    ground_noise : GroundNoise, optional
+        Ground noise added to the scene before the PSF.
+    seed : int, optional
+        Seed of the noise (>= 0), for a reproducible chip.
+
+    Returns
+    -------
+    Chip
+        The image and how it was made, with its true MTF.
+
+    Raises
+    ------
+    ParameterError
+        A bad size, depth, oversampling, GSD or noise level.
+
+    Example
+    -------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100, noise_std_dn=5.0, seed=1)
+    >>> chip.image.shape, chip.image.dtype.name, round(float(chip.true_mtf(0.5)), 4)
+    ((100, 100), 'uint16', 0.2667)
+    """
     return Renderer(sensor, shape, gsd_m=gsd_m, oversampling=oversampling, bits=bits)(
         target, noise_std_dn=noise_std_dn, ground_noise=ground_noise, seed=seed)

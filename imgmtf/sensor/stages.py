@@ -39,18 +39,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
-from ..inputs import check_number
 from ..errors import ParameterError
+from ..inputs import check_number
 
 #: name -> stage class, in the order the stages were registered
-STAGES: dict[str, type["Stage"]] = {}
+STAGES: dict[str, type[Stage]] = {}
 
 
-def register(cls: type["Stage"]) -> type["Stage"]:
+def register(cls: type[Stage]) -> type[Stage]:
     """Class decorator: make a stage known by its ``name`` (TOML, CLI, fit)."""
     if cls.name in STAGES:
         raise ValueError(f"stage name {cls.name!r} registered twice")
@@ -82,7 +82,7 @@ class FitSpec:
     rank: int = 1
 
 
-def _param(default: float, unit: str, fit: FitSpec | None = None, **flags) -> field:
+def _param(default: float, unit: str, fit: FitSpec | None = None, **flags) -> Any:
     return field(default=default, metadata={"unit": unit, "fit": fit, **flags})
 
 
@@ -131,7 +131,7 @@ class Stage:
             out[name] = length**spec.power
         return out
 
-    def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> "Stage":
+    def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> Stage:
         """A copy with the given parameters set from fit coordinates."""
         values = {}
         for name, u in coordinates.items():
@@ -147,7 +147,7 @@ class Stage:
         return {"stage": self.name, **values} if include_name else values
 
     @classmethod
-    def from_dict(cls, values: dict) -> "Stage":
+    def from_dict(cls, values: dict) -> Stage:
         """The stage from its parameters (``stage`` key optional); unknown
         keys are a :class:`ParameterError`."""
         values = {k: v for k, v in values.items() if k != "stage"}
@@ -160,7 +160,21 @@ class Stage:
 
 
 def stage_from_dict(values: dict) -> Stage:
-    """Dispatch a stage table ``{"stage": name, ...}`` to its class."""
+    """The stage a table ``{"stage": name, parameter: value, ...}``
+    describes (the TOML and JSON form, :meth:`Stage.to_dict`).
+
+    Raises
+    ------
+    ParameterError
+        Not a table, an unknown stage name, unknown parameters or bad
+        values (each named).
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import stage_from_dict
+    >>> stage_from_dict({"stage": "detector", "width_x_m": 1.0, "width_y_m": 1.0})
+    Detector(width_x_m=1.0, width_y_m=1.0)
+    """
     if not isinstance(values, dict):
         raise ParameterError(f"a stage must be a table, got {values!r}")
     name = values.get("stage")
@@ -178,9 +192,25 @@ def _gaussian_radius(sigma: float) -> float:
 @register
 @dataclass(frozen=True)
 class GaussianOptics(Stage):
-    """Optics as a 2-D Gaussian PSF of standard deviations ``sigma_x_m``
-    (across track) and ``sigma_y_m`` (along track), metres:
-    T = exp(-2 pi^2 (sx^2 fx^2 + sy^2 fy^2))."""
+    """Optics as a 2-D Gaussian PSF: T = exp(-2 pi^2 (sx^2 fx^2 + sy^2 fy^2)).
+
+    Parameters
+    ----------
+    sigma_x_m, sigma_y_m : float
+        Standard deviations of the PSF across track (x) and along track
+        (y), metres on the ground, >= 0 (default 0.39, the paper's).
+
+    Raises
+    ------
+    ParameterError
+        A parameter that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import GaussianOptics
+    >>> round(float(GaussianOptics(0.39, 0.39).transfer(0.5, 0.0, 1.0)), 4)   # at 0.5 cy/m across
+    0.4721
+    """
 
     name: ClassVar[str] = "optics"
     title: ClassVar[str] = "Gaussian optics"
@@ -198,8 +228,26 @@ class GaussianOptics(Stage):
 @register
 @dataclass(frozen=True)
 class Detector(Stage):
-    """Detector aperture (the GIFOV) as a rect of widths ``width_x_m``,
-    ``width_y_m`` (metres): T = sinc(fx wx) sinc(fy wy), sinc(t) = sin(pi t)/(pi t)."""
+    """Detector aperture (the GIFOV) as a rect: T = sinc(fx wx) sinc(fy wy),
+    sinc(t) = sin(pi t) / (pi t).
+
+    Parameters
+    ----------
+    width_x_m, width_y_m : float
+        Widths of the aperture across and along track, metres on the
+        ground, >= 0 (default 1, the paper's GIFOV).
+
+    Raises
+    ------
+    ParameterError
+        A parameter that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Detector
+    >>> round(float(Detector(1.0, 1.0).transfer(0.5, 0.0, 1.0)), 4)         # 2 / pi at Nyquist
+    0.6366
+    """
 
     name: ClassVar[str] = "detector"
     title: ClassVar[str] = "detector aperture"
@@ -216,8 +264,27 @@ class Detector(Stage):
 @register
 @dataclass(frozen=True)
 class Motion(Stage):
-    """Along-track smear during integration: a rect of ``length_m`` metres
-    along y only: T = sinc(fy S)."""
+    """Along-track smear during integration, a rect along y only:
+    T = sinc(fy S).
+
+    Parameters
+    ----------
+    length_m : float
+        The smear S, metres on the ground, >= 0 (default 0.25, the
+        paper's).
+
+    Raises
+    ------
+    ParameterError
+        A parameter that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Motion
+    >>> stage = Motion(0.25)
+    >>> float(stage.transfer(0.5, 0.0, 1.0)), round(float(stage.transfer(0.0, 0.5, 1.0)), 4)
+    (1.0, 0.9745)
+    """
 
     name: ClassVar[str] = "motion"
     title: ClassVar[str] = "along-track motion"
@@ -235,8 +302,25 @@ class Motion(Stage):
 @dataclass(frozen=True)
 class Electronics(Stage):
     """First-order 2-D Butterworth low-pass of the detector electronics:
-    T = 1 / (1 + (D / D0)^2), D = sqrt(fx^2 + fy^2), D0 = ``cutoff_cy_m``
-    (cycles per metre; inf for no filter)."""
+    T = 1 / (1 + (D / D0)^2), D = sqrt(fx^2 + fy^2).
+
+    Parameters
+    ----------
+    cutoff_cy_m : float
+        The cut-off D0, cycles per metre on the ground, > 0; ``math.inf``
+        for no filter (default 1.4, the paper's).
+
+    Raises
+    ------
+    ParameterError
+        A cut-off that is not > 0 or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Electronics
+    >>> round(float(Electronics(1.4).transfer(0.5, 0.0, 1.0)), 4)
+    0.8869
+    """
 
     name: ClassVar[str] = "electronics"
     title: ClassVar[str] = "electronics (Butterworth)"
@@ -268,6 +352,28 @@ class Diffraction(Stage):
     pixel, and so pitch / (wavelength x N x GSD) cycles per metre on the
     ground.  T = (2/pi) (acos v - v sqrt(1 - v^2)) for v = f / f_c <= 1, 0
     beyond; f is the radial frequency.
+
+    Parameters
+    ----------
+    f_number : float
+        The working f-number N, > 0 (default 8).
+    wavelength_m : float
+        The wavelength, metres, > 0 (default 550e-9).
+    pixel_pitch_m : float
+        The detector pitch in the focal plane, metres, > 0 (default 5e-6):
+        it maps the focal plane onto the GSD.
+
+    Raises
+    ------
+    ParameterError
+        A parameter that is not > 0 or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Diffraction
+    >>> stage = Diffraction(f_number=8.0, wavelength_m=550e-9, pixel_pitch_m=5e-6)
+    >>> round(stage.cutoff_cy_m(gsd_m=1.0), 4)                   # cy/m on the ground at a 1 m GSD
+    1.1364
     """
 
     name: ClassVar[str] = "diffraction"
@@ -305,8 +411,25 @@ class Diffraction(Stage):
 @register
 @dataclass(frozen=True)
 class Defocus(Stage):
-    """Defocus as a uniform disk PSF of ``radius_m`` metres (geometric
-    optics): T = 2 J1(2 pi r f) / (2 pi r f), f the radial frequency."""
+    """Defocus as a uniform disk PSF (geometric optics):
+    T = 2 J1(2 pi r f) / (2 pi r f), f the radial frequency.
+
+    Parameters
+    ----------
+    radius_m : float
+        The disk's radius r, metres on the ground, >= 0 (default 0.5).
+
+    Raises
+    ------
+    ParameterError
+        A radius that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Defocus
+    >>> round(float(Defocus(0.5).transfer(0.5, 0.0, 1.0)), 4)
+    0.7217
+    """
 
     name: ClassVar[str] = "defocus"
     title: ClassVar[str] = "defocus disk"
@@ -325,8 +448,25 @@ class Defocus(Stage):
 @register
 @dataclass(frozen=True)
 class OLPF(Stage):
-    """Four-spot birefringent optical low-pass filter: four equal points at
-    (+-d/2, +-d/2), split ``split_m`` metres: T = cos(pi d fx) cos(pi d fy)."""
+    """Four-spot birefringent optical low-pass filter, four equal points at
+    (+-d/2, +-d/2): T = cos(pi d fx) cos(pi d fy).
+
+    Parameters
+    ----------
+    split_m : float
+        The split d, metres on the ground, >= 0 (default 0.5).
+
+    Raises
+    ------
+    ParameterError
+        A split that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import OLPF
+    >>> round(float(OLPF(1.0).transfer(0.5, 0.0, 1.0)), 12)      # a 1-px split nulls Nyquist
+    0.0
+    """
 
     name: ClassVar[str] = "olpf"
     title: ClassVar[str] = "4-spot OLPF"
@@ -344,10 +484,27 @@ class OLPF(Stage):
 @register
 @dataclass(frozen=True)
 class Jitter(Stage):
-    """Random line-of-sight jitter during integration as a Gaussian of
-    standard deviations ``sigma_x_m``, ``sigma_y_m`` (metres).  Its transfer
-    has the form of the Gaussian optics', so a fit cannot tell the two apart:
-    it holds one of them."""
+    """Random line-of-sight jitter during integration, a Gaussian.  Its
+    transfer has the form of the Gaussian optics', so a fit cannot tell
+    the two apart: it holds one of them.
+
+    Parameters
+    ----------
+    sigma_x_m, sigma_y_m : float
+        Standard deviations across and along track, metres on the ground,
+        >= 0 (default 0.1).
+
+    Raises
+    ------
+    ParameterError
+        A parameter that is negative, not finite or not a number.
+
+    Example
+    -------
+    >>> from imgmtf.sensor.stages import Jitter
+    >>> round(float(Jitter(0.0, 0.2).transfer(0.0, 0.5, 1.0)), 4)
+    0.8209
+    """
 
     name: ClassVar[str] = "jitter"
     title: ClassVar[str] = "jitter"

@@ -29,15 +29,42 @@ KINDS = ("edge", "pulse")
 
 @dataclass(frozen=True)
 class Target:
-    """An edge or pulse target.
+    """A straight edge or a bar (pulse) on a uniform background.
 
-    Attributes
+    Parameters
     ----------
-    kind : "edge" or "pulse".
-    angle_deg : tilt of the edge (bar) from the column axis, in (-90, 90].
-    low_dn, high_dn : scene levels (DN) on either side, see module docstring.
-    offset_px : position along the normal relative to the chip centre (px).
-    width_px : pulse width along the normal (px); only for pulses.
+    kind : {"edge", "pulse"}
+        An edge (a step between two levels) or a bar of ``width_px``.
+    angle_deg : float
+        Angle of the target's normal from the image's x (column) axis,
+        towards +y (down), in (-90, 90] degrees: the tilt of the edge from
+        vertical.  0 is a vertical edge (its MTF is across track), 90 a
+        horizontal one (along track).  ``imgmtf measure`` reports the same
+        angle as ``normal_angle_deg``.
+    low_dn, high_dn : float
+        Scene levels, DN: ``high_dn`` on the side the normal points to (an
+        edge) or inside the bar (a pulse), ``low_dn`` elsewhere; swap them
+        to flip the polarity.
+    offset_px : float
+        Position along the normal from the chip's centre, px.
+    width_px : float
+        The bar's width along the normal, px (> 0 for a pulse, 0 for an
+        edge).
+
+    Raises
+    ------
+    ParameterError
+        An unknown kind, a value that is not a finite number, an angle
+        outside (-90, 90], a pulse without width or an edge with one.
+
+    Example
+    -------
+    >>> from imgmtf import Target
+    >>> Target("pulse", angle_deg=84.0, width_px=1.5).kind
+    'pulse'
+    >>> Target("edge", angle_deg=120.0)
+    Traceback (most recent call last):
+    imgmtf.errors.ParameterError: target angle must be in (-90, 90] degrees, got 120.0
     """
 
     kind: str = "edge"

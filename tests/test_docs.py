@@ -1,0 +1,183 @@
+"""Every example a user reads runs, so that none can drift from the code.
+
+* README.md and docs/*.md: each document's fenced blocks run in order in a
+  fresh folder holding the sample ``data/``: ``console`` blocks through the
+  CLI (each ``$ imgmtf ...`` line, its exit status 0 unless the line ends
+  with a ``# exit status N`` comment, and the output shown beneath it, where
+  ``...`` stands for any text, as in a doctest; a command shown without
+  output has its output unchecked), ``python`` blocks as doctests sharing
+  the document's names, ``toml`` blocks read as sensor files.
+* The package's docstring examples, module by module, as doctests.
+
+When a change moves what a command prints, ``python tests/test_docs.py
+--update`` rewrites the console outputs the documents show (lines with
+``...`` kept where they still match); read the diff before committing it.
+"""
+import doctest
+import importlib
+import pkgutil
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+import imgmtf
+from imgmtf.cli import main
+
+ROOT = Path(__file__).parent.parent
+# pages whose examples their own authors keep (the accuracy study, the
+# method, the scan), and the generated reproduction report
+OTHERS = {"accuracy.md", "method.md", "scan.md"}
+DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
+                            if p.name not in OTHERS)]
+FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
+EXIT_STATUS = re.compile(r"#\s*exit status (\d+)")
+DOCTEST_FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+
+
+def fenced_blocks(text: str):
+    """(language, body, line number) of every fenced block."""
+    for match in FENCE.finditer(text):
+        yield match[1], match[2], text.count("\n", 0, match.start()) + 1
+
+
+def console_steps(body: str):
+    """(command line, expected output lines) of a console block."""
+    steps: list[tuple[str, list[str]]] = []
+    for line in body.splitlines():
+        if line.startswith("$ "):
+            steps.append((line[2:], []))
+        elif steps:
+            steps[-1][1].append(line)
+        elif line.strip():
+            raise AssertionError(f"output before any command: {line!r}")
+    return steps
+
+
+def run_command(command: str, where: str) -> list[str]:
+    """Run one ``$ imgmtf ...`` line, check its exit status, return its
+    output lines (stdout and stderr as a terminal shows them)."""
+    args = shlex.split(command, comments=True)
+    assert args[0] == "imgmtf", f"{where}: console blocks run imgmtf only, got {command!r}"
+    status = EXIT_STATUS.search(command)
+    result = CliRunner().invoke(main, args[1:])
+    assert result.exit_code == int(status[1] if status else 0), (
+        f"{where}: `{command}` exited {result.exit_code}:\n{result.output}")
+    return [line.rstrip() for line in result.output.strip("\n").splitlines()]
+
+
+def run_console(body: str, where: str) -> None:
+    checker = doctest.OutputChecker()
+    for command, expected in console_steps(body):
+        got = run_command(command, where)
+        if any(line.strip() for line in expected):
+            want = "\n".join(line.rstrip() for line in expected).strip("\n") + "\n"
+            assert checker.check_output(want, "\n".join(got) + "\n", doctest.ELLIPSIS), (
+                f"{where}: `{command}` printed\n" + "\n".join(got) + f"\nthe document shows\n{want}"
+                + "(python tests/test_docs.py --update rewrites what the documents show)")
+
+
+def run_python(body: str, globs: dict, where: str) -> None:
+    if ">>>" not in body:
+        exec(compile(body, where, "exec"), globs)
+        return
+    test = doctest.DocTestParser().get_doctest(body, globs, where, where, 0)
+    report: list[str] = []
+    runner = doctest.DocTestRunner(optionflags=DOCTEST_FLAGS)
+    runner.run(test, out=report.append, clear_globs=False)
+    globs.update(test.globs)                          # the next block sees this one's names
+    assert not runner.failures, "".join(report)
+
+
+@pytest.fixture
+def sample_folder(tmp_path, monkeypatch):
+    """A fresh working folder with the repository's sample data in data/."""
+    (tmp_path / "data").symlink_to(ROOT / "data", target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.mark.parametrize("document", DOCUMENTS)
+def test_every_example_of_the_document_runs(document, sample_folder):
+    text = (ROOT / document).read_text()
+    globs: dict = {"__name__": "__docs__"}
+    ran = 0
+    for language, body, line in fenced_blocks(text):
+        where = f"{document}:{line}"
+        if language == "console":
+            run_console(body, where)
+        elif language == "python":
+            run_python(body, globs, where)
+        elif language == "toml":
+            path = sample_folder / f"block{line}.toml"
+            path.write_text(body)
+            imgmtf.Sensor.from_toml(path)
+        else:
+            continue
+        ran += 1
+    assert ran or document != "README.md"
+
+
+def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
+    readme = (ROOT / "README.md").read_text()
+    first_screen = "\n".join(readme.splitlines()[:40])
+    for command in ("python3 -m venv .venv && . .venv/bin/activate", "pip install . && imgmtf selftest",
+                    "pip install '.[test]' && pytest"):
+        assert command in first_screen
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert '".[$extras]"' in ci and "run_suite .venv-ci test" in ci and "\n    pytest" in ci
+
+
+MODULES = sorted(m.name for m in pkgutil.walk_packages(imgmtf.__path__, "imgmtf."))
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_docstring_examples(name, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)                       # examples may write files
+    module = importlib.import_module(name)
+    runner = doctest.DocTestRunner(optionflags=DOCTEST_FLAGS)
+    report: list[str] = []
+    for test in doctest.DocTestFinder().find(module, name):
+        runner.run(test, out=report.append)
+    assert not runner.failures, "".join(report)
+
+
+def update_console_outputs(document: str) -> None:
+    """Rewrite the outputs a document's console blocks show with what the
+    commands print now, in a fresh folder as the test runs them; a shown
+    line that still matches (``...`` included) is kept as written."""
+    import os
+    import tempfile
+    text = (ROOT / document).read_text()
+    checker = doctest.OutputChecker()
+    with tempfile.TemporaryDirectory() as folder:
+        here = os.getcwd()
+        os.chdir(folder)
+        os.symlink(ROOT / "data", "data", target_is_directory=True)
+        try:
+            for language, body, line in list(fenced_blocks(text)):
+                if language != "console":
+                    continue
+                lines = []
+                for command, expected in console_steps(body):
+                    got = run_command(command, f"{document}:{line}")
+                    shown = [e.rstrip() for e in expected]
+                    if any(shown) and len(shown) == len(got):
+                        got = [e if checker.check_output(e + "\n", g + "\n", doctest.ELLIPSIS) else g
+                               for e, g in zip(shown, got)]
+                    lines += [f"$ {command}", *(got if any(shown) else shown)]
+                text = text.replace(body, "\n".join(lines) + "\n", 1)
+        finally:
+            os.chdir(here)
+    (ROOT / document).write_text(text)
+
+
+if __name__ == "__main__":
+    import sys
+    if sys.argv[1:] != ["--update"]:
+        raise SystemExit("usage: python tests/test_docs.py --update  (rewrites the console outputs the docs show)")
+    for name in DOCUMENTS:
+        update_console_outputs(name)
+        print(f"updated {name}")
