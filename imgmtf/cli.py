@@ -37,7 +37,7 @@ def _reported_errors():
     try:
         yield
     except ImgmtfError as exc:
-        click.echo(f"imgmtf: error: {_one_line(exc)}", err=True)
+        click.echo(f"imgmtf: error: {_one_line(exc)}{_force_hint(exc.reason)}", err=True)
         sys.exit(1)
     except KeyboardInterrupt as exc:
         click.echo("imgmtf: interrupted", err=True)
@@ -50,6 +50,12 @@ def _reported_errors():
         click.echo(f"imgmtf: internal error: {type(exc).__name__}: {_one_line(exc)} "
                    "(please report it; IMGMTF_DEBUG=1 shows where)", err=True)
         sys.exit(1)
+
+
+def _force_hint(reason) -> str:
+    """What the CLI adds to a quality-gate refusal: the flag that overrules it."""
+    from .estimate.gate import FORCIBLE
+    return " (--force measures it anyway)" if reason in FORCIBLE else ""
 
 
 def _one_line(exc: BaseException) -> str:
@@ -602,7 +608,7 @@ def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False
         first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
     indent = " " * len(first)
     if record["status"] == "error":
-        return f"{first} error: {record['error']}"
+        return f"{first} error: {record['error']}{_force_hint(record.get('reason'))}"
     last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"

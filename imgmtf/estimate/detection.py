@@ -138,8 +138,9 @@ def meet_inside(a: Line, b: Line, shape, min_angle_deg: float = 2.0) -> bool:
 
 
 def describe(line: Line) -> str:
-    """A line as a user reads it (angle of its normal and offset)."""
-    return f"{line.theta_deg:.1f} deg, rho {line.rho_px:.1f} px"
+    """A line as a user reads it: its normal's angle (the convention of
+    ``normal_angle_deg``) and its distance from the chip's top-left pixel."""
+    return f"normal {line.theta_deg:.1f} deg, {abs(line.rho_px):.0f} px from the top-left pixel"
 
 
 def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:

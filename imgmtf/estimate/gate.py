@@ -69,14 +69,20 @@ class Check:
 
 class QualityError(UnsuitableTargetError):
     """A chip refused by the quality gate; ``checks`` lists the failed
-    checks, the first one's reason is the error's."""
+    checks, the first one's reason is the error's.  ``force=True`` (the
+    CLI's ``--force``) measures such a chip anyway, each failed check a
+    warning."""
 
     def __init__(self, failed: list[Check]):
-        others = list(dict.fromkeys(c.reason for c in failed[1:]))
+        others = [r for r in dict.fromkeys(c.reason for c in failed[1:]) if r != failed[0].reason]
         extra = f" (also failed: {', '.join(others)})" if others else ""
-        super().__init__(f"{failed[0].message}{extra}; measure it anyway with force=True (--force)",
-                         reason=failed[0].reason)
+        super().__init__(f"{failed[0].message}{extra}", reason=failed[0].reason)
         self.checks = tuple(failed)
+
+
+#: the reasons a user may overrule with ``force=True``
+FORCIBLE = frozenset({"fill", "saturated", "not-straight", "two-targets", "non-uniform", "too-short", "snr",
+                      "mtf-above-one", "mtf-undefined"})
 
 
 class TwoTargetsError(QualityError, MultipleTargetsError):
@@ -89,7 +95,7 @@ def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
     failed = [c for c in checks if not c.passed]
     if failed and not force:
         raise (TwoTargetsError if failed[0].reason == "two-targets" else QualityError)(failed)
-    return tuple(f"{c.reason}: {c.message} (forced)" for c in failed)
+    return tuple(f"{c.reason}: {c.message} (measured anyway: forced)" for c in failed)
 
 
 # -- before the profile ---------------------------------------------------------
