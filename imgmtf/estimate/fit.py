@@ -47,14 +47,18 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from statistics import NormalDist
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import ImgmtfError, ParameterError
-from ..metrics import first_crossing
 from ..inputs import check_number
+from ..metrics import first_crossing
 from ..sensor.model import DIRECTIONS, PAPER_STAGES, Sensor, direction_angle
 from ..sensor.stages import STAGES, Stage
+
+if TYPE_CHECKING:
+    from .edge import EdgeResult
 
 #: a free parameter is determined when its 1-SE range of blur length is
 #: narrower than this fraction of the length ...
@@ -149,7 +153,7 @@ class EdgeFit:
     misfit_fraction: float
     samples_x_px: np.ndarray = field(repr=False)
     residuals_dn: np.ndarray = field(repr=False)
-    measurement: object = field(repr=False)
+    measurement: EdgeResult = field(repr=False)
 
     def to_dict(self) -> dict:
         return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
@@ -182,7 +186,7 @@ class SensorFit:
     directions: dict
     confidence: float
     warnings: tuple[str, ...]
-    _model: "_Model" = field(repr=False)
+    _model: _Model = field(repr=False)
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
 
@@ -325,7 +329,7 @@ class _EdgeData:
     gsd_known: bool
     noise: float
     levels: tuple[float, float]
-    measurement: object
+    measurement: EdgeResult
 
 
 def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
@@ -352,7 +356,7 @@ def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
     y = np.asarray(result.samples_dn, float)
     order = np.argsort(x, kind="stable")
     x, y = x[order], y[order]
-    levels = tuple(float(v) for v in result.levels_dn)
+    levels = (float(result.levels_dn[0]), float(result.levels_dn[1]))
     step = abs(levels[1] - levels[0])
     if x.size < 20 or not step > 0:
         raise ImgmtfError(f"{source}: too few edge samples to fit", reason="unsuitable")
@@ -407,7 +411,7 @@ def _initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[
     return out
 
 
-def _hold_keys(hold, model: "_Model") -> set[str]:
+def _hold_keys(hold, model: _Model) -> set[str]:
     if isinstance(hold, str):
         hold = [h.strip() for h in hold.split(",") if h.strip()]
     keys = set()
@@ -427,7 +431,7 @@ class _Model:
     def __init__(self, gsd: float, stages: list[Stage], data: list[_EdgeData]):
         self.gsd, self.stages, self.data = gsd, stages, data
         self.specs, self.keys, self.units = {}, [], {}
-        for i, stage in enumerate(stages):
+        for stage in stages:
             for name, spec in stage.fit_specs().items():
                 key = f"{stage.name}.{name}"
                 self.specs[key] = spec
@@ -457,7 +461,7 @@ class _Model:
         self.free = [k for k in self.keys if k not in notes]
         return notes
 
-    def copy(self) -> "_Model":
+    def copy(self) -> _Model:
         other = object.__new__(_Model)
         other.__dict__.update(self.__dict__)
         other.values, other.ties, other.free = dict(self.values), dict(self.ties), list(self.free)
@@ -470,7 +474,7 @@ class _Model:
     def covers_axes(self, free: list[str]) -> bool:
         """Whether parameters ``free`` (with those tied to them) act on every
         axis an edge sees."""
-        axes = set()
+        axes: set[str] = set()
         for key in free:
             for k in [key] + [t for t, source in self.ties.items() if source == key]:
                 axes.update(("x", "y") if self.specs[k].axis == "xy" else (self.specs[k].axis,))
@@ -586,6 +590,7 @@ class _Model:
                 damping *= 5.0
             if cost_trial > cost:           # no step lowers the cost: a minimum
                 return z, jac
+            assert r_trial is not None       # a finite cost came from residuals
             gain, moved = cost - cost_trial, np.abs(trial - z).max()
             z, r, cost, damping = trial, r_trial, cost_trial, max(damping / 3.0, 1e-9)
             if gain <= 1e-9 * cost or moved <= 1e-12:
@@ -664,7 +669,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
 
     parameters = []
     _, upper = model.bounds()
-    for stage_before, stage in zip(model.stages, sensor.stages):
+    for stage in sensor.stages:
         units = stage.units()
         for name, value in stage.to_dict(include_name=False).items():
             key = f"{stage.name}.{name}"

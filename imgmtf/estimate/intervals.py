@@ -104,7 +104,7 @@ class Intervals:
 NO_INTERVALS = Intervals("none")
 
 
-def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) -> Intervals:  # noqa: N802
+def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) -> Intervals:
     """Bootstrap interval settings: ``replicates`` row resamplings (0: no
     intervals at all).
 
@@ -146,7 +146,7 @@ class Interval:
     high: float
 
     @classmethod
-    def none(cls) -> "Interval":
+    def none(cls) -> Interval:
         return cls(math.nan, math.nan)
 
     def __contains__(self, value: float) -> bool:

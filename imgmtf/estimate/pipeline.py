@@ -32,8 +32,9 @@ supplies only what differs:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
@@ -41,14 +42,22 @@ from ..errors import ImgmtfError, ParameterError, UnsuitableTargetError
 from ..inputs import check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
 from . import gate
-from .detection import robust_noise
+from .detection import Line, robust_noise
 from .geometry import TargetGeometry, check_angle, profile_samples, vertical_frame
-from .intervals import (Interval, Intervals, as_intervals, bootstrap_figures, influence_sd,
-                        linearised_interval)
+from .intervals import Interval, Intervals, as_intervals, bootstrap_figures, influence_sd, linearised_interval
 from .quantisation import dequantise
 from .resampling import METHODS, resample_profile
-from .spectrum import (MIN_TRANSFER, NYQUIST, corrected_mtf, flat_top_window, mtf50, mtf_area,
-                       noise_limited_frequency, restore_lsf, white_noise_mtf_sd)
+from .spectrum import (
+    MIN_TRANSFER,
+    NYQUIST,
+    corrected_mtf,
+    flat_top_window,
+    mtf50,
+    mtf_area,
+    noise_limited_frequency,
+    restore_lsf,
+    white_noise_mtf_sd,
+)
 
 DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
 STEP_RANGE_PX = (0.005, 0.25)     # finer costs time for nothing; coarser misses the LSF's shape
@@ -203,40 +212,78 @@ def make_settings(method: str = "msg", *, bootstrap=None, **options) -> Settings
 
 class TargetKind:
     """What differs between targets; see :class:`imgmtf.estimate.edge.EdgeKind`
-    and :class:`imgmtf.estimate.pulse.PulseKind`.
+    and :class:`imgmtf.estimate.pulse.PulseKind`, the two implementations.
 
-    ``name`` is the target as a user names it ("edge", "bar"), ``profile``
-    what its profile must look like (:func:`.gate.classify_profile`),
-    ``tail_power`` p of its profile's tails, level + A / |s|^p.
+    Attributes: ``name`` is the target as a user names it ("edge", "bar");
+    ``profile`` what its profile must look like
+    (:func:`.gate.classify_profile`); ``tail_power`` p of its profile's
+    tails, level + A / |s|^p; ``monotone`` whether the profile only rises
+    (a staircase can then be rebuilt, :mod:`.quantisation`);
+    ``subtracts_background`` whether its LSF-like profile is the profile
+    above a fitted background (a bar) rather than a derivative (an edge);
+    ``restore_min_divisor`` the divisor below which the recovered LSF's
+    spectrum is bridged rather than divided.
     """
 
     name: ClassVar[str]
     profile: ClassVar[str]
     tail_power: ClassVar[int]
+    monotone: ClassVar[bool]
+    subtracts_background: ClassVar[bool]
+    restore_min_divisor: ClassVar[float]
 
-    def seed(self, data: np.ndarray, noise: float):
-        """(line, list of gate checks) for the chip, whose pixel noise is
-        ``noise`` (DN)."""
+    def seed(self, data: np.ndarray, noise: float) -> tuple[Line, list[gate.Check]]:
+        """The target's line in the chip and the gate's checks of what else
+        was found, the chip's pixel noise being ``noise`` (DN)."""
         raise NotImplementedError
 
     def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
+        """The target's line fitted through its per-row locations."""
         raise NotImplementedError
 
-    def shape(self, grid, values, d, v, half_range) -> "Shape":
+    def shape(self, grid: np.ndarray, values: np.ndarray, d: np.ndarray, v: np.ndarray,
+              half_range: float) -> Shape:
+        """What the resampled profile (and its samples) say of the target."""
         raise NotImplementedError
 
-    def lsf(self, grid, values, background):
+    def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:
+        """The LSF window's flat half-width at this SNR (``factor``: a
+        user's multiple of the target's width)."""
+        raise NotImplementedError
+
+    def taper_factor(self, snr: float) -> float:
+        """The window's taper as a multiple of its core."""
+        raise NotImplementedError
+
+    def confident_snr(self, rows: int) -> float:
+        """The SNR below which the estimate carries a warning."""
+        raise NotImplementedError
+
+    def lsf(self, grid: np.ndarray, values: np.ndarray,
+            background) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
         """(x, lsf, adjoint): the LSF-like profile on ``x`` and the map of
         weights on ``x`` back to weights on ``grid``."""
         raise NotImplementedError
 
-    def lsf_tail_amplitudes(self, coefficients) -> tuple[np.ndarray, np.ndarray]:
-        """Per side, the linear map from that side's tail coefficients
-        (level, A) to the LSF-like tail amplitude a (a / s^2)."""
+    def lsf_tail_amplitudes(self) -> list[np.ndarray]:
+        """Per side (left, right), the linear map from that side's fitted
+        (level, A) to the LSF-like tail's amplitude a (a / s^2)."""
         raise NotImplementedError
 
-    def divisor(self, step: float, transfer, shape: "Shape"):
+    def divisor(self, step: float, transfer, shape: Shape) -> Callable[[np.ndarray], np.ndarray]:
         """The transfer between the system's LSF and the LSF-like profile."""
+        raise NotImplementedError
+
+    def noise_gain(self, shape: Shape, contrast: float) -> Callable[[np.ndarray], np.ndarray]:
+        """How white sample noise grows with frequency in the MTF."""
+        raise NotImplementedError
+
+    def saturation_sides(self, sides: list) -> list:
+        """The sides the saturation checks examine, named for the user."""
+        raise NotImplementedError
+
+    def peak_mask(self, s: np.ndarray, shape: Shape) -> np.ndarray | None:
+        """The samples of a bar's peak (None for an edge)."""
         raise NotImplementedError
 
 
@@ -501,7 +548,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     sx = x - c
     tail_shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
     model = np.where(sx < 0, amplitudes[0], amplitudes[1]) * tail_shape
-    combined = w * lsf + (1.0 - w) * model
+    combined: np.ndarray = w * lsf + (1.0 - w) * model
     divisor = kind.divisor(step, resampled.transfer if settings.correct else None, shape)
     mtf = corrected_mtf(combined, step, divisor)
     total = float(np.sum(combined) * step)
@@ -518,7 +565,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         return white(f) / np.maximum(np.abs(divisor(f) / divisor(np.zeros(1))), MIN_TRANSFER)
     noise_limit = noise_limited_frequency(mtf, noise_sd)
     x_c, lsf_c = restore_lsf(combined, x, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
-    mtf_nyquist = float(mtf(NYQUIST)[0])
+    mtf_nyquist = float(mtf(np.array([NYQUIST]))[0])
     f50 = mtf50(mtf)
 
     # the gate

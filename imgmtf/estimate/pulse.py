@@ -12,7 +12,6 @@ PRF's tails fall as C / x^2, like an LSF's.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -185,8 +184,8 @@ class PulseEstimator:
                  saturation=None, dtype=None, track_azimuth_deg: float | None = 0.0) -> PulseResult:
         """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
         (estimated from the profile when None); see :func:`measure_pulse`."""
-        m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
-                track_azimuth_deg=track_azimuth_deg)
+        m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
+                dtype=dtype, track_azimuth_deg=track_azimuth_deg)
         f, a = m.figures, m.arrays
         width = f["width_px"]
         band = usable_band(width)

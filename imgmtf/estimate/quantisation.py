@@ -95,7 +95,7 @@ def dequantise(distance: np.ndarray, values: np.ndarray, quantum: float):
     rise = np.interp(0.9, fraction, crossing) - np.interp(0.1, fraction, crossing)
     if rise > 0 and 0.8 * (high - low) / quantum / rise > MAX_CROSSINGS_PER_PX:
         return None
-    from scipy.interpolate import PchipInterpolator, make_smoothing_spline   # slow to import: only when needed
+    from scipy.interpolate import PchipInterpolator, make_smoothing_spline  # slow to import: only when needed
     z = ndtri((thresholds - low) / (high - low))
     if z.size > SMOOTH_ABOVE:
         # many crossings, each placed to within the samples' spacing: smooth

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 from scipy.ndimage import correlate1d
@@ -197,7 +197,7 @@ def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray
     if flat.shape[0] <= 16:
         sums = np.stack([np.bincount(bins, weights=f, minlength=n_bins) for f in flat])
     else:
-        from scipy import sparse      # only for stacks of weights (the bootstrap)
+        from scipy import sparse  # only for stacks of weights (the bootstrap)
         onehot = sparse.csr_array((np.ones(bins.size), (np.arange(bins.size), bins)),
                                   shape=(bins.size, n_bins))
         sums = (onehot.T @ flat.T).T
@@ -257,7 +257,7 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
     lam from the data but costs about a second per profile.)  A stack of
     weight vectors costs one spline fit each.
     """
-    from scipy.interpolate import make_smoothing_spline   # half a second to import: only when asked
+    from scipy.interpolate import make_smoothing_spline  # half a second to import: only when asked
     if not cutoff_cy_px > 0:
         raise ParameterError(f"spline cut-off must be > 0 cycles/pixel, got {cutoff_cy_px}")
     grid = _grid(step, half_range)

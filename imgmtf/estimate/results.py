@@ -3,8 +3,9 @@ results, and its JSON form."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
@@ -94,7 +95,7 @@ class MTFResult:
         return (f"{type(self).__name__}(MTF@Nyquist {self.mtf_nyquist:.4f}{interval}, MTF50 "
                 f"{self.mtf50_cy_px:.4f} cy/px, FWHM {self.fwhm_px:.3f} px, SNR {self.snr:.0f}, "
                 f"normal {self.normal_angle_deg:.2f} deg, {self.direction}, {self.rows_used} rows, "
-                f"method {self.method!r}{', %d warning(s)' % len(self.warnings) if self.warnings else ''})")
+                f"method {self.method!r}{f', {len(self.warnings)} warning(s)' if self.warnings else ''})")
 
     @property
     def mtf50_cy_m(self) -> float | None:
@@ -106,6 +107,8 @@ class MTFResult:
 
     def mtf_at(self, f_cy_px) -> np.ndarray:
         """The corrected MTF at any frequencies (cycles/pixel)."""
+        if self.mtf_function is None:
+            raise ValueError("this result carries no MTF function")
         return self.mtf_function(f_cy_px)
 
     def _specific(self) -> dict:

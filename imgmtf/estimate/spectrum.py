@@ -24,7 +24,7 @@ frequencies where a divisor is smaller are reported as NaN.
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
