@@ -261,12 +261,14 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8, label="Nyquist, 0.5 cy/px")
     ci = result.mtf_nyquist_ci
     yerr = ([[result.mtf_nyquist - ci.low], [ci.high - result.mtf_nyquist]] if np.isfinite(ci.low) else None)
+    interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""
     ax.errorbar([NYQUIST], [result.mtf_nyquist], yerr=yerr, fmt="o", color=c, capsize=3, ms=4,
-                label=f"MTF@Nyquist {result.mtf_nyquist:.4f}" + (f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""))
+                label=f"MTF@Nyquist {_figure(result.mtf_nyquist)}{interval}")
     ci50 = result.mtf50_ci_cy_px
     xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
+    interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
     ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
-                label=f"MTF50 {result.mtf50_cy_px:.4f} cy/px" + (f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""))
+                label=f"MTF50 {_figure(result.mtf50_cy_px)} cy/px{interval50}")
     top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
     ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
     if result.gsd_m:
@@ -276,6 +278,11 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     _title(ax, "MTF")
     ax.legend(fontsize="small")
     return fig
+
+
+def _figure(value: float) -> str:
+    """A figure as the plots print it; a bar's sinc can mask it (NaN)."""
+    return f"{value:.4f}" if np.isfinite(value) else "masked"
 
 
 def plot_measurement(result, truth=None, title: str | None = None):
@@ -290,7 +297,7 @@ def plot_measurement(result, truth=None, title: str | None = None):
     plot_mtf(result, axes[1, 1], truth=truth)
     ci = result.mtf_nyquist_ci
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if np.isfinite(ci.low) else ""
-    summary = (f"MTF at Nyquist {result.mtf_nyquist:.4f}{interval}, MTF50 {result.mtf50_cy_px:.4f} cy/px, "
+    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist)}{interval}, MTF50 {_figure(result.mtf50_cy_px)} cy/px, "
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
     for i, warning in enumerate(result.warnings[:2]):
