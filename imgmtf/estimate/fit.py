@@ -168,14 +168,42 @@ class EdgeFit:
 
 @dataclass(frozen=True, eq=False)
 class SensorFit:
-    """The fitted sensor and everything said about it; see the module
-    docstring.  ``directions`` maps "across" and "along" to the model's MTF
-    at Nyquist and MTF50 (cy/px) with intervals, and whether an edge
-    constrains that axis.  ``correlations`` lists fitted parameter pairs
-    whose correlation exceeds 0.9: the data constrain a combination of them
-    better than each.  ``warnings`` says where the model does not fit an
-    edge and which direction no edge constrains; held and tied parameters
-    say why in their ``note``."""
+    """The fitted sensor and everything said about it (see the module
+    docstring for the method).
+
+    Attributes
+    ----------
+    sensor, start : Sensor
+        The fitted sensor (its TOML is what ``imgmtf fit --out`` writes) and
+        the one the fit started from.
+    parameters : tuple of FittedParameter
+        Every parameter with its value, standard error and unit; held and
+        tied ones say why in their ``note``.
+    correlations : tuple of (str, str, float)
+        Fitted parameter pairs correlated beyond 0.9: the data constrain a
+        combination of them better than each.
+    reduced_chi_square : float
+        Of the residuals, each edge weighted by its noise (1 for a model
+        that fits to the noise).
+    edges : tuple of EdgeFit
+        Per input edge: the model's MTF at Nyquist along its normal (cy/px)
+        with an interval, the measured one, and the misfit statistics.
+    directions : dict
+        "across" and "along": the model's MTF at Nyquist and MTF50 (cy/px)
+        with intervals, and whether an edge constrains that axis.
+    confidence : float
+        Of the intervals.
+    warnings : tuple of str
+        Where the model does not fit an edge, and which direction no edge
+        constrains.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> fit.directions["across"]["constrained"], fit.misfit
+    (True, False)
+    """
 
     sensor: Sensor
     start: Sensor
@@ -260,8 +288,8 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
         An input that cannot be read or has no measurable edge (the
         message names it), or a fit that does not converge.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 60).image for a in (6.0, 84.0)]
     >>> fit = imgmtf.fit_sensor(chips)
