@@ -673,7 +673,9 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
             prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap detection
         from .atomic import ensure_folder
         from .io import raster_info
-        from .scan import ScanSettings, scan_scene, write_outputs
+        from .scene.export import write_outputs
+        from .scene.measure import scan_scene
+        from .scene.settings import ScanSettings
         settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
                                 pulse_width=pulse_width,
                                 intervals=_intervals(interval_method, replicates, confidence))

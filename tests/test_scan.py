@@ -9,7 +9,9 @@ from click.testing import CliRunner
 
 import imgmtf as im
 from imgmtf.cli import main
-from imgmtf.scan import Segment, ScanSettings, merge_segments, pair_bars, scan_scene
+from imgmtf.scene.detect import Segment, merge_segments, pair_bars
+from imgmtf.scene.measure import scan_scene
+from imgmtf.scene.settings import ScanSettings
 
 SCENE = Path(__file__).parent.parent / "data" / "scene.tif"
 TRUTH = json.loads(im.read_raster(SCENE).tags["IMGMTF"])["tiles"]
@@ -111,7 +113,7 @@ def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
 
 
 def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
-    import imgmtf.scan as scan_module
+    import imgmtf.scene.measure as scan_module
     calls = []
 
     def breaks_once(raster, settings):
