@@ -1,4 +1,12 @@
-"""Outputs of a scan: CSV, GeoJSON and the overview figure."""
+"""Outputs of a scan: CSV, GeoJSON and the overview figure.
+
+``targets.csv`` holds every candidate (``scope`` "edge"), then the
+per-target and per-scene summaries (``scope`` "target", "scene"), in the
+schema :data:`imgmtf.records.SCAN_CSV_COLUMNS`; ``targets.geojson`` the
+same records as features (a candidate a LineString, a target a Point at
+its centre, the scene's summaries without geometry); ``overview.png`` the
+scene with its targets (:func:`imgmtf.plot.plot_scan`).
+"""
 from __future__ import annotations
 
 import json
@@ -10,53 +18,90 @@ from ..errors import FileWriteError
 from ..io import RasterInfo, read_raster
 from ..records import SCAN_CSV_COLUMNS, Record, json_safe, write_csv
 from ..version import __version__
-from .detect import _display_levels
+from .detect import display_levels
+
+OVERVIEW_MAX_PX = 1500          # the overview figure's image is decimated to at most this many px a side
+_CURVES = ("frequencies_cy_px", "mtf")
 
 
-def to_geojson(records: list[Record], info: RasterInfo) -> dict:
-    """The candidates as a GeoJSON FeatureCollection of LineStrings.
+def to_geojson(records: list[Record], info: RasterInfo, summaries: list[Record] = ()) -> dict:
+    """The candidates and summaries of a scan as a GeoJSON FeatureCollection.
 
-    Georeferenced scenes (a CRS): geometry in longitude/latitude (WGS 84,
-    as RFC 7946 requires), the scene's own map coordinates in the
-    properties (``map_x0``...).  Scenes without a CRS: geometry in pixel
-    coordinates (x right, y down; the ``imgmtf_coordinates`` member says
-    so).  Every feature's properties carry the pixel coordinates and the
-    record's figures."""
-    rows = [r.to_dict() for r in records]
+    A candidate is a LineString along its segment, a target's summary a
+    Point at the target's centre, a scene's summary a feature without
+    geometry.  Georeferenced scenes (a CRS): geometry in
+    longitude/latitude (WGS 84, as RFC 7946 requires), the scene's own map
+    coordinates in the properties (``map_x0``...).  Scenes without a CRS:
+    geometry in pixel coordinates (x right, y down; the
+    ``imgmtf_coordinates`` member says so).  Every feature's properties
+    carry the pixel coordinates and the record's figures.
+
+    Example
+    -------
+    >>> geo = to_geojson(records, raster_info("scene.tif"), summarise_scan(records))   # doctest: +SKIP
+    >>> geo["features"][0]["geometry"]["type"]                                      # doctest: +SKIP
+    'LineString'
+    """
+    rows = [r.to_dict() for r in (*records, *summaries)]
+    points = [_points(r) for r in rows]
     if info.crs:
         from rasterio.warp import transform as warp
-        xs = [v for r in rows for v in (r["map_x0"], r["map_x1"])]
-        ys = [v for r in rows for v in (r["map_y0"], r["map_y1"])]
-        lon, lat = warp(info.crs, "EPSG:4326", xs, ys) if xs else ([], [])
-        lines = [[[lon[2 * i], lat[2 * i]], [lon[2 * i + 1], lat[2 * i + 1]]] for i in range(len(rows))]
+        flat = [info.transform @ (x + 0.5, y + 0.5) for p in points for x, y in p]
+        lon, lat = warp(info.crs, "EPSG:4326", [x for x, _ in flat], [y for _, y in flat]) if flat else ([], [])
         coordinates = "longitude/latitude (EPSG:4326)"
+        lonlat = iter(zip(lon, lat))
+        points = [[list(next(lonlat)) for _ in p] for p in points]
     else:
-        lines = [[[r["x0_px"], r["y0_px"]], [r["x1_px"], r["y1_px"]]] for r in rows]
         coordinates = "pixel (x right, y down, pixel centres at integers)"
-    features = [{"type": "Feature", "id": r["id"],
-                 "geometry": {"type": "LineString", "coordinates": line},
-                 "properties": {k: v for k, v in r.items() if k not in ("frequencies_cy_px", "mtf")}}
-                for r, line in zip(rows, lines)]
+        points = [[list(xy) for xy in p] for p in points]
+    features = [{"type": "Feature", "id": r.get("id") if r.get("scope") == "edge" else f"{r['scope']}-{k}",
+                 "geometry": _geometry(p),
+                 "properties": {key: value for key, value in r.items() if key not in _CURVES}}
+                for k, (r, p) in enumerate(zip(rows, points))]
     return {"type": "FeatureCollection", "imgmtf_coordinates": coordinates,
             "imgmtf_source": info.path, "imgmtf_version": __version__, "features": features}
 
 
-def write_outputs(records: list[Record], info: RasterInfo, out_dir: str, overview_band=None) -> list[str]:
-    """CSV, GeoJSON and overview PNG of a scan in ``out_dir`` (each written
-    atomically); their paths."""
+def _points(row: dict) -> list[tuple[float, float]]:
+    """A record's points (pixel x, y): a segment's ends, a target's centre, or none."""
+    if "x0_px" in row:
+        return [(row["x0_px"], row["y0_px"]), (row["x1_px"], row["y1_px"])]
+    if "x_px" in row:
+        return [(row["x_px"], row["y_px"])]
+    return []
+
+
+def _geometry(points: list) -> dict | None:
+    if len(points) == 2:
+        return {"type": "LineString", "coordinates": points}
+    if len(points) == 1:
+        return {"type": "Point", "coordinates": points[0]}
+    return None
+
+
+def write_outputs(records: list[Record], info: RasterInfo, out_dir: str, overview_band=None,
+                  summaries: list[Record] = ()) -> list[str]:
+    """``targets.csv``, ``targets.geojson`` and ``overview.png`` of a scan
+    in ``out_dir`` (each written atomically); their paths.
+
+    Raises
+    ------
+    FileWriteError
+        An output cannot be written.
+    """
     from ..plot import plot_scan
     out = ensure_folder(out_dir)
     csv_path, json_path, png_path = (str(out / n) for n in ("targets.csv", "targets.geojson", "overview.png"))
-    write_csv(records, csv_path, SCAN_CSV_COLUMNS)
+    write_csv([*records, *summaries], csv_path, SCAN_CSV_COLUMNS)
     with atomic_output(json_path) as partial:
         try:
-            Path(partial).write_text(json.dumps(json_safe(to_geojson(records, info)), indent=1))
+            Path(partial).write_text(json.dumps(json_safe(to_geojson(records, info, summaries)), indent=1))
         except OSError as exc:
             raise FileWriteError(f"{json_path}: cannot write: {exc.strerror or exc}") from None
-    scale = max(max(info.width, info.height) / 1500, 1.0)
+    scale = max(max(info.width, info.height) / OVERVIEW_MAX_PX, 1.0)
     shape = (max(int(info.height / scale), 1), max(int(info.width / scale), 1))
     overview = read_raster(info.path, overview_band, out_shape=shape).data
-    levels = _display_levels(info.path, overview_band, info)
-    rows = [r.to_dict() for r in records]
-    save_figure(lambda: plot_scan(overview, info.width / shape[1], rows, levels), png_path)
+    levels = display_levels(info.path, overview_band, info)
+    rows, summary_rows = [r.to_dict() for r in records], [r.to_dict() for r in summaries]
+    save_figure(lambda: plot_scan(overview, info.width / shape[1], rows, summary_rows, levels), png_path)
     return [csv_path, json_path, png_path]
