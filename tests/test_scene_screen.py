@@ -42,7 +42,7 @@ def band(levels=(300.0, 1500.0), noise=6.0, ramp=0.0, texture=0.0, seed=0, half=
 
 
 def test_quick_look_passes_a_clean_edge():
-    assert quick_look(*band(), half_width_px=12) is None
+    assert quick_look(*band(), noise_dn=6.0, half_width_px=12) is None
 
 
 @pytest.mark.parametrize("kind, reason", [
@@ -51,5 +51,5 @@ def test_quick_look_passes_a_clean_edge():
     ({"levels": (300.0, 320.0), "noise": 6.0}, "snr"),
 ])
 def test_quick_look_rejects_what_the_gate_would(kind, reason):
-    verdict = quick_look(*band(**kind), half_width_px=12)
+    verdict = quick_look(*band(**kind), noise_dn=kind.get("noise", 6.0), half_width_px=12)
     assert verdict is not None and verdict[0] == reason

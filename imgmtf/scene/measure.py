@@ -25,6 +25,7 @@ import numpy as np
 from ..batch import pulse_width_px
 from ..errors import ImgmtfError
 from ..estimate import gate
+from ..estimate.detection import robust_noise
 from ..estimate.pipeline import direction_label
 from ..inputs import saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
@@ -328,7 +329,8 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
     chip_mask[rows - r0, cols - c0] = True
     roi_box = [int(x + c0), int(y + r0), int(c1 - c0), int(r1 - r0)]
     site = {"roi_polygon_px": roi.corners(t0, t1), "roi": roi_box}
-    verdict = quick_look(data[rows, cols], d, t, roi.half_width_px, plan.bar_width_px)
+    noise = robust_noise(np.where(chip_mask, chip, np.nan))
+    verdict = quick_look(data[rows, cols], d, t, noise, roi.half_width_px, plan.bar_width_px)
     if verdict:
         return rejected(*verdict, verdict_by="screen")
     try:

@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..estimate import gate
-from ..estimate.detection import robust_noise
 from ..estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
 from .settings import ScanSettings
 
@@ -116,13 +115,15 @@ def _grown(mask: np.ndarray, px: int) -> np.ndarray:
     return cv2.dilate(mask.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)).astype(bool)
 
 
-def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, half_width_px: float,
+def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, noise_dn: float, half_width_px: float,
                bar_width_px: float = 0.0) -> tuple[str, str] | None:
     """(reason, message) when a glance at the ROI's pixels says the gate
     would refuse it; None otherwise.
 
     ``values`` are the ROI's pixels (DN), ``d`` their signed distances from
-    the target line and ``t`` their positions along it (px).  Each side
+    the target line and ``t`` their positions along it (px); ``noise_dn``
+    the pixel noise (DN), as the gate measures it
+    (:func:`imgmtf.estimate.detection.robust_noise`).  Each side
     (from ``SIDE_START_PX`` beyond the target, or half the ROI's width,
     whichever is farther) is fitted with a level and a trend across and
     along; the contrast is the difference of the two levels:
@@ -135,7 +136,7 @@ def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, half_width_px: 
       MAX_SIDE_TEXTURE``.
     """
     start = max(SIDE_START_PX, half_width_px / 2) + bar_width_px / 2
-    noise = _pixel_noise(values, d, t)
+    noise = noise_dn
     sides = []
     for side in (d <= -start, d >= start):
         if side.sum() < 12:
@@ -165,22 +166,3 @@ def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, half_width_px: 
                                    f"beyond the pixel noise; the gate allows {100 * gate.MAX_SIDE_TEXTURE:.0f} %): "
                                    "not a uniform field")
     return None
-
-
-def _pixel_noise(values, d, t) -> float:
-    """The pixel noise (DN): the median absolute difference of pixels
-    adjacent along the target (same 1-px strip across it, 1 px apart
-    along it), which the target itself barely changes."""
-    strip = np.round(d).astype(np.int64)
-    step = np.round(t).astype(np.int64)
-    key = (strip - strip.min()) * (int(step.max() - step.min()) + 2) + (step - step.min())
-    order = np.argsort(key, kind="stable")
-    k, v = key[order], values[order]
-    adjacent = np.diff(k) == 1
-    if adjacent.sum() < 10:
-        return robust_noise(values[None, :])
-    diff = np.diff(v)[adjacent]
-    mad = float(np.median(np.abs(diff - np.median(diff))))
-    return max(1.4826 * mad / math.sqrt(2.0), 1e-12)
-
-
