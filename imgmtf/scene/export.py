@@ -20,7 +20,7 @@ from ..records import SCAN_CSV_COLUMNS, Record, json_safe, write_csv
 from ..version import __version__
 from .detect import display_levels
 
-OVERVIEW_MAX_PX = 1500          # the overview figure's image is decimated to at most this many px a side
+OVERVIEW_MAX_PX = 1024          # the overview is read decimated to at most this many px a side (the figure's own)
 _CURVES = ("frequencies_cy_px", "mtf")
 
 
