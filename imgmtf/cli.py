@@ -644,7 +644,7 @@ def _num(value, width: int, decimals: int) -> str:
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
               help="shortest straight line worth measuring, px (a checkerboard's inner line counts whole, "
                    "both halves)")
-@click.option("--max-length", type=FiniteFloat(16), default=300.0, show_default=True,
+@click.option("--max-length", type=FiniteFloat(16, 2048), default=300.0, show_default=True,
               help="longer targets are measured over their central part, px")
 @click.option("--margin", type=click.IntRange(6, 1000), default=12, show_default=True,
               help="ROI extent either side of the target, px")

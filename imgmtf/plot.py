@@ -348,7 +348,7 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     -------
     >>> import numpy as np
     >>> fig = plot_scan(np.zeros((50, 80)), 1.0, [])
-    >>> round(fig.get_figwidth(), 1)
+    >>> float(fig.get_figwidth())
     10.0
     """
     from matplotlib.collections import LineCollection, PolyCollection

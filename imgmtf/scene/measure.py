@@ -176,9 +176,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
 
     Example
     -------
-    >>> records = scan_scene("data/scene.tif")                        # doctest: +SKIP
+    >>> records = scan_scene("data/scene.tif", ScanSettings(track_azimuth_deg=0.0))  # doctest: +SKIP
     >>> [(r.site["rank"], r.figures["mtf_nyquist"]) for r in records if r.ok]  # doctest: +SKIP
-    [(1, 0.2712), (2, 0.2597)]
+    [(1, 0.261544), (2, 0.266206)]
     """
     path = str(path)
     settings = settings or ScanSettings()
@@ -208,16 +208,17 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
         records.append(record)
     batches = _batches(plans, info, settings.tile_px)
+    halves = [half for half, _ in candidates]
 
-    def lost(batch, exc):
+    def lost(task, exc):
+        """Every candidate of a batch whose task died with its worker."""
         return [(plan.index, Record.failed(path, settings.band, settings.target, settings.method, exc,
                                            params=context.params, run_utc=run_utc, status="rejected"))
-                for plan in batch[1]]
+                for plan in task[2]]
     try:
         for _, outcomes in run_tasks(measure_batch, [(context, window, batch) for window, batch in batches],
                                      workers=workers, scheduler=scheduler, progress=progress,
-                                     description="measuring targets", on_error=lambda task, exc: lost(task[1:], exc),
-                                     ordered=False):
+                                     description="measuring targets", on_error=lost, ordered=False):
             for index, outcome in outcomes:
                 records[index] = _measured(records[index], outcome)
     except KeyboardInterrupt as exc:
@@ -226,9 +227,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             if records[i].status == "candidate":
                 records[i] = records[i].with_(status="rejected", reason="interrupted",
                                               error=f"{path}: not measured: the scan was interrupted")
-        exc.records = _ranked(_grouped(records, halves_of(candidates)))
+        exc.records = _ranked(_grouped(records, halves))
         raise
-    return _ranked(_grouped(records, halves_of(candidates)))
+    return _ranked(_grouped(records, halves))
 
 
 def _beside_screen(half: HalfEdge, clearance_px: float) -> tuple[str, str] | None:
@@ -239,10 +240,6 @@ def _beside_screen(half: HalfEdge, clearance_px: float) -> tuple[str, str] | Non
         return "two-targets", (f"another edge runs beside it {clearance_px:.1f} px away: no ROI holds this "
                                "target alone")
     return None
-
-
-def halves_of(candidates) -> list[HalfEdge]:
-    return [half for half, _ in candidates]
 
 
 def _candidates(halves: list[HalfEdge], settings: ScanSettings) -> list[tuple[HalfEdge, tuple[str, str] | None]]:

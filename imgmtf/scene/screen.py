@@ -72,7 +72,7 @@ def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
 
     Example
     -------
-    >>> w = np.full((20, 20), 900.0); w[:, 12:] = 0.0
+    >>> w = np.full((20, 20), 900.0); w[:, :6] = 300.0; w[:, 12:] = 0.0
     >>> int(fill_mask(w, "uint16").sum())
     160
     """

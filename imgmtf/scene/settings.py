@@ -8,6 +8,8 @@ from ..errors import ParameterError
 from ..estimate.intervals import Intervals
 
 MIN_TILE_PX = 256
+MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
+MAX_LENGTH_PX = 2048    # longest stretch of a target measured (its middle); beyond, rows add nothing but time
 
 
 @dataclass(frozen=True)
@@ -60,13 +62,13 @@ class ScanSettings:
     def __post_init__(self):
         if not self.min_length_px >= 16:
             raise ParameterError(f"--min-length must be at least 16 px, got {self.min_length_px}")
-        if not self.max_length_px >= self.min_length_px:
-            raise ParameterError(f"--max-length ({self.max_length_px:g} px) must be at least --min-length "
-                                 f"({self.min_length_px:g} px)")
+        if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
+            raise ParameterError(f"--max-length ({self.max_length_px:g} px) must lie between --min-length "
+                                 f"({self.min_length_px:g} px) and {MAX_LENGTH_PX} px")
         if self.margin_px < 6:
             raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")
-        if not (isinstance(self.tile_px, int) and self.tile_px >= MIN_TILE_PX):
-            raise ParameterError(f"tiles must be at least {MIN_TILE_PX} px, got {self.tile_px!r}")
+        if not (isinstance(self.tile_px, int) and MIN_TILE_PX <= self.tile_px <= MAX_TILE_PX):
+            raise ParameterError(f"tiles must be {MIN_TILE_PX} to {MAX_TILE_PX} px, got {self.tile_px!r}")
         if self.band == "all":
             raise ParameterError("scan one band at a time (--band N)")
         self.measure_settings()
