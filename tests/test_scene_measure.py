@@ -18,15 +18,22 @@ REAL = Path(__file__).parent.parent.parent / "shared" / "data" / "real-scenes"
 TARGET = QuadrantTarget((50.4, 50.3), 16.8, (9300.0, 2000.0, 9200.0, 3900.0), 40.0)
 
 
-@pytest.fixture(scope="module", params=["textured field", "0-fill"])
-def quadrant_scan(request, tmp_path_factory):
-    fill = request.param == "0-fill"
-    scene = render_quadrants(im.Sensor(), (101, 101), TARGET, field_dn=3000 + texture((101, 101), 600, seed=4),
-                             fill=fill, noise_std_dn=25.0, seed=5)
-    path = tmp_path_factory.mktemp("scenes") / f"quadrants_{'fill' if fill else 'field'}.tif"
-    im.write_geotiff(path, scene.image)
-    records = scan_scene(str(path))
-    return scene, records, summarise_scan(records)
+@pytest.fixture(scope="module")
+def quadrant_scans(tmp_path_factory):
+    """The target on a textured field, and cut out of it with a 0-fill:
+    {fill: (scene, records, summaries)}."""
+    out = {}
+    for fill in (False, True):
+        scene = render_quadrants(im.Sensor(), (101, 101), TARGET, field_dn=3000 + texture((101, 101), 600, seed=4),
+                                 fill=fill, noise_std_dn=25.0, seed=5)
+        path = tmp_path_factory.mktemp("scenes") / f"quadrants_{'fill' if fill else 'field'}.tif"
+        im.write_geotiff(path, scene.image)
+        records = scan_scene(str(path))
+        out[fill] = scene, records, summarise_scan(records)
+    return out
+
+
+BOTH = pytest.mark.parametrize("fill", [False, True], ids=["textured field", "0-fill"])
 
 
 def inner_half_edge(record, tolerance_px=3.0):
@@ -41,8 +48,9 @@ def inner_half_edge(record, tolerance_px=3.0):
     return None
 
 
-def test_the_inner_half_edges_are_accepted_within_0015_of_the_true_mtf(quadrant_scan):
-    scene, records, _ = quadrant_scan
+@BOTH
+def test_the_inner_half_edges_are_accepted_within_0015_of_the_true_mtf(quadrant_scans, fill):
+    scene, records, _ = quadrant_scans[fill]
     accepted = [r for r in records if r.ok]
     assert len({inner_half_edge(r) for r in accepted} - {None}) >= 3
     for r in accepted:
@@ -53,17 +61,16 @@ def test_the_inner_half_edges_are_accepted_within_0015_of_the_true_mtf(quadrant_
         assert r.site["target_id"] == 1 and "junction" in " ".join(r.site["ends"])
 
 
-def test_a_boundary_against_fill_is_fill_never_saturated_nor_measured(quadrant_scan):
-    scene, records, _ = quadrant_scan
-    if not scene.fill:
-        pytest.skip("the textured scene has no fill")
+def test_a_boundary_against_fill_is_fill_never_saturated_nor_measured(quadrant_scans):
+    _, records, _ = quadrant_scans[True]
     outer = [r for r in records if inner_half_edge(r, tolerance_px=8.0) is None]
     assert outer and all(r.reason == "fill" and r.site["verdict_by"] == "screen" for r in outer)
     assert not any(r.reason == "saturated" for r in records)
 
 
-def test_one_result_per_direction_combines_the_target_within_its_interval(quadrant_scan):
-    scene, _, summaries = quadrant_scan
+@BOTH
+def test_one_result_per_direction_combines_the_target_within_its_interval(quadrant_scans, fill):
+    scene, _, summaries = quadrant_scans[fill]
     targets = [s for s in summaries if s.site["scope"] == "target"]
     assert sorted(round(s.figures["normal_angle_deg"]) for s in targets) == [-73, 17]
     for s in targets:
