@@ -21,8 +21,8 @@ Timed, in this process, after one warm-up run of each:
    ``cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD).detect`` on each;
 2. ``imgmtf.scene.measure.scan_scene`` (detection, screening, measurement,
    intervals of the accepted, combination) with 1 worker;
-3. the ``imgmtf scan`` command with ``--out`` (a new process: its start-up
-   and the outputs included).
+3. the ``imgmtf scan`` command, without and with ``--out`` (a new process:
+   its start-up, about 1 s of imports, and its outputs included).
 
 Printed: the load average (the machine is shared: time when it is low),
 both times, their ratio (budget: scan within 3 x LSD, aim 1.5 x), the
@@ -168,10 +168,14 @@ def main() -> None:
     print(f"scan_scene, 1 worker ({len(records)} candidates):       {scan_s:6.2f} s   "
           f"{scan_s / lsd_s:.2f} x LSD (budget 3 x, aim 1.5 x)")
     if not args.no_cli:
+        command = [shutil.which("imgmtf") or "imgmtf", "scan", str(path)]
         with tempfile.TemporaryDirectory() as out:
-            cmd = [shutil.which("imgmtf") or "imgmtf", "scan", str(path), "--out", out, "--format", "json"]
-            cli_s, _ = timed(lambda: subprocess.run(cmd, capture_output=True, check=False), 1)
-        print(f"imgmtf scan --out (new process, outputs written): {cli_s:6.2f} s   {cli_s / lsd_s:.2f} x LSD")
+            for label, extra in (("imgmtf scan SCENE (a new process, text table)", []),
+                                 ("imgmtf scan SCENE --out DIR (CSV, GeoJSON, overview)", ["--out", out])):
+                def run(extra=extra):
+                    subprocess.run(command + extra, capture_output=True, check=False)
+                cli_s, _ = timed(run, 1)
+                print(f"{label + ':':52s} {cli_s:6.2f} s   {cli_s / lsd_s:.2f} x LSD")
     print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     reasons = Counter(r.reason or r.status for r in records)
     print("candidates: " + ", ".join(f"{k} {v}" for k, v in reasons.most_common()))
