@@ -61,7 +61,7 @@ def test_one_summary_per_target_and_direction_and_per_scene():
     records = [edge(1, 5.0, 0.26, 0.01, 1), edge(2, -85.0, 0.24, 0.01, 1, 50), edge(3, 4.0, 0.28, 0.01, 1, 100),
                edge(4, 6.0, 0.27, 0.02, 2, 300)]
     rejected = Record("s.tif", 1, "edge", "msg", "rejected", "fill", "s.tif: fill", site={"id": 5})
-    out = summarise_scan(records + [rejected])
+    out = summarise_scan([*records, rejected])
     keys = [(r.site["scope"], r.site.get("target_id"), r.figures["direction"], r.figures["n_edges"]) for r in out]
     assert keys == [("target", 1, "across-track", 2), ("target", 1, "along-track", 1),
                     ("target", 2, "across-track", 1), ("scene", None, "across-track", 3),

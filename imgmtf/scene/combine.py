@@ -153,8 +153,8 @@ def summarise_scan(records: list[Record]) -> list[Record]:
     if not accepted:
         return []
     families = normal_families([r.figures["normal_angle_deg"] for r in accepted])
-    out = []
-    targets = sorted({r.site.get("target_id") for r in accepted if r.site.get("target_id") is not None})
+    out: list[Record] = []
+    targets = sorted({int(r.site["target_id"]) for r in accepted if r.site.get("target_id") is not None})
     for target in targets:
         members = [(r, f) for r, f in zip(accepted, families) if r.site.get("target_id") == target]
         out += _family_records(members, {"scope": "target", "target_id": target})

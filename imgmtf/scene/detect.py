@@ -144,7 +144,8 @@ def detect_segments(path: str, settings: ScanSettings | None = None) -> tuple[np
     check_scene_size(info)
     lo, hi = display_levels(path, settings.band, info)
     detector = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
-    pieces, beside_fill = [], []
+    found_pieces: list[np.ndarray] = []
+    found_fill: list[np.ndarray] = []
     step = settings.tile_px - TILE_OVERLAP_PX
     for y in range(0, max(info.height - TILE_OVERLAP_PX, 1), step):
         for x in range(0, max(info.width - TILE_OVERLAP_PX, 1), step):
@@ -153,11 +154,11 @@ def detect_segments(path: str, settings: ScanSettings | None = None) -> tuple[np
             found = detector.detect(to_8bit(tile, lo, hi))[0]
             if found is not None:
                 found = found.reshape(-1, 4).astype(float)
-                pieces.append(found + (x, y, x, y))
-                beside_fill.append(_fill_beside(found, fill_mask(tile, info.dtype)))
-    if not pieces:
+                found_pieces.append(found + np.array([x, y, x, y], float))
+                found_fill.append(_fill_beside(found, fill_mask(tile, info.dtype)))
+    if not found_pieces:
         return np.zeros((0, 4)), np.zeros(0)
-    pieces, beside_fill = np.concatenate(pieces), np.concatenate(beside_fill)
+    pieces, beside_fill = np.concatenate(found_pieces), np.concatenate(found_fill)
     label = _merge_labels(pieces)
     merged = _joined(pieces, label)
     lengths = _lengths(pieces)
@@ -342,10 +343,10 @@ def _joined(pieces: np.ndarray, label: np.ndarray) -> np.ndarray:
     lengths, units = _lengths(pieces), _units(pieces)
     weight = np.bincount(label, lengths, groups)
     direction = np.column_stack([np.bincount(label, lengths * units[:, k], groups) for k in (0, 1)])
-    direction /= np.maximum(np.linalg.norm(direction, axis=1), 1e-12)[:, None]
+    direction = direction / np.maximum(np.linalg.norm(direction, axis=1), 1e-12)[:, None]
     mid = (pieces[:, :2] + pieces[:, 2:]) / 2
-    centre = np.column_stack([np.bincount(label, lengths * mid[:, k], groups) for k in (0, 1)])
-    centre /= np.maximum(weight, 1e-12)[:, None]
+    centre = np.column_stack([np.bincount(label, lengths * mid[:, k], groups)
+                              for k in (0, 1)]) / np.maximum(weight, 1e-12)[:, None]
     t_ends = np.concatenate([np.einsum("ij,ij->i", pieces[:, :2] - centre[label], direction[label]),
                              np.einsum("ij,ij->i", pieces[:, 2:] - centre[label], direction[label])])
     both = np.concatenate([label, label])
@@ -405,7 +406,8 @@ def find_junctions(segments: np.ndarray) -> tuple[list[Junction], np.ndarray]:
     close = cKDTree(x).query_pairs(JUNCTION_MERGE_PX, output_type="ndarray")
     graph = coo_matrix((np.ones(len(close)), (close[:, 0], close[:, 1])), shape=(len(x), len(x)))
     count, label = connected_components(graph, directed=False)
-    centre = np.column_stack([np.bincount(label, x[:, k], count) for k in (0, 1)]) / np.bincount(label, None, count)[:, None]
+    members_n = np.bincount(label, None, count)[:, None]
+    centre = np.column_stack([np.bincount(label, x[:, k], count) for k in (0, 1)]) / members_n
     events = np.vstack([np.column_stack([a, b, label, ta]), np.column_stack([b, a, label, tb])])
     members = np.unique(events[:, [0, 2]].astype(int), axis=0)
     degree = np.bincount(members[:, 1], None, count).astype(int)
@@ -563,5 +565,6 @@ def pair_bars(segments: list[Segment]) -> tuple[list[int], list[tuple[int, int, 
         start, end = max(min(t0[k], t1[k]), 0.0), min(max(t0[k], t1[k]), lengths[i])
         c0 = s[i, :2] + start * u + shift * normal
         c1 = s[i, :2] + end * u + shift * normal
-        bars.append((i, j, Segment(*c0, *c1, width_px=float(2 * abs(shift)))))
+        bars.append((i, j, Segment(float(c0[0]), float(c0[1]), float(c1[0]), float(c1[1]),
+                                   width_px=float(2 * abs(shift)))))
     return [i for i in range(n) if not taken[i]], bars

@@ -10,6 +10,7 @@ scene with its targets (:func:`imgmtf.plot.plot_scan`).
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 
 from ..atomic import atomic_output, ensure_folder
@@ -24,7 +25,7 @@ OVERVIEW_MAX_PX = 1024          # the overview is read decimated to at most this
 _CURVES = ("frequencies_cy_px", "mtf")
 
 
-def to_geojson(records: list[Record], info: RasterInfo, summaries: list[Record] = ()) -> dict:
+def to_geojson(records: Sequence[Record], info: RasterInfo, summaries: Sequence[Record] = ()) -> dict:
     """The candidates and summaries of a scan as a GeoJSON FeatureCollection.
 
     A candidate is a LineString along its segment, a target's summary a
@@ -43,17 +44,18 @@ def to_geojson(records: list[Record], info: RasterInfo, summaries: list[Record] 
     'LineString'
     """
     rows = [r.to_dict() for r in (*records, *summaries)]
-    points = [_points(r) for r in rows]
+    pixels = [_points(r) for r in rows]
+    points: list[list[list[float]]]
     if info.crs:
         from rasterio.warp import transform as warp
-        flat = [info.transform @ (x + 0.5, y + 0.5) for p in points for x, y in p]
+        flat = [info.transform @ (x + 0.5, y + 0.5) for p in pixels for x, y in p]
         lon, lat = warp(info.crs, "EPSG:4326", [x for x, _ in flat], [y for _, y in flat]) if flat else ([], [])
         coordinates = "longitude/latitude (EPSG:4326)"
         lonlat = iter(zip(lon, lat))
-        points = [[list(next(lonlat)) for _ in p] for p in points]
+        points = [[list(next(lonlat)) for _ in p] for p in pixels]
     else:
         coordinates = "pixel (x right, y down, pixel centres at integers)"
-        points = [[list(xy) for xy in p] for p in points]
+        points = [[list(xy) for xy in p] for p in pixels]
     features = [{"type": "Feature", "id": r.get("id") if r.get("scope") == "edge" else f"{r['scope']}-{k}",
                  "geometry": _geometry(p),
                  "properties": {key: value for key, value in r.items() if key not in _CURVES}}
@@ -79,8 +81,8 @@ def _geometry(points: list) -> dict | None:
     return None
 
 
-def write_outputs(records: list[Record], info: RasterInfo, out_dir: str, overview_band=None,
-                  summaries: list[Record] = ()) -> list[str]:
+def write_outputs(records: Sequence[Record], info: RasterInfo, out_dir: str, overview_band=None,
+                  summaries: Sequence[Record] = ()) -> list[str]:
     """``targets.csv``, ``targets.geojson`` and ``overview.png`` of a scan
     in ``out_dir`` (each written atomically); their paths.
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -196,7 +197,8 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], segments,
                                             settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
-    records, plans = [], []
+    records: list[Record] = []
+    plans: list[Plan] = []
     for (half, verdict), clearance in zip(candidates, beside):
         record = _candidate_record(half, context)
         verdict = verdict or _beside_screen(half, clearance)
@@ -227,7 +229,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             if records[i].status == "candidate":
                 records[i] = records[i].with_(status="rejected", reason="interrupted",
                                               error=f"{path}: not measured: the scan was interrupted")
-        exc.records = _ranked(_grouped(records, halves))
+        exc.records = _ranked(_grouped(records, halves))  # type: ignore[attr-defined]  # what the caller keeps
         raise
     return _ranked(_grouped(records, halves))
 
@@ -288,7 +290,7 @@ def measure_batch(task) -> list[tuple[int, Record]]:
     for plan in plans:
         try:
             out.append((plan.index, measure_candidate(plan, raster, context)))
-        except Exception as exc:  # noqa: BLE001 -- the safety net: one candidate, never the scan
+        except Exception as exc:       # the safety net: one candidate, never the scan
             out.append((plan.index, Record.failed(context.path, raster.band, context.settings.target,
                                                   context.settings.method, exc, params=context.params,
                                                   run_utc=context.run_utc, status="rejected")))
@@ -309,7 +311,7 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
     t, d = t[rows, cols], d[rows, cols]
     fill = fill_mask(data, info.dtype)
     extent = _clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
-    site = {"roi_polygon_px": roi.corners()}
+    site: dict[str, Any] = {"roi_polygon_px": roi.corners()}
 
     def rejected(reason: str, message: str, **more) -> Record:
         return Record(context.path, raster.band, settings.target, settings.method, "rejected", reason,
@@ -504,6 +506,6 @@ def _ranked(records: list[Record]) -> list[Record]:
     out = []
     for i, (r, rank) in enumerate(ranked, 1):
         site = {k: v for k, v in r.site.items() if k != "group"}
-        target = target_ids.get(r.site.get("group"))
+        target = target_ids.get(r.site["group"]) if "group" in r.site else None
         out.append(replace(r, site={"id": i, "rank": rank, "target_id": target, **site}))
     return out

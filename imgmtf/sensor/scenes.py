@@ -115,12 +115,11 @@ def texture(shape: tuple[int, int], std_dn: float, seed: int | None = None,
     """
     import cv2
     rng = np.random.default_rng(seed)
-    out = np.zeros(shape, np.float32)
+    out = np.zeros(shape)
     for sigma in scales_px:
-        layer = cv2.GaussianBlur(rng.standard_normal(shape, dtype=np.float32), (0, 0), sigma)
-        out += layer / max(float(layer.std()), 1e-12)
-    out *= std_dn / max(float(out.std()), 1e-12)
-    return out.astype(float)
+        layer = cv2.GaussianBlur(rng.standard_normal(shape, dtype=np.float32), (0, 0), sigma).astype(float)
+        out = out + layer / max(float(layer.std()), 1e-12)
+    return out * (std_dn / max(float(out.std()), 1e-12))
 
 
 def render_quadrants(sensor: Sensor, shape: tuple[int, int], target: QuadrantTarget, *,
