@@ -736,8 +736,8 @@ def _print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
         else:
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error']}")
     if summaries:
-        click.echo("combined per target and per direction (weighted by precision; consistency: the Birge "
-                   "ratio, over 1 when the half-edges disagree beyond their intervals):")
+        click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
+                   "the half-edges disagree beyond their intervals):")
         click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
                    f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'consist.':>8}")
         for summary in summaries:

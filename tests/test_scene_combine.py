@@ -32,6 +32,11 @@ def test_disagreeing_estimates_widen_the_interval_by_the_birge_ratio():
     assert (c.high - c.low) / 2 == pytest.approx(ndtri(0.975) * sd / math.sqrt(3) * 10.0)
 
 
+def test_one_estimate_keeps_its_own_interval():
+    c = combine([0.26], [(0.25, 0.27)], [40])
+    assert (c.value, c.low, c.high, c.weights) == (0.26, 0.25, 0.27, "inverse-variance")
+
+
 def test_without_intervals_the_mean_is_plain_and_has_none():
     c = combine([0.2, 0.3, float("nan")], [(float("nan"),) * 2] * 3, [40] * 3)
     assert c.value == pytest.approx(0.25) and math.isnan(c.low) and c.weights == "equal"

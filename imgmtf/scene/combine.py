@@ -93,7 +93,7 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
         interval, widened by the Birge ratio sqrt(chi^2 / (n - 1)) when that
         exceeds 1 (the estimates scatter more than their intervals say; the
         Particle Data Group's scale factor).  Without finite intervals, the
-        plain mean and no interval.
+        plain mean and no interval.  One estimate keeps its own interval.
 
     Raises
     ------
@@ -114,6 +114,9 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     if not finite.any():
         raise ValueError("no finite value to combine")
     x, bounds, rows = x[finite], bounds[finite], rows[finite]
+    if x.size == 1:                     # one estimate: its own interval, as the estimator gave it
+        return Combined(float(x[0]), float(bounds[0, 0]), float(bounds[0, 1]), math.nan,
+                        "inverse-variance" if np.isfinite(bounds[0]).all() else "equal")
     half = (bounds[:, 1] - bounds[:, 0]) / 2
     quantile = stdtrit(np.maximum(rows - 1, 1), 0.5 + confidence / 2)
     sd = half / quantile
