@@ -35,6 +35,7 @@ _LAZY = {
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records",
+    "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
 }
 

@@ -642,40 +642,51 @@ def _num(value, width: int, decimals: int) -> str:
 @click.argument("scene", type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
-              help="shortest usable target, px along it")
-@click.option("--max-length", type=FiniteFloat(16), default=300.0, show_default=True,
+              help="shortest straight line worth measuring, px (a checkerboard's inner line counts whole, "
+                   "both halves)")
+@click.option("--max-length", type=FiniteFloat(16, 2048), default=300.0, show_default=True,
               help="longer targets are measured over their central part, px")
 @click.option("--margin", type=click.IntRange(6, 1000), default=12, show_default=True,
-              help="ROI extent beyond the target, px")
+              help="ROI extent either side of the target, px")
 @click.option("--pulse-width", callback=_length_option("px"),
               help="bar width (px or m) for every bar; estimated per bar when omitted")
 @click.option("--method", type=MethodName(), default="msg", show_default=True)
 @click.option("--band", type=click.IntRange(min=1),
               help="1-based band (default: the only band, or the luminance of RGB)")
+@click.option("--saturation", callback=_parse_pair, metavar="LO,HI",
+              help="DN range the sensor records (default: an integer file's type range)")
+@click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
+              help="the ground track's direction in the image, degrees clockwise from up (default: "
+                   "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
               help="write targets.csv, targets.geojson and overview.png here")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @_interval_options
 @_parallel_options
-def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, out_dir, fmt, progress,
-         interval_method, replicates, confidence, workers, scheduler):
-    """Find every straight edge (or bar) in SCENE, measure the usable ones
-    and say why the others were rejected.  Exit status 1 when none is
-    usable; on Ctrl-C or SIGTERM the candidates measured so far are
-    reported and written (130 or 143)."""
+def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
+         out_dir, fmt, progress, interval_method, replicates, confidence, workers, scheduler):
+    """Find every straight edge (or bar) in SCENE, split at junctions into
+    half-edges (checkerboards, four-quadrant and cross targets), measure
+    each on its own ROI, say why the others were rejected, and combine the
+    accepted half-edges of each target and of the scene into one result
+    per direction.  Exit status 1 when none is usable; on Ctrl-C or SIGTERM
+    the candidates measured so far are reported and written (130 or 143)."""
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     interrupted = None
     with _reported_errors():
         from .parallel import prestart_workers
         if scheduler is None:
-            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap detection
+            prestart_workers(workers, ["imgmtf.scene.measure"])     # their imports overlap detection
         from .atomic import ensure_folder
         from .io import raster_info
-        from .scan import ScanSettings, scan_scene, write_outputs
+        from .scene.combine import summarise_scan
+        from .scene.export import write_outputs
+        from .scene.measure import scan_scene
+        from .scene.settings import ScanSettings
         settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
-                                pulse_width=pulse_width,
+                                pulse_width=pulse_width, saturation=saturation, track_azimuth_deg=track_azimuth,
                                 intervals=_intervals(interval_method, replicates, confidence))
         if out_dir:
             ensure_folder(out_dir)
@@ -686,8 +697,9 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
             records, interrupted = getattr(exc, "records", None), exc
             if records is None:
                 raise
-        written = write_outputs(records, info, out_dir, band) if out_dir else []
-        _print_scan(scene, info, kind, records, written, fmt)
+        summaries = summarise_scan(records)
+        written = write_outputs(records, info, out_dir, band, summaries) if out_dir else []
+        _print_scan(scene, info, kind, records, summaries, written, fmt)
     if interrupted is not None:
         measured = sum(r.reason != "interrupted" for r in records)
         click.echo(f"imgmtf: interrupted ({_signal_name(interrupted)}): {measured} of {len(records)} "
@@ -700,31 +712,51 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
         sys.exit(1)
 
 
-def _print_scan(scene, info, kind, records, written, fmt) -> None:
+def _print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
     if fmt == "json":
         from .records import to_json
-        for r in records:
+        for r in (*records, *summaries):
             click.echo(to_json(r))
         return
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
                f"{kind}s, {accepted} accepted")
-    click.echo(f"{'id':>3} {'rank':>4} {'dir':>6} {'len px':>6} {'tilt':>6} {'SNR':>6} {'MTF@Nyq':>7} "
+    click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
                f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
+    click.echo(f"{'':>4} {'':>4} {'':>3} {'':>7} {'deg':>7} {'px':>5} {'':>5} {'':>7} {'':>15} {'cy/px':>7}")
     for record in records:
         r = record.to_dict()
-        roi = ",".join(str(v) for v in r["roi"])
-        head = (f"{r['id']:>3} {r.get('rank') or '':>4} {r['direction'].split('-')[0]:>6} "
-                f"{r['length_px']:6.0f} {r['tilt_deg']:6.2f}")
+        head = (f"{r['id']:>4} {r.get('rank') or '':>4} {r.get('target_id') or '':>3} "
+                f"{_DIRECTIONS.get(r.get('direction'), r.get('direction') or '-'):>7} "
+                f"{_num(r.get('normal_angle_deg'), 7, 2)} {r['length_px']:5.0f}")
         if record.ok:
-            lo, hi = r.get("mtf_nyquist_ci") or (None, None)
-            interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
-            click.echo(f"{head} {_num(r.get('snr'), 6, 0)} {_num(r.get('mtf_nyquist'), 7, 4)} "
-                       f"{interval:>15} {_num(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
+            roi = ",".join(str(v) for v in r["roi"])
+            click.echo(f"{head} {_num(r.get('snr'), 5, 0)} {_num(r.get('mtf_nyquist'), 7, 4)} "
+                       f"{_interval(r.get('mtf_nyquist_ci')):>15} {_num(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
         else:
-            click.echo(f"{head} {'rejected':>38}  {r['reason']}: {r['error']}")
+            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error']}")
+    if summaries:
+        click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
+                   "the half-edges disagree beyond their intervals):")
+        click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
+                   f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'consist.':>8}")
+        for summary in summaries:
+            r = summary.to_dict()
+            click.echo(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
+                       f"{_DIRECTIONS.get(r['direction'], r['direction']):>7} {_num(r['normal_angle_deg'], 7, 2)} "
+                       f"{r['n_edges']:>5} {_num(r['mtf_nyquist'], 7, 4)} {_interval(r['mtf_nyquist_ci']):>15} "
+                       f"{_num(r.get('mtf50_cy_px'), 7, 4)} {_interval(r.get('mtf50_ci_cy_px')):>15} "
+                       f"{_num(r.get('consistency'), 8, 2)}")
     for path in written:
         click.echo(f"wrote {path}")
+
+
+_DIRECTIONS = {"across-track": "across", "along-track": "along"}
+
+
+def _interval(pair) -> str:
+    lo, hi = pair or (None, None)
+    return f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
 
 
 # -- reproduce ----------------------------------------------------------------

@@ -308,33 +308,111 @@ def plot_measurement(result, truth=None, title: str | None = None):
 
 
 # -- a scene scan ------------------------------------------------------------------
-def plot_scan(overview: np.ndarray, scale: float, records, levels=None, ax=None):
-    """The scene (``overview``, decimated by ``scale`` scene px per overview
-    px, shown between ``levels`` = (black, white) DN) with every candidate's
-    ROI: accepted ones green, labelled with their rank and MTF at Nyquist;
-    rejected ones red, labelled with id and reason."""
-    from matplotlib.patches import Rectangle
+_DIRECTION_SHORT = {"across-track": "across", "along-track": "along", "oblique": "oblique", "unknown": ""}
+
+
+def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=None, ax=None,
+              width_in: float = 10.0):
+    """The overview of a scan: the scene with its accepted targets
+    prominent and labelled, its rejected candidates faint.
+
+    Parameters
+    ----------
+    overview : 2-D array, the scene decimated by ``scale`` scene px per
+        overview px (DN).
+    scale : scene pixels per overview pixel.
+    records : the candidates' flat records (``Record.to_dict()``):
+        accepted ones are drawn as their tilted ROI (``roi_polygon_px``)
+        and segment in green; rejected ones as a thin faint line coloured
+        by reason, each reason counted in the legend.
+    summaries : the per-target summaries (``scope`` "target"): each
+        target is labelled at its centre with, per direction, MTF at
+        Nyquist and MTF50 (cy/px).
+    levels : (black, white) DN of the display; default the 0.5 and 99.5
+        percentiles.
+    ax : an axes to draw on; a new figure, sized to the scene's aspect
+        with no blank margins, when None.
+    width_in : the new figure's width (inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Notes
+    -----
+    Drawn with one collection per reason and one for the accepted ROIs,
+    so that a scene with thousands of candidates draws in a fraction of a
+    second.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> fig = plot_scan(np.zeros((50, 80)), 1.0, [])
+    >>> float(fig.get_figwidth())
+    10.0
+    """
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.lines import Line2D
     height, width = overview.shape
-    fig, ax = _axes(ax, size=(min(12.0, 3 + 8 * width / max(height, width)),
-                              min(9.0, 2 + 8 * height / max(height, width))))
-    lo, hi = levels or (np.nanpercentile(overview, [0.5, 99.5]) if np.isfinite(overview).any() else (0, 1))
+    extent_w, extent_h = width * scale, height * scale
+    if ax is None:
+        margins = (0.55, 0.1, 0.4, 0.45)            # left, right, bottom, top (in): tick labels, title
+        image_w = width_in - margins[0] - margins[1]
+        image_h = image_w * extent_h / max(extent_w, 1e-9)
+        fig = Figure(figsize=(width_in, image_h + margins[2] + margins[3]))
+        fig_h = fig.get_figheight()
+        ax = fig.add_axes((margins[0] / width_in, margins[2] / fig_h, image_w / width_in, image_h / fig_h))
+    fig = ax.figure
+    finite = np.isfinite(overview)
+    lo, hi = levels or (np.percentile(overview[finite], [0.5, 99.5]) if finite.any() else (0.0, 1.0))
     ax.imshow(overview, cmap="gray", vmin=lo, vmax=hi if hi > lo else lo + 1,
-              extent=(-0.5, width * scale - 0.5, height * scale - 0.5, -0.5), interpolation="nearest")
-    for r in records:
-        x, y, w, h = r["roi"]
-        accepted = r["status"] == "accepted"
-        colour = "tab:green" if accepted else "tab:red"
-        ax.add_patch(Rectangle((x - 0.5, y - 0.5), w, h, fill=False, lw=1.2 if accepted else 0.7,
-                               ec=colour, alpha=1.0 if accepted else 0.7))
-        ax.plot([r["x0_px"], r["x1_px"]], [r["y0_px"], r["y1_px"]], color=colour, lw=0.8)
-        label = (f"#{r['rank']} {r['mtf_nyquist']:.3f}" if accepted and r.get("mtf_nyquist") is not None
-                 else f"{r['id']}: {r['reason']}")
-        ax.annotate(label, (x, y), xytext=(1, -1), textcoords="offset points", fontsize=6,
-                    color=colour, va="bottom", bbox=dict(fc="white", ec="none", alpha=0.6, pad=0.5))
-    n_ok = sum(r["status"] == "accepted" for r in records)
-    ax.set(title=f"{n_ok} accepted (rank, MTF at Nyquist), {len(records) - n_ok} rejected",
-           xlabel="x (px)", ylabel="y (px)")
+              extent=(-0.5, extent_w - 0.5, extent_h - 0.5, -0.5), interpolation="nearest")
+    ax.set(xlim=(-0.5, extent_w - 0.5), ylim=(extent_h - 0.5, -0.5))
+    ax.tick_params(labelsize=7)
+    accepted = [r for r in records if r.get("status") == "accepted"]
+    rejected = [r for r in records if r.get("status") != "accepted"]
+    handles = []
+    by_reason: dict[str, list] = {}
+    for r in rejected:
+        by_reason.setdefault(r.get("reason") or "rejected", []).append(
+            [(r["x0_px"], r["y0_px"]), (r["x1_px"], r["y1_px"])])
+    palette = ["#ff7f0e", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f",
+               "#1f77b4", "#aec7e8", "#ffbb78", "#c5b0d5"]
+    for k, (reason, lines) in enumerate(sorted(by_reason.items(), key=lambda kv: -len(kv[1]))):
+        colour = palette[k % len(palette)]
+        ax.add_collection(LineCollection(lines, colors=colour, linewidths=0.6, alpha=0.45))
+        handles.append(Line2D([], [], color=colour, lw=1.5, alpha=0.7, label=f"{reason} ({len(lines)})"))
+    if accepted:
+        polygons = [r["roi_polygon_px"] for r in accepted if r.get("roi_polygon_px")]
+        ax.add_collection(PolyCollection(polygons, facecolors=(0.2, 1.0, 0.2, 0.08), edgecolors="#00e000",
+                                         linewidths=1.0))
+        ax.add_collection(LineCollection([[(r["x0_px"], r["y0_px"]), (r["x1_px"], r["y1_px"])] for r in accepted],
+                                         colors="#00ff00", linewidths=1.6))
+        handles.insert(0, Line2D([], [], color="#00e000", lw=2.5, label=f"accepted ({len(accepted)})"))
+    targets = [s for s in summaries if s.get("scope") == "target"]
+    for target_id in sorted({s["target_id"] for s in targets}):
+        rows = [s for s in targets if s["target_id"] == target_id]
+        lines = [f"T{target_id}"] + [
+            f"{_DIRECTION_SHORT.get(s['direction'], s['direction'])} {s['normal_angle_deg']:.0f}\u00b0: "
+            f"{_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}" for s in rows]
+        x, y = rows[0]["x_px"], rows[0]["y_px"]
+        right, low = x > 0.7 * extent_w, y < 0.15 * extent_h       # keep the label inside the image
+        ax.annotate("\n".join(lines), (x, y), xytext=(-6 if right else 6, -6 if low else 6),
+                    textcoords="offset points", fontsize=6.5, color="black", va="top" if low else "bottom",
+                    ha="right" if right else "left", annotation_clip=True,
+                    bbox={"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.8), "ec": "#00a000", "lw": 0.8})
+    n_targets = len({s["target_id"] for s in targets})
+    ax.set_title(f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
+                 f"target{'s' * (n_targets != 1)} (labels: MTF at Nyquist | MTF50 cy/px per direction); "
+                 f"{len(rejected)} rejected", fontsize=8, loc="left")
+    if handles:
+        ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8, title="candidates",
+                  title_fontsize=7)
     return fig
+
+
+def _num(value) -> str:
+    return "-" if value is None else f"{value:.3f}"
 
 
 # -- the reproduction study ----------------------------------------------------

@@ -12,12 +12,13 @@ estimator's settings with the run's: bootstrap, ROI, scan thresholds...),
 The JSON form (:meth:`Record.to_dict`) is flat: the estimate's own keys
 (:meth:`imgmtf.estimate.results.MTFResult.to_dict`, units in the names)
 beside the provenance.  The CSV schema is :data:`CSV_COLUMNS`; a scan's CSV
-adds the columns of :data:`SCAN_COLUMNS` (where the target lies).
+adds the columns of :data:`SCAN_COLUMNS` (where the target lies, and the
+per-target and per-scene summaries).
 
 Reason codes of failed records: those of :mod:`imgmtf.errors`
 (``unreadable``, ``too-large``, ``unsupported-type``, ``image``,
 ``no-target``, ``two-targets``, ``unsuitable``, ``parameter``...), the
-scan's screening codes (``angle``, ``too-short``, ``non-uniform``...), and
+scan's screening codes (``angle``, ``too-short``, ``fill``, ``non-uniform``...), and
 ``internal`` for an unexpected failure of the software on that input.
 """
 from __future__ import annotations
@@ -36,7 +37,7 @@ from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
 from .version import __version__
 
-OK_STATUSES = ("ok", "accepted")
+OK_STATUSES = ("ok", "accepted", "combined")
 FAILED_STATUSES = ("error", "rejected")
 INTERNAL = "internal"
 
@@ -66,7 +67,8 @@ class Record:
     method : str
         The resampling method.
     status : str
-        ``ok``/``error`` (measure), ``accepted``/``rejected`` (scan).
+        ``ok``/``error`` (measure), ``accepted``/``rejected`` (a scan
+        candidate), ``combined`` (a scan's summary of a target or scene).
     reason : str or None
         Machine-readable code of a failure (``unreadable``, ``two-targets``,
         ``saturated``...; None when ok).
@@ -76,7 +78,8 @@ class Record:
         The estimate's JSON summary (units in the names: ``mtf50_cy_px``,
         ``fwhm_px``...), empty for a failure.
     site : mapping
-        Where a scan candidate lies (``id``, ``rank``, ``x0_px``...); empty
+        Where a scan candidate lies (``id``, ``rank``, ``scope``,
+        ``target_id``, ``x0_px``...), or what a scan summary covers; empty
         for ``measure``.
     plot : str or None
         The figure written for this record, if any.
@@ -225,10 +228,17 @@ CURVE_COLUMNS = tuple(f"mtf_at_{f:.2f}_cy_px" for f in CURVE_FREQUENCIES_CY_PX)
 CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # what a scan adds: the candidate's rank and where it lies in the scene
 # (pixel coordinates, x right, y down; map coordinates in the scene's CRS
-# units), and its screening figures
+# units), its screening figures and which stage gave its verdict
+# (``verdict_by``: ``screen`` or ``gate``); ``scope`` tells a candidate
+# (``edge``) from a summary that combines the accepted half-edges of a
+# target or of the scene per direction (``target``, ``scene``), with its
+# ``n_edges``, ``edge_ids`` (the candidates' ids), ``consistency`` (the
+# Birge ratio of their MTF at Nyquist) and a target's centre (``x_px``,
+# ``y_px``)
 SCAN_COLUMNS = (
-    "id", "rank", "x0_px", "y0_px", "x1_px", "y1_px", "length_px",
-    "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation",
+    "id", "rank", "scope", "target_id", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "line_length_px",
+    "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation", "verdict_by",
+    "n_edges", "edge_ids", "consistency", "weights", "x_px", "y_px",
 )
 
 # a scan's CSV: id and rank first, then the summary, the site's columns, the curve

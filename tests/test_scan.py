@@ -9,7 +9,9 @@ from click.testing import CliRunner
 
 import imgmtf as im
 from imgmtf.cli import main
-from imgmtf.scan import Segment, ScanSettings, merge_segments, pair_bars, scan_scene
+from imgmtf.scene.combine import summarise_scan
+from imgmtf.scene.measure import scan_scene
+from imgmtf.scene.settings import ScanSettings
 
 SCENE = Path(__file__).parent.parent / "data" / "scene.tif"
 TRUTH = json.loads(im.read_raster(SCENE).tags["IMGMTF"])["tiles"]
@@ -25,9 +27,14 @@ def tile_of(record):
 
 
 @pytest.fixture(scope="module")
-def edge_scan():
+def scan_records():
     # the sample scene is map-projected for its GeoJSON, but rendered with rows along track
-    return [r.to_dict() for r in scan_scene(str(SCENE), ScanSettings(track_azimuth_deg=0.0))]
+    return scan_scene(str(SCENE), ScanSettings(track_azimuth_deg=0.0))
+
+
+@pytest.fixture(scope="module")
+def edge_scan(scan_records):
+    return [r.to_dict() for r in scan_records]
 
 
 def test_scan_accepts_the_good_edges_with_true_mtf_in_their_intervals(edge_scan):
@@ -63,13 +70,23 @@ def test_scan_measures_the_bar_as_a_pulse_target():
     assert abs(accepted[0]["mtf_nyquist"] - tile_of(accepted[0])["true_mtf_nyquist"]) < 0.006
 
 
-def test_merge_joins_collinear_pieces_and_pairs_make_bars():
-    pieces = np.array([[10, 0, 11, 40], [11.1, 42, 12.2, 80], [30, 0, 30.5, 50]], float)
-    merged = merge_segments(pieces)
-    assert len(merged) == 2 and merged[0].length_px == pytest.approx(80.0, abs=0.1)
-    lone, bars = pair_bars([Segment(10, 0, 12, 80), Segment(13, 0, 15, 80), Segment(40, 0, 41, 80)])
-    assert len(lone) == 1 and len(bars) == 1
-    assert bars[0][0].width_px == pytest.approx(3.0 * 80 / np.hypot(80, 2), abs=0.01)
+def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_records):
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    from imgmtf.plot import plot_scan
+    summaries = [s.to_dict() for s in summarise_scan(scan_records)]
+    rows = [r.to_dict() for r in scan_records]
+    fig = plot_scan(np.zeros((128, 256)), 2.0, rows, summaries)
+    ax = fig.axes[0]
+    reasons = {r["reason"] for r in rows if r["status"] == "rejected"}
+    lines = [c for c in ax.collections if isinstance(c, LineCollection) and not isinstance(c, PolyCollection)]
+    assert len(lines) == len(reasons) + 1 and not ax.patches          # one collection per reason, no boxes
+    assert len([c for c in ax.collections if isinstance(c, PolyCollection)]) == 1
+    assert sorted(t.get_text().split()[0] for t in ax.texts) == ["T1", "T2"]      # the targets, labelled
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "accepted (2)" in legend and f"angle ({sum(r['reason'] == 'angle' for r in rows)})" in legend
+    x0, y0, x1, y1 = ax.get_position().extents          # the image fills its axes: no blank band
+    assert (x1 - x0) * fig.get_figwidth() / ((y1 - y0) * fig.get_figheight()) == pytest.approx(2.0)
 
 
 def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
@@ -86,6 +103,11 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     assert props["params"]["scan"]["min_length_px"] == 40.0 and props["path"] == str(SCENE)
     assert props["map_x0"] == pytest.approx(500000 + props["x0_px"] + 0.5)
     assert (out / "targets.csv").read_text().count("\n") == len(geo["features"]) + 1
+    # without --track-azimuth a map-projected scene has no known direction; its summaries follow the edges
+    assert props["direction"] == "unknown"
+    targets = [f for f in geo["features"] if f["properties"]["scope"] == "target"]
+    assert len(targets) == 2 and all(f["geometry"]["type"] == "Point" for f in targets)
+    assert geo["features"][-1]["properties"]["scope"] == "scene" and geo["features"][-1]["geometry"] is None
     assert (out / "overview.png").stat().st_size > 20_000
 
 
@@ -111,16 +133,16 @@ def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
 
 
 def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
-    import imgmtf.scan as scan_module
+    import imgmtf.scene.measure as scan_module
     calls = []
 
-    def breaks_once(raster, settings):
-        calls.append(raster.origin)
+    def breaks_once(*args):
+        calls.append(args)
         if len(calls) == 1:
             raise ZeroDivisionError("float division by zero")
-        return real(raster, settings)
-    real = scan_module.measure_raster
-    monkeypatch.setattr(scan_module, "measure_raster", breaks_once)
+        return real(*args)
+    real = scan_module._estimate
+    monkeypatch.setattr(scan_module, "_estimate", breaks_once)
     records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
     internal = [r for r in records if r.reason == "internal"]
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error

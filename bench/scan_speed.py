@@ -1,0 +1,197 @@
+"""Scan speed and yield on a large textured scene, against OpenCV's LSD.
+
+The scene (built once, cached in ``--cache``, default the system's temp
+folder): 4096 x 4096 px, 16-bit, rows along track, no CRS.
+
+* a textured field: level 2000 DN plus 600 tilted rectangular "parcels"
+  (20-400 px, levels +-700 DN, each with its own texture of 30-200 DN),
+  plus a multi-scale texture of 60 DN (:func:`imgmtf.sensor.scenes.texture`),
+  all blurred by a Gaussian of 0.8 px;
+* 14 edge targets, each a 160-256 px chip rendered by the generic sensor
+  (:func:`imgmtf.render`: exact, truth known) at a tilt of 2-12 deg from
+  the column or the row axis, levels 500-1500 DN apart, system noise 4-8 DN,
+  pasted on a jittered 4 x 4 grid (two cells left empty);
+* everything drawn from ``numpy.random.default_rng(SEED)``, SEED = 20240512,
+  so the scene is the same on every machine.
+
+Timed, in this process, after one warm-up run of each:
+
+1. LSD: the scene read in the same 1024 px tiles (32 px overlap) as scan
+   reads them, scaled to 8 bits with the same levels, and
+   ``cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD).detect`` on each;
+2. ``imgmtf.scene.measure.scan_scene`` (detection, screening, measurement,
+   intervals of the accepted, combination) with 1 worker;
+3. the ``imgmtf scan`` command, without and with ``--out`` (a new process:
+   its start-up, about 1 s of imports, and its outputs included).
+
+Printed: the load average (the machine is shared: time when it is low),
+both times, their ratio (budget: scan within 3 x LSD, aim 1.5 x), the
+number of candidates by reason, and how many of the 14 edges were accepted
+with their MTF at Nyquist against the truth.
+
+usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+import imgmtf as im
+from imgmtf.sensor.scenes import texture
+
+SEED = 20240512
+SIZE = 4096
+N_EDGES = 14
+
+
+def _parcels(image: np.ndarray, rng: np.random.Generator, count: int = 600) -> None:
+    """Paint ``count`` tilted rectangles of random size, level and texture."""
+    rows, cols = image.shape
+    for _ in range(count):
+        w, h = rng.uniform(20, 400, 2)
+        cx, cy = rng.uniform(0, cols), rng.uniform(0, rows)
+        a = rng.uniform(0, math.pi)
+        r = math.ceil(math.hypot(w, h) / 2) + 1
+        x0, x1 = max(int(cx) - r, 0), min(int(cx) + r, cols)
+        y0, y1 = max(int(cy) - r, 0), min(int(cy) + r, rows)
+        if x1 <= x0 or y1 <= y0:
+            continue
+        y, x = np.mgrid[y0:y1, x0:x1].astype(float)
+        u = (x - cx) * math.cos(a) + (y - cy) * math.sin(a)
+        v = -(x - cx) * math.sin(a) + (y - cy) * math.cos(a)
+        inside = (np.abs(u) <= w / 2) & (np.abs(v) <= h / 2)
+        level = rng.uniform(-700, 700)
+        grain = rng.uniform(30, 200) * rng.standard_normal(inside.sum())
+        block = image[y0:y1, x0:x1]
+        block[inside] = 2000 + level + grain
+
+
+def build_scene(path: Path) -> list[dict]:
+    """Write the scene to ``path`` (GeoTIFF, no CRS); the truth of its 14
+    edges (tile, angle, true MTF at Nyquist and MTF50)."""
+    import cv2
+    rng = np.random.default_rng(SEED)
+    image = np.full((SIZE, SIZE), 2000.0, np.float32)
+    _parcels(image, rng)
+    image += texture((SIZE, SIZE), 60.0, seed=int(rng.integers(1 << 31))).astype(np.float32)
+    image = cv2.GaussianBlur(image, (0, 0), 0.8).astype(float)
+    sensor = im.Sensor()
+    cell = SIZE // 4
+    cells = [(r, c) for r in range(4) for c in range(4)]
+    truth = []
+    for k in rng.permutation(len(cells))[:N_EDGES]:
+        r, c = cells[k]
+        size = int(rng.integers(160, 257))
+        tilt = float(rng.uniform(2, 12)) * (1 if rng.random() < 0.5 else -1)
+        angle = tilt if rng.random() < 0.5 else math.copysign(90.0, tilt) - tilt
+        low = float(rng.uniform(800, 1800))
+        high = low + float(rng.uniform(500, 1500))
+        if rng.random() < 0.5:
+            low, high = high, low
+        chip = im.render(sensor, im.Target("edge", angle, low, high), size,
+                         noise_std_dn=float(rng.uniform(4, 8)), seed=int(rng.integers(1 << 31)))
+        x0 = c * cell + int(rng.integers(40, cell - size - 40))
+        y0 = r * cell + int(rng.integers(40, cell - size - 40))
+        image[y0:y0 + size, x0:x0 + size] = chip.image
+        truth.append({"tile_xywh": [x0, y0, size, size], "angle_deg": angle,
+                      "true_mtf_nyquist": float(chip.true_mtf(0.5)),
+                      "true_mtf50_cy_px": chip.true_mtf50_cy_px()})
+    image += rng.normal(0, 5, image.shape)
+    im.write_geotiff(path, np.clip(np.rint(image), 0, 65535).astype(np.uint16),
+                     provenance={"seed": SEED, "edges": truth, "imgmtf_version": im.__version__})
+    return truth
+
+
+def scene(cache: Path) -> tuple[Path, list[dict]]:
+    path = cache / f"scan_speed_{SIZE}_{SEED}.tif"
+    if not path.exists():
+        t = time.perf_counter()
+        build_scene(path)
+        print(f"built {path} in {time.perf_counter() - t:.1f} s")
+    return path, json.loads(im.read_raster(path, window=(0, 0, 1, 1)).tags["IMGMTF"])["edges"]
+
+
+def lsd_only(path: Path) -> int:
+    """Read the scene in scan's tiles at scan's 8-bit levels and run LSD on
+    each; the number of segments."""
+    import cv2
+
+    from imgmtf.io import raster_info
+    from imgmtf.scene.detect import TILE_OVERLAP_PX, display_levels, to_8bit
+    from imgmtf.scene.settings import ScanSettings
+    info = raster_info(str(path))
+    lo, hi = display_levels(str(path), None, info)
+    tile_px = ScanSettings().tile_px
+    detector = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
+    step, found = tile_px - TILE_OVERLAP_PX, 0
+    for y in range(0, max(info.height - TILE_OVERLAP_PX, 1), step):
+        for x in range(0, max(info.width - TILE_OVERLAP_PX, 1), step):
+            w, h = min(tile_px, info.width - x), min(tile_px, info.height - y)
+            tile = im.read_raster(str(path), window=(x, y, w, h)).data
+            lines = detector.detect(to_8bit(tile, lo, hi))[0]
+            found += 0 if lines is None else len(lines)
+    return found
+
+
+def timed(fn, runs: int):
+    fn()
+    best, out = math.inf, None
+    for _ in range(runs):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()))
+    parser.add_argument("--runs", type=int, default=3, help="timed runs of each; the best is kept")
+    parser.add_argument("--no-cli", action="store_true", help="skip the imgmtf scan command")
+    args = parser.parse_args()
+    from imgmtf.scene.measure import scan_scene
+    path, truth = scene(args.cache)
+    print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
+    lsd_s, segments = timed(lambda: lsd_only(path), args.runs)
+    scan_s, records = timed(lambda: scan_scene(str(path)), args.runs)
+    print(f"LSD (read + 8 bits + detect, {segments} segments): {lsd_s:6.2f} s")
+    print(f"scan_scene, 1 worker ({len(records)} candidates):       {scan_s:6.2f} s   "
+          f"{scan_s / lsd_s:.2f} x LSD (budget 3 x, aim 1.5 x)")
+    if not args.no_cli:
+        command = [shutil.which("imgmtf") or "imgmtf", "scan", str(path)]
+        with tempfile.TemporaryDirectory() as out:
+            for label, extra in (("imgmtf scan SCENE (a new process, text table)", []),
+                                 ("imgmtf scan SCENE --out DIR (CSV, GeoJSON, overview)", ["--out", out])):
+                def run(extra=extra):
+                    subprocess.run(command + extra, capture_output=True, check=False)
+                cli_s, _ = timed(run, 1)
+                print(f"{label + ':':52s} {cli_s:6.2f} s   {cli_s / lsd_s:.2f} x LSD")
+    print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+    reasons = Counter(r.reason or r.status for r in records)
+    print("candidates: " + ", ".join(f"{k} {v}" for k, v in reasons.most_common()))
+    found = 0
+    for t in truth:
+        x, y, w, h = t["tile_xywh"]
+        inside = [r for r in records if r.ok and x <= (r.site["x0_px"] + r.site["x1_px"]) / 2 < x + w
+                  and y <= (r.site["y0_px"] + r.site["y1_px"]) / 2 < y + h]
+        best = min(inside, key=lambda r: r.site["rank"]) if inside else None
+        found += best is not None
+        got = f"{best.figures['mtf_nyquist']:.4f} (error {best.figures['mtf_nyquist'] - t['true_mtf_nyquist']:+.4f})" \
+            if best else "not accepted"
+        print(f"  edge at {t['angle_deg']:6.2f} deg in {x},{y},{w},{h}: true {t['true_mtf_nyquist']:.4f}, got {got}")
+    print(f"{found} of {len(truth)} edges accepted (target >= 10); "
+          f"{sum(r.ok for r in records)} accepted in all")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,511 @@
+"""Measurement: every candidate's ROI, its screens and its estimate.
+
+A candidate (a half-edge, or a bar) is measured on its own tilted ROI: a
+rectangle along it, ``margin_px`` either side (plus half a bar), that
+stops ``JUNCTION_CLEARANCE_PX`` short of every segment it meets at a
+junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
+short of fill and nodata, and ``END_TRIM_PX`` short of a free end.  The
+estimators see it as a mask (:func:`imgmtf.measure_edge`'s ``mask=``), so
+nothing outside it enters the estimate.
+
+Order of work, cheapest first: fill and the geometric screens (unread);
+then, per batch of candidates sharing a tile (one windowed read): the
+ROI's extent clear of junctions and fill, a quick look at its pixels
+(:mod:`.screen`), and the estimate, whose quality gate gives the verdict
+(:mod:`imgmtf.estimate.gate`).  The gate runs before the estimate's
+intervals are computed, so only the accepted candidates pay for them.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..batch import pulse_width_px
+from ..errors import ImgmtfError
+from ..estimate import gate
+from ..estimate.detection import robust_noise
+from ..estimate.pipeline import direction_label
+from ..inputs import saturation_levels
+from ..io import RasterInfo, raster_info, read_raster
+from ..parallel import run_tasks
+from ..records import Record, utc_now
+from .detect import (
+    BAR_MAX_SEPARATION_PX,
+    HalfEdge,
+    detect_segments,
+    find_junctions,
+    pair_bars,
+    parallel_clearance,
+    split_at_junctions,
+)
+from .screen import FILL_SIDE_PX, fill_mask, fill_screen, geometry_screen, quick_look
+from .settings import ScanSettings
+
+JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its target meets
+FILL_CLEARANCE_PX = 4           # ... this far from fill and nodata (the target was blurred with the ground beyond it)
+END_TRIM_PX = 3.0               # ... and stops this short of a free end (a corner LSD did not see)
+MIN_HALF_WIDTH_PX = 10.0        # an ROI narrower either side of its target holds too little of the sides
+
+
+@dataclass(frozen=True)
+class Roi:
+    """A tilted rectangle: from (``x``, ``y``) along the unit vector
+    (``ux``, ``uy``) over ``t0_px`` to ``t1_px``, and ``half_width_px``
+    either side of that line (scene pixels)."""
+
+    x: float
+    y: float
+    ux: float
+    uy: float
+    t0_px: float
+    t1_px: float
+    half_width_px: float
+
+    def frame(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(t, d) of points: along the line from (x, y), and across it (px)."""
+        rx, ry = xs - self.x, ys - self.y
+        return rx * self.ux + ry * self.uy, -rx * self.uy + ry * self.ux
+
+    def point(self, t, d) -> tuple[np.ndarray, np.ndarray]:
+        t, d = np.asarray(t, float), np.asarray(d, float)
+        return self.x + t * self.ux - d * self.uy, self.y + t * self.uy + d * self.ux
+
+    def corners(self, t0: float | None = None, t1: float | None = None) -> list[list[float]]:
+        """The rectangle's corners (x, y), optionally over [t0, t1] only."""
+        t0 = self.t0_px if t0 is None else t0
+        t1 = self.t1_px if t1 is None else t1
+        h = self.half_width_px
+        xs, ys = self.point([t0, t1, t1, t0], [-h, -h, h, h])
+        return [[round(float(x), 2), round(float(y), 2)] for x, y in zip(xs, ys)]
+
+    def bbox(self, width: int, height: int) -> tuple[int, int, int, int]:
+        """(x, y, w, h) of the pixels it touches, within a scene of that size."""
+        h = self.half_width_px
+        xs, ys = self.point([self.t0_px, self.t1_px, self.t1_px, self.t0_px], [-h, -h, h, h])
+        x0, y0 = max(math.floor(xs.min()), 0), max(math.floor(ys.min()), 0)
+        x1, y1 = min(math.ceil(xs.max()), width - 1), min(math.ceil(ys.max()), height - 1)
+        return x0, y0, max(x1 - x0 + 1, 1), max(y1 - y0 + 1, 1)
+
+
+def plan_roi(half: HalfEdge, settings: ScanSettings, beside_px: float = math.inf) -> Roi:
+    """The largest ROI a candidate may have: along its segment (a free end
+    trimmed by ``END_TRIM_PX``; a junction end reaching the junction, which
+    the partners' clearance then keeps off), at most ``max_length_px`` of
+    its middle, ``margin_px`` (plus half a bar) either side, or less, to
+    stay ``JUNCTION_CLEARANCE_PX`` clear of a segment running beside it
+    ``beside_px`` away."""
+    s = half.segment
+    length = s.length_px
+    ux, uy = (s.x1 - s.x0) / length, (s.y1 - s.y0) / length
+    t0 = 0.0 if half.junctions[0] is not None else min(END_TRIM_PX, length / 2)
+    t1 = length if half.junctions[1] is not None else max(length - END_TRIM_PX, length / 2)
+    if t1 - t0 > settings.max_length_px:
+        middle = (t0 + t1) / 2
+        t0, t1 = middle - settings.max_length_px / 2, middle + settings.max_length_px / 2
+    half_width = min(settings.margin_px + s.width_px / 2, beside_px - JUNCTION_CLEARANCE_PX)
+    return Roi(s.x0, s.y0, ux, uy, t0, t1, half_width)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """One candidate to read and measure: its index among the records, its
+    largest ROI, the segments it must keep clear of (rows x0, y0, x1, y1)
+    and its bar width (0 for an edge)."""
+
+    index: int
+    roi: Roi
+    partners: np.ndarray
+    bar_width_px: float = 0.0
+
+
+@dataclass(frozen=True)
+class Context:
+    """What every candidate of a scan shares: the scene, how to measure,
+    and the record's provenance."""
+
+    path: str
+    info: RasterInfo
+    settings: ScanSettings
+    track_azimuth_deg: float | None
+    params: dict
+    run_utc: str
+
+
+def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
+    """The ground track's azimuth in the scene: the user's, else 0 (rows
+    along track) for a scene in sensor geometry, unknown (None) for a
+    map-projected one."""
+    if settings.track_azimuth_deg is not None:
+        return settings.track_azimuth_deg
+    return None if info.crs else 0.0
+
+
+# -- the scan -------------------------------------------------------------------------
+def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int = 1,
+               scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
+    """Every candidate target of the scene as a record: accepted ones first
+    in rank order, then rejected ones by length.
+
+    Parameters
+    ----------
+    path : the scene (any raster GDAL reads, up to 1 Gpx).
+    settings : how to scan (:class:`imgmtf.scene.settings.ScanSettings`).
+    workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
+
+    Returns
+    -------
+    list of Record
+        One per candidate (a half-edge between junctions, or a bar), with
+        ``status`` accepted or rejected, the reason of a rejection, the
+        figures of an accepted one, and in its site where it lies
+        (``x0_px``...), its ROI (``roi``, ``roi_polygon_px``), ``id``,
+        ``rank`` and, for the half-edges of a target with an accepted
+        one, ``target_id``.  Combine them with
+        :func:`imgmtf.scene.combine.summarise_scan`.
+
+    Raises
+    ------
+    ImgmtfError
+        The scene cannot be read or scanned (too large, flat, unreadable).
+        An interrupt (KeyboardInterrupt, or SIGTERM under
+        :func:`imgmtf.parallel.terminate_raises`) propagates with the
+        records so far as its ``records`` attribute: candidates not yet
+        measured are rejected with reason ``interrupted``.
+
+    Example
+    -------
+    >>> records = scan_scene("data/scene.tif", ScanSettings(track_azimuth_deg=0.0))  # doctest: +SKIP
+    >>> [(r.site["rank"], r.figures["mtf_nyquist"]) for r in records if r.ok]  # doctest: +SKIP
+    [(1, 0.261544), (2, 0.266206)]
+    """
+    path = str(path)
+    settings = settings or ScanSettings()
+    run_utc = utc_now()
+    info = raster_info(path)
+    segments, fill_fraction = detect_segments(path, settings)
+    junctions, events = find_junctions(segments)
+    halves = split_at_junctions(segments, junctions, events, fill_fraction)
+    track = track_azimuth(info, settings)
+    params = {**settings.measure_settings().params(), "track_azimuth_deg": track, "scan": settings.as_dict()}
+    context = Context(path, info, settings, track, params, run_utc)
+    candidates = [(half, verdict or fill_screen(half.fill_fraction) or geometry_screen(half, settings))
+                  for half, verdict in _candidates(halves, settings)]
+    unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
+    beside = np.full(len(candidates), np.inf)
+    beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], segments,
+                                            settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
+    records: list[Record] = []
+    plans: list[Plan] = []
+    for (half, verdict), clearance in zip(candidates, beside):
+        record = _candidate_record(half, context)
+        verdict = verdict or _beside_screen(half, clearance)
+        if verdict:
+            record = record.with_(status="rejected", reason=verdict[0], error=f"{path}: {verdict[1]}",
+                                  site={"verdict_by": "screen"})
+        else:
+            partners = np.array([p.as_array() for p in half.partners]).reshape(-1, 4)
+            plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
+        records.append(record)
+    batches = _batches(plans, info, settings.tile_px)
+    halves = [half for half, _ in candidates]
+
+    def lost(task, exc):
+        """Every candidate of a batch whose task died with its worker."""
+        return [(plan.index, Record.failed(path, settings.band, settings.target, settings.method, exc,
+                                           params=context.params, run_utc=run_utc, status="rejected"))
+                for plan in task[2]]
+    try:
+        for _, outcomes in run_tasks(measure_batch, [(context, window, batch) for window, batch in batches],
+                                     workers=workers, scheduler=scheduler, progress=progress,
+                                     description="measuring targets", on_error=lost, ordered=False):
+            for index, outcome in outcomes:
+                records[index] = _measured(records[index], outcome)
+    except KeyboardInterrupt as exc:
+        pending = {plan.index for _, batch in batches for plan in batch}
+        for i in pending:
+            if records[i].status == "candidate":
+                records[i] = records[i].with_(status="rejected", reason="interrupted",
+                                              error=f"{path}: not measured: the scan was interrupted")
+        exc.records = _ranked(_grouped(records, halves))  # type: ignore[attr-defined]  # what the caller keeps
+        raise
+    return _ranked(_grouped(records, halves))
+
+
+def _beside_screen(half: HalfEdge, clearance_px: float) -> tuple[str, str] | None:
+    """``two-targets`` when another segment runs so close beside the
+    candidate that its ROI, kept clear of it, would be narrower than
+    ``MIN_HALF_WIDTH_PX`` either side."""
+    if clearance_px - JUNCTION_CLEARANCE_PX < MIN_HALF_WIDTH_PX + half.segment.width_px / 2:
+        return "two-targets", (f"another edge runs beside it {clearance_px:.1f} px away: no ROI holds this "
+                               "target alone")
+    return None
+
+
+def _candidates(halves: list[HalfEdge], settings: ScanSettings) -> list[tuple[HalfEdge, tuple[str, str] | None]]:
+    """The half-edges as candidates of the scan's target: for edges, lone
+    half-edges and bars alike (the gate tells an edge from a bar); for
+    pulses, bars, and lone half-edges rejected as ``not-a-bar``."""
+    long_enough = [h for h in halves if h.line_length_px >= settings.min_length_px / 2]
+    lone, bars = pair_bars([h.segment for h in long_enough])
+    out: list[tuple[HalfEdge, tuple[str, str] | None]] = []
+    lone_verdict = ("not-a-bar", "a lone edge, not the two sides of a bar") if settings.target == "pulse" else None
+    out += [(long_enough[i], lone_verdict) for i in lone]
+    for i, j, bar in bars:
+        a, b = long_enough[i], long_enough[j]
+        out.append((HalfEdge(bar, min(a.line_length_px, b.line_length_px), (None, None),
+                             a.partners + b.partners, max(a.fill_fraction, b.fill_fraction)), None))
+    return out
+
+
+def _batches(plans: list[Plan], info: RasterInfo, tile_px: int) -> list[tuple[tuple[int, int, int, int], list[Plan]]]:
+    """Plans grouped by the tile their ROI's centre falls in, each group
+    with the window (x, y, w, h) that holds all their ROIs: one read each."""
+    groups: dict[tuple[int, int], list[Plan]] = {}
+    boxes: dict[tuple[int, int], list[tuple[int, int, int, int]]] = {}
+    for plan in plans:
+        box = plan.roi.bbox(info.width, info.height)
+        key = ((box[0] + box[2] // 2) // tile_px, (box[1] + box[3] // 2) // tile_px)
+        groups.setdefault(key, []).append(plan)
+        boxes.setdefault(key, []).append(box)
+    out = []
+    for key in sorted(groups):
+        b = np.array(boxes[key])
+        x0, y0 = b[:, 0].min(), b[:, 1].min()
+        x1, y1 = (b[:, 0] + b[:, 2]).max(), (b[:, 1] + b[:, 3]).max()
+        out.append(((int(x0), int(y0), int(x1 - x0), int(y1 - y0)), groups[key]))
+    return out
+
+
+# -- one batch of candidates (a task) ---------------------------------------------------
+def measure_batch(task) -> list[tuple[int, Record]]:
+    """Read one window of the scene and measure every candidate in it: a
+    record (accepted or rejected) per candidate, whatever goes wrong with
+    one of them (reason ``internal``)."""
+    context, window, plans = task
+    raster = read_raster(context.path, context.settings.band, window=window)
+    out = []
+    for plan in plans:
+        try:
+            out.append((plan.index, measure_candidate(plan, raster, context)))
+        except Exception as exc:       # the safety net: one candidate, never the scan
+            out.append((plan.index, Record.failed(context.path, raster.band, context.settings.target,
+                                                  context.settings.method, exc, params=context.params,
+                                                  run_utc=context.run_utc, status="rejected")))
+    return out
+
+
+def measure_candidate(plan: Plan, raster, context: Context) -> Record:
+    """One candidate: its ROI within ``raster`` (a window of the scene),
+    the screens, and the gate's verdict on its estimate."""
+    settings, info = context.settings, context.info
+    roi = plan.roi
+    bx, by = raster.origin
+    x, y, w, h = roi.bbox(info.width, info.height)
+    data = raster.data[y - by: y - by + h, x - bx: x - bx + w]
+    t, d = roi.frame(np.arange(x, x + w, dtype=float)[None, :], np.arange(y, y + h, dtype=float)[:, None])
+    band = (np.abs(d) <= roi.half_width_px) & (t >= roi.t0_px) & (t <= roi.t1_px)
+    rows, cols = np.nonzero(band)
+    t, d = t[rows, cols], d[rows, cols]
+    fill = fill_mask(data, info.dtype)
+    extent = _clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
+    site: dict[str, Any] = {"roi_polygon_px": roi.corners()}
+
+    def rejected(reason: str, message: str, **more) -> Record:
+        return Record(context.path, raster.band, settings.target, settings.method, "rejected", reason,
+                      f"{context.path}: {message}", site={**site, **more}, params=context.params,
+                      run_utc=context.run_utc)
+    if isinstance(extent[0], str):
+        return rejected(*extent, verdict_by="screen")
+    t0, t1 = extent
+    inside = (t >= t0) & (t < t1)
+    rows, cols, t, d = rows[inside], cols[inside], t[inside], d[inside]
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    chip = data[r0:r1, c0:c1]
+    chip_mask = np.zeros(chip.shape, bool)
+    chip_mask[rows - r0, cols - c0] = True
+    roi_box = [int(x + c0), int(y + r0), int(c1 - c0), int(r1 - r0)]
+    site = {"roi_polygon_px": roi.corners(t0, t1), "roi": roi_box}
+    noise = robust_noise(np.where(chip_mask, chip, np.nan))
+    verdict = quick_look(data[rows, cols], d, t, noise, roi.half_width_px, plan.bar_width_px)
+    if verdict:
+        return rejected(*verdict, verdict_by="screen")
+    try:
+        # the quality gate refuses a chip before its intervals are computed
+        # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
+        result = _estimate(chip, chip_mask, raster, context, plan)
+    except ImgmtfError as exc:
+        return rejected(exc.reason, _one_line(exc), verdict_by="gate", **_gate_figures(getattr(exc, "checks", ())))
+    x_, y_, w_, h_ = result.roi
+    figures = {**result.to_dict(curves=False), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
+               "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
+    return Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
+                           status="accepted", site={**site, "verdict_by": "gate"})
+
+
+def _estimate(chip, mask, raster, context: Context, plan: Plan):
+    """The estimator's result on the masked chip."""
+    settings = context.settings
+    estimator = settings.measure_settings().estimator()
+    common = {"mask": mask, "gsd_m": raster.gsd_m, "dtype": raster.dtype,
+              "track_azimuth_deg": context.track_azimuth_deg,
+              "saturation": settings.saturation or saturation_levels(raster.dtype)}
+    if settings.target == "edge":
+        return estimator(chip, **common)
+    return estimator(chip, width_px=pulse_width_px(settings.pulse_width, raster), **common)
+
+
+def _clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
+    """The longest stretch [t0, t1) of the ROI clear of fill (and
+    ``FILL_CLEARANCE_PX`` around it), of the partners (within
+    ``JUNCTION_CLEARANCE_PX``) and of the scene's border, in whole pixels
+    along the line; or (reason, message) when none is long enough: ``fill``
+    for a boundary of the fill (fill along its sides) or an ROI the fill
+    leaves too short, ``too-short`` otherwise.  ``t``, ``d``, ``xs``, ``ys``
+    describe the ROI's pixels; ``fill`` is the fill of the window they
+    index (its top-left pixel at the smallest ``xs``, ``ys``)."""
+    from .screen import _grown
+    bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
+    k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
+    bad = np.zeros(bins, bool)
+    by_fill = np.zeros(bins, bool)
+    if fill.any():
+        r, c = ys - ys.min(), xs - xs.min()
+        near_fill = fill[r, c] & (np.abs(d) <= FILL_SIDE_PX)
+        boundary = fill_screen(float(np.mean(np.bincount(k[near_fill], minlength=bins) > 0)))
+        if boundary:
+            return boundary
+        by_fill = np.bincount(k[_grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
+        bad |= by_fill
+    for p in partners:
+        bad |= np.bincount(k[_distance_to_segment(xs, ys, p) <= JUNCTION_CLEARANCE_PX], minlength=bins) > 0
+    # the band's cross-section must lie inside the scene
+    centres = roi.t0_px + np.arange(bins) + 0.5
+    for side in (-1.0, 1.0):
+        px, py = roi.point(centres, side * roi.half_width_px)
+        bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
+    free = np.concatenate([[0], (~bad).astype(int), [0]])
+    step = np.diff(free)
+    starts, ends = np.nonzero(step == 1)[0], np.nonzero(step == -1)[0]
+    longest = int(np.argmax(ends - starts)) if starts.size else None
+    length = float(ends[longest] - starts[longest]) if longest is not None else 0.0
+    rows = int(length * max(abs(roi.ux), abs(roi.uy)))      # rows (or columns) it crosses
+    if rows < gate.MIN_ROWS:
+        if by_fill.mean() >= 0.5:
+            return "fill", (f"fill or nodata leaves only {rows} rows of the target clear (at least "
+                            f"{gate.MIN_ROWS} needed)")
+        return "too-short", (f"only {rows} rows of the target lie clear of its junctions, fill and the "
+                             f"scene's border (at least {gate.MIN_ROWS} needed)")
+    return roi.t0_px + starts[longest], roi.t0_px + ends[longest]
+
+
+def _distance_to_segment(xs, ys, s) -> np.ndarray:
+    """Distance (px) of points from the segment s = (x0, y0, x1, y1)."""
+    dx, dy = s[2] - s[0], s[3] - s[1]
+    length2 = max(dx * dx + dy * dy, 1e-12)
+    f = np.clip(((xs - s[0]) * dx + (ys - s[1]) * dy) / length2, 0.0, 1.0)
+    return np.hypot(xs - (s[0] + f * dx), ys - (s[1] + f * dy))
+
+
+def _gate_figures(checks) -> dict:
+    """The gate's own measure of the sides' variation: the largest level
+    drift or texture of either side, as a fraction of the contrast."""
+    values = [c.value for c in checks if c.reason == "non-uniform" and c.value is not None]
+    return {"side_variation": round(float(max(values)), 4)} if values else {}
+
+
+def _line_rms(geometry) -> float:
+    """RMS (px) of the kept per-row locations about the fitted line."""
+    kept = geometry.kept
+    resid = geometry.locations[kept] - (geometry.slope * geometry.rows[kept] + geometry.intercept)
+    return round(float(np.sqrt(np.mean(resid ** 2))), 4)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+# -- records ----------------------------------------------------------------------------
+def _candidate_record(half: HalfEdge, context: Context) -> Record:
+    """A candidate's record before it is screened: where it lies."""
+    segment, info, settings = half.segment, context.info, context.settings
+    site = {
+        "scope": "edge",
+        "x0_px": round(segment.x0, 2), "y0_px": round(segment.y0, 2),
+        "x1_px": round(segment.x1, 2), "y1_px": round(segment.y1, 2),
+        "length_px": round(segment.length_px, 1), "line_length_px": round(half.line_length_px, 1),
+        "tilt_deg": round(segment.tilt_deg, 2), "normal_angle_deg": round(segment.normal_angle_deg, 2),
+        "direction": direction_label(segment.normal_angle_deg, context.track_azimuth_deg),
+        "ends": [_end(j) for j in half.junctions],
+        "roi": list(plan_roi(half, settings).bbox(info.width, info.height)),
+    }
+    if segment.width_px > 0 or settings.target == "pulse":
+        site["bar_width_px"] = round(segment.width_px, 2)
+    if not info.transform.is_identity:
+        (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
+                                  for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
+        site.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
+    return Record(context.path, settings.band, settings.target, settings.method, "candidate", site=site,
+                  params=context.params, run_utc=context.run_utc)
+
+
+def _end(junction: int | None) -> str:
+    return "free" if junction is None else f"junction {junction}"
+
+
+def _measured(candidate: Record, outcome: Record) -> Record:
+    """A candidate with its measurement's outcome, figures and settings."""
+    return candidate.with_(status=outcome.status, reason=outcome.reason, error=outcome.error,
+                           band=outcome.band if outcome.band is not None else candidate.band,
+                           figures=outcome.figures, site=outcome.site,
+                           params={**outcome.params, **candidate.params})
+
+
+def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
+    """Targets: the measured candidates (those that reached the gate, or
+    were accepted) joined through the junctions they share; each target
+    with an accepted half-edge gets a ``target_id`` (1, 2... in the order
+    of its best rank is assigned after ranking, see :func:`_ranked`)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
+    owners: dict[int, list[int]] = {}
+    for i in reached:
+        for j in halves[i].junctions:
+            if j is not None:
+                owners.setdefault(j, []).append(i)
+    n = len(records)
+    a = [m[0] for m in owners.values() for _ in m[1:]]
+    b = [x for m in owners.values() for x in m[1:]]
+    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    groups_with_accepted = {label[i] for i, r in enumerate(records) if r.ok}
+    return [r.with_(site={"group": int(label[i])}) if i in reached and label[i] in groups_with_accepted else r
+            for i, r in enumerate(records)]
+
+
+def _ranked(records: list[Record]) -> list[Record]:
+    """Accepted records by interval width (then SNR), rejected ones by
+    length; ``id`` (and ``rank`` for accepted ones) first in their site,
+    and ``target_id`` numbering the targets by their best rank."""
+    accepted = [r for r in records if r.ok]
+    rejected = [r for r in records if not r.ok]
+
+    def interval_width(r):
+        low, high = r.figures.get("mtf_nyquist_ci") or (None, None)
+        return (high - low) if low is not None and high is not None else math.inf
+    accepted.sort(key=lambda r: (interval_width(r), -(r.figures.get("snr") or math.inf)))
+    rejected.sort(key=lambda r: -r.site["length_px"])
+    ranked = [(r, rank) for rank, r in enumerate(accepted, 1)] + [(r, None) for r in rejected]
+    target_ids: dict[int, int] = {}
+    for r, _ in ranked:
+        if "group" in r.site and r.site["group"] not in target_ids:
+            target_ids[r.site["group"]] = len(target_ids) + 1
+    out = []
+    for i, (r, rank) in enumerate(ranked, 1):
+        site = {k: v for k, v in r.site.items() if k != "group"}
+        target = target_ids.get(r.site["group"]) if "group" in r.site else None
+        out.append(replace(r, site={"id": i, "rank": rank, "target_id": target, **site}))
+    return out

@@ -1,0 +1,168 @@
+"""Cheap screens: what rejects a candidate before it is measured.
+
+Three kinds, from cheapest on:
+
+1. fill (:func:`fill_mask`, :func:`fill_screen`): the pixels of the scene
+   that are fill or nodata, found as detection reads its tiles; a segment
+   with fill beside it is a boundary of the fill (reason ``fill``) and is
+   never measured, and every other ROI stops short of fill;
+2. geometry (:func:`geometry_screen`), unread: a line shorter than
+   ``min_length_px``, or tilted less than ``MIN_ANGLE_DEG`` from an image
+   axis or more than ``MAX_ANGLE_DEG``;
+3. a quick look at the ROI's pixels (:func:`quick_look`): its contrast
+   against the pixel noise and the uniformity of its two sides.  It
+   rejects only what fails the quality gate's own limits
+   (:mod:`imgmtf.estimate.gate`) ``QUICK_LOOK_SLACK`` times over, so that
+   what it rejects the gate would have refused; everything else is
+   measured, and its verdict is the gate's.
+"""
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..estimate import gate
+from ..estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
+from .settings import ScanSettings
+
+if TYPE_CHECKING:
+    from .detect import HalfEdge
+
+QUICK_LOOK_SLACK = 1.0          # the quick look rejects what fails the gate's limits this many times over
+SIDE_START_PX = 4.0             # a side's level is read this far from the target at least (px)
+FILL_SIDE_PX = 3.0              # fill this close to a segment along half of it: a boundary of the fill
+MIN_FILL_PIXELS = 8             # fewer pixels at a fill value are not a fill region
+
+
+def fill_screen(fill_fraction: float) -> tuple[str, str] | None:
+    """``fill`` when fill or nodata lies beside a segment along half its
+    length or more: a boundary of the fill, never an edge of the scene."""
+    if fill_fraction >= 0.5:
+        return "fill", (f"a boundary of fill or nodata along {100 * fill_fraction:.0f} % of its length "
+                        "(not an edge of the scene)")
+    return None
+
+
+def geometry_screen(half: HalfEdge, settings: ScanSettings) -> tuple[str, str] | None:
+    """(reason, message) when the candidate can be rejected unread: its
+    line is shorter than ``min_length_px`` (``too-short``) or its tilt is
+    outside the estimators' range (``angle``); None otherwise."""
+    segment = half.segment
+    if half.line_length_px < settings.min_length_px:
+        return "too-short", (f"a straight line {half.line_length_px:.0f} px long, shorter than the minimum "
+                             f"{settings.min_length_px:g} px")
+    if segment.tilt_deg < MIN_ANGLE_DEG:
+        return "angle", (f"{segment.tilt_deg:.2f} deg from the image axis: too close for "
+                         f"sub-pixel sampling (needs {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)")
+    if segment.tilt_deg > MAX_ANGLE_DEG:
+        return "angle", (f"{segment.tilt_deg:.2f} deg from the image axis: too close to 45 deg "
+                         f"for sub-pixel sampling (needs {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)")
+    return None
+
+
+def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
+    """The fill and nodata pixels of a window of the scene: NaN (declared
+    nodata), and every region at one fill value (0, an integer type's
+    limits) whose boundary is hard, as the gate tells fill from a clipped
+    side (:func:`imgmtf.estimate.gate.fill_check`): the pixels around it
+    differ from it by more than ``FILL_BOUNDARY`` of the window's contrast,
+    where a dark side clipped at 0 meets values close to 0.
+
+    Example
+    -------
+    >>> w = np.full((20, 20), 900.0); w[:, :6] = 300.0; w[:, 12:] = 0.0
+    >>> int(fill_mask(w, "uint16").sum())
+    160
+    """
+    nodata = ~np.isfinite(window)
+    values = window[~nodata] if nodata.any() else window.ravel()
+    fill = nodata.copy()
+    if values.size == 0:
+        return fill
+    low, high = float(values.min()), float(values.max())
+    candidates = {0.0}
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        info = np.iinfo(np.dtype(dtype))
+        candidates |= {float(info.min), float(info.max)}
+    if low < 0 <= np.median(values):
+        candidates.add(low)
+    for value in candidates:
+        if not (value == low or value == high):     # a fill value is the least or the greatest
+            continue
+        at = window == value
+        count = int(at.sum())
+        if count < MIN_FILL_PIXELS or count == values.size:
+            continue
+        rest = values[values != value]
+        lo, hi = float(rest.min()), float(rest.max())
+        contrast = hi - lo
+        # a value other than 0 must lie well outside the rest: a sentinel, not a clipped level
+        if contrast <= 0 or (value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast):
+            continue
+        border = _grown(at, 1) & ~at & ~nodata
+        if border.any() and np.median(np.abs(window[border] - value)) > gate.FILL_BOUNDARY * contrast:
+            fill |= at
+    return fill
+
+
+def _grown(mask: np.ndarray, px: int) -> np.ndarray:
+    """``mask`` dilated by a square of ``px`` pixels each way."""
+    if px <= 0 or not mask.any():
+        return mask.copy()
+    import cv2
+    return cv2.dilate(mask.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)).astype(bool)
+
+
+def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, noise_dn: float, half_width_px: float,
+               bar_width_px: float = 0.0) -> tuple[str, str] | None:
+    """(reason, message) when a glance at the ROI's pixels says the gate
+    would refuse it; None otherwise.
+
+    ``values`` are the ROI's pixels (DN), ``d`` their signed distances from
+    the target line and ``t`` their positions along it (px); ``noise_dn``
+    the pixel noise (DN), as the gate measures it
+    (:func:`imgmtf.estimate.detection.robust_noise`).  Each side
+    (from ``SIDE_START_PX`` beyond the target, or half the ROI's width,
+    whichever is farther) is fitted with a level and a trend across and
+    along; the contrast is the difference of the two levels:
+
+    * ``snr``: the contrast is under ``MIN_SNR / QUICK_LOOK_SLACK`` times
+      the pixel noise;
+    * ``non-uniform``: a side's trend over its extent exceeds
+      ``QUICK_LOOK_SLACK * MAX_SIDE_TREND`` of the contrast, or its texture
+      (scatter beyond the pixel noise) ``QUICK_LOOK_SLACK *
+      MAX_SIDE_TEXTURE``.
+    """
+    start = max(SIDE_START_PX, half_width_px / 2) + bar_width_px / 2
+    noise = noise_dn
+    sides = []
+    for side in (d <= -start, d >= start):
+        if side.sum() < 12:
+            return None                  # too little to judge: the gate will
+        x, y, v = d[side], t[side], values[side]
+        design = np.stack([np.ones_like(x), x - x.mean(), y - y.mean()])
+        coef = np.linalg.solve(design @ design.T + 1e-9 * np.eye(3), design @ v)
+        resid = v - coef @ design
+        trend = max(abs(coef[1]) * np.ptp(x), abs(coef[2]) * np.ptp(y))
+        texture = math.sqrt(max(float(resid @ resid) / max(v.size - 3, 1) - noise ** 2, 0.0))
+        sides.append((float(coef[0]), trend, texture))
+    if bar_width_px > 0:
+        core = np.abs(d) <= max(bar_width_px / 2, 0.5)
+        background = 0.5 * (sides[0][0] + sides[1][0])
+        contrast = abs(float(np.median(values[core])) - background) if core.any() else 0.0
+    else:
+        contrast = abs(sides[1][0] - sides[0][0])
+    if contrast < gate.MIN_SNR / QUICK_LOOK_SLACK * noise:
+        return "snr", (f"a contrast of {contrast:.1f} DN against a pixel noise of {noise:.1f} DN: "
+                       "no target stands out")
+    for name, (_, trend, texture) in zip(("left", "right"), sides):
+        if trend > QUICK_LOOK_SLACK * gate.MAX_SIDE_TREND * contrast:
+            return "non-uniform", (f"the {name} side's level drifts by {100 * trend / contrast:.0f} % of the "
+                                   f"contrast (the gate allows {100 * gate.MAX_SIDE_TREND:.0f} %): not a uniform field")
+        if texture > QUICK_LOOK_SLACK * gate.MAX_SIDE_TEXTURE * contrast:
+            return "non-uniform", (f"the {name} side is textured ({100 * texture / contrast:.0f} % of the contrast "
+                                   f"beyond the pixel noise; the gate allows {100 * gate.MAX_SIDE_TEXTURE:.0f} %): "
+                                   "not a uniform field")
+    return None

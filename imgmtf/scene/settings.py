@@ -1,0 +1,84 @@
+"""How to scan a scene: the settings every stage of a scan reads."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..batch import MeasureSettings
+from ..errors import ParameterError
+from ..estimate.intervals import Intervals
+
+MIN_TILE_PX = 256
+MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
+MAX_LENGTH_PX = 2048    # longest stretch of a target measured (its middle); beyond, rows add nothing but time
+
+
+@dataclass(frozen=True)
+class ScanSettings:
+    """How to scan a scene.
+
+    Parameters
+    ----------
+    target : str
+        "edge" or "pulse".
+    min_length_px : float
+        Shortest straight line worth measuring (px): a half-edge counts the
+        whole line it was split from at junctions (a checkerboard's inner
+        line, both halves), so that short texture is left out and the
+        half-edges of a small target are not.
+    max_length_px : float
+        Longer targets are measured over their central part (px).
+    margin_px : int
+        ROI extent either side of the target, across it (px).
+    tile_px : int
+        Side of the tiles read for detection (px).
+    method, band, pulse_width, intervals, saturation, track_azimuth_deg
+        As in :class:`imgmtf.batch.MeasureSettings`; without a track
+        azimuth, a scene in sensor geometry has its rows along track and a
+        map-projected one (with a CRS) an unknown direction.
+
+    Raises
+    ------
+    ParameterError
+        A setting out of range.
+
+    Example
+    -------
+    >>> ScanSettings(min_length_px=30.0).as_dict()["min_length_px"]
+    30.0
+    """
+
+    target: str = "edge"
+    min_length_px: float = 40.0
+    max_length_px: float = 300.0
+    margin_px: int = 12
+    tile_px: int = 1024
+    method: str = "msg"
+    band: int | None = None
+    pulse_width: tuple[float, str] | None = None
+    intervals: Intervals = field(default_factory=Intervals)
+    saturation: tuple[float, float] | None = None
+    track_azimuth_deg: float | None = None
+
+    def __post_init__(self):
+        if not self.min_length_px >= 16:
+            raise ParameterError(f"--min-length must be at least 16 px, got {self.min_length_px}")
+        if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
+            raise ParameterError(f"--max-length ({self.max_length_px:g} px) must lie between --min-length "
+                                 f"({self.min_length_px:g} px) and {MAX_LENGTH_PX} px")
+        if self.margin_px < 6:
+            raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")
+        if not (isinstance(self.tile_px, int) and MIN_TILE_PX <= self.tile_px <= MAX_TILE_PX):
+            raise ParameterError(f"tiles must be {MIN_TILE_PX} to {MAX_TILE_PX} px, got {self.tile_px!r}")
+        if self.band == "all":
+            raise ParameterError("scan one band at a time (--band N)")
+        self.measure_settings()
+
+    def measure_settings(self) -> MeasureSettings:
+        """The settings of each candidate's estimate."""
+        return MeasureSettings(self.target, self.method, self.band, None, self.pulse_width, self.intervals,
+                               saturation=self.saturation, track_azimuth_deg=self.track_azimuth_deg)
+
+    def as_dict(self) -> dict:
+        """The scan's own settings, as records carry them."""
+        return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
+                "margin_px": self.margin_px, "tile_px": self.tile_px}

@@ -1,0 +1,150 @@
+"""Scanning four-quadrant targets: half-edges split at the centre, each
+measured on its own ROI clear of the junction and of fill, combined per
+direction; on synthetic scenes with a known MTF and on real L0R chips."""
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.scene.combine import combine, normal_families, summarise_scan
+from imgmtf.scene.measure import scan_scene
+from imgmtf.scene.settings import ScanSettings
+from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants, texture
+
+REAL = Path(__file__).parent.parent.parent / "shared" / "data" / "real-scenes"
+# A Baotou-like target: tilted 16.8 deg, two bright quadrants and two dark ones of different levels
+TARGET = QuadrantTarget((50.4, 50.3), 16.8, (9300.0, 2000.0, 9200.0, 3900.0), 40.0)
+
+
+@pytest.fixture(scope="module")
+def quadrant_scans(tmp_path_factory):
+    """The target on a textured field, and cut out of it with a 0-fill:
+    {fill: (scene, records, summaries)}."""
+    out = {}
+    for fill in (False, True):
+        scene = render_quadrants(im.Sensor(), (101, 101), TARGET, field_dn=3000 + texture((101, 101), 600, seed=4),
+                                 fill=fill, noise_std_dn=25.0, seed=5)
+        path = tmp_path_factory.mktemp("scenes") / f"quadrants_{'fill' if fill else 'field'}.tif"
+        im.write_geotiff(path, scene.image)
+        records = scan_scene(str(path))
+        out[fill] = scene, records, summarise_scan(records)
+    return out
+
+
+BOTH = pytest.mark.parametrize("fill", [False, True], ids=["textured field", "0-fill"])
+
+
+def inner_half_edge(record, tolerance_px=3.0):
+    """The inner half-edge of TARGET a record lies on (its index), or None."""
+    ends = [(record.site["x0_px"], record.site["y0_px"]), (record.site["x1_px"], record.site["y1_px"])]
+    for k, half in enumerate(TARGET.half_edges()):
+        centre, far = (half["x0_px"], half["y0_px"]), (half["x1_px"], half["y1_px"])
+        if min(math.dist(e, centre) for e in ends) < tolerance_px and \
+                min(math.dist(e, far) for e in ends) < 8.0 and \
+                abs((record.site["normal_angle_deg"] - half["normal_angle_deg"] + 90) % 180 - 90) < 2.0:
+            return k
+    return None
+
+
+@BOTH
+def test_the_inner_half_edges_are_accepted_within_0015_of_the_true_mtf(quadrant_scans, fill):
+    scene, records, _ = quadrant_scans[fill]
+    accepted = [r for r in records if r.ok]
+    assert len({inner_half_edge(r) for r in accepted} - {None}) >= 3
+    for r in accepted:
+        assert inner_half_edge(r) is not None                 # no field or fill boundary
+        truth = float(scene.true_mtf(0.5, r.figures["normal_angle_deg"]))
+        assert abs(r.figures["mtf_nyquist"] - truth) < 0.015
+        # its ROI stops short of the centre: no accepted edge runs across it
+        assert r.site["target_id"] == 1 and "junction" in " ".join(r.site["ends"])
+
+
+def test_a_boundary_against_fill_is_fill_never_saturated_nor_measured(quadrant_scans):
+    _, records, _ = quadrant_scans[True]
+    outer = [r for r in records if inner_half_edge(r, tolerance_px=8.0) is None]
+    assert outer and all(r.reason == "fill" and r.site["verdict_by"] == "screen" for r in outer)
+    assert not any(r.reason == "saturated" for r in records)
+
+
+@BOTH
+def test_one_result_per_direction_combines_the_target_within_its_interval(quadrant_scans, fill):
+    scene, _, summaries = quadrant_scans[fill]
+    targets = [s for s in summaries if s.site["scope"] == "target"]
+    assert sorted(round(s.figures["normal_angle_deg"]) for s in targets) == [-73, 17]
+    for s in targets:
+        truth = float(scene.true_mtf(0.5, s.figures["normal_angle_deg"]))
+        low, high = s.figures["mtf_nyquist_ci"]
+        assert s.figures["direction"] == "oblique" and s.figures["n_edges"] >= 1
+        assert abs(s.figures["mtf_nyquist"] - truth) < 0.01 and low < s.figures["mtf_nyquist"] < high
+    assert [s.figures["n_edges"] for s in summaries if s.site["scope"] == "scene"] == \
+        [s.figures["n_edges"] for s in targets]
+
+
+# -- real L0R chips ---------------------------------------------------------------------
+def hand_roi(shape, centre, far, half_width=12.0, start=5.0, stop=4.0):
+    """A hand-chosen tilted ROI along a half-edge: from ``start`` px off the
+    target's centre to ``stop`` px short of its far corner (or fill),
+    ``half_width`` px either side: (x, y, w, h) and the mask."""
+    y, x = np.mgrid[0:shape[0], 0:shape[1]].astype(float)
+    u = np.subtract(far, centre) / math.dist(far, centre)
+    t = (x - centre[0]) * u[0] + (y - centre[1]) * u[1]
+    d = -(x - centre[0]) * u[1] + (y - centre[1]) * u[0]
+    mask = (np.abs(d) <= half_width) & (t >= start) & (t <= math.dist(far, centre) - stop)
+    rows, cols = np.nonzero(mask)
+    return (cols.min(), rows.min(), np.ptp(cols) + 1, np.ptp(rows) + 1), mask
+
+
+# (file, provenance, target centre, far ends of its four inner half-edges), read off the images
+REAL_TARGETS = [
+    ("baotou_l0r_checkerboard.tif", "JorgeGIlG/MTF_Estimator data/baotou_CALVAL_L0R_... (GPL-3.0, read in place)",
+     (51.5, 50.4), [(63.1, 11.6), (11.1, 38.2), (89.9, 61.9), (39.9, 88.5)]),
+    ("pan_l0r_checkerboard.tif", "rdegoul/qgis-image-quality-toolset test/data/target2 (Apache-2.0)",
+     (41.6, 36.2), [(35.2, 4.0), (9.8, 43.0), (47.9, 68.6), (72.9, 29.4)]),
+]
+
+
+@pytest.mark.parametrize("name, provenance, centre, ends", REAL_TARGETS, ids=[t[0] for t in REAL_TARGETS])
+def test_real_checkerboards_agree_with_measure_on_hand_chosen_rois(name, provenance, centre, ends):
+    path = REAL / name
+    if not path.exists():
+        pytest.skip(f"{path} absent (from {provenance})")
+    records = scan_scene(str(path))
+    accepted = [r for r in records if r.ok]
+    assert len(accepted) >= 3
+    assert all(r.reason == "fill" for r in records if not r.ok and "baotou" in name)
+    raster = im.read_raster(path)
+    hand = []
+    for far in ends:
+        roi, mask = hand_roi(raster.data.shape, centre, far)
+        try:
+            hand.append(im.measure_edge(raster.data, roi=roi, mask=mask, dtype=raster.dtype))
+        except im.ImgmtfError:
+            continue
+    families = normal_families([r.figures["normal_angle_deg"] for r in accepted]
+                               + [h.normal_angle_deg for h in hand])
+    scanned, by_hand = families[:len(accepted)], families[len(accepted):]
+    for family in set(scanned):
+        mine = [h for h, f in zip(hand, by_hand) if f == family]
+        ours = [r for r, f in zip(accepted, scanned) if f == family]
+        expected = combine([h.mtf50_cy_px for h in mine], [(h.mtf50_ci_cy_px.low, h.mtf50_ci_cy_px.high)
+                                                            for h in mine], [h.rows_used for h in mine])
+        got = combine([r.figures["mtf50_cy_px"] for r in ours], [r.figures["mtf50_ci_cy_px"] for r in ours],
+                      [r.figures["rows_used"] for r in ours])
+        assert got.value == pytest.approx(expected.value, rel=0.03)
+    summary = [s for s in summarise_scan(records) if s.site["scope"] == "scene"]
+    assert len(summary) == 2 and {s.figures["direction"] for s in summary} == {"oblique"}
+
+
+@pytest.mark.parametrize("name, provenance", [
+    ("sentinel2_b04_bagnolo.tif", "rdegoul/qgis-image-quality-toolset test/data/target1 (Apache-2.0)"),
+    ("landsat9_b5_radiance_desert.tif", "rdegoul/qgis-image-quality-toolset test/data/target4 (Apache-2.0)"),
+])
+def test_map_projected_crops_scan_without_error_and_without_a_direction(name, provenance):
+    path = REAL / name
+    if not path.exists():
+        pytest.skip(f"{path} absent (from {provenance})")
+    records = scan_scene(str(path), ScanSettings(intervals=im.Intervals("none")))
+    assert records and not any(r.reason == "internal" for r in records)
+    assert {r.site["direction"] for r in records} == {"unknown"}         # a CRS: rows are not along track
