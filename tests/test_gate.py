@@ -111,6 +111,11 @@ def test_a_sharpened_edge_reads_above_one_and_is_refused():
 def test_edge_and_bar_are_one_classification():
     bar = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, 0.1, 2.0), 100).image
     refused(bar, "not-an-edge")
+    # cropped close, a noisy bar defeats every row's step fit: still a bar
+    bar = im.render(im.Sensor(), im.Target("pulse", -5.0, 200, 1200, 0.1, 3.0), 122).image
+    noisy = bar + np.random.default_rng(1).normal(0.0, 6.0, bar.shape)
+    centre = int(np.argmax(bar[61]))
+    refused(noisy[:, centre - 19:centre + 19], "not-an-edge")
     refused(edge(), "not-a-bar", measure=im.measure_pulse)
     grid = np.linspace(-10, 10, 401)
     assert gate.classify_profile(0.5 * (1 + erf(grid))) == "edge"

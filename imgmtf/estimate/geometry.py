@@ -21,6 +21,7 @@ from .resampling import sample_gap
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
 MAX_ANGLE_DEG = 44.0           # closer to 45 deg, phases repeat every 2 px
 MAX_SAMPLE_GAP_PX = 0.25       # at least 4 sample positions per pixel
+EDGE_FIT_HALF_WINDOW_PX = 10      # each row's Fermi fit sees this far either side of the seed
 MAX_HALF_RANGE_PX = 96.0       # profile samples kept within this distance (a long tail's reach)
 MIN_HALF_RANGE_PX = 4.0        # and at least this much on each side
 
@@ -66,7 +67,7 @@ class TargetGeometry:
         return (x - self.slope * y - self.intercept) / math.hypot(1.0, self.slope)
 
 
-def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = 10,
+def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = EDGE_FIT_HALF_WINDOW_PX,
                 transposed: bool = False) -> TargetGeometry:
     """Fit the Fermi model in every row around ``seed_x`` (the seed edge
     column per row) and a robust line through the locations.
