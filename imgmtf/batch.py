@@ -15,10 +15,9 @@ import numpy as np
 
 from .atomic import atomic_output, ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
-from .estimate.edge import EdgeEstimator
 from .estimate.intervals import Intervals
-from .estimate.pulse import PulseEstimator, check_width
-from .inputs import saturation_levels
+from .estimate.resampling import check_method
+from .inputs import check_width, saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
 from .records import Record, utc_now
@@ -63,9 +62,13 @@ class MeasureSettings:
             raise ParameterError("a pulse width applies to pulse targets only")
         if self.pulse_width is not None and self.pulse_width[1] == "px":
             check_width(self.pulse_width[0])
-        self.estimator()   # an unknown method fails here, before any file is read
+        check_method(self.method)   # an unknown method fails here, before any file is read
 
     def estimator(self):
+        # the estimators load SciPy and OpenCV: imported by the processes
+        # that measure (WORKER_MODULES), not by a batch's parent
+        from .estimate.edge import EdgeEstimator
+        from .estimate.pulse import PulseEstimator
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
         return kind(self.method, intervals=self.intervals, force=self.force)
 

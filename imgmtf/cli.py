@@ -26,6 +26,9 @@ from .errors import FileWriteError, ImgmtfError, ParameterError
 # Bounds of the size-like options (see docs): what a run may allocate.
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
+# what a process measuring files loads: batch imports the estimators only where
+# it measures, so that a batch's parent, which collects records, stays light
+MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse")
 
 
 @contextmanager
@@ -269,9 +272,9 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
         if kind == "pulse":
             value, unit = pulse_width
             width_px = value if unit == "px" else value / gsd_m
-            from .estimate.pulse import MIN_WIDTH_PX
-            if not width_px >= MIN_WIDTH_PX:
-                raise ParameterError(f"a {width_px:g} px wide pulse is narrower than the {MIN_WIDTH_PX} px "
+            from .inputs import MIN_BAR_WIDTH_PX
+            if not width_px >= MIN_BAR_WIDTH_PX:
+                raise ParameterError(f"a {width_px:g} px wide pulse is narrower than the {MIN_BAR_WIDTH_PX} px "
                                      "imgmtf can measure (is the unit right?)")
             if width_px > size:
                 raise ParameterError(f"the pulse width must be at most the chip ({size} px), "
@@ -505,7 +508,7 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
     with _reported_errors():
         from .parallel import InputOrder, prestart_workers
         if scheduler is None and not plot_path:
-            prestart_workers(workers, ["imgmtf.batch"])     # their imports overlap ours
+            prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
         from .batch import MeasureSettings, expand_inputs, measure_files
         from .records import CsvWriter, JsonLinesWriter, utc_now
         settings = MeasureSettings(kind, method, band, roi, pulse_width,

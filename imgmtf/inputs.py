@@ -12,6 +12,8 @@ MIN_SIZE_PX = 16
 MAX_ABS_DN = 1e15                 # no sensor records more; beyond, squares overflow
 # Rec. 709 luma weights (red, green, blue), applied to the stored values
 LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
+MIN_BAR_WIDTH_PX = 0.2              # narrower, a bar's signal is below any noise
+MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
 
 
 def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
@@ -176,3 +178,30 @@ def saturation_levels(dtype) -> tuple[float, float] | None:
         info = np.iinfo(dtype)
         return float(info.min), float(info.max)
     return None
+
+
+def check_width(width_px: float) -> float:
+    """A bar's width (px) as a float.
+
+    Raises
+    ------
+    ParameterError
+        A width that is not a number of at least ``MIN_BAR_WIDTH_PX``, or one
+        whose sinc has its first zero below ``MIN_FIRST_ZERO_CY_PX``.
+
+    Example
+    -------
+    >>> check_width(3)
+    3.0
+    """
+    if isinstance(width_px, (int, float, np.integer, np.floating)) and not width_px > 0:
+        raise ParameterError(f"the pulse width must be > 0 px, got {width_px!r}")
+    width_px = check_number("the pulse width (px)", width_px, positive=True)
+    if width_px < MIN_BAR_WIDTH_PX:
+        raise ParameterError(f"a {width_px:g} px wide bar is narrower than {MIN_BAR_WIDTH_PX} px: its signal "
+                             "would be below any noise (is the unit right?)")
+    if 1.0 / width_px < MIN_FIRST_ZERO_CY_PX:
+        raise ParameterError(
+            f"a {width_px:g} px wide bar puts the first zero of its sinc at {1 / width_px:.3f} cy/px, "
+            f"below {MIN_FIRST_ZERO_CY_PX} cy/px: too little of the MTF can be recovered")
+    return width_px

@@ -219,6 +219,20 @@ def test_help_imports_no_numerical_library():
     assert out.stdout.strip() == "[]"
 
 
+def test_a_batchs_parent_checks_its_options_without_the_estimators(tmp_path):
+    # the parent of --workers N only collects records: SciPy and scikit-image
+    # load in the workers, in parallel, not in its start-up
+    import subprocess
+    import sys
+    code = ("import sys; from imgmtf.cli import MethodName; from imgmtf.batch import MeasureSettings, "
+            "expand_inputs; MethodName().convert('spline', None, None); "
+            "MeasureSettings('pulse', 'spline', pulse_width=(3.0, 'px')); "
+            f"expand_inputs([{str(tmp_path)!r}]); "
+            "print(sorted(m for m in ('scipy', 'skimage', 'cv2', 'matplotlib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
 def test_simulate_writes_png_or_refuses_other_formats(run, tmp_path):
     from imgmtf.io import read_raster
     for bits in ("8", "16"):

@@ -30,7 +30,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import stdtrit
 
 from ..errors import ParameterError
 from ..metrics import first_crossing
@@ -184,6 +183,7 @@ def linearised_interval(value: float, sd: float, rows: int, confidence: float,
     deviation in quadrature."""
     if not (math.isfinite(value) and math.isfinite(sd)) or rows < 3:
         return Interval.none()
+    from scipy.special import stdtrit  # here, not at import: a batch's parent never needs SciPy
     half = float(stdtrit(rows - 1, 0.5 + confidence / 2)) * math.hypot(sd, systematic)
     return Interval(value - half, value + half)
 

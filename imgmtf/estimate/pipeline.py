@@ -46,7 +46,7 @@ from .detection import Line, robust_noise
 from .geometry import TargetGeometry, check_angle, profile_samples, vertical_frame
 from .intervals import Interval, Intervals, as_intervals, bootstrap_figures, influence_sd, linearised_interval
 from .quantisation import dequantise
-from .resampling import METHODS, resample_profile
+from .resampling import METHODS, check_method, resample_profile
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
@@ -141,8 +141,7 @@ class Settings:
     force: bool = False
 
     def __post_init__(self):
-        if not isinstance(self.method, str) or self.method not in METHODS:
-            raise ParameterError(f"unknown method {self.method!r}; choose one of {', '.join(METHODS)}")
+        check_method(self.method)
         set_ = object.__setattr__
         set_(self, "step_px", check_number("step_px", self.step_px, low=STEP_RANGE_PX[0], high=STEP_RANGE_PX[1]))
         if not isinstance(self.correct, (bool, np.bool_)):

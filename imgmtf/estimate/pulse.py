@@ -17,8 +17,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
-from ..inputs import check_number
+from ..errors import TargetNotFoundError, UnsuitableTargetError
+from ..inputs import check_width
 from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
@@ -27,8 +27,6 @@ from .pipeline import TAPER_FACTOR, Shape, TargetKind, make_settings, outer_samp
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 
-MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
-MIN_WIDTH_PX = 0.2              # narrower, a bar's signal is below any noise
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
 MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
@@ -260,23 +258,6 @@ def usable_band(width_px: float) -> float:
     """First frequency (cy/px) where |sinc(f W)| falls to ``MIN_TRANSFER``."""
     f = np.linspace(0.0, 1.0 / width_px, 2001)
     return float(f[np.argmax(np.abs(np.sinc(f * width_px)) < MIN_TRANSFER)])
-
-
-def check_width(width_px: float) -> float:
-    """The width (px) as a float; refuses a width that is not a number of
-    at least ``MIN_WIDTH_PX`` and one whose sinc has its first zero below
-    ``MIN_FIRST_ZERO_CY_PX``."""
-    if isinstance(width_px, (int, float, np.integer, np.floating)) and not width_px > 0:
-        raise ParameterError(f"the pulse width must be > 0 px, got {width_px!r}")
-    width_px = check_number("the pulse width (px)", width_px, positive=True)
-    if width_px < MIN_WIDTH_PX:
-        raise ParameterError(f"a {width_px:g} px wide bar is narrower than {MIN_WIDTH_PX} px: its signal "
-                             "would be below any noise (is the unit right?)")
-    if 1.0 / width_px < MIN_FIRST_ZERO_CY_PX:
-        raise ParameterError(
-            f"a {width_px:g} px wide bar puts the first zero of its sinc at {1 / width_px:.3f} cy/px, "
-            f"below {MIN_FIRST_ZERO_CY_PX} cy/px: too little of the MTF can be recovered")
-    return width_px
 
 
 def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:

@@ -25,7 +25,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.ndimage import correlate1d
 
 from ..errors import ImageContentError, ParameterError
 
@@ -76,6 +75,9 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     :func:`resample_profile`) enter the moment sums linearly, so a stack of
     weight vectors is fitted in one pass.
     """
+    # SciPy here, not at import: the CLI checks a method's name without it
+    from scipy.ndimage import correlate1d
+
     if order < 0 or order > 8:
         raise ParameterError(f"local polynomial order must be 0..8, got {order}")
     # at angles whose sample positions repeat (tan a = 1/q), a window must
@@ -389,6 +391,24 @@ METHODS: dict[str, ResamplingMethod] = {
 }
 
 
+def check_method(method: str) -> ResamplingMethod:
+    """The registered method of that name.
+
+    Raises
+    ------
+    ParameterError
+        ``method`` is not a key of :data:`METHODS`.
+
+    Example
+    -------
+    >>> check_method("iso").defaults
+    {'bin_px': 0.25}
+    """
+    if not isinstance(method, str) or method not in METHODS:
+        raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    return METHODS[method]
+
+
 def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = "msg",
                      step: float = 0.05, half_range: float, weights=None, **options) -> Resampled:
     """Resample an over-sampled, unevenly spaced profile onto a uniform grid.
@@ -434,11 +454,9 @@ def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = 
     >>> round(float(np.interp(0.0, r.grid, r.values)), 3), round(r.step, 3)
     (0.5, 0.05)
     """
-    if method not in METHODS:
-        raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    spec = check_method(method)
     if not step > 0:
         raise ParameterError(f"resampling step must be > 0 px, got {step}")
-    spec = METHODS[method]
     unknown = set(options) - set(spec.defaults)
     if unknown:
         raise ParameterError(f"method {method!r} takes no option(s) {', '.join(sorted(unknown))}")
