@@ -506,7 +506,7 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     with _reported_errors():
-        from .parallel import InputOrder, prestart_workers
+        from .parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:
             prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
         from .batch import MeasureSettings, expand_inputs, measure_files
@@ -542,9 +542,10 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
             def emit(batches):
                 for batch in batches:
                     for record in batch:
-                        for writer in writers:
-                            writer.write(record)
-                        counts["ok" if record.ok else "error"] += 1
+                        with signals_deferred():    # a row reaches every output or none
+                            for writer in writers:
+                                writer.write(record)
+                            counts["ok" if record.ok else "error"] += 1
             try:
                 with _closing(completed):
                     for index, batch in completed:

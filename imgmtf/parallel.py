@@ -72,6 +72,31 @@ def terminate_raises():
         signal.signal(signal.SIGTERM, previous)
 
 
+@contextmanager
+def signals_deferred():
+    """Ctrl-C and SIGTERM held back until the block ends, then handled as
+    they would have been: for a step that must not be cut in two, such as
+    writing one row to every output.  (Python runs signal handlers in the
+    main thread only, so outside it there is nothing to defer.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    arrived: list[int] = []
+    previous = {signum: signal.signal(signum, lambda signum, frame: arrived.append(signum))
+                for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        for signum in arrived:
+            handler = previous[signum]
+            if callable(handler):
+                handler(signum, None)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(signum)
+
+
 def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, scheduler: str | None = None,
               progress: bool | None = None, description: str = "measuring",
               on_error: Callable | None = None, ordered: bool = True) -> Iterator:

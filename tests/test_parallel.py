@@ -2,6 +2,8 @@
 processes and on a Dask distributed cluster."""
 import json
 import math
+import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -9,7 +11,7 @@ from click.testing import CliRunner
 
 from imgmtf.cli import main
 from imgmtf.errors import ParameterError
-from imgmtf.parallel import run_tasks
+from imgmtf.parallel import run_tasks, signals_deferred
 
 DATA = Path(__file__).parent.parent / "data"
 
@@ -57,3 +59,13 @@ def test_prestarted_workers_are_used_once_and_never_left_behind():
     parallel.prestart_workers(2, ["json"])
     assert list(run_tasks(math.sqrt, [9], workers=2)) == [3]     # one task runs here: the pool goes
     assert not parallel._prestarted
+
+
+def test_a_signal_inside_a_deferred_block_is_handled_after_it():
+    steps = []
+    with pytest.raises(KeyboardInterrupt):
+        with signals_deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            steps.append("after the signal")        # the block is not cut short
+    assert steps == ["after the signal"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
