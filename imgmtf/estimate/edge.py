@@ -22,7 +22,7 @@ from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, locate_edge, row_windows
 from .pipeline import Settings, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
-from .spectrum import MIN_TRANSFER, edge_divisor, relative_edge_response, rise_distance
+from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
 
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row
 # edge chips, 95 % of msg estimates fall within +-5 % of the true MTF at
@@ -131,7 +131,7 @@ class EdgeKind(TargetKind):
             out[..., 2:] += h / (2 * step)
             out[..., :-2] -= h / (2 * step)
             return out
-        return grid[1:-1], (values[..., 2:] - values[..., :-2]) / (2 * step), adjoint
+        return (*central_difference(grid, values), adjoint)
 
     def lsf_tail_amplitudes(self):
         # ESF = level + A / |s|: its slope is +A / s^2 on the left, -A / s^2 on the right
