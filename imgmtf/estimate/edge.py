@@ -184,18 +184,9 @@ class EdgeEstimator:
         f, a = m.figures, m.arrays
         left, right = f["side_levels"]
         return EdgeResult(
-            method=self.settings.method, params=m.params, normal_angle_deg=f["normal_angle_deg"],
-            tilt_deg=f["tilt_deg"], direction=f["direction"], orientation=f["orientation"],
-            polarity="rising" if right > left else "falling",
-            bright_side=_bright_side(right > left, f["transposed"]),
-            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
-            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
-            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
-            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
-            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
-            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
-            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=m.warnings,
-            mtf_function=a["mtf_function"], rer=f["rer"], esf_x_px=a["grid"],
+            **m.result_fields(), method=self.settings.method, params=m.params,
+            polarity="rising" if right > left else "falling", warnings=m.warnings,
+            bright_side=_bright_side(right > left, f["transposed"]), rer=f["rer"], esf_x_px=a["grid"],
             esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
 
 

@@ -403,6 +403,22 @@ class Measurement:
     warnings: tuple
     params: dict
 
+    def result_fields(self) -> dict:
+        """The :class:`.results.MTFResult` fields every kind fills alike;
+        the kind adds ``method``, ``params``, ``polarity``, ``warnings`` and
+        its own."""
+        f, a = self.figures, self.arrays
+        return dict(
+            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
+            orientation=f["orientation"], rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"],
+            noise_dn=f["noise_dn"], mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"],
+            mtf_nyquist_ci=f["mtf_nyquist_ci"], mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"],
+            mtfa=f["mtfa"], gsd_m=f["gsd_m"], frequencies_cy_px=a["frequencies"], mtf=a["mtf"],
+            lsf_x_px=a["lsf_x"], lsf=a["lsf"], samples_x_px=a["samples_x"], samples_dn=a["samples_dn"],
+            geometry=a["geometry"], roi=f["roi"], noise_limit_cy_px=f["noise_limit_cy_px"],
+            lsf_half_width_px=f["lsf_half_width_px"], tail_fraction=f["tail_fraction"], checks=self.checks,
+            mtf_function=a["mtf_function"])
+
 
 def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd_m=None, saturation=None,
         dtype=None, track_azimuth_deg: float | None = 0.0) -> Measurement:

@@ -193,17 +193,8 @@ class PulseEstimator:
                             "Nyquist: MTF values near its zeros are masked (NaN)")
         background, peak = f["levels"]
         return PulseResult(
-            method=self.settings.method, params={**m.params, "pulse_width_px": width},
-            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
-            orientation=f["orientation"], polarity="bright" if f["sign"] > 0 else "dark",
-            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
-            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
-            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
-            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
-            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
-            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
-            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=tuple(warnings),
-            mtf_function=a["mtf_function"], pulse_width_px=float(width),
+            **m.result_fields(), method=self.settings.method, params={**m.params, "pulse_width_px": width},
+            polarity="bright" if f["sign"] > 0 else "dark", warnings=tuple(warnings), pulse_width_px=float(width),
             width_estimated=f["width_estimated"], usable_band_cy_px=band, prf_x_px=a["grid"],
             prf=f["prf01"], prf_fwhm_px=fwhm(a["grid"], f["prf01"]), background_dn=float(background),
             peak_dn=float(peak))
