@@ -33,6 +33,7 @@ SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
 OUTER_PX = 5                    # a row window's pixels this far from the centre are background
+WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-width at 10 %
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
@@ -117,15 +118,14 @@ class PulseKind(TargetKind):
             raise UnsuitableTargetError(
                 f"the bar ({width:.1f} px) is too wide for the chip: it needs "
                 f"{width / 2 + 2:.1f} px of background on each side of its centre", reason="border")
-        area = float(np.sum(prf01[np.abs(grid) <= max(1.6 * h10, width / 2 + 1.0)]) * (grid[1] - grid[0]))
+        area = float(np.sum(prf01[np.abs(grid) <= _core_px(h10, width)]) * (grid[1] - grid[0]))
         return Shape(0.0, h10, float(background), float(background + sign * height),
                      min(1.5 * h10 + 1.0, half_range - 1.0),
                      {"width_px": width, "width_estimated": self.width_px is None, "prf01": prf01,
                       "sign": sign, "area_px": area, "h10": h10})
 
     def core_px(self, shape, snr, factor):
-        width = shape.extra["width_px"]
-        return max((factor or 1.6) * shape.scale_px, width / 2 + 1.0)
+        return _core_px(shape.scale_px, shape.extra["width_px"], factor)
 
     def taper_factor(self, snr: float) -> float:
         return TAPER_FACTOR
@@ -301,6 +301,14 @@ def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_wi
         geometry = fit_line(rows[usable], centres, transposed, expected)
         centre_x = geometry.slope * rows + geometry.intercept
     return geometry
+
+
+def _core_px(h10: float, width_px: float, factor: float | None = None) -> float:
+    """The LSF window's flat half-width (px): ``factor`` (default
+    ``WINDOW_FACTOR``) times the PRF's half-width at 10 % ``h10``, and at
+    least the bar's half-width and a pixel; the bar's area is measured over
+    the same core."""
+    return max((factor or WINDOW_FACTOR) * h10, width_px / 2 + 1.0)
 
 
 def _half_width_at(grid: np.ndarray, prf01: np.ndarray, level: float) -> float:
