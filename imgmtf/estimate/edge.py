@@ -153,11 +153,23 @@ class EdgeKind(TargetKind):
 class EdgeEstimator:
     """A configured slanted-edge estimator: set up once, apply to many chips.
 
-    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
-    keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
-    intervals); ``snr_threshold=None`` uses the measured threshold for the
-    edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
-    adapts the LSF window to the SNR (:func:`window_factor`).
+    Parameters
+    ----------
+    method : str, optional
+        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
+        (default "msg").
+    **settings
+        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
+        intervals); ``snr_threshold=None`` uses the measured threshold for
+        the edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
+        adapts the LSF window to the SNR (:func:`window_factor`).
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or keyword, or a setting out of its range.
+        Calling the estimator raises as :func:`measure_edge` does.
 
     Examples
     --------

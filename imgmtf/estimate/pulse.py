@@ -158,9 +158,22 @@ class PulseKind(TargetKind):
 class PulseEstimator:
     """A configured pulse estimator: set up once, apply to many chips.
 
-    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
-    keywords; ``snr_threshold=None`` uses the paper's 100 (the reproduction
-    study measured edges only).
+    Parameters
+    ----------
+    method : str, optional
+        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
+        (default "msg").
+    **settings
+        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
+        intervals); ``snr_threshold=None`` uses the paper's 100 (the
+        reproduction study measured edges only).
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or keyword, or a setting out of its range.
+        Calling the estimator raises as :func:`measure_pulse` does.
 
     Examples
     --------
