@@ -86,6 +86,7 @@ SYSTEMATIC_DEQUANTISED_MTF50 = 0.003      # relative
 NARROW_WINDOW_NYQUIST = 0.009
 NARROW_WINDOW_MTF50 = 0.03                # relative
 LEVERAGE_CAP = 0.9
+MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
 
 
 @dataclass(frozen=True, eq=False)
@@ -596,11 +597,11 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
     fwhm_px = fwhm(x_c, lsf_c)
     # where a divisor's zeros hide the MTF (a bar's sinc), a figure there is rightly missing
-    f_check = np.arange(0.0, 2.0, 0.005)
+    f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
     hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
     first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
     checks.append(gate.figures_check(
-        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / 0.005))]),
+        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
         mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
     warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
     if cut:
