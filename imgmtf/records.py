@@ -38,7 +38,6 @@ from .errors import FileWriteError, ImgmtfError
 from .version import __version__
 
 OK_STATUSES = ("ok", "accepted", "combined")
-FAILED_STATUSES = ("error", "rejected")
 INTERNAL = "internal"
 
 # keys of an estimate's dict that are the record's own fields

@@ -22,7 +22,7 @@ from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, locate_edge, row_windows
 from .pipeline import Settings, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
-from .spectrum import MIN_TRANSFER, edge_divisor, relative_edge_response, rise_distance
+from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
 
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row
 # edge chips, 95 % of msg estimates fall within +-5 % of the true MTF at
@@ -131,7 +131,7 @@ class EdgeKind(TargetKind):
             out[..., 2:] += h / (2 * step)
             out[..., :-2] -= h / (2 * step)
             return out
-        return grid[1:-1], (values[..., 2:] - values[..., :-2]) / (2 * step), adjoint
+        return (*central_difference(grid, values), adjoint)
 
     def lsf_tail_amplitudes(self):
         # ESF = level + A / |s|: its slope is +A / s^2 on the left, -A / s^2 on the right
@@ -153,11 +153,23 @@ class EdgeKind(TargetKind):
 class EdgeEstimator:
     """A configured slanted-edge estimator: set up once, apply to many chips.
 
-    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
-    keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
-    intervals); ``snr_threshold=None`` uses the measured threshold for the
-    edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
-    adapts the LSF window to the SNR (:func:`window_factor`).
+    Parameters
+    ----------
+    method : str, optional
+        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
+        (default "msg").
+    **settings
+        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
+        intervals); ``snr_threshold=None`` uses the measured threshold for
+        the edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
+        adapts the LSF window to the SNR (:func:`window_factor`).
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or keyword, or a setting out of its range.
+        Calling the estimator raises as :func:`measure_edge` does.
 
     Examples
     --------
@@ -184,18 +196,9 @@ class EdgeEstimator:
         f, a = m.figures, m.arrays
         left, right = f["side_levels"]
         return EdgeResult(
-            method=self.settings.method, params=m.params, normal_angle_deg=f["normal_angle_deg"],
-            tilt_deg=f["tilt_deg"], direction=f["direction"], orientation=f["orientation"],
-            polarity="rising" if right > left else "falling",
-            bright_side=_bright_side(right > left, f["transposed"]),
-            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
-            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
-            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
-            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
-            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
-            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
-            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=m.warnings,
-            mtf_function=a["mtf_function"], rer=f["rer"], esf_x_px=a["grid"],
+            **m.result_fields(), method=self.settings.method, params=m.params,
+            polarity="rising" if right > left else "falling", warnings=m.warnings,
+            bright_side=_bright_side(right > left, f["transposed"]), rer=f["rer"], esf_x_px=a["grid"],
             esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
 
 

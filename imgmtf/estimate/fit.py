@@ -12,9 +12,9 @@ where ESF is the sensor's exact edge response along that edge's normal
 offset) are the edge's own nuisance parameters.  All edges share the
 stages' parameters, so an across-track and an along-track edge together
 constrain both axes.  The parameters are fitted by bounded least squares
-(:func:`scipy.optimize.least_squares`), each edge weighted by the inverse
-of its noise, measured without the model (second differences of the
-profile).
+(an active-set Levenberg-Marquardt, :meth:`_Model.solve`), each edge
+weighted by the inverse of its noise, measured without the model (each
+sample against the line through its two neighbours, :func:`profile_noise`).
 
 Identifiability, in three steps:
 
@@ -27,10 +27,13 @@ Identifiability, in three steps:
    for widths, the length itself for diffraction), bounded from 0 (stage
    absent) to a few pixels; see :class:`imgmtf.sensor.stages.FitSpec`.
 3. Holding.  After a fit, a parameter whose one-standard-error range is
-   wider than 25 % of its blur length (and than 0.05 px) is not determined
-   by the data: the best-known of those (detector first, optics last) is
-   held at its starting value, and the fit is redone, until every free
-   parameter is determined.  Optics sigma, electronics cut-off and detector
+   wider than ``DETERMINED_RELATIVE`` (50 %) of its blur length and than
+   ``DETERMINED_PX`` (0.2 px) is not determined by the data: the best-known
+   of those (detector first, optics last) is held at its starting value,
+   and the fit is redone, until every free parameter is determined.  Then,
+   best-known first, a parameter is held when freeing it gains less than
+   ``LIKELIHOOD_RATIO`` in chi-square, keeping one free parameter on each
+   axis an edge sees.  Optics sigma, electronics cut-off and detector
    width shape the MTF alike, and such pairs are reported with their
    correlation.
 
@@ -60,10 +63,10 @@ from ..sensor.stages import STAGES, Stage
 if TYPE_CHECKING:
     from .edge import EdgeResult
 
-#: a free parameter is determined when its 1-SE range of blur length is
-#: narrower than this fraction of the length ...
+#: a free parameter is undetermined when its 1-SE range of blur length is
+#: wider than this fraction of the length ...
 DETERMINED_RELATIVE = 0.5
-#: ... or than this many pixels
+#: ... and than this many pixels
 DETERMINED_PX = 0.2
 #: residual bins along the normal (px) for the misfit test
 MISFIT_BIN_PX = 0.25

@@ -111,21 +111,13 @@ def fill_check(image: np.ndarray, dtype) -> Check:
     if not used.all():
         image = np.where(used, image, np.nan)
     values = image[used]
-    candidates = {0.0}
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        info = np.iinfo(np.dtype(dtype))
-        candidates |= {float(info.min), float(info.max)}
-    if values.min() < 0 <= np.median(values):
-        candidates.add(float(values.min()))
-    for value in sorted(candidates):
+    for value in fill_values(values, dtype):
         mask = image == value
         count = int(mask.sum())
         if count < 8 or count < MIN_FILL_FRACTION * values.size or count == values.size:
             continue
-        rest = image[~mask & used]
-        lo, hi = float(rest.min()), float(rest.max())
-        contrast = hi - lo
-        if contrast <= 0 or (value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast):
+        contrast = fill_contrast(value, image[~mask & used])
+        if contrast <= 0:
             continue
         border = np.zeros_like(mask)
         border[1:, :] |= mask[:-1, :]
@@ -141,6 +133,39 @@ def fill_check(image: np.ndarray, dtype) -> Check:
                          f"{value:g} DN with a hard boundary (no nodata tag declares it): crop the "
                          "ROI away from it", jump, FILL_BOUNDARY)
     return Check("fill", True, "no fill in the chip")
+
+
+def fill_values(values: np.ndarray, dtype) -> list[float]:
+    """The values (DN, ascending) that undeclared fill may take among
+    ``values``, a chip's finite pixels stored as ``dtype``: 0, an integer
+    type's limits, and a negative minimum where the rest is not negative
+    (-9999).
+
+    Example
+    -------
+    >>> fill_values(np.array([-9999.0, 5.0, 7.0]), "float32")
+    [-9999.0, 0.0]
+    """
+    candidates = {0.0}
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        info = np.iinfo(np.dtype(dtype))
+        candidates |= {float(info.min), float(info.max)}
+    low = float(values.min())
+    if low < 0 <= np.median(values):
+        candidates.add(low)
+    return sorted(candidates)
+
+
+def fill_contrast(value: float, rest: np.ndarray) -> float:
+    """The contrast (DN) of ``rest``, the pixels beside a fill candidate
+    ``value``; 0 where ``value`` cannot be fill: 0 always can, any other
+    value only well outside the rest's range (a sentinel, not a clipped
+    target's level)."""
+    lo, hi = float(rest.min()), float(rest.max())
+    contrast = hi - lo
+    if value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast:
+        return 0.0
+    return contrast
 
 
 def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:

@@ -107,6 +107,25 @@ def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) ->
     """Bootstrap interval settings: ``replicates`` row resamplings (0: no
     intervals at all).
 
+    Parameters
+    ----------
+    replicates : int, optional
+        Bootstrap replicates, 20 to 5000, or 0 for no intervals (default 200).
+    confidence : float, optional
+        Coverage the interval aims at, in (0, 1) (default 0.95).
+    seed : int, optional
+        Random seed of the row resampling (default 0).
+
+    Returns
+    -------
+    Intervals
+        Method "bootstrap", or "none" for 0 replicates.
+
+    Raises
+    ------
+    ParameterError
+        A number of replicates or a confidence out of range.
+
     Examples
     --------
     >>> Bootstrap(0).method
@@ -117,8 +136,6 @@ def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) ->
     if isinstance(replicates, (int, np.integer)) and not isinstance(replicates, bool) and replicates == 0:
         return Intervals("none", confidence)
     return Intervals("bootstrap", confidence, replicates, seed)
-
-
 
 
 def as_intervals(value) -> Intervals:

@@ -86,6 +86,7 @@ SYSTEMATIC_DEQUANTISED_MTF50 = 0.003      # relative
 NARROW_WINDOW_NYQUIST = 0.009
 NARROW_WINDOW_MTF50 = 0.03                # relative
 LEVERAGE_CAP = 0.9
+MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
 
 
 @dataclass(frozen=True, eq=False)
@@ -403,6 +404,22 @@ class Measurement:
     warnings: tuple
     params: dict
 
+    def result_fields(self) -> dict:
+        """The :class:`.results.MTFResult` fields every kind fills alike;
+        the kind adds ``method``, ``params``, ``polarity``, ``warnings`` and
+        its own."""
+        f, a = self.figures, self.arrays
+        return dict(
+            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
+            orientation=f["orientation"], rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"],
+            noise_dn=f["noise_dn"], mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"],
+            mtf_nyquist_ci=f["mtf_nyquist_ci"], mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"],
+            mtfa=f["mtfa"], gsd_m=f["gsd_m"], frequencies_cy_px=a["frequencies"], mtf=a["mtf"],
+            lsf_x_px=a["lsf_x"], lsf=a["lsf"], samples_x_px=a["samples_x"], samples_dn=a["samples_dn"],
+            geometry=a["geometry"], roi=f["roi"], noise_limit_cy_px=f["noise_limit_cy_px"],
+            lsf_half_width_px=f["lsf_half_width_px"], tail_fraction=f["tail_fraction"], checks=self.checks,
+            mtf_function=a["mtf_function"])
+
 
 def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd_m=None, saturation=None,
         dtype=None, track_azimuth_deg: float | None = 0.0) -> Measurement:
@@ -580,11 +597,11 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
     fwhm_px = fwhm(x_c, lsf_c)
     # where a divisor's zeros hide the MTF (a bar's sinc), a figure there is rightly missing
-    f_check = np.arange(0.0, 2.0, 0.005)
+    f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
     hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
     first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
     checks.append(gate.figures_check(
-        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / 0.005))]),
+        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
         mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
     warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
     if cut:

@@ -33,6 +33,7 @@ SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
 OUTER_PX = 5                    # a row window's pixels this far from the centre are background
+WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-width at 10 %
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
@@ -117,15 +118,14 @@ class PulseKind(TargetKind):
             raise UnsuitableTargetError(
                 f"the bar ({width:.1f} px) is too wide for the chip: it needs "
                 f"{width / 2 + 2:.1f} px of background on each side of its centre", reason="border")
-        area = float(np.sum(prf01[np.abs(grid) <= max(1.6 * h10, width / 2 + 1.0)]) * (grid[1] - grid[0]))
+        area = float(np.sum(prf01[np.abs(grid) <= _core_px(h10, width)]) * (grid[1] - grid[0]))
         return Shape(0.0, h10, float(background), float(background + sign * height),
                      min(1.5 * h10 + 1.0, half_range - 1.0),
                      {"width_px": width, "width_estimated": self.width_px is None, "prf01": prf01,
                       "sign": sign, "area_px": area, "h10": h10})
 
     def core_px(self, shape, snr, factor):
-        width = shape.extra["width_px"]
-        return max((factor or 1.6) * shape.scale_px, width / 2 + 1.0)
+        return _core_px(shape.scale_px, shape.extra["width_px"], factor)
 
     def taper_factor(self, snr: float) -> float:
         return TAPER_FACTOR
@@ -158,9 +158,22 @@ class PulseKind(TargetKind):
 class PulseEstimator:
     """A configured pulse estimator: set up once, apply to many chips.
 
-    Takes the settings of :class:`imgmtf.estimate.pipeline.Settings` as
-    keywords; ``snr_threshold=None`` uses the paper's 100 (the reproduction
-    study measured edges only).
+    Parameters
+    ----------
+    method : str, optional
+        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
+        (default "msg").
+    **settings
+        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
+        intervals); ``snr_threshold=None`` uses the paper's 100 (the
+        reproduction study measured edges only).
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or keyword, or a setting out of its range.
+        Calling the estimator raises as :func:`measure_pulse` does.
 
     Examples
     --------
@@ -193,17 +206,8 @@ class PulseEstimator:
                             "Nyquist: MTF values near its zeros are masked (NaN)")
         background, peak = f["levels"]
         return PulseResult(
-            method=self.settings.method, params={**m.params, "pulse_width_px": width},
-            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
-            orientation=f["orientation"], polarity="bright" if f["sign"] > 0 else "dark",
-            rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"], noise_dn=f["noise_dn"],
-            mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"], mtf_nyquist_ci=f["mtf_nyquist_ci"],
-            mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"], mtfa=f["mtfa"], gsd_m=f["gsd_m"],
-            frequencies_cy_px=a["frequencies"], mtf=a["mtf"], lsf_x_px=a["lsf_x"], lsf=a["lsf"],
-            samples_x_px=a["samples_x"], samples_dn=a["samples_dn"], geometry=a["geometry"], roi=f["roi"],
-            noise_limit_cy_px=f["noise_limit_cy_px"], lsf_half_width_px=f["lsf_half_width_px"],
-            tail_fraction=f["tail_fraction"], checks=m.checks, warnings=tuple(warnings),
-            mtf_function=a["mtf_function"], pulse_width_px=float(width),
+            **m.result_fields(), method=self.settings.method, params={**m.params, "pulse_width_px": width},
+            polarity="bright" if f["sign"] > 0 else "dark", warnings=tuple(warnings), pulse_width_px=float(width),
             width_estimated=f["width_estimated"], usable_band_cy_px=band, prf_x_px=a["grid"],
             prf=f["prf01"], prf_fwhm_px=fwhm(a["grid"], f["prf01"]), background_dn=float(background),
             peak_dn=float(peak))
@@ -310,6 +314,14 @@ def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_wi
         geometry = fit_line(rows[usable], centres, transposed, expected)
         centre_x = geometry.slope * rows + geometry.intercept
     return geometry
+
+
+def _core_px(h10: float, width_px: float, factor: float | None = None) -> float:
+    """The LSF window's flat half-width (px): ``factor`` (default
+    ``WINDOW_FACTOR``) times the PRF's half-width at 10 % ``h10``, and at
+    least the bar's half-width and a pixel; the bar's area is measured over
+    the same core."""
+    return max((factor or WINDOW_FACTOR) * h10, width_px / 2 + 1.0)
 
 
 def _half_width_at(grid: np.ndarray, prf01: np.ndarray, level: float) -> float:

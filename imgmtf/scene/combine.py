@@ -145,6 +145,18 @@ def summarise_scan(records: list[Record]) -> list[Record]:
     and ``weights``; a target's also its centre (``x_px``, ``y_px``, the
     mean of its half-edges' ends).
 
+    Parameters
+    ----------
+    records : list of Record
+        A scan's records (:func:`imgmtf.scene.measure.scan_scene`); only the
+        accepted ones that carry an MTF at Nyquist are combined.
+
+    Returns
+    -------
+    list of Record
+        The targets' summaries (by ``target_id``), then the scene's; empty
+        when no record was accepted.
+
     Example
     -------
     >>> from imgmtf.scene.measure import scan_scene                   # doctest: +SKIP

@@ -82,24 +82,15 @@ def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
     if values.size == 0:
         return fill
     low, high = float(values.min()), float(values.max())
-    candidates = {0.0}
-    if np.issubdtype(np.dtype(dtype), np.integer):
-        info = np.iinfo(np.dtype(dtype))
-        candidates |= {float(info.min), float(info.max)}
-    if low < 0 <= np.median(values):
-        candidates.add(low)
-    for value in candidates:
+    for value in gate.fill_values(values, dtype):
         if not (value == low or value == high):     # a fill value is the least or the greatest
             continue
         at = window == value
         count = int(at.sum())
         if count < MIN_FILL_PIXELS or count == values.size:
             continue
-        rest = values[values != value]
-        lo, hi = float(rest.min()), float(rest.max())
-        contrast = hi - lo
-        # a value other than 0 must lie well outside the rest: a sentinel, not a clipped level
-        if contrast <= 0 or (value != 0 and lo - 0.5 * contrast <= value <= hi + 0.5 * contrast):
+        contrast = gate.fill_contrast(value, values[values != value])
+        if contrast <= 0:
             continue
         border = _grown(at, 1) & ~at & ~nodata
         if border.any() and np.median(np.abs(window[border] - value)) > gate.FILL_BOUNDARY * contrast:
