@@ -624,9 +624,15 @@ def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False
              f"{_num(record.get('mtf50_cy_px'), 7, 4)} {_num(record.get('fwhm_px'), 6, 3)} {_num(last, 6, 3)}"]
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
-                     f"{record['mtf50_cy_m']:.4g} cy/m, FWHM {record['fwhm_m']:.4g} m")
+                     f"{_ground(record.get('mtf50_cy_m'))} cy/m, FWHM {_ground(record.get('fwhm_m'))} m")
     cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def _ground(value) -> str:
+    """A figure in metres to 4 significant digits; '-' where it is not
+    defined (a bar's MTF50 behind its sinc's zero)."""
+    return "-" if value is None else f"{value:.4g}"
 
 
 def _snr(value) -> str:

@@ -134,6 +134,15 @@ def test_pulse_measure_json_fields_and_width_units(run, tmp_path):
     assert (tmp_path / "bar.png").exists()
 
 
+def test_a_bar_whose_mtf50_hides_behind_its_sinc_prints_a_dash_on_the_ground(run, tmp_path):
+    path = tmp_path / "bar3.tif"        # 3 px: the sinc's zero at 0.33 cy/px hides MTF50 (0.36)
+    assert run("simulate", "--target", "pulse", "--pulse-width", "3", "--size", 100, "--noise-std", 2,
+               "--seed", 1, "--out", path).exit_code == 0
+    r = run("measure", "--target", "pulse", path)
+    assert r.exit_code == 0, r.output
+    assert "on the ground (GSD 1 m): MTF50 - cy/m, FWHM 1.2" in r.stdout
+
+
 def test_pulse_width_errors(run, chip, tmp_path):
     r = run("measure", "--target", "pulse", "--pulse-width", "-1", chip)
     assert r.exit_code == 1 and "must be > 0" in r.stderr

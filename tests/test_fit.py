@@ -86,6 +86,16 @@ def test_an_image_without_an_edge_is_named():
         im.fit_sensor([im.render(TRUTH, im.Target("edge", 6.0), 40).image, np.full((40, 40), 500, np.uint16)])
 
 
+def test_a_refused_file_is_named_and_keeps_the_gates_reason(tmp_path):
+    from imgmtf.estimate.gate import QualityError
+    from imgmtf.io import write_png
+    path = tmp_path / "noise.png"
+    write_png(path, np.random.default_rng(0).integers(0, 255, (60, 60)).astype(np.uint8))
+    with pytest.raises(QualityError, match="noise.png: ") as refused:
+        im.fit_sensor([path])
+    assert refused.value.reason == refused.value.checks[0].reason
+
+
 def test_cli_json_contract_toml_and_plot(pair, tmp_path):
     from imgmtf.io import write_geotiff
     paths = []

@@ -381,7 +381,9 @@ def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
             result = measure_edge(image, gsd_m=gsd_m if gsd_m is not None else gsd,
                                   saturation=saturation_levels(dtype), bootstrap=Bootstrap(0))
         except ImgmtfError as exc:
-            raise type(exc)(f"{source}: {exc}", reason=exc.reason) from None
+            # name the input, keeping the error's class, reason and checks
+            exc.args = (f"{source}: {exc}",)
+            raise
         integer = np.issubdtype(dtype, np.integer)
     x = np.asarray(result.samples_x_px, float)
     y = np.asarray(result.samples_dn, float)
