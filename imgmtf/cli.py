@@ -102,6 +102,20 @@ def check_output_file(path: str) -> None:
         raise FileWriteError(f"{path}: cannot write: permission denied in {folder}")
 
 
+#: the formats matplotlib writes (with Pillow, one of its dependencies)
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
+
+
+def check_figure_file(path: str) -> None:
+    """As :func:`check_output_file`, and the suffix one of the figure
+    formats, so a wrong one is refused before any work, not after it."""
+    check_output_file(path)
+    suffix = Path(path).suffix.lower()
+    if suffix not in FIGURE_SUFFIXES:
+        raise ParameterError(f"{path}: a figure is written as {', '.join(s[1:] for s in FIGURE_SUFFIXES)} "
+                             f"(by its suffix); got {suffix or 'no suffix'}")
+
+
 class FiniteFloat(click.FloatRange):
     """A float option that refuses NaN and infinities (FloatRange lets NaN
     through every bound)."""
@@ -309,6 +323,10 @@ def sensor_command(sensor_path, plot_path, save_path):
     MTF at Nyquist across and along track."""
     with _reported_errors():
         from .sensor.model import DIRECTIONS, Sensor
+        if plot_path:
+            check_figure_file(plot_path)
+        if save_path:
+            check_output_file(save_path)
         sensor = _load_sensor(sensor_path)
         click.echo(f"sensor, GSD {sensor.gsd_m:g} m "
                    f"({'the paper' + chr(39) + 's generic sensor' if sensor == Sensor() else sensor_path})")
@@ -369,6 +387,10 @@ def fit(paths, stages, sensor_path, hold, gsd, band, recursive, confidence, out_
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
+        if plot_path:
+            check_figure_file(plot_path)
+        if out_path:
+            check_output_file(out_path)
         start = Sensor.from_toml(sensor_path) if sensor_path else None
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
                             confidence=confidence)
@@ -519,8 +541,10 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
             raise ParameterError(f"no image files in {', '.join(paths)}")
         if plot_path and len(files) > 1:
             raise ParameterError("--plot takes a single input; use --plot-dir for several")
-        for output in filter(None, (plot_path, csv_path)):
-            check_output_file(output)
+        if plot_path:
+            check_figure_file(plot_path)
+        if csv_path:
+            check_output_file(csv_path)
         run_utc = utc_now()
         if plot_path:
             from .batch import measure_file

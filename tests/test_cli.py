@@ -200,6 +200,14 @@ def test_unwritable_outputs_are_named_before_any_work(run, chip, tmp_path):
         assert len(result.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("command", [["measure"], ["sensor"], ["fit"]])
+def test_a_figure_with_an_unknown_suffix_is_refused_before_any_work(run, chip, tmp_path, command):
+    out = tmp_path / "figure.txt"
+    result = run(*command, "--plot", out, *([chip] if command != ["sensor"] else []))
+    assert result.exit_code == 1 and f"{out}: a figure is written as png" in result.stderr
+    assert result.stdout == "" and not out.exists()
+
+
 def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
     result = run("measure", "--bootstrap", "100000", chip)
     assert result.exit_code == 1 and "from 20 to 5000, got 100000" in result.stderr
