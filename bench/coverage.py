@@ -8,7 +8,8 @@ Each chip is measured (msg) and the script counts how often the nominal
 N chips a true coverage of 95 % is read within +-2 sqrt(0.95 * 0.05 / N)
 (+-3.1 % for N = 200) in 95 % of runs.
 
-Cases: fixed (target, rows, SNR, blur) families, and "mixed": SNR drawn
+Cases: fixed (target, rows, SNR, blur) families (bars of 1.5 px, their
+width given, or read off the profile by the estimator), and "mixed": SNR drawn
 log-uniformly from 25 to 200, 40 to 200 rows, Gaussian (sigma 0.35-0.7 px)
 or diffraction (f/5.6-f/16) blur with the pixel aperture.
 
@@ -45,6 +46,8 @@ CASES = [  # (name, target, rows, snr, ground noise, blur)
     ("edge 100 rows SNR 100 +ground", "edge", 100, 100, True, "paper"),
     ("bar 100 rows SNR 100", "pulse", 100, 100, False, "paper"),
     ("bar 100 rows SNR 50", "pulse", 100, 50, False, "paper"),
+    ("bar width read SNR 200", "pulse-width-read", 100, 200, False, "paper"),
+    ("bar width read SNR 100", "pulse-width-read", 100, 100, False, "paper"),
     ("mixed", "edge", None, None, False, "mixed"),
 ]
 
@@ -68,6 +71,8 @@ def _one(case, intervals, seed):
         rows = int(rng.integers(40, 201))
         snr = float(np.exp(rng.uniform(np.log(25), np.log(200))))
     angle = float(rng.uniform(3.0, 12.0)) * rng.choice([-1, 1])
+    width_given = kind == "pulse"            # "pulse-width-read": the estimator reads it off the profile
+    kind = "edge" if kind == "edge" else "pulse"
     target = im.Target(kind, angle, LOW, HIGH, float(rng.uniform(-0.5, 0.5)),
                        PULSE_WIDTH_PX if kind == "pulse" else 0.0)
     width = 100 if blur in ("diffraction", "mixed") else 60
@@ -78,7 +83,8 @@ def _one(case, intervals, seed):
         if kind == "edge":
             r = im.measure_edge(chip.image, intervals=settings)
         else:
-            r = im.measure_pulse(chip.image, width_px=PULSE_WIDTH_PX, intervals=settings)
+            r = im.measure_pulse(chip.image, width_px=PULSE_WIDTH_PX if width_given else None,
+                                 intervals=settings)
     except im.ImgmtfError:
         return None
     true_nyq, true_50 = float(chip.true_mtf(0.5)), chip.true_mtf50_cy_px()

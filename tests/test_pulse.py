@@ -111,3 +111,38 @@ def test_estimate_width_closed_form():
     x = np.arange(-10, 10.0001, 0.05)
     box = (np.abs(x) <= 1.25).astype(float)
     assert estimate_width(x, box) == pytest.approx(2.5, rel=0.02)
+
+
+def test_width_gradient_predicts_how_the_read_width_moves():
+    from scipy.special import erf
+
+    from imgmtf.estimate.pulse import width_gradient
+    x = np.arange(-400, 401) * 0.05
+
+    def blurred_bar(w, sigma=0.5):    # a bar of width w through a Gaussian PSF, in closed form
+        return 0.5 * (erf((x + w / 2) / (math.sqrt(2) * sigma)) - erf((x - w / 2) / (math.sqrt(2) * sigma)))
+    prf = blurred_bar(1.5)
+    width = estimate_width(x, prf)
+    assert width == pytest.approx(1.5, abs=1e-3)
+    change = blurred_bar(1.52) - prf                   # the same bar 0.02 px wider
+    assert width_gradient(x, prf, width) @ change == pytest.approx(0.02, rel=0.02)
+
+
+def test_sinc_log_slope_is_the_derivative_of_the_sincs_log():
+    from imgmtf.estimate.pulse import sinc_log_slope
+    f, w, h = np.array([0.0, 0.2, 0.5, 0.9]), 1.5, 1e-6
+    numeric = (np.log(np.abs(np.sinc(f * (w + h)))) - np.log(np.abs(np.sinc(f * (w - h))))) / (2 * h)
+    assert sinc_log_slope(f, w) == pytest.approx(numeric, abs=1e-6)
+
+
+def test_a_read_width_carries_its_uncertainty_into_the_interval_and_says_so():
+    chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.2, 1.5), 100, noise_std_dn=2.0,
+                     seed=1)
+    given, read = measure_pulse(chip.image, width_px=1.5), measure_pulse(chip.image)
+    # at Nyquist a 1.5 px bar's MTF moves 2.2 % per 0.01 px of width: that uncertainty dominates
+    assert read.mtf_nyquist_ci.width > 2.0 * given.mtf_nyquist_ci.width
+    assert float(chip.true_mtf(0.5)) in read.mtf_nyquist_ci
+    assert any("read off its profile" in w and "--pulse-width" in w for w in read.warnings)
+    assert not any("read off its profile" in w for w in given.warnings)
+    boot = measure_pulse(chip.image, bootstrap=50)
+    assert any("bootstrap holds the bar's width" in w for w in boot.warnings)

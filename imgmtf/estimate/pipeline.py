@@ -86,6 +86,8 @@ SYSTEMATIC_DEQUANTISED_MTF50 = 0.003      # relative
 NARROW_WINDOW_NYQUIST = 0.009
 NARROW_WINDOW_MTF50 = 0.03                # relative
 LEVERAGE_CAP = 0.9
+BACKGROUND_FRACTION = 2.0 / 3.0   # a bar's background is read from the samples beyond this share of the range
+WIDTH_SHARE_WARNING = 0.5         # an estimated width making more of the variance at Nyquist is worth a warning
 MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
 
 
@@ -285,6 +287,13 @@ class TargetKind:
     def peak_mask(self, s: np.ndarray, shape: Shape) -> np.ndarray | None:
         """The samples of a bar's peak (None for an edge)."""
         raise NotImplementedError
+
+    def width_gradient(self, grid: np.ndarray, shape: Shape):
+        """Where the divisor rests on a width read off the profile (a bar's
+        estimated width W): (dW / d values on ``grid``, dW / d background,
+        f -> d ln|divisor(f)| / dW), which carry the width's own noise into
+        the intervals; None where the divisor is known."""
+        return None
 
 
 @dataclass(frozen=True)
@@ -504,6 +513,17 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         raise
     c = shape.centre
     s = d - c
+    # the samples' pull on a width read off this profile (see TargetKind.width_gradient)
+    width_influence = None
+    width_gradient = kind.width_gradient(grid, shape)
+    if width_gradient is not None and resampled.adjoint is not None:
+        on_grid, per_background, log_slope = width_gradient
+        full = np.zeros((1, resampled.grid.size))
+        full[0, span[0]: span[1]] = on_grid
+        dwidth_dv = resampled.adjoint(full)[0]
+        for side in outer_samples(d, half_range, BACKGROUND_FRACTION):
+            dwidth_dv[side] += 0.5 * per_background / max(int(side.sum()), 1)
+        width_influence = (dwidth_dv, log_slope)
 
     # noise and SNR: each side's scatter about its own level and tail
     plateau = [fit_side(s, v, side & (np.abs(s) >= shape.plateau_px), kind.tail_power)
@@ -611,11 +631,20 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     # intervals
     nyquist_ci = mtf50_ci = Interval.none()
     if settings.intervals.method == "influence":
-        nyquist_ci, mtf50_ci = _influence_intervals(
+        nyquist_ci, mtf50_ci, width_share = _influence_intervals(
             settings.intervals, mtf, mtf_nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
             tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share, rebuilt is not None,
-            narrowed)
+            narrowed, width_influence)
+        if width_share is not None and width_share > WIDTH_SHARE_WARNING:
+            warnings.append(
+                f"the bar's width, read off its profile ({shape.extra['width_px']:.3f} px), is uncertain "
+                f"enough to make {100 * width_share:.0f} % of the variance at Nyquist: give the width "
+                "if it is known (--pulse-width, width_px=)")
     elif settings.intervals.method == "bootstrap":
+        if width_influence is not None:
+            warnings.append(f"the bootstrap holds the bar's width ({shape.extra['width_px']:.3f} px, read "
+                            "off its profile) fixed, so its intervals leave out the width's uncertainty: "
+                            "give the width if it is known, or use the default (influence) intervals")
         nyquist_ci, mtf50_ci = _bootstrap_intervals(
             settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
 
@@ -706,7 +735,7 @@ def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) ->
 
 def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
                          tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share,
-                         dequantised, narrowed):
+                         dequantised, narrowed, width_influence):
     """Linearised intervals for MTF at Nyquist and MTF50 (see
     :mod:`.intervals`).
 
@@ -716,8 +745,13 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
     amplitude (its least-squares operator), and for a bar through the
     background under the window.  Each figure is |F(f)| / |F(0)| divided by
     the corrections, so its gradient follows, and with each sample's
-    residual (scaled up by its leverage) gives the row influences."""
+    residual (scaled up by its leverage) gives the row influences.  Where
+    the divisor rests on a width read off the same samples
+    (``width_influence``: dW / dv and f -> d ln|divisor(f)| / dW), its pull
+    joins the gradient; the share of the variance at Nyquist it makes is
+    returned third (None without it)."""
     step = float(x[1] - x[0])
+    width_share = None
     freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
     e = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                   # (n_f, n_x)
     left = x < c
@@ -754,7 +788,14 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
         # the MTF is this ratio divided by the corrections: scale the gradient alike
         scale = float(mtf(np.array([f]))[0]) / ratio if ratio else 0.0
         grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
+        if width_influence is not None:
+            dwidth_dv, log_slope = width_influence
+            fixed_sd, _ = influence_sd(grad * residual, row)
+            # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
+            grad = grad - float(mtf(np.array([f]))[0]) * float(log_slope(f)) * dwidth_dv
         sd, n_rows = influence_sd(grad * residual, row)
+        if j == 1 and width_influence is not None:
+            width_share = 1.0 - (fixed_sd / sd) ** 2 if sd > 0 else 0.0
         if j == 1:
             systematic = (SYSTEMATIC_NYQUIST + TAIL_MODEL_UNCERTAINTY * abs(tail_share) * abs(nyquist)
                           + (SYSTEMATIC_DEQUANTISED if dequantised else 0.0) + NARROW_WINDOW_NYQUIST * narrowed)
@@ -769,7 +810,7 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
             out.append(linearised_interval(f50, sd50, n_rows, intervals.confidence, systematic))
     while len(out) < 2:
         out.append(Interval.none())
-    return out[0], out[1]
+    return out[0], out[1], width_share
 
 
 def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, x, span_px):
