@@ -24,6 +24,7 @@ import click
 from .errors import FileWriteError, ImgmtfError, ParameterError
 
 # Bounds of the size-like options (see docs): what a run may allocate.
+MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
 # what a process measuring files loads: batch imports the estimators only where
@@ -45,8 +46,8 @@ def _reported_errors():
     except KeyboardInterrupt as exc:
         click.echo("imgmtf: interrupted", err=True)
         sys.exit(_interrupt_code(exc))
-    except BrokenPipeError:
-        raise                     # click exits quietly when stdout's reader has gone (| head)
+    except (BrokenPipeError, click.ClickException):
+        raise                     # click exits quietly when stdout's reader has gone (| head), or with 2
     except Exception as exc:
         if os.environ.get("IMGMTF_DEBUG"):
             raise
@@ -458,8 +459,8 @@ def _parallel_options(command):
     command = click.option("--scheduler", metavar="ADDRESS",
                            help="run on a Dask distributed cluster (tcp://host:8786), or 'local' "
                                 "for a local Dask cluster of --workers processes; needs imgmtf[dask]")(command)
-    return click.option("--workers", type=click.IntRange(min=1), default=1, show_default=True,
-                        help="parallel worker processes, each on one thread (at most 64)")(command)
+    return click.option("--workers", type=click.IntRange(1, MAX_WORKERS), default=1, show_default=True,
+                        help="parallel worker processes, each on one thread")(command)
 
 
 def _interval_options(command):
@@ -470,18 +471,23 @@ def _interval_options(command):
                            help="intervals from a bootstrap of N row resamplings (20 to 5000; slower); "
                                 "0: no intervals")(command)
     return click.option("--intervals", "interval_method", type=click.Choice(["influence", "bootstrap", "none"]),
-                        default="influence", show_default=True,
+                        show_default="influence",
                         help="confidence intervals: linearised row influence (about the cost of one fit), "
                              "a bootstrap over rows, or none")(command)
 
 
-def _intervals(method: str, replicates: int | None, confidence: float):
+def _intervals(method: str | None, replicates: int | None, confidence: float):
     """The interval settings the options ask for: --bootstrap N means a
-    bootstrap of N replicates (0: none), whatever --intervals says."""
+    bootstrap of N replicates (0: none); an --intervals that says otherwise
+    is a usage error, not silently overruled."""
     from .estimate.intervals import Intervals
     if replicates is not None:
-        method = "bootstrap" if replicates else "none"
-    return Intervals(method, confidence, **({"replicates": replicates} if replicates else {}))
+        implied = "bootstrap" if replicates else "none"
+        if method not in (None, implied):
+            raise click.UsageError(f"--bootstrap {replicates} asks for {implied} intervals, "
+                                   f"--intervals {method} for others: give one")
+        method = implied
+    return Intervals(method or "influence", confidence, **({"replicates": replicates} if replicates else {}))
 
 
 @main.command(short_help="Measure the MTF of the edge or bar in image files or folders.")
@@ -798,7 +804,7 @@ def _interval(pair) -> str:
 @click.option("--out", required=True, type=click.Path(file_okay=False), help="output folder")
 @click.option("--quick", is_flag=True,
               help="few chips (8 per SNR level): a check that the study runs, too few for its thresholds")
-@click.option("--workers", type=click.IntRange(1, 64), default=os.cpu_count() or 1,
+@click.option("--workers", type=click.IntRange(1, MAX_WORKERS), default=os.cpu_count() or 1,
               show_default="all cores", help="worker processes")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bars on stderr (default: on a terminal)")

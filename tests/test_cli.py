@@ -216,6 +216,14 @@ def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
         row = json.loads(result.stdout)
         assert result.exit_code == 0 and row["params"]["intervals"]["method"] == method
         assert (row["mtf_nyquist_ci"][0] is None) == (method == "none")
+    result = run("measure", "--intervals", "none", "--bootstrap", "200", chip)
+    assert result.exit_code == 2 and "--bootstrap 200 asks for bootstrap intervals" in result.output
+    assert run("measure", "--intervals", "bootstrap", "--bootstrap", "50", chip).exit_code == 0
+
+
+def test_workers_bound_is_the_pools():
+    from imgmtf import cli, parallel
+    assert cli.MAX_WORKERS == parallel.MAX_WORKERS
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):
