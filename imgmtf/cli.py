@@ -25,6 +25,7 @@ from .errors import FileWriteError, ImgmtfError, ParameterError
 
 # Bounds of the size-like options (see docs): what a run may allocate.
 MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
+DEFAULT_LEVELS_DN = {16: (200.0, 1200.0), 8: (30.0, 210.0)}    # simulate's dark and bright sides
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
 # what a process measuring files loads: batch imports the estimators only where
@@ -241,9 +242,9 @@ def main(ctx):
               help="angle of the edge's normal from the x (column) axis, degrees in (-90, 90], which "
                    "is the edge's tilt from vertical: near 0 across track, near 90 along track "
                    "(measure reports it as normal_angle_deg)")
-@click.option("--low", type=FiniteFloat(), default=200.0, show_default=True,
+@click.option("--low", type=FiniteFloat(), show_default="200 at 16 bits, 30 at 8",
               help="DN on the dark side (outside a pulse)")
-@click.option("--high", type=FiniteFloat(), default=1200.0, show_default=True,
+@click.option("--high", type=FiniteFloat(), show_default="1200 at 16 bits, 210 at 8",
               help="DN on the bright side (inside a pulse)")
 @click.option("--pulse-width", callback=_length_option("px"),
               help="bar width of a pulse target: 1.5 or 1.5px (pixels), 1.5m (metres on the ground)")
@@ -267,6 +268,9 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
     (or a PNG)."""
     with _reported_errors():
+        default_low, default_high = DEFAULT_LEVELS_DN[int(bits)]     # a step that fits the bit depth
+        low = default_low if low is None else low
+        high = default_high if high is None else high
         from .io import write_geotiff, write_png
         from .sensor.noise import GroundNoise
         from .sensor.rendering import render

@@ -134,6 +134,14 @@ def test_pulse_measure_json_fields_and_width_units(run, tmp_path):
     assert (tmp_path / "bar.png").exists()
 
 
+def test_simulate_fits_its_default_step_to_the_bit_depth(run, tmp_path):
+    path = tmp_path / "e8.tif"
+    result = run("simulate", "--bits", 8, "--out", path)
+    assert result.exit_code == 0 and "clipped" not in result.output
+    r = run("measure", "--format", "json", path)
+    assert r.exit_code == 0 and json.loads(r.stdout)["mtf_nyquist"] == pytest.approx(0.2667, abs=0.005)
+
+
 def test_a_bar_whose_mtf50_hides_behind_its_sinc_prints_a_dash_on_the_ground(run, tmp_path):
     path = tmp_path / "bar3.tif"        # 3 px: the sinc's zero at 0.33 cy/px hides MTF50 (0.36)
     assert run("simulate", "--target", "pulse", "--pulse-width", "3", "--size", 100, "--noise-std", 2,

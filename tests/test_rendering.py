@@ -92,3 +92,8 @@ def test_other_gsd_scales_the_true_mtf():
 def test_invalid_render_settings(kwargs):
     with pytest.raises(ParameterError):
         im.Renderer(im.Sensor(), **kwargs)
+
+
+def test_a_target_outside_the_chip_is_refused_before_any_work():
+    with pytest.raises(ParameterError, match="offset of 1e\\+09 px puts the edge outside the 50 x 50 px chip"):
+        im.render(im.Sensor(), im.Target("edge", 6.0, offset_px=1e9), 50)

@@ -172,7 +172,7 @@ class Renderer:
         self.sensor, self.oversampling, self.bits = sensor, int(oversampling), bits
         self.shape: tuple[int, int] = (rows, cols)
         self._y, self._x = np.mgrid[0:rows, 0:cols].astype(float)
-        self._responses: dict[float, object] = {}
+        self._responses: dict[float, tuple[float, object]] = {}     # angle -> (reach px, response)
 
     @functools.cached_property
     def psf(self) -> SampledPSF:
@@ -197,13 +197,19 @@ class Renderer:
                     float(noise_std_dn), ground_noise, seed, clipped)
 
     def _response(self, target: Target):
-        """The sensor's line response along the target's normal, kept per angle."""
-        if target.angle_deg not in self._responses:
-            rows, cols = self.shape
-            reach = math.hypot(rows, cols) / 2.0 + abs(target.offset_px) + target.width_px + 2.0
-            self._responses[target.angle_deg] = self.sensor.line_response(
-                target.angle_deg, self.gsd_m, reach_px=reach)
-        return self._responses[target.angle_deg]
+        """The sensor's line response along the target's normal, kept per
+        angle (and made anew where a target needs it to reach further)."""
+        rows, cols = self.shape
+        half_diagonal = math.hypot(rows, cols) / 2.0
+        if abs(target.offset_px) > half_diagonal + target.width_px:
+            raise ParameterError(f"a target offset of {target.offset_px:g} px puts the {target.kind} outside "
+                                 f"the {rows} x {cols} px chip (at most {half_diagonal:.1f} px from its centre)")
+        reach = half_diagonal + abs(target.offset_px) + target.width_px + 2.0
+        kept = self._responses.get(target.angle_deg)
+        if kept is None or kept[0] < reach:
+            kept = (reach, self.sensor.line_response(target.angle_deg, self.gsd_m, reach_px=reach))
+            self._responses[target.angle_deg] = kept
+        return kept[1]
 
     def _blurred_ground_noise(self, ground_noise: GroundNoise, rng: np.random.Generator) -> np.ndarray:
         """Ground noise on the sub-pixel grid (with a margin of the PSF's
