@@ -682,7 +682,7 @@ def _num(value, width: int, decimals: int) -> str:
 
 
 # -- scan ---------------------------------------------------------------------
-@main.command()
+@main.command(short_help="Find, measure and combine every edge or bar in a scene.")
 @click.argument("scene", type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
@@ -810,7 +810,8 @@ def _interval(pair) -> str:
               help="few chips (8 per SNR level): a check that the study runs, too few for its thresholds")
 @click.option("--workers", type=click.IntRange(1, MAX_WORKERS), default=os.cpu_count() or 1,
               show_default="all cores", help="worker processes")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="random seed of the study's chips and noise (an integer >= 0)")
 @click.option("--progress/--no-progress", default=None, help="progress bars on stderr (default: on a terminal)")
 def reproduce(out, quick, workers, seed, progress):
     """Rerun the paper's study: its Tables 1-2 and Figures 2-3, 9-10 and

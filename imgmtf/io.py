@@ -355,7 +355,7 @@ def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) ->
     if width * height > MAX_READ_PIXELS:
         what = "the window" if windowed else "the image"
         raise ImageReadError(
-            f"{path}: {what} is {width} x {height} px ({width * height / 2**20:.1f} Mpx), more than "
+            f"{path}: {what} is {width} x {height} px ({width * height / 2**20:.2f} Mpx), more than "
             f"the {MAX_READ_PIXELS // 2**20} Mpx read at once; measure a part of it "
             f"(--roi X,Y,W,H)", reason="too-large")
 
