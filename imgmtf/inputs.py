@@ -3,6 +3,7 @@ that can be measured."""
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -90,6 +91,26 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     return int(number) if integer else number
 
 
+def as_array(image) -> np.ndarray:
+    """``image`` as a NumPy array; a file's path is refused with the way to
+    read it (it would otherwise become a 0-d array of one string).
+
+    Raises
+    ------
+    ParameterError
+        ``image`` is a path (str or os.PathLike).
+
+    Example
+    -------
+    >>> as_array([[1, 2], [3, 4]]).shape
+    (2, 2)
+    """
+    if isinstance(image, (str, os.PathLike)):
+        raise ParameterError(f"expected an image array, got the path {str(image)!r}: read it with "
+                             "imgmtf.read_raster(path).data (or measure files with `imgmtf measure`)")
+    return np.asarray(image)
+
+
 def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, int]]:
     """Validate a 2-D image and crop it to ``roi`` = (x, y, width, height).
 
@@ -106,7 +127,7 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         An image that cannot be measured (NaN or nodata among the pixels
         used, too small, flat, values no sensor records).
     """
-    array = np.asarray(image)
+    array = as_array(image)
     if array.ndim == 3 and array.shape[-1] in (3, 4):
         raise ImageContentError(f"expected a 2-D image, got an array of shape {array.shape}: for a colour "
                                 "image measure its luminance, imgmtf.luminance(image) (what the CLI does "
@@ -161,8 +182,11 @@ def check_roi(roi, shape: tuple[int, int], where: str = "") -> tuple[int, int, i
     image of ``shape`` = (rows, cols); ``where`` (a file) prefixes errors."""
     prefix = f"{where}: " if where else ""
     try:
-        x, y, w, h = (int(v) for v in roi)
-    except (TypeError, ValueError):
+        numbers = [float(v) for v in roi]
+        if not all(n.is_integer() for n in numbers):        # 60.5 px is a typo, not a width to truncate
+            raise ValueError
+        x, y, w, h = (int(n) for n in numbers)
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"{prefix}ROI must be four integers x, y, width, height; got {roi!r}") from None
     rows, cols = shape
     if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > cols or y + h > rows:

@@ -152,6 +152,18 @@ def test_estimator_is_reusable_and_result_serialises():
                 "mtfa", "gsd_m", "frequencies_cy_px", "mtf", "warnings", "params"):
         assert key in d
     assert a.mtf_at([0.5])[0] == pytest.approx(a.mtf_nyquist)
+    assert a.mtf_at([-0.5])[0] == a.mtf_at([0.5])[0]         # an MTF is even in f
+    assert np.isnan(a.mtf_at([4.5])[0])                        # beyond the transform's reach
+
+
+def test_a_path_or_a_fractional_roi_is_refused_with_the_way_out():
+    from imgmtf.errors import ParameterError
+    with pytest.raises(ParameterError, match="read_raster"):
+        measure_edge("data/edge.tif")
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0)
+    with pytest.raises(ParameterError, match="ROI must be four integers"):
+        measure_edge(chip, roi=(20, 0, 60.5, 100))
+    assert measure_edge(chip, roi=(20.0, 0, 60, 100)).roi[2] == 60    # whole numbers as floats are fine
 
 
 def test_noisy_fwhm_and_noise_limit():

@@ -39,7 +39,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import ImgmtfError, ParameterError, UnsuitableTargetError
-from ..inputs import check_number, prepare_image, quantum, saturation_levels
+from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
 from . import gate
 from .detection import Line, robust_noise
@@ -454,7 +454,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     ImgmtfError
         Every refusal: unusable input, no target, a failed quality check.
     """
-    array = np.asarray(image)
+    array = as_array(image)
     stored = np.dtype(dtype) if dtype is not None else array.dtype
     data, (x0, y0) = prepare_image(array, roi, mask)
     gsd_m = None if gsd_m is None else check_number("gsd_m", gsd_m, positive=True)

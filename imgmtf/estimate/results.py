@@ -106,7 +106,8 @@ class MTFResult:
         return self.fwhm_px * self.gsd_m if self.gsd_m else None
 
     def mtf_at(self, f_cy_px) -> np.ndarray:
-        """The corrected MTF at any frequencies (cycles/pixel)."""
+        """The corrected MTF at frequencies ``f_cy_px`` (cy/px): even in f,
+        NaN beyond the transform's reach (4 cy/px) and near a divisor's zeros."""
         if self.mtf_function is None:
             raise ValueError("this result carries no MTF function")
         return self.mtf_function(f_cy_px)

@@ -143,7 +143,7 @@ def corrected_mtf(profile: np.ndarray, step: float,
 
     def mtf(f):
         f = np.atleast_1d(np.asarray(f, float))
-        return np.interp(f, freqs, corrected, right=np.nan)
+        return np.interp(np.abs(f), freqs, corrected, right=np.nan)    # even: MTF(-f) = MTF(f)
     return mtf
 
 
