@@ -86,6 +86,14 @@ def test_an_image_without_an_edge_is_named():
         im.fit_sensor([im.render(TRUTH, im.Target("edge", 6.0), 40).image, np.full((40, 40), 500, np.uint16)])
 
 
+def test_a_missing_gsd_is_said_and_a_given_one_is_not(pair):
+    images = [c.image for c in pair]           # arrays carry no GSD
+    unknown = im.fit_sensor(images, stages="optics,detector", hold="detector")
+    assert any("no GSD in the inputs" in w for w in unknown.warnings)
+    given = im.fit_sensor(images, stages="optics,detector", hold="detector", gsd_m=1.0)
+    assert not any("no GSD" in w for w in given.warnings)
+
+
 def test_a_refused_file_is_named_and_keeps_the_gates_reason(tmp_path):
     from imgmtf.estimate.gate import QualityError
     from imgmtf.io import write_png

@@ -323,7 +323,8 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
         if not undetermined:
             break
         worst = max(undetermined, key=lambda i: (model.specs[model.free[i]].rank, undetermined[i]))
-        notes[model.free[worst]] = ("held", f"not determined by the data (1-SE range {undetermined[worst]:.2g} px); "
+        notes[model.free[worst]] = ("held", f"not determined by the data (within one standard error its blur "
+                                            f"length spans {undetermined[worst]:.2g} px); "
                                             "held at its starting value")
         z = model.hold(z, worst)
     # hold, best-known first, each parameter the data do not need (holding it
@@ -766,6 +767,9 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
         if direction not in seen:
             warnings.append(f"no {direction}-track edge: the {direction}-track MTF is an extrapolation "
                             "of the model (tied and held parameters)")
+    if not any(d.gsd_known for d in model.data):
+        warnings.append(f"no GSD in the inputs: lengths are in units of {model.gsd:g} m per pixel "
+                        "(at 1 m, metres are pixels); give the GSD (--gsd, gsd_m=) for lengths on the ground")
     return SensorFit(sensor, start, tuple(parameters), tuple(correlations), reduced, tuple(edges), directions,
                      confidence, tuple(warnings), model, u, covariance)
 
