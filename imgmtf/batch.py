@@ -139,9 +139,15 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
                 warnings = [*record.figures.get("warnings", []), message]
                 record = record.with_(figures={"warnings": warnings})
         records.append(record)
-    if skipped and records:
-        note = (f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured")
-        records[0] = records[0].with_(figures={"warnings": [*records[0].get("warnings", []), note]})
+    notes = []
+    if skipped:
+        notes.append(f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured")
+    if any(r.band == "luminance" for r in records):
+        # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
+        notes.append("measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded as stored "
+                     "(not linearised)" + (", alpha ignored" if info.alpha_bands else ""))
+    if notes and records:
+        records[0] = records[0].with_(figures={"warnings": [*records[0].get("warnings", []), *notes]})
     return records
 
 

@@ -290,6 +290,10 @@ def test_band_all_on_an_rgba_photo_measures_the_colours_and_skips_alpha(run, tmp
     assert any("band 4 is alpha" in w for w in rows[0]["warnings"])
     text = run("measure", "--band", "all", tmp_path / "photo.png").stdout
     assert "band" in text.splitlines()[0] and "band 4 is alpha" in text
+    assert not any("luminance" in w for row in rows for w in row["warnings"])
+    row = json.loads(run("measure", "--format", "json", tmp_path / "photo.png").stdout)
+    assert row["band"] == "luminance"
+    assert any("luminance of the stored RGB values" in w and "alpha ignored" in w for w in row["warnings"])
 
 
 def test_text_table_names_units_and_fits_long_paths(run, chip, tmp_path):
