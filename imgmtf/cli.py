@@ -820,13 +820,14 @@ def reproduce(out, quick, workers, seed, progress):
     from .reproduce import THRESHOLD_SNRS, run_study
     with _reported_errors():
         result = run_study(out, quick=quick, workers=workers, seed=seed, progress=progress)
-    for method, snr in result["thresholds"].items():
-        found = (f"trustworthy from SNR {snr:g}" if math.isfinite(snr)
-                 else f"not trustworthy up to SNR {max(THRESHOLD_SNRS)}")
-        click.echo(f"{method:8s} {found}")
-    if quick:
-        click.echo(f"(a quick run: {result['chips_per_level']} chips per SNR level are too few for a "
-                   "threshold; run without --quick for one)")
+    if quick:       # a threshold from a handful of chips per level would be noise printed as a finding
+        click.echo(f"thresholds: n/a (a quick run: {result['chips_per_level']} chips per SNR level are too few "
+                   "for one; run without --quick)")
+    else:
+        for method, snr in result["thresholds"].items():
+            found = (f"trustworthy from SNR {snr:g}" if math.isfinite(snr)
+                     else f"not trustworthy up to SNR {max(THRESHOLD_SNRS)}")
+            click.echo(f"{method:8s} {found}")
     click.echo(f"wrote {Path(out) / 'report.md'} ({result['seconds']:.0f} s)")
 
 

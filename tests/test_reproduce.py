@@ -33,7 +33,8 @@ def test_results_do_not_depend_on_the_number_of_workers():
 def test_cli_quick_run_reports_and_says_it_is_quick(quick_run):
     out, r = quick_run
     assert r.exit_code == 0, r.output
-    assert "msg      " in r.stdout and "a quick run: 1 chips per SNR level are too few" in r.stdout
+    assert "thresholds: n/a (a quick run: 1 chips per SNR level are too few" in r.stdout
+    assert "trustworthy" not in r.stdout                     # no threshold from a handful of chips
     assert not r.stderr                                       # --no-progress: no bars
     assert len(read(out / "system_noise.csv")) == 2 * 4       # 2 chips x every method
 
