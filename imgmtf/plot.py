@@ -183,15 +183,20 @@ def plot_locations(result, ax=None):
     kept = g.kept
     fitted = g.slope * g.rows + g.intercept
     rms = float(np.sqrt(np.mean((g.locations[kept] - fitted[kept]) ** 2)))
-    ax.plot(g.locations[kept], g.rows[kept], "o", ms=3, mfc="none",
-            label=f"row {result.target} location (scatter {rms:.3f} px RMS)")
+
+    def image_xy(along, across):
+        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it
+        return (along, across) if g.transposed else (across, along)
+    line = "column" if g.transposed else "row"
+    ax.plot(*image_xy(g.rows[kept], g.locations[kept]), "o", ms=3, mfc="none",
+            label=f"{line} {result.target} location (scatter {rms:.3f} px RMS)")
     if (~kept).any():
-        ax.plot(g.locations[~kept], g.rows[~kept], "x", color="C3", label=f"rejected ({(~kept).sum()})")
-    ax.plot(fitted, g.rows, "-", color="C1", label="least-squares line")
+        ax.plot(*image_xy(g.rows[~kept], g.locations[~kept]), "x", color="C3",
+                label=f"rejected ({(~kept).sum()})")
+    ax.plot(*image_xy(g.rows, fitted), "-", color="C1", label="least-squares line")
     ax.set_aspect("equal", adjustable="datalim")
     ax.invert_yaxis()
-    frame = "column" if not g.transposed else "row"
-    ax.set(xlabel=f"{frame} (px)", ylabel="row (px)" if not g.transposed else "column (px)")
+    ax.set(xlabel="column (px)", ylabel="row (px)")
     _title(ax, f"{result.target.capitalize()}: normal at {result.normal_angle_deg:.2f} deg, "
                f"tilt {result.tilt_deg:.2f} deg")
     ax.legend(fontsize="small")
@@ -257,8 +262,9 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
         ax.plot(f, truth(f), "--", color="0.2", lw=1.0, label="true")
     if np.isfinite(result.noise_limit_cy_px) and result.noise_limit_cy_px < f.max():
         ax.axvspan(result.noise_limit_cy_px, f.max(), color="0.5", alpha=0.1, lw=0,
-                   label=f"below 3 x its noise (from {result.noise_limit_cy_px:.2f} cy/px)")
-    ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8, label="Nyquist, 0.5 cy/px")
+                   label=_once(ax, "below 3 x its noise",
+                               f"below 3 x its noise (from {result.noise_limit_cy_px:.2f} cy/px)"))
+    ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8, label=_once(ax, "Nyquist", "Nyquist, 0.5 cy/px"))
     ci = result.mtf_nyquist_ci
     yerr = ([[result.mtf_nyquist - ci.low], [ci.high - result.mtf_nyquist]] if np.isfinite(ci.low) else None)
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""
@@ -278,6 +284,13 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     _title(ax, "MTF")
     ax.legend(fontsize="small")
     return fig
+
+
+def _once(ax, prefix: str, label: str) -> str:
+    """``label``, unless a label starting with ``prefix`` is already in the
+    axes' legend (several measurements drawn on one axes)."""
+    drawn = ax.get_legend_handles_labels()[1]
+    return "_nolegend_" if any(d.startswith(prefix) for d in drawn) else label
 
 
 def _figure(value: float) -> str:
