@@ -97,11 +97,13 @@ def test_a_missing_gsd_is_said_and_a_given_one_is_not(pair):
 def test_a_refused_file_is_named_and_keeps_the_gates_reason(tmp_path):
     from imgmtf.estimate.gate import QualityError
     from imgmtf.io import write_png
-    path = tmp_path / "noise.png"
-    write_png(path, np.random.default_rng(0).integers(0, 255, (60, 60)).astype(np.uint8))
-    with pytest.raises(QualityError, match="noise.png: ") as refused:
+    path = tmp_path / "filled.png"
+    image = im.render(TRUTH, im.Target("edge", 6.0, 30.0, 200.0), 60, bits=8).image
+    image[:, :12] = 0                          # a 0-filled border the gate refuses
+    write_png(path, image)
+    with pytest.raises(QualityError, match="filled.png: ") as refused:
         im.fit_sensor([path])
-    assert refused.value.reason == refused.value.checks[0].reason
+    assert refused.value.reason == refused.value.checks[0].reason == "fill"
 
 
 def test_cli_json_contract_toml_and_plot(pair, tmp_path):

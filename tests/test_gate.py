@@ -52,6 +52,13 @@ def test_fill_with_a_hard_boundary_is_refused_and_a_dark_plateau_is_not():
     # a second, unblurred step to a level inside the data's range is not fill
     step = edge().astype(float) + np.where(np.arange(100) > 80, 300.0, 0.0)[None, :]
     assert gate.fill_check(step, np.uint16).passed
+    # pixels of 0 DN scattered through noise (1 in 180 of uniform values) are no fill region,
+    # but a one-pixel column of them is
+    noise = np.random.default_rng(0).integers(0, 180, (100, 100)).astype(np.uint8)
+    assert (noise == 0).mean() > gate.MIN_FILL_FRACTION and gate.fill_check(noise, np.uint8).passed
+    column = edge().astype(float)
+    column[:, 3] = 0
+    assert not gate.fill_check(column, np.uint16).passed
 
 
 def test_saturation_by_type_limit_by_given_range_and_by_a_clip_no_one_declared():

@@ -43,6 +43,7 @@ MIN_ROWS_ON_LINE = 0.7          # fraction of rows the line must hold
 MAX_SAGITTA_PX = 0.3            # bow of the row locations over the edge's length
 FILL_BOUNDARY = 0.05            # a fill region's neighbours differ from it by this fraction of the contrast
 MIN_FILL_FRACTION = 0.005
+MIN_FILL_CLUSTERED = 0.5        # the share of fill pixels with a fill neighbour: fill is a region
 SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
 PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
 CLIP_REACH = 0.4                # a noise-free side holding its extreme this much sooner than the other: clipped
@@ -119,12 +120,14 @@ def fill_check(image: np.ndarray, dtype) -> Check:
         contrast = fill_contrast(value, image[~mask & used])
         if contrast <= 0:
             continue
-        border = np.zeros_like(mask)
-        border[1:, :] |= mask[:-1, :]
-        border[:-1, :] |= mask[1:, :]
-        border[:, 1:] |= mask[:, :-1]
-        border[:, :-1] |= mask[:, 1:]
-        border &= ~mask & used
+        beside_fill = np.zeros_like(mask)
+        beside_fill[1:, :] |= mask[:-1, :]
+        beside_fill[:-1, :] |= mask[1:, :]
+        beside_fill[:, 1:] |= mask[:, :-1]
+        beside_fill[:, :-1] |= mask[:, 1:]
+        if (mask & beside_fill).sum() < MIN_FILL_CLUSTERED * count:
+            continue        # scattered pixels at that value (noise, texture): fill comes in regions
+        border = beside_fill & ~mask & used
         if not border.any():
             continue
         jump = float(np.median(np.abs(image[border] - value))) / contrast
