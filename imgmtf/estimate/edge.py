@@ -16,10 +16,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import TargetNotFoundError
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
-from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, locate_edge, row_windows
+from .geometry import TargetGeometry, locate_edge
 from .pipeline import Settings, Shape, TargetKind, make_settings, outer_samples, run
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
@@ -82,17 +81,7 @@ class EdgeKind(TargetKind):
         return line, checks
 
     def locate(self, work, seed_x, transposed) -> TargetGeometry:
-        try:
-            return locate_edge(work, seed_x, transposed=transposed)
-        except TargetNotFoundError:
-            # a narrow bar defeats every row's step fit; say so, rather than
-            # that nothing is there, when the rows' mean profile returns
-            _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
-            counts = inside.sum(axis=0)
-            if counts.min() > 0 and gate.classify_profile(values.sum(axis=0) / counts) == "bar":
-                raise gate.UnsuitableTargetError(gate.kind_check("bar", "edge").message,
-                                                 reason="not-an-edge") from None
-            raise
+        return locate_edge(work, seed_x, transposed=transposed)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
         # the levels: the samples in the outer eighth of the range each side

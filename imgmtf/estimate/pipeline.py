@@ -38,12 +38,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import ImgmtfError, ParameterError, UnsuitableTargetError
+from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
 from . import gate
 from .detection import Line, robust_noise
-from .geometry import TargetGeometry, check_angle, profile_samples, vertical_frame
+from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, check_angle, profile_samples, row_windows, vertical_frame
 from .intervals import Interval, Intervals, as_intervals, bootstrap_figures, influence_sd, linearised_interval
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
@@ -338,6 +338,24 @@ def _tail_integral(s, v, side: int, start: float, half_range: float, kind) -> tu
     return float(to_amplitude @ fit.coef) * span, amplitude_sd * span
 
 
+def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) -> None:
+    """Where the target could not be followed row by row (a bar defeats an
+    edge's step fits, and leaves its phases too sparse), the rows' mean
+    profile about the seed says whether it is the other kind of target:
+    that is the reason to give (``not-an-edge``, ``not-a-bar``).
+
+    Raises
+    ------
+    UnsuitableTargetError
+        The mean profile is of the other kind."""
+    _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
+    counts = inside.sum(axis=0)
+    if counts.min() > 0:
+        check = gate.kind_check(gate.classify_profile(values.sum(axis=0) / counts), kind.profile)
+        if not check.passed:
+            raise UnsuitableTargetError(check.message, reason=check.reason) from None
+
+
 def outer_samples(d: np.ndarray, half_range: float, fraction: float) -> tuple[np.ndarray, np.ndarray]:
     """Masks of the samples beyond ``fraction`` of the range on the left
     and on the right (at least the three outermost pixels' worth each)."""
@@ -469,9 +487,13 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         line, seed_checks = kind.seed(data, pixel_noise)
         checks += seed_checks
         work, seed_x, transposed = vertical_frame(data, line)
-        geometry = kind.locate(work, seed_x, transposed)
-        check_angle(geometry, kind.name)
-        d, v, row, half_range = profile_samples(work, geometry, kind.name)
+        try:
+            geometry = kind.locate(work, seed_x, transposed)
+            check_angle(geometry, kind.name)
+            d, v, row, half_range = profile_samples(work, geometry, kind.name)
+        except (TargetNotFoundError, UnsuitableTargetError):
+            refuse_other_kind(kind, work, seed_x)
+            raise
     except ImgmtfError:
         # what the gate already knows (fill, a second target) explains more
         # than the failure it caused further on
