@@ -812,7 +812,8 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
         grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
         if width_influence is not None:
             dwidth_dv, log_slope = width_influence
-            fixed_sd, _ = influence_sd(grad * residual, row)
+            if j == 1:
+                fixed_sd, _ = influence_sd(grad * residual, row)
             # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
             grad = grad - float(mtf(np.array([f]))[0]) * float(log_slope(f)) * dwidth_dv
         sd, n_rows = influence_sd(grad * residual, row)
