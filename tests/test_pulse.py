@@ -113,10 +113,10 @@ def test_estimate_width_closed_form():
     assert estimate_width(x, box) == pytest.approx(2.5, rel=0.02)
 
 
-def test_width_gradient_predicts_how_the_read_width_moves():
+def test_the_width_reading_predicts_how_the_read_width_moves():
     from scipy.special import erf
 
-    from imgmtf.estimate.pulse import width_gradient
+    from imgmtf.estimate.pulse import width_reading
     x = np.arange(-400, 401) * 0.05
 
     def blurred_bar(w, sigma=0.5):    # a bar of width w through a Gaussian PSF, in closed form
@@ -125,7 +125,9 @@ def test_width_gradient_predicts_how_the_read_width_moves():
     width = estimate_width(x, prf)
     assert width == pytest.approx(1.5, abs=1e-3)
     change = blurred_bar(1.52) - prf                   # the same bar 0.02 px wider
-    assert width_gradient(x, prf, width) @ change == pytest.approx(0.02, rel=0.02)
+    reading = width_reading(x, prf, width, 1.0)
+    assert reading.width_change(reading.on_grid[0] @ change) == pytest.approx(0.02, rel=0.02)
+    assert reading.values[0] == pytest.approx(0.0, abs=1e-4)           # R(f0) = 0: the zero read
 
 
 def test_sinc_log_slope_is_the_derivative_of_the_sincs_log():
@@ -146,3 +148,17 @@ def test_a_read_width_carries_its_uncertainty_into_the_interval_and_says_so():
     assert not any("read off its profile" in w for w in given.warnings)
     boot = measure_pulse(chip.image, bootstrap=50)
     assert any("bootstrap holds the bar's width" in w for w in boot.warnings)
+
+
+def test_fieller_spread_of_a_read_width_matches_its_closed_form():
+    from imgmtf.estimate.pipeline import WidthReading
+    f0, slope, sd, t = 0.6, -0.25, 0.004, 2.0
+    freqs = np.concatenate([[f0], np.arange(0.3, 0.96, 0.02)])
+    reading = WidthReading(1 / f0, freqs, np.zeros((freqs.size, 3)), np.zeros(freqs.size),
+                           slope * (freqs - f0), slope, lambda f: f)
+    a = t * sd / abs(slope)                    # |R(f)| <= t sd for |f - f0| <= a
+    expected = 0.5 * (1 / (f0 - a) - 1 / (f0 + a))
+    assert reading.spread_px(np.full(freqs.size - 1, sd), t) == pytest.approx(expected, rel=1e-9)
+    # a spectrum that never leaves its noise below f0: no width is read at all
+    assert reading.spread_px(np.full(freqs.size - 1, 1.0), t) == math.inf
+    assert reading.width_change(slope * f0 * f0) == pytest.approx(1.0)

@@ -180,17 +180,25 @@ def influence_sd(influence: np.ndarray, rows: np.ndarray) -> tuple[float, int]:
     influences, their variance plus Bartlett-weighted covariances of
     neighbouring rows (lags up to 4 (n / 100)^(2/9)).  Returns (sd, number
     of rows)."""
+    sds, n = influence_sds(np.asarray(influence, float)[None, :], rows)
+    return float(sds[0]), n
+
+
+def influence_sds(influences: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, int]:
+    """:func:`influence_sd` of every row of ``influences`` (estimates,
+    samples) at once.  Returns (sds, number of rows)."""
     ids, inverse = np.unique(rows, return_inverse=True)
-    per_row = np.bincount(inverse, weights=influence, minlength=ids.size)
-    n = per_row.size
+    n, m = ids.size, influences.shape[0]
+    bins = (inverse[None, :] + n * np.arange(m)[:, None]).ravel()
+    per_row = np.bincount(bins, weights=influences.ravel(), minlength=m * n).reshape(m, n)
     if n < 3:
-        return math.nan, n
-    centred = per_row - per_row.mean()
-    variance = float(centred @ centred)
+        return np.full(m, math.nan), n
+    centred = per_row - per_row.mean(axis=1, keepdims=True)
+    variance = np.einsum("ij,ij->i", centred, centred)
     lags = int(math.ceil(4 * (n / 100.0) ** (2.0 / 9.0)))
     for lag in range(1, min(lags, n - 1) + 1):
-        variance += 2.0 * (1.0 - lag / (lags + 1.0)) * float(centred[lag:] @ centred[:-lag])
-    return math.sqrt(max(variance, 0.0) * n / (n - 1)), n
+        variance += 2.0 * (1.0 - lag / (lags + 1.0)) * np.einsum("ij,ij->i", centred[:, lag:], centred[:, :-lag])
+    return np.sqrt(np.maximum(variance, 0.0) * n / (n - 1)), n
 
 
 def linearised_interval(value: float, sd: float, rows: int, confidence: float,

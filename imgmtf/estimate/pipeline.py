@@ -44,7 +44,15 @@ from ..metrics import fwhm
 from . import gate
 from .detection import Line, robust_noise
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, check_angle, profile_samples, row_windows, vertical_frame
-from .intervals import Interval, Intervals, as_intervals, bootstrap_figures, influence_sd, linearised_interval
+from .intervals import (
+    Interval,
+    Intervals,
+    as_intervals,
+    bootstrap_figures,
+    influence_sd,
+    influence_sds,
+    linearised_interval,
+)
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
 from .spectrum import (
@@ -288,12 +296,58 @@ class TargetKind:
         """The samples of a bar's peak (None for an edge)."""
         raise NotImplementedError
 
-    def width_gradient(self, grid: np.ndarray, shape: Shape):
+    def read_width(self, grid: np.ndarray, shape: Shape) -> WidthReading | None:
         """Where the divisor rests on a width read off the profile (a bar's
-        estimated width W): (dW / d values on ``grid``, dW / d background,
-        f -> d ln|divisor(f)| / dW), which carry the width's own noise into
-        the intervals; None where the divisor is known."""
+        estimated width), how it was read (:class:`WidthReading`), so that
+        its own noise joins the intervals; None where the divisor is known."""
         return None
+
+
+@dataclass(frozen=True, eq=False)
+class WidthReading:
+    """A width W (px) read off the profile as the first zero f0 = 1 / W of
+    R(f), a linear functional of the profile's values (a bar's spectrum
+    about its centre).  ``freqs`` (cy/px): f0, then a grid about it;
+    ``on_grid``: dR(f) / d value, one row per frequency over the profile's
+    grid; ``per_background``: dR(f) / d background level; ``values``: R at
+    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW."""
+
+    width_px: float
+    freqs: np.ndarray
+    on_grid: np.ndarray
+    per_background: np.ndarray
+    values: np.ndarray
+    slope: float
+    log_slope: Callable[[np.ndarray], np.ndarray]
+
+    def width_change(self, spectrum_change_at_zero):
+        """The change of W (px) a change dR of R at f0 makes: the zero moves
+        by -dR / R'(f0), and W = 1 / f0 by dR / (R'(f0) f0^2)."""
+        f_zero = float(self.freqs[0])
+        return spectrum_change_at_zero / (self.slope * f_zero * f_zero)
+
+    def spread_px(self, spectrum_sd: np.ndarray, t: float) -> float:
+        """Half the width (px) of the set of W whose zero 1 / W the data
+        cannot tell from f0: the run of the grid about f0 where
+        |R(f)| <= t sd(R(f)) (Fieller's interval for a zero, which stays
+        honest where R is shallow and the linearised one is not); inf when
+        the run reaches the grid's low end (no zero is read at all)."""
+        f, margin = self.freqs[1:], t * spectrum_sd - np.abs(self.values[1:])
+        inside = margin >= 0
+        k = int(np.clip(np.searchsorted(f, self.freqs[0]), 1, f.size - 1))
+        k = k if inside[k] else k - 1
+        if not inside[k]:
+            return 0.0
+        outside = np.flatnonzero(~inside)
+        below, above = outside[outside < k], outside[outside > k]
+        if below.size == 0:
+            return math.inf
+
+        def edge(i, j):      # where the margin crosses 0 between grid points i (inside) and j (outside)
+            return f[i] + (f[j] - f[i]) * margin[i] / (margin[i] - margin[j])
+        f_low = edge(below[-1] + 1, below[-1])
+        f_high = edge(above[0] - 1, above[0]) if above.size else f[-1]
+        return 0.5 * (1.0 / f_low - 1.0 / f_high)
 
 
 @dataclass(frozen=True)
@@ -535,17 +589,20 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         raise
     c = shape.centre
     s = d - c
-    # the samples' pull on a width read off this profile (see TargetKind.width_gradient)
+    # the samples' pull on a width read off this profile (see TargetKind.read_width)
     width_influence = None
-    width_gradient = kind.width_gradient(grid, shape)
-    if width_gradient is not None and resampled.adjoint is not None:
-        on_grid, per_background, log_slope = width_gradient
-        full = np.zeros((1, resampled.grid.size))
-        full[0, span[0]: span[1]] = on_grid
-        dwidth_dv = resampled.adjoint(full)[0]
-        for side in outer_samples(d, half_range, BACKGROUND_FRACTION):
-            dwidth_dv[side] += 0.5 * per_background / max(int(side.sum()), 1)
-        width_influence = (dwidth_dv, log_slope)
+    reading = kind.read_width(grid, shape)
+    if reading is not None and resampled.adjoint is not None:
+        def spectrum_pull(reading=reading, resampled=resampled, span=span):
+            """dR(f) / dv for the reading's frequencies, through the
+            resampling the width was read from (built only for intervals)."""
+            full = np.zeros((reading.freqs.size, resampled.grid.size))
+            full[:, span[0]: span[1]] = reading.on_grid
+            pull = resampled.adjoint(full)
+            for side in outer_samples(d, half_range, BACKGROUND_FRACTION):
+                pull[:, side] += 0.5 * reading.per_background[:, None] / max(int(side.sum()), 1)
+            return pull
+        width_influence = (reading, spectrum_pull)
 
     # noise and SNR: each side's scatter about its own level and tail
     plateau = [fit_side(s, v, side & (np.abs(s) >= shape.plateau_px), kind.tail_power)
@@ -769,9 +826,11 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
     the corrections, so its gradient follows, and with each sample's
     residual (scaled up by its leverage) gives the row influences.  Where
     the divisor rests on a width read off the same samples
-    (``width_influence``: dW / dv and f -> d ln|divisor(f)| / dW), its pull
-    joins the gradient; the share of the variance at Nyquist it makes is
-    returned third (None without it)."""
+    (``width_influence``: its :class:`WidthReading` and a function giving
+    dR(f) / dv), its
+    pull joins the gradient, widened where Fieller's set for the zero is
+    wider than the linearised one; the share of the variance at Nyquist it
+    makes is returned third (None without it)."""
     step = float(x[1] - x[0])
     width_share = None
     freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
@@ -803,6 +862,18 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
     residual = v - np.where(inside, np.interp(d, run_grid, run_values), model_dn)
     if resampled.leverage is not None:
         residual = residual / np.sqrt(1.0 - np.minimum(resampled.leverage, LEVERAGE_CAP))
+    width_pull = None
+    if width_influence is not None:
+        reading, spectrum_pull = width_influence
+        dspectrum_dv = spectrum_pull()
+        dwidth_dv = reading.width_change(dspectrum_dv[0])
+        width_sd, n_rows = influence_sd(dwidth_dv * residual, row)
+        spectrum_sd, _ = influence_sds(dspectrum_dv[1:] * residual, row)
+        from scipy.special import stdtrit
+        t = float(stdtrit(max(n_rows - 1, 1), 0.5 + intervals.confidence / 2))
+        spread = reading.spread_px(spectrum_sd, t)
+        widen = max(1.0, spread / (t * width_sd)) if width_sd > 0 else 1.0
+        width_pull = (widen * dwidth_dv, reading.log_slope)
     out = []
     for j in range(1, n_f):
         fj, f = transform[j], freqs[j]
@@ -810,14 +881,14 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
         # the MTF is this ratio divided by the corrections: scale the gradient alike
         scale = float(mtf(np.array([f]))[0]) / ratio if ratio else 0.0
         grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
-        if width_influence is not None:
-            dwidth_dv, log_slope = width_influence
+        if width_pull is not None:
+            dwidth_dv, log_slope = width_pull
             if j == 1:
                 fixed_sd, _ = influence_sd(grad * residual, row)
             # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
             grad = grad - float(mtf(np.array([f]))[0]) * float(log_slope(f)) * dwidth_dv
         sd, n_rows = influence_sd(grad * residual, row)
-        if j == 1 and width_influence is not None:
+        if j == 1 and width_pull is not None:
             width_share = 1.0 - (fixed_sd / sd) ** 2 if sd > 0 else 0.0
         if j == 1:
             systematic = (SYSTEMATIC_NYQUIST + TAIL_MODEL_UNCERTAINTY * abs(tail_share) * abs(nyquist)

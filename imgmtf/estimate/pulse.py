@@ -23,11 +23,22 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
-from .pipeline import BACKGROUND_FRACTION, TAPER_FACTOR, Shape, TargetKind, make_settings, outer_samples, run
+from .pipeline import (
+    BACKGROUND_FRACTION,
+    TAPER_FACTOR,
+    Shape,
+    TargetKind,
+    WidthReading,
+    make_settings,
+    outer_samples,
+    run,
+)
 from .results import MTFResult, finite
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
+ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
+ZERO_SET_STEP_CY_PX = 0.02       # ...on this grid (its crossings interpolated)
 MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
@@ -154,13 +165,10 @@ class PulseKind(TargetKind):
     def peak_mask(self, s, shape):
         return np.abs(s - shape.centre) <= max(0.5 * shape.extra["width_px"], 0.5)
 
-    def width_gradient(self, grid, shape):
+    def read_width(self, grid, shape):
         if not shape.extra["width_estimated"]:
             return None
-        width = shape.extra["width_px"]
-        # prf01 = (values - background) / (high - low): the zero moves with both
-        per_value = width_gradient(grid, shape.extra["prf01"], width) / (shape.high - shape.low)
-        return per_value, -float(per_value.sum()), lambda f: sinc_log_slope(f, width)
+        return width_reading(grid, shape.extra["prf01"], shape.extra["width_px"], shape.high - shape.low)
 
 
 class PulseEstimator:
@@ -272,13 +280,12 @@ def usable_band(width_px: float) -> float:
     return float(f[np.argmax(np.abs(np.sinc(f * width_px)) < MIN_TRANSFER)])
 
 
-def width_gradient(grid: np.ndarray, prf01: np.ndarray, width_px: float) -> np.ndarray:
-    """How the width :func:`estimate_width` reads moves with each value of
-    the normalised profile ``prf01`` on ``grid`` (px per unit of prf01).
-
-    The width is 1 / f0, f0 the zero of R(f) = sum cos(2 pi f x) prf01 dx;
-    a change dR at f0 moves the zero by -dR / R'(f0), so
-    dW / d prf01_k = cos(2 pi f0 x_k) dx / (R'(f0) f0^2).
+def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast_dn: float) -> WidthReading:
+    """How :func:`estimate_width` read ``width_px`` off ``prf01``, the
+    profile normalised by ``contrast_dn`` (its values minus the background,
+    over the peak's height in DN): R(f) and its pull on the profile's
+    values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
+    about it, for the intervals (:class:`imgmtf.estimate.pipeline.WidthReading`).
 
     Example
     -------
@@ -288,16 +295,19 @@ def width_gradient(grid: np.ndarray, prf01: np.ndarray, width_px: float) -> np.n
     >>> x = np.arange(-400, 401) * 0.05
     >>> def bar(w):
     ...     return 0.5 * (erf((x + w / 2) / 0.7071) - erf((x - w / 2) / 0.7071))
-    >>> g = width_gradient(x, bar(1.5), estimate_width(x, bar(1.5)))
-    >>> round(float(g @ (bar(1.52) - bar(1.5))), 3)
+    >>> reading = width_reading(x, bar(1.5), estimate_width(x, bar(1.5)), 1.0)
+    >>> round(float(reading.width_change(reading.on_grid[0] @ (bar(1.52) - bar(1.5)))), 3)
     0.02
     """
+    f_zero = 1.0 / width_px
+    low, high = (f * f_zero for f in ZERO_SET_SPAN)
+    freqs = np.concatenate([[f_zero], np.arange(low, min(high, MAX_ZERO_SEARCH_CY_PX), ZERO_SET_STEP_CY_PX)])
     step = float(grid[1] - grid[0])
-    f0 = 1.0 / width_px
-    slope = -float(np.sum(2 * np.pi * grid * np.sin(2 * np.pi * f0 * grid) * prf01)) * step
-    if slope == 0:
-        return np.zeros_like(grid)
-    return np.cos(2 * np.pi * f0 * grid) * step / (slope * f0 * f0)
+    cosines = np.cos(2 * np.pi * freqs[:, None] * grid[None, :]) * step
+    slope = -float(np.sum(2 * np.pi * grid * np.sin(2 * np.pi * f_zero * grid) * prf01)) * step
+    on_grid = cosines / contrast_dn             # prf01 = (values - background) / contrast
+    return WidthReading(width_px, freqs, on_grid, -on_grid.sum(axis=1), cosines @ prf01, slope,
+                        lambda f: sinc_log_slope(f, width_px))
 
 
 def sinc_log_slope(f, width_px: float):
