@@ -75,3 +75,12 @@ def test_one_summary_per_target_and_direction_and_per_scene():
     assert first.status == "combined" and first.ok and first.figures["edge_ids"] == [1, 3]
     assert first.figures["mtf_nyquist"] == pytest.approx(0.27) and first.site["x_px"] == pytest.approx(51.0)
     assert out[3].figures["mtf_nyquist"] == pytest.approx((0.26 + 0.28 + 0.27 / 4) / 2.25)
+
+
+def test_the_combined_curve_weights_each_curve_as_its_nyquist_interval_earns():
+    from imgmtf.scene.combine import combined_curve
+    curves = [[1.0, 0.5, math.nan], [1.0, 0.3, 0.2]]
+    out = combined_curve(curves, [interval(0.5, 0.01, 30), interval(0.3, 0.02, 30)], [30, 30])
+    assert out == pytest.approx([1.0, (4 * 0.5 + 0.3) / 5, 0.2])      # a masked value leaves the other
+    equal = combined_curve(curves, [(math.nan, math.nan)] * 2, [30, 30])
+    assert equal[1] == pytest.approx(0.4)

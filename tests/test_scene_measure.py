@@ -148,3 +148,29 @@ def test_map_projected_crops_scan_without_error_and_without_a_direction(name, pr
     records = scan_scene(str(path), ScanSettings(intervals=im.Intervals("none")))
     assert records and not any(r.reason == "internal" for r in records)
     assert {r.site["direction"] for r in records} == {"unknown"}         # a CRS: rows are not along track
+
+
+def test_accepted_half_edges_and_their_combination_carry_the_mtf_curve(quadrant_scans):
+    _, records, summaries = quadrant_scans[False]
+    accepted = [r for r in records if r.ok]
+    for r in [*accepted, *summaries]:
+        f, mtf = np.asarray(r.figures["frequencies_cy_px"]), np.asarray(r.figures["mtf"], float)
+        assert mtf[0] == pytest.approx(1.0) and mtf[np.argmin(abs(f - 0.5))] == pytest.approx(
+            r.figures["mtf_nyquist"], abs=1e-6)
+    row = accepted[0].csv_row()
+    assert row["mtf_at_0.50_cy_px"] == pytest.approx(accepted[0].figures["mtf_nyquist"], abs=1e-6)
+
+
+def test_a_low_contrast_boundary_on_a_textured_field_is_not_accepted(tmp_path):
+    # the target's dark quadrants meet a field of about their level: a short, noisy outer
+    # boundary (SNR 37 on 21 rows, where 173 is needed) that read 0.036 low when accepted
+    target = QuadrantTarget((60.52, 61.94), 10.6, (9300.0, 2000.0, 9200.0, 3900.0), 45.0)
+    scene = render_quadrants(im.Sensor(), (121, 121), target, field_dn=3000 + texture((121, 121), 600, seed=2),
+                             noise_std_dn=25.0, seed=2)
+    path = tmp_path / "field.tif"
+    im.write_geotiff(path, scene.image)
+    records = scan_scene(str(path))
+    for r in records:
+        if r.ok:
+            assert abs(r.figures["mtf_nyquist"] - float(scene.true_mtf(0.5, r.figures["normal_angle_deg"]))) < 0.015
+    assert any(r.reason == "snr" and "too noisy for its length" in r.error for r in records)

@@ -53,3 +53,15 @@ def test_quick_look_passes_a_clean_edge():
 def test_quick_look_rejects_what_the_gate_would(kind, reason):
     verdict = quick_look(*band(**kind), noise_dn=kind.get("noise", 6.0), half_width_px=12)
     assert verdict is not None and verdict[0] == reason
+
+
+def test_a_half_edge_is_as_long_as_the_longer_of_its_line_and_its_reach_to_the_junctions():
+    from imgmtf.scene.detect import HalfEdge, Segment
+    from imgmtf.scene.screen import geometry_screen
+    from imgmtf.scene.settings import ScanSettings
+    # LSD saw 36 px of the line; its ends, moved onto their junctions, span 46 px
+    half = HalfEdge(Segment(10.0, 0.0, 16.0, 45.6), line_length_px=36.0, junctions=(1, 2))
+    assert geometry_screen(half, ScanSettings()) is None
+    short = HalfEdge(Segment(10.0, 0.0, 14.0, 39.6), line_length_px=36.0)
+    reason, message = geometry_screen(short, ScanSettings())
+    assert reason == "too-short" and "39.8 px long, shorter than the minimum 40 px" in message

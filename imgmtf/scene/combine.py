@@ -106,7 +106,7 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     >>> round(c.value, 4), c.weights
     (0.262, 'inverse-variance')
     """
-    from scipy.special import ndtri, stdtrit
+    from scipy.special import ndtri
     x = np.asarray(values, float)
     bounds = np.asarray(intervals, float).reshape(-1, 2)
     rows = np.asarray(rows, float)
@@ -117,12 +117,9 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     if x.size == 1:                     # one estimate: its own interval, as the estimator gave it
         return Combined(float(x[0]), float(bounds[0, 0]), float(bounds[0, 1]), math.nan,
                         "inverse-variance" if np.isfinite(bounds[0]).all() else "equal")
-    half = (bounds[:, 1] - bounds[:, 0]) / 2
-    quantile = stdtrit(np.maximum(rows - 1, 1), 0.5 + confidence / 2)
-    sd = half / quantile
-    if not (np.isfinite(sd).all() and (sd > 0).all()):
+    w = precision_weights(bounds, rows, confidence)
+    if w is None:
         return Combined(float(np.mean(x)), math.nan, math.nan, math.nan, "equal")
-    w = 1.0 / sd ** 2
     mean = float(np.sum(w * x) / np.sum(w))
     sd_mean = 1.0 / math.sqrt(float(np.sum(w)))
     n = x.size
@@ -185,6 +182,40 @@ def _family_records(members: list[tuple[Record, int]], site: dict) -> list[Recor
     return out
 
 
+def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray | None:
+    """Each estimate's weight 1 / sd^2, its standard deviation the
+    interval's half-width over its Student-t quantile (``rows`` - 1
+    degrees of freedom); None when an interval is missing or empty.
+
+    Example
+    -------
+    >>> w = precision_weights([(0.25, 0.27), (0.25, 0.29)], [40, 40])
+    >>> round(float(w[0] / w[1]), 3)                 # half the width: four times the weight
+    4.0
+    """
+    from scipy.special import stdtrit
+    bounds = np.asarray(intervals, float).reshape(-1, 2)
+    quantile = stdtrit(np.maximum(np.asarray(rows, float) - 1, 1), 0.5 + confidence / 2)
+    sd = (bounds[:, 1] - bounds[:, 0]) / 2 / quantile
+    if not (np.isfinite(sd).all() and (sd > 0).all()):
+        return None
+    return 1.0 / sd ** 2
+
+
+def combined_curve(curves, intervals, rows, confidence: float = 0.95) -> np.ndarray:
+    """The MTF curves of several half-edges (rows of ``curves``, on one
+    frequency grid) averaged with the weights their MTF at Nyquist earned
+    (:func:`precision_weights` of its ``intervals``; equal without them),
+    NaN-aware (a bar's masked frequencies)."""
+    curves = np.asarray(curves, float)
+    w = precision_weights(intervals, rows, confidence)
+    w = np.ones(curves.shape[0]) if w is None else w
+    weights = np.where(np.isfinite(curves), w[:, None], 0.0)
+    total = weights.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, np.nansum(weights * np.nan_to_num(curves), axis=0) / total, np.nan)
+
+
 def _summary(group: list[Record], site: dict) -> Record:
     first = group[0]
     confidence = (first.params.get("intervals") or {}).get("confidence", 0.95)
@@ -208,6 +239,12 @@ def _summary(group: list[Record], site: dict) -> Record:
     }
     if figures["gsd_m"] and mtf50:
         figures["mtf50_cy_m"] = finite(mtf50.value / figures["gsd_m"])
+    frequencies = first.figures.get("frequencies_cy_px")
+    curves = [r.figures.get("mtf") or [] for r in group]
+    if frequencies and all(len(c) == len(frequencies) for c in curves):
+        curve = combined_curve([[math.nan if v is None else v for v in c] for c in curves],
+                               [_pair(r.figures.get("mtf_nyquist_ci")) for r in group], rows, confidence)
+        figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
     where = dict(site)
     if site["scope"] == "target":
         ends = np.array([[r.site[k] for k in ("x0_px", "y0_px", "x1_px", "y1_px")] for r in group]).reshape(-1, 2)

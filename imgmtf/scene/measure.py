@@ -48,6 +48,7 @@ JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its ta
 FILL_CLEARANCE_PX = 4           # ... this far from fill and nodata (the target was blurred with the ground beyond it)
 END_TRIM_PX = 3.0               # ... and stops this short of a free end (a corner LSD did not see)
 MIN_HALF_WIDTH_PX = 10.0        # an ROI narrower either side of its target holds too little of the sides
+MIN_CONFIDENCE = 0.3            # an accepted target's SNR is at least this fraction of what its length needs
 
 
 @dataclass(frozen=True)
@@ -338,11 +339,26 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
         result = _estimate(chip, chip_mask, raster, context, plan)
     except ImgmtfError as exc:
         return rejected(exc.reason, _one_line(exc), verdict_by="gate", **_gate_figures(getattr(exc, "checks", ())))
+    needed = _confident_snr(settings.target, result.rows_used)
+    if result.snr < MIN_CONFIDENCE * needed:
+        # measure would report it with a warning; a scan chooses its targets, and at a small fraction
+        # of the SNR its length needs, ground texture beside a target biases it beyond its interval
+        return rejected("snr", f"SNR {result.snr:.0f} is below {MIN_CONFIDENCE:g} x the {needed:.0f} a "
+                        f"{result.rows_used}-row {result.target} needs for 95 % of estimates within 5 %: "
+                        "too noisy for its length to calibrate with", verdict_by="gate", snr=result.snr)
     x_, y_, w_, h_ = result.roi
-    figures = {**result.to_dict(curves=False), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
+    figures = {**result.to_dict(curves=True), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
                "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
     return Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
                            status="accepted", site={**site, "verdict_by": "gate"})
+
+
+def _confident_snr(target: str, rows: int) -> float:
+    """The SNR from which the estimator trusts a target of this kind and
+    length (:meth:`imgmtf.estimate.pipeline.TargetKind.confident_snr`)."""
+    from ..estimate.edge import EdgeKind
+    from ..estimate.pulse import PulseKind
+    return (EdgeKind if target == "edge" else PulseKind).confident_snr(rows)
 
 
 def _estimate(chip, mask, raster, context: Context, plan: Plan):

@@ -46,12 +46,15 @@ def fill_screen(fill_fraction: float) -> tuple[str, str] | None:
 
 
 def geometry_screen(half: HalfEdge, settings: ScanSettings) -> tuple[str, str] | None:
-    """(reason, message) when the candidate can be rejected unread: its
-    line is shorter than ``min_length_px`` (``too-short``) or its tilt is
-    outside the estimators' range (``angle``); None otherwise."""
+    """(reason, message) when the candidate can be rejected unread: it is
+    shorter than ``min_length_px`` (``too-short``: the longer of the line it
+    was split from and the half-edge itself, whose ends the junctions may
+    have moved outward) or its tilt is outside the estimators' range
+    (``angle``); None otherwise."""
     segment = half.segment
-    if half.line_length_px < settings.min_length_px:
-        return "too-short", (f"a straight line {half.line_length_px:.0f} px long, shorter than the minimum "
+    length = max(half.line_length_px, segment.length_px)
+    if length < settings.min_length_px:
+        return "too-short", (f"a straight line {length:.1f} px long, shorter than the minimum "
                              f"{settings.min_length_px:g} px")
     if segment.tilt_deg < MIN_ANGLE_DEG:
         return "angle", (f"{segment.tilt_deg:.2f} deg from the image axis: too close for "
