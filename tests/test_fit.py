@@ -53,6 +53,12 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     wrong = im.fit_sensor(chip.image, stages="optics,detector", hold="detector")
     assert wrong.misfit and any("does not fit" in w for w in wrong.warnings)
     assert wrong.edges[0].misfit_p < 1e-3
+    # the advice names stages the model lacks, never one it has
+    from imgmtf.estimate.fit import _other_stages
+    assert _other_stages(wrong.sensor.stages) == "try other stages (e.g. diffraction, defocus, olpf)"
+    assert _other_stages(right.sensor.stages) == "try other stages (e.g. defocus, olpf)"
+    everything = im.Sensor(1.0, [st.Diffraction(8.0), st.Defocus(1.0), st.OLPF(0.7), st.Detector()])
+    assert "imgmtf measure" in _other_stages(everything.stages)
 
 
 def test_profile_noise_needs_no_model():

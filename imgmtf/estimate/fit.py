@@ -650,6 +650,16 @@ class _Model:
         return out
 
 
+def _other_stages(stages) -> str:
+    """What to try when the model misfits: the long-tailed stages it lacks,
+    or, with all of them in, the non-parametric estimate."""
+    have = {s.name for s in stages}
+    missing = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
+    if missing:
+        return f"try other stages (e.g. {', '.join(missing)})"
+    return "compare with the non-parametric estimate (imgmtf measure), which assumes no form of blur"
+
+
 def _coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
 
@@ -715,7 +725,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
                     note = "at the bound of its range"
                     warnings.append(f"{key} is at the bound of its range ({value:.4g} {units[name]}): the model "
                                     "strains to fit the edges, whose blur may have another form; its MTF may be "
-                                    "biased: try other stages (e.g. diffraction, defocus, olpf)")
+                                    f"biased: {_other_stages(model.stages)}")
             elif key in notes:
                 se, (status, note) = math.nan, notes[key]
             else:  # a parameter the fit does not touch (wavelength, pitch)
@@ -750,7 +760,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
         if p < MISFIT_P and fraction > MISFIT_FRACTION:
             warnings.append(f"{d.source}: the model does not fit this edge: its residuals are structured "
                             f"along the normal ({100 * fraction:.2f} % of the step, p = {p:.1g}); its MTF may be "
-                            "biased: try other stages (e.g. diffraction, defocus, olpf)")
+                            f"biased: {_other_stages(model.stages)}")
 
     if not model.covers_axes(model.free):
         warnings.append("no parameter acting on every axis an edge sees could be determined: the MTF there is "
