@@ -777,8 +777,10 @@ def _print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
             roi = ",".join(str(v) for v in r["roi"])
             click.echo(f"{head} {_num(r.get('snr'), 5, 0)} {_num(r.get('mtf_nyquist'), 7, 4)} "
                        f"{_interval(r.get('mtf_nyquist_ci')):>15} {_num(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
-        else:
-            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error']}")
+            for warning in r.get("warnings") or []:
+                click.echo(f"{'':>{len(head)}} warning: {warning}")
+        else:       # the scene's name heads the table: the message need not repeat it
+            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
     if summaries:
         click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
                    "the half-edges disagree beyond their intervals):")

@@ -334,11 +334,13 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     overview : 2-D array, the scene decimated by ``scale`` scene px per
         overview px (DN).
     scale : scene pixels per overview pixel.
-    records : the candidates' flat records (``Record.to_dict()``):
+    records : the candidates' records (:class:`imgmtf.Record`, as
+        :func:`imgmtf.scan_scene` returns them, or their ``to_dict()``):
         accepted ones are drawn as their tilted ROI (``roi_polygon_px``)
         and segment in green; rejected ones as a thin faint line coloured
         by reason, each reason counted in the legend.
-    summaries : the per-target summaries (``scope`` "target"): each
+    summaries : the per-target summaries (``scope`` "target", records or
+        dicts, as :func:`imgmtf.summarise_scan` returns them): each
         target is labelled at its centre with, per direction, MTF at
         Nyquist and MTF50 (cy/px).
     levels : (black, white) DN of the display; default the 0.5 and 99.5
@@ -366,10 +368,12 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     """
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.lines import Line2D
+    records = [r.to_dict() if hasattr(r, "to_dict") else r for r in records]
+    summaries = [r.to_dict() if hasattr(r, "to_dict") else r for r in summaries]
     height, width = overview.shape
     extent_w, extent_h = width * scale, height * scale
     if ax is None:
-        margins = (0.55, 0.1, 0.4, 0.45)            # left, right, bottom, top (in): tick labels, title
+        margins = (0.7, 0.1, 0.55, 0.45)            # left, right, bottom, top (in): axis labels, title
         image_w = width_in - margins[0] - margins[1]
         image_h = image_w * extent_h / max(extent_w, 1e-9)
         fig = Figure(figsize=(width_in, image_h + margins[2] + margins[3]))
@@ -382,6 +386,8 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
               extent=(-0.5, extent_w - 0.5, extent_h - 0.5, -0.5), interpolation="nearest")
     ax.set(xlim=(-0.5, extent_w - 0.5), ylim=(extent_h - 0.5, -0.5))
     ax.tick_params(labelsize=7)
+    ax.set_xlabel("column (px)", fontsize=7)
+    ax.set_ylabel("row (px)", fontsize=7)
     accepted = [r for r in records if r.get("status") == "accepted"]
     rejected = [r for r in records if r.get("status") != "accepted"]
     handles = []
@@ -402,6 +408,16 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
         ax.add_collection(LineCollection([[(r["x0_px"], r["y0_px"]), (r["x1_px"], r["y1_px"])] for r in accepted],
                                          colors="#00ff00", linewidths=1.6))
         handles.insert(0, Line2D([], [], color="#00e000", lw=2.5, label=f"accepted ({len(accepted)})"))
+        centres = {s["target_id"]: (s["x_px"], s["y_px"]) for s in summaries if s.get("scope") == "target"}
+        for r in accepted:          # each accepted half-edge's id, as in the table and the CSV
+            if r.get("id") is None:
+                continue
+            ends = np.array([[r["x0_px"], r["y0_px"]], [r["x1_px"], r["y1_px"]]])
+            # near the end away from the target's label (at its centre), a fifth of the way in
+            far = int(np.argmax(np.hypot(*(ends - centres.get(r.get("target_id"), ends.mean(axis=0))).T)))
+            x, y = 0.8 * ends[far] + 0.2 * ends[1 - far]
+            ax.text(x, y, str(r["id"]), fontsize=6.5, color="#004d00", ha="center", va="center",
+                    bbox={"boxstyle": "circle,pad=0.15", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "none"})
     targets = [s for s in summaries if s.get("scope") == "target"]
     for target_id in sorted({s["target_id"] for s in targets}):
         rows = [s for s in targets if s["target_id"] == target_id]

@@ -76,13 +76,17 @@ def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_rec
     from imgmtf.plot import plot_scan
     summaries = [s.to_dict() for s in summarise_scan(scan_records)]
     rows = [r.to_dict() for r in scan_records]
+    # records as scan_scene returns them draw as their dicts do
+    assert len(plot_scan(np.zeros((128, 256)), 2.0, scan_records, summarise_scan(scan_records)).axes[0].texts) == 4
     fig = plot_scan(np.zeros((128, 256)), 2.0, rows, summaries)
     ax = fig.axes[0]
     reasons = {r["reason"] for r in rows if r["status"] == "rejected"}
     lines = [c for c in ax.collections if isinstance(c, LineCollection) and not isinstance(c, PolyCollection)]
     assert len(lines) == len(reasons) + 1 and not ax.patches          # one collection per reason, no boxes
     assert len([c for c in ax.collections if isinstance(c, PolyCollection)]) == 1
-    assert sorted(t.get_text().split()[0] for t in ax.texts) == ["T1", "T2"]      # the targets, labelled
+    # the targets labelled, and each accepted half-edge by its id
+    assert sorted(t.get_text().split()[0] for t in ax.texts) == ["1", "2", "T1", "T2"]
+    assert ax.get_xlabel() == "column (px)" and ax.get_ylabel() == "row (px)"
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "accepted (2)" in legend and f"angle ({sum(r['reason'] == 'angle' for r in rows)})" in legend
     x0, y0, x1, y1 = ax.get_position().extents          # the image fills its axes: no blank band
@@ -93,6 +97,10 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     out = tmp_path / "scan"
     result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
     assert result.exit_code == 0, result.output
+    # the table names the scene once; an accepted edge's warnings stand beneath it
+    rejected = [line for line in result.stdout.splitlines() if " rejected " in line]
+    assert rejected and not any(f"{SCENE}:" in line for line in rejected)
+    assert "warning: the image is not in sensor geometry" in result.stdout
     geo = json.loads((out / "targets.geojson").read_text())
     assert geo["imgmtf_coordinates"].startswith("longitude/latitude")
     first = geo["features"][0]
