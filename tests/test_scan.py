@@ -156,3 +156,14 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error
     assert internal[0].error.startswith(str(SCENE))
     assert sum(r.ok for r in records) >= 1
+
+
+def test_a_scene_without_a_crs_gives_features_without_geometry(scan_records, tmp_path):
+    from imgmtf.io import raster_info
+    from imgmtf.scene.export import to_geojson
+    plain = tmp_path / "plain.tif"
+    im.write_geotiff(plain, im.read_raster(SCENE).data.astype(np.uint16))     # the pixels, no georeference
+    geo = to_geojson(scan_records, raster_info(str(plain)), summarise_scan(scan_records))
+    assert geo["imgmtf_coordinates"].startswith("none")
+    assert all(f["geometry"] is None for f in geo["features"])      # never pixels read as degrees
+    assert all("x0_px" in f["properties"] for f in geo["features"] if f["properties"]["scope"] == "edge")

@@ -33,7 +33,7 @@ def to_geojson(records: Sequence[Record], info: RasterInfo, summaries: Sequence[
     geometry.  Georeferenced scenes (a CRS): geometry in
     longitude/latitude (WGS 84, as RFC 7946 requires), the scene's own map
     coordinates in the properties (``map_x0``...).  Scenes without a CRS:
-    geometry in pixel coordinates (x right, y down; the
+    no geometry (a GIS would read pixel coordinates as degrees; the
     ``imgmtf_coordinates`` member says so).  Every feature's properties
     carry the pixel coordinates and the record's figures.
 
@@ -53,9 +53,9 @@ def to_geojson(records: Sequence[Record], info: RasterInfo, summaries: Sequence[
         coordinates = "longitude/latitude (EPSG:4326)"
         lonlat = iter(zip(lon, lat))
         points = [[list(next(lonlat)) for _ in p] for p in pixels]
-    else:
-        coordinates = "pixel (x right, y down, pixel centres at integers)"
-        points = [[list(xy) for xy in p] for p in pixels]
+    else:           # RFC 7946 geometry is longitude/latitude: pixels there would be misplaced
+        coordinates = "none: the scene has no CRS; pixel coordinates (x right, y down) are in the properties"
+        points = [[] for _ in pixels]
     features = [{"type": "Feature", "id": r.get("id") if r.get("scope") == "edge" else f"{r['scope']}-{k}",
                  "geometry": _geometry(p),
                  "properties": {key: value for key, value in r.items() if key not in _CURVES}}
