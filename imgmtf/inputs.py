@@ -69,16 +69,21 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     """``value`` as a float (an int with ``integer``) if it is a finite real
     number >= 0 (> 0 with ``positive``; any sign with ``signed``; inf
     allowed with ``allow_inf``; within [``low``, ``high``] when given),
-    NumPy scalars included; else a :class:`ParameterError` naming ``name``.
+    NumPy scalars and 0-d arrays included; else a :class:`ParameterError` naming ``name``.
 
     Examples
     --------
     >>> check_number("gsd_m", 0.5, positive=True)
     0.5
     """
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]                  # a 0-d array (np.asarray(2.0)) is its one number
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ParameterError(f"{name} must be a number, got {value!r}")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:                  # an int beyond any float (a TOML integer of 400 digits)
+        raise ParameterError(f"{name} must be finite, got an integer of {len(str(abs(value)))} digits") from None
     bad = math.isnan(number) or (math.isinf(number) and not (allow_inf and number > 0))
     if bad or (number < 0 and not signed):
         raise ParameterError(f"{name} must be finite{'' if signed else ' and >= 0'}, got {value!r}")
@@ -87,7 +92,9 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     if integer and number != int(number):
         raise ParameterError(f"{name} must be a whole number, got {value!r}")
     if (low is not None and number < low) or (high is not None and number > high):
-        raise ParameterError(f"{name} must lie in [{low:g}, {high:g}], got {value!r}")
+        bounds = (f"lie in [{low:g}, {high:g}]" if low is not None and high is not None
+                  else f"be at least {low:g}" if low is not None else f"be at most {high:g}")
+        raise ParameterError(f"{name} must {bounds}, got {value!r}")
     return int(number) if integer else number
 
 
