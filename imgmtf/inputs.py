@@ -164,14 +164,21 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
     values = data[used]
-    if np.abs(values).max() > MAX_ABS_DN:
-        raise ImageContentError(f"pixel values reach {np.abs(values).max():.3g}: beyond {MAX_ABS_DN:g} "
-                                "they are not DN an imaging sensor records; rescale the image")
+    check_magnitude(values)
     if values.max() == values.min():
         raise ImageContentError("the image is flat: no contrast to measure")
     if mask is not None:
         data[~mask] = np.nan
     return data, (x0, y0)
+
+
+def check_magnitude(values: np.ndarray, where: str = "") -> None:
+    """Refuse finite ``values`` beyond :data:`MAX_ABS_DN` (an image in the
+    wrong units); ``where`` (a file) prefixes the message."""
+    peak = float(np.abs(values).max()) if values.size else 0.0
+    if peak > MAX_ABS_DN:
+        raise ImageContentError(f"{where + ': ' if where else ''}pixel values reach {peak:.3g}: beyond "
+                                f"{MAX_ABS_DN:g} they are not DN an imaging sensor records; rescale the image")
 
 
 def quantum(data: np.ndarray, dtype) -> float:

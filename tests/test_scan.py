@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rasterio
 from click.testing import CliRunner
 
 import imgmtf as im
@@ -117,6 +118,23 @@ def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
     im.write_geotiff(flat, (1000 + rng.normal(0, 5, (128, 128))).astype(np.uint16))
     result = CliRunner().invoke(main, ["scan", str(flat)])
     assert result.exit_code == 1 and f"{flat}: no usable edge found" in result.output
+
+
+def test_cli_scan_of_values_no_sensor_records_is_refused_for_the_scene(tmp_path):
+    huge = tmp_path / "huge.tif"
+    image = im.render(im.Sensor(), im.Target("edge", 6.0), 64).image * 1e300
+    with rasterio.open(huge, "w", driver="GTiff", width=64, height=64, count=1, dtype="float64",
+                       transform=rasterio.Affine(1, 0, 0, 0, -1, 64)) as dst:
+        dst.write(image, 1)
+    result = CliRunner().invoke(main, ["scan", str(huge)])
+    assert result.exit_code == 1 and "Warning" not in result.output
+    assert result.stderr.strip() == (f"imgmtf: error: {huge}: pixel values reach 1.2e+303: beyond 1e+15 they are "
+                                     "not DN an imaging sensor records; rescale the image")
+
+
+def test_cli_scan_max_length_below_min_length_is_a_usage_error():
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--min-length", "40", "--max-length", "20"])
+    assert result.exit_code == 2 and "--max-length (20 px) is below --min-length (40 px)" in result.output
 
 
 def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
