@@ -166,3 +166,19 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error
     assert internal[0].error.startswith(str(SCENE))
     assert sum(r.ok for r in records) >= 1
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: ScanSettings(margin_px="12"), "margin_px must be a number, got '12'"),
+    (lambda: ScanSettings(margin_px=12.5), "margin_px must be a whole number"),
+    (lambda: ScanSettings(min_length_px=None), "min_length_px must be a number"),
+    (lambda: ScanSettings(band=0), "band must be at least 1, got 0"),
+    (lambda: ScanSettings(band="all"), "scan one band at a time"),
+    (lambda: scan_scene(np.zeros((64, 64))), r"path must be the scene's file name \(str or os.PathLike\), got ndarray"),
+    (lambda: scan_scene(str(SCENE), {"target": "edge"}), "settings must be a ScanSettings"),
+    (lambda: summarise_scan(None), "records must be a list of a scan's Records, got None"),
+    (lambda: summarise_scan([1]), r"records must be a scan's Records \(imgmtf.scan_scene\), got 1"),
+])
+def test_api_arguments_of_the_wrong_kind_are_named(make, message):
+    with pytest.raises(im.ParameterError, match=message):
+        make()
