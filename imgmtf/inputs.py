@@ -42,6 +42,8 @@ def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
     ImageContentError
         The array is not 3-D with 3 or 4 channels, or its values are not
         real numbers.
+    ParameterError
+        ``channel_axis`` is not an axis of a 3-D array.
 
     Example
     -------
@@ -56,6 +58,9 @@ def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
     array = np.asarray(rgb)
     if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):
         raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
+    if isinstance(channel_axis, (bool, np.bool_)) or not isinstance(channel_axis, (int, np.integer)) \
+            or not -3 <= channel_axis < 3:
+        raise ParameterError(f"channel_axis must be an axis of a 3-D array (-3 to 2), got {channel_axis!r}")
     if array.ndim != 3 or array.shape[channel_axis] not in (3, 4):
         raise ImageContentError(f"expected a colour image of shape (H, W, 3) or (H, W, 4) with the channels "
                                 f"on axis {channel_axis}, got an array of shape {array.shape}")
