@@ -117,7 +117,7 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
         bands = info.bands(settings.band)
     except Exception as exc:               # the safety net: a record, never an abort
         return [settings.failed(path, settings.band, exc, run_utc)]
-    skipped = info.alpha_bands if settings.band == "all" else []
+    skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
     records = []
     for band in bands:
         try:

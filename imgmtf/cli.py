@@ -718,6 +718,8 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
     the candidates measured so far are reported and written (130 or 143)."""
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
+    if max_length < min_length:
+        raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
     interrupted = None
     with _reported_errors():
         from .parallel import prestart_workers

@@ -42,6 +42,8 @@ def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
     ImageContentError
         The array is not 3-D with 3 or 4 channels, or its values are not
         real numbers.
+    ParameterError
+        ``channel_axis`` is not an axis of a 3-D array.
 
     Example
     -------
@@ -56,6 +58,9 @@ def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
     array = np.asarray(rgb)
     if not (np.issubdtype(array.dtype, np.number) and not np.iscomplexobj(array)):
         raise ImageContentError(f"expected real pixel values, got dtype {array.dtype}")
+    if isinstance(channel_axis, (bool, np.bool_)) or not isinstance(channel_axis, (int, np.integer)) \
+            or not -3 <= channel_axis < 3:
+        raise ParameterError(f"channel_axis must be an axis of a 3-D array (-3 to 2), got {channel_axis!r}")
     if array.ndim != 3 or array.shape[channel_axis] not in (3, 4):
         raise ImageContentError(f"expected a colour image of shape (H, W, 3) or (H, W, 4) with the channels "
                                 f"on axis {channel_axis}, got an array of shape {array.shape}")
@@ -69,16 +74,21 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     """``value`` as a float (an int with ``integer``) if it is a finite real
     number >= 0 (> 0 with ``positive``; any sign with ``signed``; inf
     allowed with ``allow_inf``; within [``low``, ``high``] when given),
-    NumPy scalars included; else a :class:`ParameterError` naming ``name``.
+    NumPy scalars and 0-d arrays included; else a :class:`ParameterError` naming ``name``.
 
     Examples
     --------
     >>> check_number("gsd_m", 0.5, positive=True)
     0.5
     """
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]                  # a 0-d array (np.asarray(2.0)) is its one number
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ParameterError(f"{name} must be a number, got {value!r}")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:                  # an int beyond any float (a TOML integer of 400 digits)
+        raise ParameterError(f"{name} must be finite, got an integer of {len(str(abs(value)))} digits") from None
     bad = math.isnan(number) or (math.isinf(number) and not (allow_inf and number > 0))
     if bad or (number < 0 and not signed):
         raise ParameterError(f"{name} must be finite{'' if signed else ' and >= 0'}, got {value!r}")
@@ -87,7 +97,9 @@ def check_number(name: str, value, *, positive: bool = False, allow_inf: bool = 
     if integer and number != int(number):
         raise ParameterError(f"{name} must be a whole number, got {value!r}")
     if (low is not None and number < low) or (high is not None and number > high):
-        raise ParameterError(f"{name} must lie in [{low:g}, {high:g}], got {value!r}")
+        bounds = (f"lie in [{low:g}, {high:g}]" if low is not None and high is not None
+                  else f"be at least {low:g}" if low is not None else f"be at most {high:g}")
+        raise ParameterError(f"{name} must {bounds}, got {value!r}")
     return int(number) if integer else number
 
 
@@ -157,14 +169,21 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
     values = data[used]
-    if np.abs(values).max() > MAX_ABS_DN:
-        raise ImageContentError(f"pixel values reach {np.abs(values).max():.3g}: beyond {MAX_ABS_DN:g} "
-                                "they are not DN an imaging sensor records; rescale the image")
+    check_magnitude(values)
     if values.max() == values.min():
         raise ImageContentError("the image is flat: no contrast to measure")
     if mask is not None:
         data[~mask] = np.nan
     return data, (x0, y0)
+
+
+def check_magnitude(values: np.ndarray, where: str = "") -> None:
+    """Refuse finite ``values`` beyond :data:`MAX_ABS_DN` (an image in the
+    wrong units); ``where`` (a file) prefixes the message."""
+    peak = float(np.abs(values).max()) if values.size else 0.0
+    if peak > MAX_ABS_DN:
+        raise ImageContentError(f"{where + ': ' if where else ''}pixel values reach {peak:.3g}: beyond "
+                                f"{MAX_ABS_DN:g} they are not DN an imaging sensor records; rescale the image")
 
 
 def quantum(data: np.ndarray, dtype) -> float:

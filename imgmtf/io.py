@@ -239,6 +239,11 @@ class RasterInfo:
         return self.count in (3, 4) and list(self.colours[:3]) == ["red", "green", "blue"]
 
     @property
+    def is_grey_alpha(self) -> bool:
+        """A grey band and its transparency (a grey+alpha PNG): the grey band is the image."""
+        return self.count == 2 and list(self.colours) == ["gray", "alpha"]
+
+    @property
     def alpha_bands(self) -> list[int]:
         """1-based numbers of the bands that hold transparency, not DN."""
         return [i + 1 for i, colour in enumerate(self.colours) if colour == "alpha"]
@@ -287,10 +292,10 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     Raster
         The pixels with the file's GSD, tags, type and provenance.
 
-    With ``band=None`` a single-band file gives its band and an RGB or RGBA
-    file (8/16-bit, colour-interpreted as such) gives the Rec. 709 luminance
-    of its stored values (alpha ignored; no gamma decoding).  Any other
-    multi-band file needs ``band``.  Nodata pixels become NaN.
+    With ``band=None`` a single-band file (or a grey one with alpha) gives
+    its band and an RGB or RGBA file (8/16-bit, colour-interpreted as
+    such) gives the Rec. 709 luminance of its stored values (alpha
+    ignored; no gamma decoding).  Any other multi-band file needs ``band``.  Nodata pixels become NaN.
 
     ``window`` = (x, y, width, height) reads only that part of the image
     (``Raster.origin`` is its top-left pixel), so a large scene is never
@@ -305,7 +310,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
         larger than :data:`MAX_READ_PIXELS` for one read (reason
         ``too-large``: read a window of it).
     ParameterError
-        A bad ``band`` or ``window``.
+        A bad ``band``, ``window`` or ``out_shape``.
 
     Example
     -------
@@ -316,7 +321,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     >>> raster.data.shape, raster.origin, raster.gsd_m
     ((64, 64), (100, 60), 2.0)
     """
-    path = str(path)
+    path = _file_name(path)
     with _opened(path) as src:
         count = src.count
         colours = [c.name for c in src.colorinterp]
@@ -324,15 +329,19 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
                           _gsd_m(src), src.transform, None)
         map_projected = src.crs is not None
         x, y, w, h = info.check_window(window) if window is not None else (0, 0, src.width, src.height)
+        if out_shape is not None:
+            out_shape = _check_shape(path, out_shape)
         check_read_size(path, (w, h) if out_shape is None else (out_shape[1], out_shape[0]),
                         windowed=window is not None)
         region = Window(x, y, w, h)
         if band is not None:
-            if not (isinstance(band, (int, np.integer)) and 1 <= band <= count):
+            if isinstance(band, (bool, np.bool_)) or not isinstance(band, (int, np.integer)):
+                raise ParameterError(f"{path}: band must be a 1-based integer, got {band!r}")
+            if not 1 <= band <= count:
                 raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
             chosen: int | str = int(band)
             data = _band(src, int(band), region, out_shape)
-        elif count == 1:
+        elif count == 1 or info.is_grey_alpha:
             chosen, data = 1, _band(src, 1, region, out_shape)
         elif info.is_rgb:
             chosen = "luminance"
@@ -344,6 +353,18 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     if data.size == 0:
         raise ImageContentError(f"{path}: the image is empty")
     return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y), map_projected)
+
+
+def _check_shape(path: str, shape) -> tuple[int, int]:
+    """``shape`` = (rows, cols), two whole numbers >= 1, else a ParameterError naming ``path``."""
+    try:
+        rows, cols = shape
+        if all(isinstance(n, (int, np.integer)) and not isinstance(n, (bool, np.bool_)) and n >= 1
+               for n in (rows, cols)):
+            return int(rows), int(cols)
+    except (TypeError, ValueError):
+        pass
+    raise ParameterError(f"{path}: out_shape must be (rows, cols), two whole numbers >= 1, got {shape!r}")
 
 
 def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) -> None:
@@ -379,11 +400,19 @@ def check_regular_file(path: str) -> None:
         raise ImageReadError(f"{path}: is {kind}, not an image file; imgmtf reads regular files only")
 
 
+def _file_name(path) -> str:
+    """``path`` (str or os.PathLike) as a str; a ParameterError for anything else (None, an array)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"expected an image file's name (str or os.PathLike), got {type(path).__name__}")
+    return str(path)
+
+
 @contextmanager
 def _opened(path):
     """An open rasterio dataset of a regular file with real pixels, GDAL's
-    failures turned into ImageReadError."""
-    path = str(path)
+    failures turned into ImageReadError; a ParameterError for a path that
+    is no file name (None, an array)."""
+    path = _file_name(path)
     check_regular_file(path)
     try:
         with warnings.catch_warnings():

@@ -12,6 +12,29 @@ from .estimate.spectrum import NYQUIST
 from .metrics import fwhm
 
 
+def _expect(value, kind: str) -> None:
+    """Refuse, with a ParameterError, a ``value`` that is not what the figure
+    draws: a measurement ("result"), a sensor ("sensor") or a fit ("fit")."""
+    from .errors import ParameterError
+    from .estimate.fit import SensorFit
+    from .estimate.results import MTFResult
+    from .sensor.model import Sensor
+    expected = {"result": (MTFResult, "a measurement (imgmtf.measure_edge or measure_pulse)"),
+                "sensor": (Sensor, "an imgmtf.Sensor"), "fit": (SensorFit, "a fit (imgmtf.fit_sensor)")}
+    cls, what = expected[kind]
+    if not isinstance(value, cls):
+        raise ParameterError(f"this figure draws {what}, got {type(value).__name__}")
+
+
+def _truth(truth) -> None:
+    """Refuse a ``truth`` that is not a function of frequency (cy/px) or None."""
+    if truth is not None and not callable(truth):
+        from .errors import ParameterError
+        hint = (" (for a sensor: lambda f: sensor.normal_transfer(f, result.normal_angle_deg))"
+                if hasattr(truth, "normal_transfer") else "")
+        raise ParameterError(f"truth must be a function of frequency in cy/px, got {type(truth).__name__}{hint}")
+
+
 def _axes(ax, size=(5.0, 3.6)):
     if ax is None:
         fig = Figure(figsize=size, layout="constrained")
@@ -28,6 +51,7 @@ def _view_radius_m(sensor) -> float:
 def plot_psf(sensor, ax=None, oversampling: int = 20):
     """The system PSF image (paper Fig. 2a), axes in metres, its core and
     shoulders shown in a square of 3 FWHM."""
+    _expect(sensor, "sensor")
     fig, ax = _axes(ax)
     psf = sensor.psf(oversampling)
     half = psf.data.shape[0] // 2 * psf.step_m
@@ -42,6 +66,7 @@ def plot_psf(sensor, ax=None, oversampling: int = 20):
 
 def plot_sensor_lsf(sensor, ax=None):
     """Across- and along-track LSFs with their FWHM (paper Fig. 2b, c)."""
+    _expect(sensor, "sensor")
     fig, ax = _axes(ax)
     for direction in ("across", "along"):
         x, lsf = sensor.lsf(direction)
@@ -56,6 +81,7 @@ def plot_sensor_lsf(sensor, ax=None):
 def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
     """The system MTF with its value at Nyquist (paper Fig. 3): across and
     along track, or in one ``direction`` with each stage's MTF beside it."""
+    _expect(sensor, "sensor")
     fig, ax = _axes(ax)
     f = np.linspace(0, 1.0, 401)
     if direction is None:
@@ -78,6 +104,7 @@ def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
 def plot_sensor(sensor):
     """PSF, LSFs, and each stage's MTF beside the system's across and along
     track (the paper's Figs. 2-3)."""
+    _expect(sensor, "sensor")
     fig = Figure(figsize=(17, 4), layout="constrained")
     axes = fig.subplots(1, 4)
     plot_psf(sensor, axes[0])
@@ -92,6 +119,10 @@ def plot_sensor(sensor):
 def plot_fit_edge(fit, index: int, ax=None):
     """One edge of a sensor fit: its measured (non-parametric) MTF against
     the fitted model's along its normal, with the model's interval."""
+    _expect(fit, "fit")
+    if not -len(fit.edges) <= index < len(fit.edges):
+        from .errors import ParameterError
+        raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
     fig, ax = _axes(ax)
     edge = fit.edges[index]
     m = edge.measurement
@@ -115,6 +146,7 @@ def plot_fit_residuals(fit, ax=None):
     """Each edge's residuals (data - model) averaged in 0.25 px bins along
     its normal, in % of its step, with the noise's 2-sigma band of a bin
     mean: structure outside it is what the misfit warning reports."""
+    _expect(fit, "fit")
     fig, ax = _axes(ax)
     for i, edge in enumerate(fit.edges):
         x = edge.samples_x_px - edge.offset_px
@@ -140,6 +172,7 @@ def plot_fit_residuals(fit, ax=None):
 def plot_fit(fit, max_edges: int = 6):
     """Measured against model MTF for each edge (the first ``max_edges``),
     the residuals along the normals, and the fitted sensor's 2-D PSF."""
+    _expect(fit, "fit")
     shown = min(len(fit.edges), max_edges)
     panels = shown + 2
     cols = min(panels, 4)
@@ -178,6 +211,7 @@ def plot_locations(result, ax=None):
     """Per-row sub-pixel target locations and the fitted line (paper Fig.
     5a), at equal scale in both axes so that the tilt looks as it is; the
     rows' RMS scatter about the line is in the legend."""
+    _expect(result, "result")
     fig, ax = _axes(ax)
     g = result.geometry
     kept = g.kept
@@ -207,6 +241,7 @@ def plot_profile(result, ax=None):
     """Over-sampled profile samples and the resampled profile: the ESF of an
     edge (paper Fig. 5b) or the PRF of a pulse, normalised; the LSF window's
     flat core is shaded, its taper lighter."""
+    _expect(result, "result")
     fig, ax = _axes(ax)
     if result.target == "edge":
         lo, hi = result.levels_dn
@@ -236,6 +271,7 @@ def _window_bands(ax, result):
 
 def plot_lsf(result, ax=None):
     """The recovered LSF with its full width at half maximum marked."""
+    _expect(result, "result")
     fig, ax = _axes(ax)
     x, lsf = result.lsf_x_px, result.lsf
     ax.plot(x, lsf, color="C0", label="LSF")
@@ -254,6 +290,8 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     """The MTF along the normal with MTF at Nyquist and MTF50 marked with
     their confidence intervals, the frequencies beyond the noise limit
     shaded, and ``truth(f)`` (cycles/pixel) overlaid when known."""
+    _expect(result, "result")
+    _truth(truth)
     fig, ax = _axes(ax)
     f = result.frequencies_cy_px
     line, = ax.plot(f, result.mtf, color=color, label=label or "measured")
@@ -302,6 +340,8 @@ def plot_measurement(result, truth=None, title: str | None = None):
     """Target locations, profile (ESF or PRF), LSF and MTF of one
     measurement, headed by ``title`` (the file) and the figures a report
     quotes; ``truth(f)`` overlays a known MTF."""
+    _expect(result, "result")
+    _truth(truth)
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     axes = fig.subplots(2, 2)
     plot_locations(result, axes[0, 0])
@@ -368,8 +408,10 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     """
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.lines import Line2D
-    records = [r.to_dict() if hasattr(r, "to_dict") else r for r in records]
-    summaries = [r.to_dict() if hasattr(r, "to_dict") else r for r in summaries]
+
+    from .records import Record
+    records = [r.to_dict() if isinstance(r, Record) else r for r in records]     # scan_scene's own output
+    summaries = [r.to_dict() if isinstance(r, Record) else r for r in summaries]
     height, width = overview.shape
     extent_w, extent_h = width * scale, height * scale
     if ax is None:

@@ -81,10 +81,20 @@ def test_a_fit_that_does_not_converge_is_an_imgmtf_error(pair):
     (dict(hold="motion"), ParameterError, "cannot hold 'motion'"),
     (dict(gsd_m=-1.0), ParameterError, "gsd_m must be"),
     (dict(confidence=1.5), ParameterError, "confidence"),
+    (dict(stages=3), ParameterError, "stages must be a list of names, or one comma-separated string, got 3"),
+    (dict(hold=None), ParameterError, "hold must be a list of names"),
 ])
 def test_bad_fit_arguments(pair, kwargs, error, message):
     with pytest.raises(error, match=message):
         im.fit_sensor([pair[0].image], **{"stages": "optics,detector", **kwargs})
+
+
+def test_edges_of_the_wrong_kind_are_named():
+    with pytest.raises(ParameterError, match="edges must be a list of files, arrays or EdgeResults, got None"):
+        im.fit_sensor(None)
+    bar = im.measure_pulse(im.render(TRUTH, im.Target("pulse", 6.0, width_px=3.0), 64).image)
+    with pytest.raises(ParameterError, match="edge 1: a PulseResult; the fit takes edges"):
+        im.fit_sensor([bar])
 
 
 def test_an_image_without_an_edge_is_named():

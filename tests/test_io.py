@@ -44,6 +44,37 @@ def test_rgb_png_reads_as_luminance_without_gsd(tmp_path):
     assert r.data[0, 0] == pytest.approx(0.2126 * 100 + 0.7152 * 200 + 0.0722 * 50)
 
 
+def test_a_grey_png_with_alpha_reads_as_its_grey_band_and_says_alpha_is_not_measured(tmp_path):
+    from PIL import Image
+
+    from imgmtf.batch import MeasureSettings, measure_file
+    grey = im.render(im.Sensor(), im.Target("edge", 6.0, 30, 210), 40, bits=8).image
+    path = tmp_path / "la.png"
+    Image.fromarray(np.stack([grey, np.full_like(grey, 255)], -1), "LA").save(path)
+    r = read_raster(path)
+    assert r.band == 1 and np.array_equal(r.data, grey)
+    record = measure_file(str(path), MeasureSettings())[0].to_dict()
+    assert record["status"] == "ok" and f"{path}: band 2 is alpha (transparency, not DN): not measured" in \
+        record["warnings"]
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(band="1"), "band must be a 1-based integer, got '1'"),
+    (dict(band=1.0), "band must be a 1-based integer, got 1.0"),
+    (dict(out_shape=(-1, 5)), r"out_shape must be \(rows, cols\), two whole numbers >= 1, got \(-1, 5\)"),
+    (dict(out_shape="a"), "out_shape must be"),
+])
+def test_read_arguments_of_the_wrong_kind_are_named(tmp_path, kwargs, message):
+    path = tmp_path / "a.tif"
+    write_geotiff(path, np.zeros((20, 20), np.uint16))
+    with pytest.raises(ParameterError, match=message):
+        read_raster(path, **kwargs)
+    with pytest.raises(ParameterError, match=r"expected an image file's name \(str or os.PathLike\), got NoneType"):
+        read_raster(None)
+    with pytest.raises(ParameterError, match=r"channel_axis must be an axis of a 3-D array \(-3 to 2\), got 5"):
+        im.luminance(np.zeros((3, 4, 4)), channel_axis=5)
+
+
 def test_nodata_becomes_nan(tmp_path):
     data = np.arange(400, dtype=np.uint16).reshape(20, 20)
     path = tmp_path / "n.tif"

@@ -108,6 +108,9 @@ def test_line_response_keeps_the_diffraction_tail():
     ("gsd_m = 1\n[[stages]]\nstage = 'lens'\n", "unknown stage 'lens'"),
     ("gsd_m = 1\n[[stages]]\nstage = 'olpf'\nsplit_m = -1\n", "olpf split_m must be finite and >= 0"),
     ("gsd_m = 1\nstages = []\n", "at least one stage"),
+    ("gsd_m = 1" + "0" * 400 + "\n", "gsd_m must be finite, got an integer of 401 digits"),
+    ("gsd_m = 1e-300\n", r"gsd_m must lie in \[1e-12, 1e\+15\]"),
+    ("gsd_m = 1\n[[stages]]\nstage = 'optics'\nsigma_x_m = 1e300\n", "optics sigma_x_m must be at most 1e\\+15 m"),
     (b"\x89PNG\r\n\x1a\n\x00\xff\xfe", "not a text"),
 ])
 def test_bad_toml_is_a_config_error_naming_the_file(tmp_path, text, message):

@@ -29,3 +29,25 @@ def test_two_measurements_on_one_axes_keep_the_callers_colours_and_one_nyquist_e
     assert sum(label.startswith("Nyquist") for label in labels) == 1
     curves = {ln.get_label(): ln.get_color() for ln in ax.get_lines()}
     assert curves["msg"] == "C2" and curves["again"] == "C3"
+
+
+def test_arguments_of_the_wrong_kind_are_named():
+    import pytest
+
+    from imgmtf.plot import plot_fit_edge, plot_sensor
+    result = _measured(6.0)
+    for call, message in [(lambda: plot_mtf(None), "this figure draws a measurement .*, got NoneType"),
+                          (lambda: plot_sensor(result), "this figure draws an imgmtf.Sensor, got EdgeResult"),
+                          (lambda: plot_mtf(result, truth=im.Sensor()), "truth must be a function of frequency"),
+                          (lambda: plot_fit_edge(im.fit_sensor([result]), 3), "edge index 3 is outside the fit's 1")]:
+        with pytest.raises(im.ParameterError, match=message):
+            call()
+
+
+def test_a_scan_overview_takes_scan_scenes_records_as_they_come():
+    from imgmtf.plot import plot_scan
+    records = [im.Record.measured("a.tif", 1, {"normal_angle_deg": 6.0}, params={}, run_utc="", status="accepted")]
+    records[0] = records[0].with_(site={"id": 1, "x0_px": 5.0, "y0_px": 5.0, "x1_px": 8.0, "y1_px": 40.0,
+                                        "roi_polygon_px": [[0, 0], [20, 0], [20, 45], [0, 45]]})
+    fig = plot_scan(np.zeros((50, 80)), 1.0, records)
+    assert isinstance(fig, Figure)

@@ -88,10 +88,23 @@ def test_other_gsd_scales_the_true_mtf():
     assert chip.true_mtf(0.5) == pytest.approx(abs(s.normal_transfer(0.25, 6.0)), rel=1e-12)
 
 
-@pytest.mark.parametrize("kwargs", [dict(shape=1), dict(bits=12), dict(gsd_m=-1.0)])
+@pytest.mark.parametrize("kwargs", [dict(shape=1), dict(bits=12), dict(gsd_m=-1.0), dict(shape=20.0),
+                                    dict(gsd_m="2"), dict(sensor=None)])
 def test_invalid_render_settings(kwargs):
     with pytest.raises(ParameterError):
-        im.Renderer(im.Sensor(), **kwargs)
+        im.Renderer(**{"sensor": im.Sensor(), **kwargs})
+
+
+@pytest.mark.parametrize("target, kwargs, message", [
+    (None, {}, "target must be an imgmtf.Target"),
+    ("edge", {}, "target must be an imgmtf.Target"),
+    (im.Target(), dict(seed=-1), "seed must be an integer >= 0"),
+    (im.Target(), dict(seed=1.5), "seed must be an integer >= 0"),
+    (im.Target(), dict(ground_noise=3), "ground_noise must be an imgmtf.GroundNoise"),
+])
+def test_a_call_of_the_wrong_kind_is_refused_by_name(target, kwargs, message):
+    with pytest.raises(ParameterError, match=message):
+        im.Renderer(im.Sensor(), 20)(target, **kwargs)
 
 
 def test_a_target_outside_the_chip_is_refused_before_any_work():

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rasterio
 from click.testing import CliRunner
 
 import imgmtf as im
@@ -127,6 +128,23 @@ def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
     assert result.exit_code == 1 and f"{flat}: no usable edge found" in result.output
 
 
+def test_cli_scan_of_values_no_sensor_records_is_refused_for_the_scene(tmp_path):
+    huge = tmp_path / "huge.tif"
+    image = im.render(im.Sensor(), im.Target("edge", 6.0), 64).image * 1e300
+    with rasterio.open(huge, "w", driver="GTiff", width=64, height=64, count=1, dtype="float64",
+                       transform=rasterio.Affine(1, 0, 0, 0, -1, 64)) as dst:
+        dst.write(image, 1)
+    result = CliRunner().invoke(main, ["scan", str(huge)])
+    assert result.exit_code == 1 and "Warning" not in result.output
+    assert result.stderr.strip() == (f"imgmtf: error: {huge}: pixel values reach 1.2e+303: beyond 1e+15 they are "
+                                     "not DN an imaging sensor records; rescale the image")
+
+
+def test_cli_scan_max_length_below_min_length_is_a_usage_error():
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--min-length", "40", "--max-length", "20"])
+    assert result.exit_code == 2 and "--max-length (20 px) is below --min-length (40 px)" in result.output
+
+
 def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
     result = CliRunner().invoke(main, ["scan", str(SCENE), "--target", "pulse", "--bootstrap", "0"])
     assert result.exit_code == 0, result.output
@@ -167,3 +185,19 @@ def test_a_scene_without_a_crs_gives_features_without_geometry(scan_records, tmp
     assert geo["imgmtf_coordinates"].startswith("none")
     assert all(f["geometry"] is None for f in geo["features"])      # never pixels read as degrees
     assert all("x0_px" in f["properties"] for f in geo["features"] if f["properties"]["scope"] == "edge")
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: ScanSettings(margin_px="12"), "margin_px must be a number, got '12'"),
+    (lambda: ScanSettings(margin_px=12.5), "margin_px must be a whole number"),
+    (lambda: ScanSettings(min_length_px=None), "min_length_px must be a number"),
+    (lambda: ScanSettings(band=0), "band must be at least 1, got 0"),
+    (lambda: ScanSettings(band="all"), "scan one band at a time"),
+    (lambda: scan_scene(np.zeros((64, 64))), r"path must be the scene's file name \(str or os.PathLike\), got ndarray"),
+    (lambda: scan_scene(str(SCENE), {"target": "edge"}), "settings must be a ScanSettings"),
+    (lambda: summarise_scan(None), "records must be a list of a scan's Records, got None"),
+    (lambda: summarise_scan([1]), r"records must be a scan's Records \(imgmtf.scan_scene\), got 1"),
+])
+def test_api_arguments_of_the_wrong_kind_are_named(make, message):
+    with pytest.raises(im.ParameterError, match=message):
+        make()

@@ -306,9 +306,11 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     if start is not None and not isinstance(start, Sensor):
         raise ParameterError(f"start must be a Sensor, got {start!r}")
     names = _stage_names(stages, start)
-    if isinstance(edges, (str, Path, np.ndarray)):
+    from .edge import EdgeResult
+    if isinstance(edges, (str, Path, np.ndarray, EdgeResult)):
         edges = [edges]
-    data = [_edge_data(item, k, gsd_m, band) for k, item in enumerate(edges)]
+    items = _listed("edges", edges, "files, arrays or EdgeResults")
+    data = [_edge_data(item, k, gsd_m, band) for k, item in enumerate(items)]
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
@@ -368,6 +370,10 @@ def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
     from ..inputs import saturation_levels
     from .edge import EdgeResult, measure_edge
     from .intervals import Bootstrap
+    from .results import MTFResult
+    if isinstance(item, MTFResult) and not isinstance(item, EdgeResult):
+        raise ParameterError(f"edge {k + 1}: a {type(item).__name__}; the fit takes edges (an EdgeResult, "
+                             "an image array or a file)")
     if isinstance(item, EdgeResult):
         source, result, integer = f"edge {k + 1}", item, False
     else:
@@ -422,7 +428,7 @@ def _stage_names(names, start: Sensor | None) -> list[str]:
         names = [s.name for s in start.stages] if start is not None else list(PAPER_STAGES)
     elif isinstance(names, str):
         names = [n.strip() for n in names.split(",") if n.strip()]
-    names = list(names)
+    names = _listed("stages", names)
     if not names:
         raise ParameterError("no stages to fit")
     for name in names:
@@ -431,6 +437,14 @@ def _stage_names(names, start: Sensor | None) -> list[str]:
     if len(set(names)) != len(names):
         raise ParameterError(f"a stage is named twice in {', '.join(names)}")
     return names
+
+
+def _listed(name: str, values, kinds: str = "names, or one comma-separated string") -> list:
+    """``values`` as a list; a ParameterError naming ``name`` when it is no collection (None, 3)."""
+    try:
+        return list(values)
+    except TypeError:
+        raise ParameterError(f"{name} must be a list of {kinds}, got {values!r}") from None
 
 
 def _initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[Stage]:
@@ -449,7 +463,7 @@ def _hold_keys(hold, model: _Model) -> set[str]:
     if isinstance(hold, str):
         hold = [h.strip() for h in hold.split(",") if h.strip()]
     keys = set()
-    for item in hold:
+    for item in _listed("hold", hold):
         matches = [k for k in model.keys if k == item or k.split(".")[0] == item]
         if not matches:
             raise ParameterError(f"cannot hold {item!r}: not a fitted stage or parameter; "

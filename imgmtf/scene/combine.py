@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..estimate.pipeline import direction_label
 from ..estimate.results import finite
 from ..records import Record
@@ -154,6 +155,11 @@ def summarise_scan(records: list[Record]) -> list[Record]:
         The targets' summaries (by ``target_id``), then the scene's; empty
         when no record was accepted.
 
+    Raises
+    ------
+    ParameterError
+        ``records`` is not a collection of Records.
+
     Example
     -------
     >>> from imgmtf.scene.measure import scan_scene                   # doctest: +SKIP
@@ -161,6 +167,13 @@ def summarise_scan(records: list[Record]) -> list[Record]:
     ...  for r in summarise_scan(scan_scene("baotou.tif"))]                 # doctest: +SKIP
     [('target', 'oblique', 0.1724), ('target', 'oblique', 0.1740), ('scene', ...), ...]
     """
+    try:
+        records = list(records)
+    except TypeError:
+        raise ParameterError(f"records must be a list of a scan's Records, got {records!r}") from None
+    strays = [r for r in records if not isinstance(r, Record)]
+    if strays:
+        raise ParameterError(f"records must be a scan's Records (imgmtf.scan_scene), got {strays[0]!r}")
     accepted = [r for r in records if r.ok and r.figures.get("mtf_nyquist") is not None]
     if not accepted:
         return []

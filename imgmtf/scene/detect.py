@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from ..errors import ImgmtfError
-from ..inputs import saturation_levels
+from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from .screen import FILL_SIDE_PX, fill_mask
 from .settings import ScanSettings
@@ -198,11 +198,14 @@ def check_scene_size(info: RasterInfo) -> None:
 def display_levels(path, band, info: RasterInfo) -> tuple[float, float]:
     """The 0.5 and 99.5 percentiles of a decimated read of the whole scene,
     fill (0, NaN) and saturated pixels (at an integer type's limits) left
-    out so that neither can squash the rest of the scene into a few levels."""
+    out so that neither can squash the rest of the scene into a few levels;
+    an ImageContentError for values no sensor records (beyond 1e15 DN).
+    """
     scale = max(info.width, info.height) / 1024
     shape = (max(int(info.height / scale), 1), max(int(info.width / scale), 1)) if scale > 1 else None
     data = read_raster(path, band, out_shape=shape).data
     finite = data[np.isfinite(data)]
+    check_magnitude(finite, str(path))
     limits = saturation_levels(info.dtype)
     if limits is not None:
         finite = finite[(finite > limits[0]) & (finite < limits[1])]

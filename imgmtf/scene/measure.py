@@ -18,13 +18,14 @@ intervals are computed, so only the accepted candidates pay for them.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..batch import pulse_width_px
-from ..errors import ImgmtfError
+from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
 from ..estimate.pipeline import direction_label
@@ -170,7 +171,8 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     Raises
     ------
     ImgmtfError
-        The scene cannot be read or scanned (too large, flat, unreadable).
+        The scene cannot be read or scanned (too large, flat, unreadable);
+        a ParameterError for a path or settings of the wrong kind.
         An interrupt (KeyboardInterrupt, or SIGTERM under
         :func:`imgmtf.parallel.terminate_raises`) propagates with the
         records so far as its ``records`` attribute: candidates not yet
@@ -182,8 +184,12 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     >>> [(r.site["rank"], r.figures["mtf_nyquist"]) for r in records if r.ok]  # doctest: +SKIP
     [(1, 0.261544), (2, 0.266206)]
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"path must be the scene's file name (str or os.PathLike), got {type(path).__name__}")
     path = str(path)
-    settings = settings or ScanSettings()
+    settings = ScanSettings() if settings is None else settings
+    if not isinstance(settings, ScanSettings):
+        raise ParameterError(f"settings must be a ScanSettings, got {settings!r}")
     run_utc = utc_now()
     info = raster_info(path)
     segments, fill_fraction = detect_segments(path, settings)

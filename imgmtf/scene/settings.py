@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from ..batch import MeasureSettings
 from ..errors import ParameterError
 from ..estimate.intervals import Intervals
+from ..inputs import check_number
 
 MIN_TILE_PX = 256
 MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
@@ -60,6 +61,14 @@ class ScanSettings:
     track_azimuth_deg: float | None = None
 
     def __post_init__(self):
+        for name in ("min_length_px", "max_length_px"):
+            object.__setattr__(self, name, check_number(name, getattr(self, name)))
+        for name in ("margin_px", "tile_px"):
+            object.__setattr__(self, name, check_number(name, getattr(self, name), integer=True))
+        if self.band == "all":
+            raise ParameterError("scan one band at a time (--band N)")
+        if self.band is not None:
+            object.__setattr__(self, "band", check_number("band", self.band, low=1, integer=True))
         if not self.min_length_px >= 16:
             raise ParameterError(f"--min-length must be at least 16 px, got {self.min_length_px}")
         if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
@@ -69,8 +78,6 @@ class ScanSettings:
             raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")
         if not (isinstance(self.tile_px, int) and MIN_TILE_PX <= self.tile_px <= MAX_TILE_PX):
             raise ParameterError(f"tiles must be {MIN_TILE_PX} to {MAX_TILE_PX} px, got {self.tile_px!r}")
-        if self.band == "all":
-            raise ParameterError("scan one band at a time (--band N)")
         self.measure_settings()
 
     def measure_settings(self) -> MeasureSettings:

@@ -38,6 +38,9 @@ from ..metrics import first_crossing, fwhm
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 
 DIRECTIONS = ("across", "along")
+#: the GSDs a sensor is rendered or read at, m: a picometre to a light-year (beyond, the
+#: frequencies in cy/m square to overflow, or the stages' sizes in px do)
+GSD_RANGE_M = (1e-12, 1e15)
 #: the paper's stages, what ``imgmtf fit`` fits by default
 PAPER_STAGES = ("optics", "detector", "motion", "electronics")
 #: largest 2-D grid (cells) and 1-D line (samples) a sensor may ask for
@@ -94,7 +97,7 @@ class Sensor:
     stages: tuple[Stage, ...]
 
     def __init__(self, gsd_m: float = 1.0, stages=None, **keywords):
-        gsd = check_number("sensor gsd_m", gsd_m, positive=True)
+        gsd = check_gsd("sensor gsd_m", gsd_m)
         if stages is None:
             stages = _paper_stages(keywords)
         elif keywords:
@@ -181,7 +184,7 @@ class Sensor:
         if n > MAX_LINE_SAMPLES:
             raise ParameterError(
                 f"the sensor's blur spans {half:.3g} px of {gsd:g} m: its line response would need "
-                f"{n} samples (over {MAX_LINE_SAMPLES}); check the stage parameters against the GSD")
+                f"{n:.3g} samples (over {MAX_LINE_SAMPLES}); check the stage parameters against the GSD")
         f = np.fft.rfftfreq(n, d=step_px)
         remainder = self.normal_transfer(f, angle_deg, gsd) - _reference_transfer(reference, f)
         lsf = np.fft.fftshift(np.fft.irfft(remainder, n)) / step_px
@@ -343,7 +346,13 @@ class Sensor:
             raise ConfigError(f"{path}: {exc}") from None
 
     def _gsd(self, gsd_m) -> float:
-        return self.gsd_m if gsd_m is None else check_number("gsd_m", gsd_m, positive=True)
+        return self.gsd_m if gsd_m is None else check_gsd("gsd_m", gsd_m)
+
+
+def check_gsd(name: str, gsd_m) -> float:
+    """``gsd_m`` as a float in :data:`GSD_RANGE_M`, else a ParameterError naming ``name``."""
+    check_number(name, gsd_m, positive=True)
+    return check_number(name, gsd_m, low=GSD_RANGE_M[0], high=GSD_RANGE_M[1])
 
 
 @dataclass(frozen=True, eq=False)

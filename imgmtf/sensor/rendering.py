@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..metrics import first_crossing, fwhm
 from ..version import __version__
-from .model import MAX_GRID_CELLS, SampledPSF, Sensor
+from .model import MAX_GRID_CELLS, SampledPSF, Sensor, check_gsd
 from .noise import GroundNoise, add_system_noise
 from .targets import Target
 
@@ -154,10 +154,12 @@ class Renderer:
 
     def __init__(self, sensor: Sensor = Sensor(), shape: int | tuple[int, int] = 50, *,
                  gsd_m: float | None = None, oversampling: int = 20, bits: int = 16):
-        size = (shape, shape) if isinstance(shape, (int, np.integer)) else tuple(shape)
+        if not isinstance(sensor, Sensor):
+            raise ParameterError(f"sensor must be an imgmtf.Sensor, got {sensor!r}")
+        size = (shape, shape) if isinstance(shape, (int, np.integer)) else tuple(np.atleast_1d(shape))
         if len(size) != 2 or any(isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer))
                                  or n < 2 for n in size):
-            raise ParameterError(f"chip size must be at least 2 x 2 pixels, got {shape}")
+            raise ParameterError(f"chip size must be at least 2 x 2 pixels, got {shape!r}")
         rows, cols = (int(n) for n in size)
         if rows * cols > MAX_GRID_CELLS:
             raise ParameterError(f"a {rows} x {cols} px chip is over the {MAX_GRID_CELLS}-pixel limit")
@@ -166,9 +168,7 @@ class Renderer:
         if isinstance(oversampling, (bool, np.bool_)) or not (
                 isinstance(oversampling, (int, np.integer)) and oversampling >= 1):
             raise ParameterError(f"oversampling must be a positive integer, got {oversampling!r}")
-        self.gsd_m = sensor.gsd_m if gsd_m is None else float(gsd_m)
-        if not self.gsd_m > 0 or not math.isfinite(self.gsd_m):
-            raise ParameterError(f"GSD must be > 0 m, got {gsd_m}")
+        self.gsd_m = sensor.gsd_m if gsd_m is None else check_gsd("gsd_m", gsd_m)
         self.sensor, self.oversampling, self.bits = sensor, int(oversampling), bits
         self.shape: tuple[int, int] = (rows, cols)
         self._y, self._x = np.mgrid[0:rows, 0:cols].astype(float)
@@ -182,6 +182,13 @@ class Renderer:
 
     def __call__(self, target: Target, *, noise_std_dn: float = 0.0,
                  ground_noise: GroundNoise | None = None, seed: int | None = None) -> Chip:
+        if not isinstance(target, Target):
+            raise ParameterError(f"target must be an imgmtf.Target, got {target!r}")
+        if ground_noise is not None and not isinstance(ground_noise, GroundNoise):
+            raise ParameterError(f"ground_noise must be an imgmtf.GroundNoise or None, got {ground_noise!r}")
+        if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer))
+                                 or seed < 0):
+            raise ParameterError(f"seed must be an integer >= 0 or None, got {seed!r}")
         rng = np.random.default_rng(seed)
         rows, cols = self.shape
         d = target.signed_distance(self._x, self._y, ((cols - 1) / 2.0, (rows - 1) / 2.0))
@@ -264,7 +271,8 @@ def render(sensor: Sensor, target: Target, shape: int | tuple[int, int] = 50, *,
     Raises
     ------
     ParameterError
-        A bad size, depth, oversampling, GSD or noise level.
+        A bad sensor, target, size, depth, oversampling, GSD, noise level
+        or seed.
 
     Example
     -------

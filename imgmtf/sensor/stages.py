@@ -46,6 +46,10 @@ import numpy as np
 from ..errors import ParameterError
 from ..inputs import check_number
 
+#: largest finite stage parameter (m, cy/m, or an f-number): a light-year is 9.5e15 m, and beyond
+#: 1e154 a parameter's square overflows in the transfer functions
+MAX_PARAMETER = 1e15
+
 #: name -> stage class, in the order the stages were registered
 STAGES: dict[str, type[Stage]] = {}
 
@@ -100,6 +104,9 @@ class Stage:
             value = check_number(f"{self.name} {f.name}", getattr(self, f.name),
                                  positive=f.metadata.get("positive", False),
                                  allow_inf=f.metadata.get("allow_inf", False))
+            if math.isfinite(value) and value > MAX_PARAMETER:
+                raise ParameterError(f"{self.name} {f.name} must be at most {MAX_PARAMETER:g} "
+                                     f"{f.metadata['unit']}, got {value:g}".rstrip())
             object.__setattr__(self, f.name, value)
 
     def transfer(self, fx, fy, gsd_m: float) -> np.ndarray:
