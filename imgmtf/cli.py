@@ -220,8 +220,10 @@ def _parse_roi(ctx, param, value):
         parts = ()
     if len(parts) != 4:
         raise click.BadParameter(f"expected X,Y,W,H (four integers), got {value!r}")
-    if parts[2] <= 0 or parts[3] <= 0 or parts[0] < 0 or parts[1] < 0:
-        raise click.BadParameter(f"expected X, Y >= 0 and W, H > 0 px, got {value!r}")
+    from .inputs import MIN_SIZE_PX
+    if parts[2] < MIN_SIZE_PX or parts[3] < MIN_SIZE_PX or parts[0] < 0 or parts[1] < 0:
+        raise click.BadParameter(f"expected X, Y >= 0 and W, H >= {MIN_SIZE_PX} px (the smallest chip "
+                                 f"measured), got {value!r}")
     return parts
 
 

@@ -178,7 +178,8 @@ def test_pulse_width_errors(run, chip, tmp_path):
     (["simulate", "--angle", "120", "--out", "a.tif"], "-90<x<=90"),
     (["simulate", "--gsd", "-1", "--out", "a.tif"], "x>0"),
     (["simulate", "--noise-std", "nan", "--out", "a.tif"], "not a finite number"),
-    (["measure", "--roi", "0,0,0,5", "x.tif"], "W, H > 0"),
+    (["measure", "--roi", "0,0,0,5", "x.tif"], "W, H >= 16 px"),
+    (["measure", "--roi", "20,20,10,10", "x.tif"], "W, H >= 16 px (the smallest chip measured)"),
     (["measure", "--band", "0", "x.tif"], "numbered from 1"),
     (["scan", "--margin", "2", "x.tif"], "6<=x<=1000"),
 ])
