@@ -9,7 +9,6 @@ GPL-3.0 files are read there, never copied), and the tests are skipped when
 that folder is absent."""
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import imgmtf as im
@@ -69,5 +68,8 @@ def test_a_photo_with_no_edge_is_refused():
     from skimage import data
     with pytest.raises(im.ImgmtfError) as info:
         im.measure_edge(data.coins())
-    assert info.value.reason in ("not-straight", "no-target", "not-an-edge")
-    assert np.isfinite(im.measure_edge(data.coins(), force=True).mtf_nyquist) or True
+    # coins' outlines hold short straight-looking chords: two of them far apart are two targets,
+    # and the rows' scatter about either says no straight edge
+    assert info.value.reason in ("not-straight", "no-target", "not-an-edge", "two-targets")
+    if info.value.reason == "two-targets":
+        assert "not-straight" in {c.reason for c in info.value.checks}

@@ -67,22 +67,38 @@ def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> lis
     if edges.sum() < 5:
         return []
     acc, thetas, rhos = hough_line(edges, theta=_THETAS)
-    return _peaks(acc.astype(float), thetas, rhos, max_lines)
+    return _peaks(acc.astype(np.int64), thetas, rhos, edges, max_lines)
 
 
-def _peaks(acc, thetas, rhos, max_lines, min_distance_px=5, min_angle_deg=8.0) -> list[Line]:
-    """Strongest accumulator cells, each suppressing its neighbourhood
-    (``min_distance_px`` in rho, ``min_angle_deg`` in theta) before the
-    next is taken; cells below a quarter of the strongest are ignored."""
+def _peaks(acc, thetas, rhos, edges, max_lines, min_distance_px=5, min_angle_deg=8.0,
+           on_line_px=1.0) -> list[Line]:
+    """Strongest accumulator cells, strongest first: each line's own edge
+    pixels (within ``on_line_px`` of it) then stop voting, and its
+    neighbourhood (``min_distance_px`` in rho, ``min_angle_deg`` in theta)
+    is suppressed, before the next is taken; cells below a quarter of the
+    strongest are ignored.  Taking back the votes keeps a short segment
+    far from the origin, whose pixels also elect lines a few degrees and
+    more than ``min_distance_px`` away, from passing for two lines."""
     threshold = 0.25 * acc.max()
     dr = min_distance_px
     dt = int(round(min_angle_deg / _THETA_STEP_DEG))
+    offset = int(round(-rhos[0]))
+    cos, sin = np.cos(thetas), np.sin(thetas)
+    ys, xs = np.nonzero(edges)
+    voting = np.ones(xs.size, bool)
     lines = []
     for _ in range(max_lines):
         i, j = np.unravel_index(int(np.argmax(acc)), acc.shape)
         if acc[i, j] < threshold or acc[i, j] == 0:
             break
         lines.append(Line(float(np.rad2deg(thetas[j])), float(rhos[i]), int(acc[i, j])))
+        on = voting & (np.abs(xs * cos[j] + ys * sin[j] - rhos[i]) <= on_line_px)
+        if on.any():        # their votes in every direction, binned as hough_line bins them
+            bins = np.rint(np.outer(xs[on], cos) + np.outer(ys[on], sin)).astype(np.int64) + offset
+            cells = (bins * thetas.size + np.arange(thetas.size)).ravel()
+            acc -= np.bincount(cells, minlength=acc.size).reshape(acc.shape)
+            np.maximum(acc, 0, out=acc)
+            voting &= ~on
         acc[max(i - dr, 0): i + dr + 1, max(j - dt, 0): j + dt + 1] = 0
     return lines
 
