@@ -706,12 +706,15 @@ def _num(value, width: int, decimals: int) -> str:
                    "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
               help="write targets.csv, targets.geojson and overview.png here")
+@click.option("--edge-figures", is_flag=True,
+              help="with --out: also one measurement figure per accepted half-edge (locations, profile, LSF, "
+                   "MTF), DIR/edges/edge<id>.png")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @_interval_options
 @_parallel_options
 def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         out_dir, fmt, progress, interval_method, replicates, confidence, workers, scheduler):
+         out_dir, edge_figures, fmt, progress, interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in SCENE, split at junctions into
     half-edges (checkerboards, four-quadrant and cross targets), measure
     each on its own ROI, say why the others were rejected, and combine the
@@ -722,6 +725,8 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
         raise click.UsageError("--pulse-width applies to --target pulse only")
     if max_length < min_length:
         raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
+    if edge_figures and not out_dir:
+        raise click.UsageError("--edge-figures writes into the --out folder: give --out DIR")
     interrupted = None
     with _reported_errors():
         from .parallel import prestart_workers
@@ -740,7 +745,8 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
             ensure_folder(out_dir)
         info = raster_info(scene)
         try:
-            records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress)
+            records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress,
+                                 figures_dir=str(Path(out_dir) / "edges") if edge_figures else None)
         except KeyboardInterrupt as exc:
             records, interrupted = getattr(exc, "records", None), exc
             if records is None:

@@ -201,3 +201,18 @@ def test_a_scene_without_a_crs_gives_features_without_geometry(scan_records, tmp
 def test_api_arguments_of_the_wrong_kind_are_named(make, message):
     with pytest.raises(im.ParameterError, match=message):
         make()
+
+
+def test_edge_figures_one_per_accepted_half_edge_named_by_its_id(tmp_path):
+    out = tmp_path / "scan"
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--edge-figures", "--workers", "2",
+                                       "--format", "json"])
+    assert result.exit_code == 0, result.output
+    rows = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
+    accepted = [r for r in rows if r["status"] == "accepted"]
+    assert accepted and sorted(p.name for p in (out / "edges").iterdir()) == sorted(
+        f"edge{r['id']}.png" for r in accepted)
+    assert all(r["plot"] == str(out / "edges" / f"edge{r['id']}.png") for r in accepted)
+    assert not any(r.get("plot") for r in rows if r["status"] == "rejected")
+    refused = CliRunner().invoke(main, ["scan", str(SCENE), "--edge-figures"])
+    assert refused.exit_code == 2 and "give --out DIR" in refused.output

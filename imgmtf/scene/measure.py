@@ -20,11 +20,13 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..batch import pulse_width_px
+from ..atomic import ensure_folder
+from ..batch import pulse_width_px, save_figure
 from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
@@ -134,6 +136,7 @@ class Context:
     track_azimuth_deg: float | None
     params: dict
     run_utc: str
+    figures_dir: str | None = None      # where each accepted candidate's figure goes, if anywhere
 
 
 def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
@@ -147,7 +150,8 @@ def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
 
 # -- the scan -------------------------------------------------------------------------
 def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int = 1,
-               scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
+               scheduler: str | None = None, progress: bool | None = None,
+               figures_dir: str | None = None) -> list[Record]:
     """Every candidate target of the scene as a record: accepted ones first
     in rank order, then rejected ones by length.
 
@@ -156,6 +160,10 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     path : the scene (any raster GDAL reads, up to 1 Gpx).
     settings : how to scan (:class:`imgmtf.scene.settings.ScanSettings`).
     workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
+    figures_dir : a folder (created) for one measurement figure per
+        accepted candidate, ``edge<id>.png`` (:func:`imgmtf.plot.plot_measurement`:
+        its locations, profile, LSF and MTF); its path is the record's
+        ``plot``.
 
     Returns
     -------
@@ -197,7 +205,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     halves = split_at_junctions(segments, junctions, events, fill_fraction)
     track = track_azimuth(info, settings)
     params = {**settings.measure_settings().params(), "track_azimuth_deg": track, "scan": settings.as_dict()}
-    context = Context(path, info, settings, track, params, run_utc)
+    if figures_dir is not None:
+        figures_dir = str(ensure_folder(figures_dir))
+    context = Context(path, info, settings, track, params, run_utc, figures_dir)
     candidates = [(half, verdict or fill_screen(half.fill_fraction) or geometry_screen(half, settings))
                   for half, verdict in _candidates(halves, settings)]
     unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
@@ -236,9 +246,22 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             if records[i].status == "candidate":
                 records[i] = records[i].with_(status="rejected", reason="interrupted",
                                               error=f"{path}: not measured: the scan was interrupted")
-        exc.records = _ranked(_grouped(records, halves))  # type: ignore[attr-defined]  # what the caller keeps
+        exc.records = _named_figures(_ranked(_grouped(records, halves)))  # type: ignore[attr-defined]  # kept
         raise
-    return _ranked(_grouped(records, halves))
+    return _named_figures(_ranked(_grouped(records, halves)))
+
+
+def _named_figures(records: list[Record]) -> list[Record]:
+    """Each accepted candidate's figure renamed from its measuring order to
+    its id (``edge<id>.png``), which is known only once all are ranked."""
+    out = []
+    for r in records:
+        if r.plot:
+            named = str(Path(r.plot).with_name(f"edge{r.site['id']}.png"))
+            os.replace(r.plot, named)
+            r = r.with_(plot=named)
+        out.append(r)
+    return out
 
 
 def _beside_screen(half: HalfEdge, clearance_px: float) -> tuple[str, str] | None:
@@ -355,8 +378,25 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
     x_, y_, w_, h_ = result.roi
     figures = {**result.to_dict(curves=True), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
                "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
-    return Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
-                           status="accepted", site={**site, "verdict_by": "gate"})
+    record = Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
+                             status="accepted", site={**site, "verdict_by": "gate"})
+    if context.figures_dir:
+        record = _with_figure(record, result, context, plan)
+    return record
+
+
+def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record:
+    """The accepted candidate's measurement figure saved (under its
+    measuring order, renamed to its id later), or a warning saying why not."""
+    from ..plot import plot_measurement
+    target = str(Path(context.figures_dir or ".") / f"candidate{plan.index}.png")
+    title = f"{context.path}: ROI {','.join(str(v) for v in record.figures['roi'])}"
+    try:
+        save_figure(lambda: plot_measurement(result, title=title), target)
+    except Exception as exc:        # a figure never costs the record
+        return record.with_(figures={"warnings": [*record.figures.get("warnings", []),
+                                                  f"{target}: the figure failed: {type(exc).__name__}: {exc}"]})
+    return record.with_(plot=target)
 
 
 def _confident_snr(target: str, rows: int) -> float:
@@ -481,7 +521,7 @@ def _measured(candidate: Record, outcome: Record) -> Record:
     """A candidate with its measurement's outcome, figures and settings."""
     return candidate.with_(status=outcome.status, reason=outcome.reason, error=outcome.error,
                            band=outcome.band if outcome.band is not None else candidate.band,
-                           figures=outcome.figures, site=outcome.site,
+                           figures=outcome.figures, site=outcome.site, plot=outcome.plot,
                            params={**outcome.params, **candidate.params})
 
 
