@@ -129,15 +129,8 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
             continue
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         if plot_path:
-            target = _band_plot_path(plot_path, band, len(bands))
-            try:
-                save_figure(functools.partial(_measurement_figure, result, raster), target)
-                record = record.with_(plot=target)
-            except Exception as exc:
-                message = str(exc) if isinstance(exc, ImgmtfError) else (
-                    f"{target}: the figure failed: {type(exc).__name__}: {exc}")
-                warnings = [*record.figures.get("warnings", []), message]
-                record = record.with_(figures={"warnings": warnings})
+            record = with_figure(record, functools.partial(_measurement_figure, result, raster),
+                                 _band_plot_path(plot_path, band, len(bands)))
         records.append(record)
     notes = []
     if skipped:
@@ -254,6 +247,19 @@ def true_mtf(raster):
     except (KeyError, TypeError, ValueError, ImgmtfError):
         return None
     return lambda f_cy_px: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
+
+
+def with_figure(record: Record, make_figure, path: str) -> Record:
+    """``record`` with the figure ``make_figure()`` builds saved to
+    ``path`` (its ``plot``), or, when that fails, a warning saying why: a
+    figure never costs a measurement its record."""
+    try:
+        save_figure(make_figure, path)
+    except Exception as exc:
+        message = str(exc) if isinstance(exc, ImgmtfError) else (
+            f"{path}: the figure failed: {type(exc).__name__}: {exc}")
+        return record.with_(figures={"warnings": [*record.figures.get("warnings", []), message]})
+    return record.with_(plot=path)
 
 
 def save_figure(make_figure, path: str, dpi: int = 110) -> None:

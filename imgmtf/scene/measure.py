@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..atomic import ensure_folder
-from ..batch import pulse_width_px, save_figure
+from ..batch import pulse_width_px, with_figure
 from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
@@ -389,14 +389,9 @@ def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record
     """The accepted candidate's measurement figure saved (under its
     measuring order, renamed to its id later), or a warning saying why not."""
     from ..plot import plot_measurement
-    target = str(Path(context.figures_dir or ".") / f"candidate{plan.index}.png")
     title = f"{context.path}: ROI {','.join(str(v) for v in record.figures['roi'])}"
-    try:
-        save_figure(lambda: plot_measurement(result, title=title), target)
-    except Exception as exc:        # a figure never costs the record
-        return record.with_(figures={"warnings": [*record.figures.get("warnings", []),
-                                                  f"{target}: the figure failed: {type(exc).__name__}: {exc}"]})
-    return record.with_(plot=target)
+    return with_figure(record, lambda: plot_measurement(result, title=title),
+                       str(Path(context.figures_dir or ".") / f"candidate{plan.index}.png"))
 
 
 def _confident_snr(target: str, rows: int) -> float:
