@@ -35,6 +35,7 @@ SCHEDULER_TIMEOUT_S = 10        # how long to keep trying a remote Dask schedule
 _prestarted: list = []      # at most one pool started ahead by prestart_workers
 MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
+SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 # what numerical libraries read, at load time, for their thread count
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
@@ -234,10 +235,11 @@ def _pool_completed(function, items, workers, on_error):
     futures = {}
     finished = False
     try:
-        futures = {pool.submit(function, item): i for i, item in enumerate(items)}
+        with signals_deferred():
+            futures = {pool.submit(function, item): i for i, item in enumerate(items)}
         waiting = set(futures)
         while waiting:
-            done, waiting = wait(waiting, return_when=FIRST_COMPLETED)
+            done, waiting = _wait_between_signals(waiting)
             for future in done:
                 index = futures[future]
                 try:
@@ -258,6 +260,19 @@ def _pool_completed(function, items, workers, on_error):
             pool.shutdown()
         else:
             _stop(pool, futures)
+
+
+def _wait_between_signals(waiting: set) -> tuple[set, set]:
+    """``wait(waiting, return_when=FIRST_COMPLETED)``, with Ctrl-C and
+    SIGTERM handled only between waits: an exception raised inside
+    concurrent.futures' wait can leave a future's lock taken, and the
+    pool's manager thread then blocks on it for ever, so the interpreter
+    hangs at exit.  Short waits keep the signal's handling prompt."""
+    while True:
+        with signals_deferred():
+            done, waiting = wait(waiting, timeout=SIGNAL_POLL_S, return_when=FIRST_COMPLETED)
+        if done:
+            return done, waiting
 
 
 def _stop(pool: ProcessPoolExecutor, futures) -> None:
