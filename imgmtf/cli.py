@@ -375,6 +375,8 @@ def sensor_command(sensor_path, plot_path, save_path):
 @click.option("--gsd", type=FiniteFloat(0, min_open=True),
               help="GSD in metres (default: the files', else 1: parameters in px)")
 @click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
+@click.option("--roi", callback=_parse_roi,
+              help="X,Y,W,H window in pixels read from every file (default: the whole image)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the intervals")
@@ -383,7 +385,7 @@ def sensor_command(sensor_path, plot_path, save_path):
               help="json: one object with the parameters, directions and a record per edge")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
-def fit(paths, stages, sensor_path, hold, gsd, band, recursive, confidence, out_path, fmt, plot_path):
+def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence, out_path, fmt, plot_path):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model."""
@@ -400,7 +402,7 @@ def fit(paths, stages, sensor_path, hold, gsd, band, recursive, confidence, out_
             check_output_file(out_path)
         start = Sensor.from_toml(sensor_path) if sensor_path else None
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
-                            confidence=confidence)
+                            roi=roi, confidence=confidence)
         written = []
         if out_path:
             from .version import __version__
@@ -431,11 +433,12 @@ def _fit_report(result) -> None:
         click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
                    "better than each")
     pct = f"{100 * result.confidence:g}%"
-    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
-        click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {e.direction:>6} {e.mtf_nyquist:7.4f} "
+        click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {_DIRECTIONS.get(e.direction, e.direction):>7} "
+                   f"{e.constrains:>6} {e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")
     click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
@@ -653,7 +656,7 @@ def _text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
     direction = record.get("direction") or "-"
-    direction = {"across-track": "across", "along-track": "along"}.get(direction, direction)
+    direction = _DIRECTIONS.get(direction, direction)
     cells = [f"{first} {_num(record.get('normal_angle_deg'), 7, 2)} "
              f"{_num(record.get('tilt_deg'), 5, 1)} {direction:>7} "
              f"{_snr(record.get('snr'))} {_num(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "

@@ -28,7 +28,8 @@ def test_recovers_the_parameters_and_each_edges_mtf(pair):
     assert values["optics.sigma_x_m"].status == "fitted" and values["detector.width_x_m"].status == "held"
     for chip, edge in zip(pair, fit.edges):
         assert abs(edge.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002
-        assert edge.direction == ("across" if abs(chip.target.angle_deg) < 45 else "along")
+        assert edge.constrains == ("across" if abs(chip.target.angle_deg) < 45 else "along")
+        assert edge.direction == ("across-track" if abs(chip.target.angle_deg) < 45 else "along-track")
     assert fit.directions["along"]["mtf_nyquist"] == pytest.approx(TRUTH.mtf_nyquist("along"), abs=0.002)
     assert not fit.misfit and not any("does not fit" in w for w in fit.warnings)
 
@@ -69,7 +70,7 @@ def test_profile_noise_needs_no_model():
 
 
 def test_a_fit_that_does_not_converge_is_an_imgmtf_error(pair):
-    data = [fit_module._edge_data(pair[0].image, 0, None, None)]
+    data = [fit_module._edge_data(pair[0].image, 0, None, None, None)]
     model = fit_module._Model(1.0, fit_module._initial_stages(["optics"], None, 1.0), data)
     with pytest.raises(ImgmtfError, match="did not converge"):
         model.solve(model.initial_vector(), max_iterations=0)
@@ -120,6 +121,42 @@ def test_a_refused_file_is_named_and_keeps_the_gates_reason(tmp_path):
     with pytest.raises(QualityError, match="filled.png: ") as refused:
         im.fit_sensor([path])
     assert refused.value.reason == refused.value.checks[0].reason == "fill"
+
+
+def test_an_oblique_edge_is_labelled_as_measure_labels_it():
+    """Labelled by its normal, as measure does ("oblique" past 10 deg from an
+    axis), whatever axis it mostly constrains."""
+    chip = im.Renderer(TRUTH, 60)(im.Target("edge", 30.0, 200.0, 1200.0))
+    edge = im.fit_sensor(chip.image, stages="optics,detector", hold="detector").edges[0]
+    assert (edge.direction, edge.constrains) == ("oblique", "across")
+    assert edge.direction == im.measure_edge(chip.image, track_azimuth_deg=0).direction
+
+
+def test_roi_takes_the_same_window_of_files_and_arrays(pair, tmp_path):
+    """A window holding the edge gives what the cropped chip gives; one
+    outside the input is refused, naming it."""
+    from imgmtf.io import write_geotiff
+    image = pair[0].image
+    padded = np.pad(image, ((0, 0), (0, 40)))          # 0-fill to the right: the whole is refused
+    path = tmp_path / "wide.tif"
+    roi = (0, 0, image.shape[1], image.shape[0])
+    padded = np.round(padded).astype(np.uint16)
+    write_geotiff(path, padded)
+    cropped = im.fit_sensor(padded[:, :image.shape[1]], stages="optics,detector",
+                            hold="detector").edges[0].mtf_nyquist
+    for item in (padded, path):
+        fit = im.fit_sensor(item, stages="optics,detector", hold="detector", roi=roi)
+        assert fit.edges[0].mtf_nyquist == pytest.approx(cropped, abs=1e-6)
+    with pytest.raises(ImgmtfError, match="array 1"):
+        im.fit_sensor(padded)
+    with pytest.raises(ParameterError, match="array 1"):
+        im.fit_sensor(image, roi=(0, 0, image.shape[1] + 5, 20))
+    with pytest.raises(ParameterError, match="already measured"):
+        im.fit_sensor(im.measure_edge(image), roi=roi)
+    result = CliRunner().invoke(main, ["fit", str(path), "--stages", "optics,detector", "--hold", "detector",
+                                       "--roi", ",".join(map(str, roi)), "--format", "json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["edges"][0]["mtf_nyquist"] == pytest.approx(cropped, abs=1e-6)
 
 
 def test_cli_json_contract_toml_and_plot(pair, tmp_path):

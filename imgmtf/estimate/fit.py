@@ -59,6 +59,7 @@ from ..inputs import check_number
 from ..metrics import first_crossing
 from ..sensor.model import DIRECTIONS, PAPER_STAGES, Sensor, direction_angle
 from ..sensor.stages import STAGES, Stage
+from .pipeline import direction_label
 
 if TYPE_CHECKING:
     from .edge import EdgeResult
@@ -120,7 +121,13 @@ class EdgeFit:
     normal_angle_deg : float
         Angle of the edge normal from the x axis (the edge's tilt from the column axis).
     direction : str
-        "across" (|angle| < 45 deg) or "along" track: the axis it mostly constrains.
+        "across-track" or "along-track" when the normal lies within 10 deg
+        of that axis, else "oblique": the label :func:`imgmtf.measure_edge`
+        gives with rows along track (``track_azimuth_deg=0``), the geometry
+        the fit assumes.
+    constrains : str
+        "across" (|angle| < 45 deg) or "along": the image axis whose
+        parameters the edge mostly constrains.
     mtf_nyquist, mtf_nyquist_ci : float, (float, float)
         The fitted model's MTF at 0.5 cy/px along the normal, and its interval.
     mtf50_cy_px : float
@@ -140,6 +147,7 @@ class EdgeFit:
     source: str
     normal_angle_deg: float
     direction: str
+    constrains: str
     gsd_m: float
     rows_used: int
     snr: float
@@ -160,7 +168,7 @@ class EdgeFit:
 
     def to_dict(self) -> dict:
         return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
-                "gsd_m": self.gsd_m, "rows_used": self.rows_used, "snr": _json(self.snr),
+                "constrains": self.constrains, "gsd_m": self.gsd_m, "rows_used": self.rows_used, "snr": _json(self.snr),
                 "mtf_nyquist": self.mtf_nyquist, "mtf_nyquist_ci": [_json(v) for v in self.mtf_nyquist_ci],
                 "mtf50_cy_px": _json(self.mtf50_cy_px),
                 "measured_mtf_nyquist": _json(self.measured_mtf_nyquist), "noise_dn": self.noise_dn,
@@ -253,7 +261,8 @@ class SensorFit:
 
 
 def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_m: float | None = None,
-               band: int | None = None, confidence: float = 0.95) -> SensorFit:
+               band: int | None = None, roi: tuple[int, int, int, int] | None = None,
+               confidence: float = 0.95) -> SensorFit:
     """Fit a sensor's stages to the profiles of one or more edges.
 
     Parameters
@@ -276,6 +285,9 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     band : int, optional
         1-based band of multi-band files (default: the only band or the
         luminance).
+    roi : (int, int, int, int), optional
+        (x, y, width, height) window, px, taken from every file or array
+        (only it is read from a file); not for EdgeResults.
     confidence : float
         Of the intervals, in (0, 1).
 
@@ -286,7 +298,8 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     Raises
     ------
     ParameterError
-        Unknown stage or parameter names, no edges, bad ``confidence``.
+        Unknown stage or parameter names, no edges, bad ``confidence``, a
+        ``roi`` outside an input.
     ImgmtfError
         An input that cannot be read or has no measurable edge (the
         message names it), or a fit that does not converge.
@@ -310,7 +323,7 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     if isinstance(edges, (str, Path, np.ndarray, EdgeResult)):
         edges = [edges]
     items = _listed("edges", edges, "files, arrays or EdgeResults")
-    data = [_edge_data(item, k, gsd_m, band) for k, item in enumerate(items)]
+    data = [_edge_data(item, k, gsd_m, band, roi) for k, item in enumerate(items)]
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
@@ -366,8 +379,8 @@ class _EdgeData:
     measurement: EdgeResult
 
 
-def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
-    from ..inputs import saturation_levels
+def _edge_data(item, k: int, gsd_m, band, roi) -> _EdgeData:
+    from ..inputs import check_roi, saturation_levels
     from .edge import EdgeResult, measure_edge
     from .intervals import Bootstrap
     from .results import MTFResult
@@ -375,15 +388,21 @@ def _edge_data(item, k: int, gsd_m, band) -> _EdgeData:
         raise ParameterError(f"edge {k + 1}: a {type(item).__name__}; the fit takes edges (an EdgeResult, "
                              "an image array or a file)")
     if isinstance(item, EdgeResult):
+        if roi is not None:
+            raise ParameterError(f"edge {k + 1}: an EdgeResult is already measured: a roi applies to "
+                                 "files and arrays")
         source, result, integer = f"edge {k + 1}", item, False
     else:
         if isinstance(item, (str, Path)):
             from ..io import read_raster
-            raster = read_raster(item, band)
+            raster = read_raster(item, band, window=roi)
             source, image, gsd, dtype = str(item), raster.data, raster.gsd_m, np.dtype(raster.dtype)
         else:
             image = np.asarray(item)
             source, gsd, dtype = f"array {k + 1}", None, image.dtype
+            if roi is not None:
+                left, top, width, height = check_roi(roi, image.shape[:2], source)
+                image = image[top: top + height, left: left + width]
         try:
             result = measure_edge(image, gsd_m=gsd_m if gsd_m is not None else gsd,
                                   saturation=saturation_levels(dtype), bootstrap=Bootstrap(0))
@@ -765,7 +784,8 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
         value, low, high = _mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
-        edge = EdgeFit(d.source, d.normal_angle_deg, "across" if abs(d.normal_angle_deg) < 45 else "along", d.gsd_m,
+        edge = EdgeFit(d.source, d.normal_angle_deg, direction_label(d.normal_angle_deg, 0.0),
+                       "across" if abs(d.normal_angle_deg) < 45 else "along", d.gsd_m,
                        int(measured.rows_used), float(measured.snr), float(value), (float(low), float(high)),
                        first_crossing(f, np.abs(sensor.normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5),
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
@@ -779,7 +799,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
     if not model.covers_axes(model.free):
         warnings.append("no parameter acting on every axis an edge sees could be determined: the MTF there is "
                         "the starting sensor's; give more or sharper edges, or other stages")
-    seen = {e.direction for e in edges}
+    seen = {e.constrains for e in edges}
     directions = {}
     for direction in DIRECTIONS:
         angle = direction_angle(direction)
