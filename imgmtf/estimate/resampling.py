@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ImageContentError, ParameterError
+from ..filters import correlate1d
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,9 +76,6 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     :func:`resample_profile`) enter the moment sums linearly, so a stack of
     weight vectors is fitted in one pass.
     """
-    # SciPy here, not at import: the CLI checks a method's name without it
-    from scipy.ndimage import correlate1d
-
     if order < 0 or order > 8:
         raise ParameterError(f"local polynomial order must be 0..8, got {order}")
     # at angles whose sample positions repeat (tan a = 1/q), a window must
@@ -106,7 +104,7 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         one correlation per power of the offset for all moments at once."""
         kmax = moments.shape[-2] - 1
         # offset^p multiplies only the moments j <= kmax - p
-        shifted = [correlate1d(moments[..., : kmax + 1 - p, :], offsets ** p, axis=-1, mode="constant")
+        shifted = [correlate1d(moments[..., : kmax + 1 - p, :], offsets ** p)
                    for p in range(kmax + 1)]
         return np.stack([sum(math.comb(k, j) * shifted[k - j][..., j, :] for j in range(k + 1))
                          for k in range(kmax + 1)], axis=-2)
@@ -121,7 +119,7 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     # ... and order + 1 distinct sample positions (occupied bins), without
     # which its normal matrix is singular (sample lattices, partial windows)
     occupied = _bin_sums(bins, grid.size, (w > 0)[..., None, :].astype(float))[..., 0, :] > 0
-    distinct = correlate1d(occupied.astype(float), np.ones(2 * half_bins + 1), axis=-1, mode="constant")
+    distinct = correlate1d(occupied.astype(float), np.ones(2 * half_bins + 1))
     trim = (grid.size - out.size) // 2
     inner = np.zeros(grid.size, bool)
     inner[trim: trim + out.size] = True
@@ -226,7 +224,7 @@ def _local_polynomial_transfer(order: int, width: float) -> Callable:
 
 
 TABLE_STEP = 1e-3          # in f * width: interpolation error below 2e-6
-TABLE_END = 40.0           # beyond, a local polynomial passes less than 1e-4
+TABLE_END = 8.0            # f * width reaches about 4 (1 px windows to 4 cy/px); beyond, computed directly
 
 
 @functools.lru_cache(maxsize=16)
@@ -244,7 +242,9 @@ def _equivalent_kernel_transfer(order: int, scaled: np.ndarray) -> np.ndarray:
     phi = u[None, :] ** np.arange(order + 1)[:, None]
     gram = (phi * weights) @ phi.T
     kernel = np.linalg.solve(gram, np.eye(order + 1)[:, 0]) @ phi * weights
-    return np.cos(2 * np.pi * scaled[:, None] * u[None, :]) @ kernel
+    # the kernel is even and the nodes symmetric: twice the half at u > 0
+    half = u > 0
+    return np.cos(2 * np.pi * scaled[:, None] * u[None, half]) @ (2 * kernel[half])
 
 
 def smoothing_spline(distance, values, step: float, half_range: float, *,
