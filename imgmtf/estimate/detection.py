@@ -14,10 +14,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from skimage.feature import canny
-from skimage.transform import hough_line
 
 from ..errors import ImageContentError, TargetNotFoundError
+from .edgemap import canny, hough_line
 
 _THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
 _THETAS = np.deg2rad(np.arange(-90.0, 90.0, _THETA_STEP_DEG))
@@ -66,8 +65,8 @@ def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> lis
                       use_quantiles=True, mask=mask)
     if edges.sum() < 5:
         return []
-    acc, thetas, rhos = hough_line(edges, theta=_THETAS)
-    return _peaks(acc.astype(np.int64), thetas, rhos, edges, max_lines)
+    acc, thetas, rhos = hough_line(edges, _THETAS)
+    return _peaks(acc, thetas, rhos, edges, max_lines)
 
 
 def _peaks(acc, thetas, rhos, edges, max_lines, min_distance_px=5, min_angle_deg=8.0,
