@@ -52,6 +52,7 @@ from .intervals import (
     influence_sd,
     influence_sds,
     linearised_interval,
+    t_quantile,
 )
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
@@ -869,8 +870,7 @@ def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_
         dwidth_dv = reading.width_change(dspectrum_dv[0])
         width_sd, n_rows = influence_sd(dwidth_dv * residual, row)
         spectrum_sd, _ = influence_sds(dspectrum_dv[1:] * residual, row)
-        from scipy.special import stdtrit
-        t = float(stdtrit(max(n_rows - 1, 1), 0.5 + intervals.confidence / 2))
+        t = t_quantile(0.5 + intervals.confidence / 2, max(n_rows - 1, 1))
         spread = reading.spread_px(spectrum_sd, t)
         widen = max(1.0, spread / (t * width_sd)) if width_sd > 0 else 1.0
         width_pull = (widen * dwidth_dv, reading.log_slope)

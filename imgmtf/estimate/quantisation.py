@@ -18,7 +18,6 @@ brings MTF at Nyquist within about 0.009 of the truth (bench/edge_accuracy.py).
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
 MAX_LEVELS = 256          # with more steps the staircase's own error is below 0.001 at Nyquist
 MAX_CROSSINGS_PER_PX = 100  # denser steps (a sharp edge of many DN) read true as they are, and
@@ -95,7 +94,9 @@ def dequantise(distance: np.ndarray, values: np.ndarray, quantum: float):
     rise = np.interp(0.9, fraction, crossing) - np.interp(0.1, fraction, crossing)
     if rise > 0 and 0.8 * (high - low) / quantum / rise > MAX_CROSSINGS_PER_PX:
         return None
-    from scipy.interpolate import PchipInterpolator, make_smoothing_spline  # slow to import: only when needed
+    # SciPy is slow to import: only for the few staircase edges that need it
+    from scipy.interpolate import PchipInterpolator, make_smoothing_spline
+    from scipy.special import ndtr, ndtri
     z = ndtri((thresholds - low) / (high - low))
     if z.size > SMOOTH_ABOVE:
         # many crossings, each placed to within the samples' spacing: smooth
