@@ -30,7 +30,10 @@ MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
 # what a process measuring files loads: batch imports the estimators only where
 # it measures, so that a batch's parent, which collects records, stays light
-MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse")
+# what a measurement imports, numpy's lazily loaded parts included: loaded once
+# in the workers' fork server rather than by each worker's first file
+MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", "numpy.fft", "numpy.ma",
+                     "numpy.polynomial")
 
 
 @contextmanager

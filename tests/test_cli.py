@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -262,6 +263,20 @@ def test_a_batchs_parent_checks_its_options_without_the_estimators(tmp_path):
             "expand_inputs; MethodName().convert('spline', None, None); "
             "MeasureSettings('pulse', 'spline', pulse_width=(3.0, 'px')); "
             f"expand_inputs([{str(tmp_path)!r}]); "
+            "print(sorted(m for m in ('scipy', 'skimage', 'cv2', 'matplotlib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_measuring_an_edge_file_loads_neither_scipy_nor_scikit_image():
+    # a one-chip measurement's start-up is mostly imports: the default edge
+    # estimate (seed search, resampling, intervals) runs on NumPy alone
+    import subprocess
+    import sys
+    chip = Path(__file__).parent.parent / "data" / "edge_16bit.tif"
+    code = ("import sys; from click.testing import CliRunner; from imgmtf.cli import main; "
+            f"r = CliRunner().invoke(main, ['measure', '--format', 'json', {str(chip)!r}]); "
+            "assert r.exit_code == 0, r.output; "
             "print(sorted(m for m in ('scipy', 'skimage', 'cv2', 'matplotlib') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"

@@ -51,14 +51,40 @@ def test_measure_and_scan_on_a_local_dask_cluster(tmp_path):
     assert len(accepted) == 2
 
 
-def test_prestarted_workers_are_used_once_and_never_left_behind():
+def test_prestarted_workers_are_used_once_and_never_left_behind(monkeypatch):
+    # where there is no fork server: a pool of workers started ahead
     from imgmtf import parallel
+    monkeypatch.setattr(parallel.multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     parallel.prestart_workers(2, ["json"])
+    assert parallel._prestarted
     assert list(run_tasks(math.sqrt, [9, 4, 1], workers=2)) == [3, 2, 1]
     assert not parallel._prestarted
     parallel.prestart_workers(2, ["json"])
     assert list(run_tasks(math.sqrt, [9], workers=2)) == [3]     # one task runs here: the pool goes
     assert not parallel._prestarted
+
+
+def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread(tmp_path):
+    """prestart_workers starts the fork server importing the modules once, and
+    with one numerical-library thread; the caller's environment is left as
+    it was.  (In a process of its own: a process has one fork server.)"""
+    import subprocess
+    import sys
+    if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
+        pytest.skip("no fork server on this platform")
+    (tmp_path / "probe.py").write_text(
+        "import os, sys\n"
+        "def state(name):\n"
+        "    return name in sys.modules, os.environ.get('OPENBLAS_NUM_THREADS')\n")
+    code = ("import os, probe; from imgmtf.parallel import prestart_workers, run_tasks; "
+            "os.environ.pop('OPENBLAS_NUM_THREADS', None); "
+            "prestart_workers(2, ['probe', 'colorsys']); "
+            "print(list(run_tasks(probe.state, ['colorsys', 'wave'], workers=2)), "
+            "os.environ.get('OPENBLAS_NUM_THREADS'))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[(True, '1'), (False, '1')] None"
 
 
 def test_a_signal_inside_a_deferred_block_is_handled_after_it():
