@@ -801,14 +801,14 @@ def _print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
         click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
                    "the half-edges disagree beyond their intervals):")
         click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
-                   f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'consist.':>8}")
+                   f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'FWHM':>6} {'consist.':>8}")
         for summary in summaries:
             r = summary.to_dict()
             click.echo(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
                        f"{_DIRECTIONS.get(r['direction'], r['direction']):>7} {_num(r['normal_angle_deg'], 7, 2)} "
                        f"{r['n_edges']:>5} {_num(r['mtf_nyquist'], 7, 4)} {_interval(r['mtf_nyquist_ci']):>15} "
                        f"{_num(r.get('mtf50_cy_px'), 7, 4)} {_interval(r.get('mtf50_ci_cy_px')):>15} "
-                       f"{_num(r.get('consistency'), 8, 2)}")
+                       f"{_num(r.get('fwhm_px'), 6, 3)} {_num(r.get('consistency'), 8, 2)}")
     for path in written:
         click.echo(f"wrote {path}")
 

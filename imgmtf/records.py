@@ -232,12 +232,14 @@ CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # (``edge``) from a summary that combines the accepted half-edges of a
 # target or of the scene per direction (``target``, ``scene``), with its
 # ``n_edges``, ``edge_ids`` (the candidates' ids), ``consistency`` (the
-# Birge ratio of their MTF at Nyquist) and a target's centre (``x_px``,
-# ``y_px``)
+# Birge ratio of their MTF at Nyquist), the lowest SNR among them
+# (``snr_min``) and a target's centre (``x_px``, ``y_px``); its ``fwhm_px``
+# and ``rer`` are its half-edges' averaged with the weights of the MTF at
+# Nyquist
 SCAN_COLUMNS = (
     "id", "rank", "scope", "target_id", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "line_length_px",
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation", "verdict_by",
-    "n_edges", "edge_ids", "consistency", "weights", "x_px", "y_px",
+    "n_edges", "edge_ids", "consistency", "weights", "snr_min", "x_px", "y_px",
 )
 
 # a scan's CSV: id and rank first, then the summary, the site's columns, the curve

@@ -57,7 +57,7 @@ def edge(id_, normal, mtf, sd, target, x=0.0):
     return Record("s.tif", 1, "edge", "msg", "accepted",
                   figures={"normal_angle_deg": normal, "mtf_nyquist": mtf, "mtf_nyquist_ci": interval(mtf, sd, 30),
                            "mtf50_cy_px": 0.3, "mtf50_ci_cy_px": interval(0.3, 0.003, 30), "rows_used": 30,
-                           "gsd_m": None},
+                           "fwhm_px": 1.2 + 0.1 * id_, "snr": 100.0 * id_, "gsd_m": None},
                   site={"id": id_, "target_id": target, "x0_px": x, "y0_px": 0.0, "x1_px": x + 2, "y1_px": 40.0},
                   params={"intervals": {"confidence": 0.95}, "track_azimuth_deg": 0.0})
 
@@ -75,6 +75,10 @@ def test_one_summary_per_target_and_direction_and_per_scene():
     assert first.status == "combined" and first.ok and first.figures["edge_ids"] == [1, 3]
     assert first.figures["mtf_nyquist"] == pytest.approx(0.27) and first.site["x_px"] == pytest.approx(51.0)
     assert out[3].figures["mtf_nyquist"] == pytest.approx((0.26 + 0.28 + 0.27 / 4) / 2.25)
+    # FWHM weighted as the MTF at Nyquist is; the lowest SNR of the half-edges
+    assert first.figures["fwhm_px"] == pytest.approx(1.4) and first.figures["snr_min"] == 100.0
+    assert out[3].figures["fwhm_px"] == pytest.approx((1.3 + 1.5 + 1.6 / 4) / 2.25)
+    assert first.figures["rer"] is None and "fwhm_m" not in first.figures      # none given, no GSD
 
 
 def test_the_combined_curve_weights_each_curve_as_its_nyquist_interval_earns():

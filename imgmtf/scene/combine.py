@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from statistics import NormalDist
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..estimate.intervals import t_quantile
 from ..estimate.pipeline import direction_label
 from ..estimate.results import finite
 from ..records import Record
@@ -107,7 +109,6 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     >>> round(c.value, 4), c.weights
     (0.262, 'inverse-variance')
     """
-    from scipy.special import ndtri
     x = np.asarray(values, float)
     bounds = np.asarray(intervals, float).reshape(-1, 2)
     rows = np.asarray(rows, float)
@@ -125,7 +126,7 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     sd_mean = 1.0 / math.sqrt(float(np.sum(w)))
     n = x.size
     birge = math.sqrt(float(np.sum(w * (x - mean) ** 2)) / (n - 1)) if n > 1 else math.nan
-    half_width = float(ndtri(0.5 + confidence / 2)) * sd_mean * max(1.0, birge)
+    half_width = NormalDist().inv_cdf(0.5 + confidence / 2) * sd_mean * max(1.0, birge)
     return Combined(mean, mean - half_width, mean + half_width, birge, "inverse-variance")
 
 
@@ -206,9 +207,8 @@ def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray |
     >>> round(float(w[0] / w[1]), 3)                 # half the width: four times the weight
     4.0
     """
-    from scipy.special import stdtrit
     bounds = np.asarray(intervals, float).reshape(-1, 2)
-    quantile = stdtrit(np.maximum(np.asarray(rows, float) - 1, 1), 0.5 + confidence / 2)
+    quantile = np.array([t_quantile(0.5 + confidence / 2, max(int(n) - 1, 1)) for n in rows])
     sd = (bounds[:, 1] - bounds[:, 0]) / 2 / quantile
     if not (np.isfinite(sd).all() and (sd > 0).all()):
         return None
@@ -250,8 +250,18 @@ def _summary(group: list[Record], site: dict) -> Record:
         "consistency": finite(nyquist.consistency), "weights": nyquist.weights,
         "rows_used": int(sum(rows)), "gsd_m": first.figures.get("gsd_m"),
     }
-    if figures["gsd_m"] and mtf50:
-        figures["mtf50_cy_m"] = finite(mtf50.value / figures["gsd_m"])
+    # FWHM and RER have no interval of their own: averaged with the weights
+    # the MTF at Nyquist earned, as the curve is
+    weights = precision_weights([_pair(r.figures.get("mtf_nyquist_ci")) for r in group], rows, confidence)
+    for key in ("fwhm_px", "rer"):
+        figures[key] = _weighted_mean([r.figures.get(key) for r in group], weights)
+    snrs = [r.figures.get("snr") for r in group]
+    figures["snr_min"] = finite(min((v for v in snrs if v is not None), default=math.nan))
+    if figures["gsd_m"]:
+        if mtf50:
+            figures["mtf50_cy_m"] = finite(mtf50.value / figures["gsd_m"])
+        if figures["fwhm_px"] is not None:
+            figures["fwhm_m"] = finite(figures["fwhm_px"] * figures["gsd_m"])
     frequencies = first.figures.get("frequencies_cy_px")
     curves = [r.figures.get("mtf") or [] for r in group]
     if frequencies and all(len(c) == len(frequencies) for c in curves):
@@ -265,6 +275,15 @@ def _summary(group: list[Record], site: dict) -> Record:
     return Record(first.path, first.band, first.target, first.method, "combined", figures=figures, site=where,
                   params={"intervals": first.params.get("intervals"), "track_azimuth_deg": track,
                           "scan": first.params.get("scan")}, run_utc=first.run_utc)
+
+
+def _weighted_mean(values, weights) -> float | None:
+    """Mean of the finite ``values`` (None where a half-edge has none) with
+    ``weights`` (equal when None); None when no value is finite."""
+    x = np.array([math.nan if v is None else v for v in values], float)
+    w = np.ones(x.size) if weights is None else np.asarray(weights, float)
+    ok = np.isfinite(x)
+    return finite(float(np.sum(w[ok] * x[ok]) / np.sum(w[ok]))) if ok.any() else None
 
 
 def _pair(interval) -> tuple[float, float]:
