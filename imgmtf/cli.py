@@ -28,10 +28,10 @@ MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without im
 DEFAULT_LEVELS_DN = {16: (200.0, 1200.0), 8: (30.0, 210.0)}    # simulate's dark and bright sides
 MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
-# what a process measuring files loads: batch imports the estimators only where
-# it measures, so that a batch's parent, which collects records, stays light
-# what a measurement imports, numpy's lazily loaded parts included: loaded once
-# in the workers' fork server rather than by each worker's first file
+# what a process measuring files loads, NumPy's lazily loaded parts included:
+# imported once by the workers' fork server rather than by each worker's first
+# file (batch imports the estimators only where it measures, so that a batch's
+# parent, which collects records, stays light)
 MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", "numpy.fft", "numpy.ma",
                      "numpy.polynomial")
 

@@ -144,7 +144,7 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
 def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     """Get ``workers`` local worker processes with ``modules`` imported
     ready now for the next :func:`run_tasks` of as many workers: their
-    start-up (the numerical libraries' imports, about half a second) then
+    start-up (Python and the numerical libraries' imports, 0.2-0.5 s) then
     overlaps the caller's own instead of following it.
 
     Where processes can be forked from a fork server, the server imports
