@@ -73,3 +73,24 @@ def test_dispatcher_errors(samples):
     with pytest.raises(ParameterError, match="step"):
         resample_profile(d, v, method="msg", step=0, half_range=5)
     assert set(METHODS) == {"msg", "sliding", "spline", "iso"}
+
+
+def test_penalised_spline_is_scipys_smoothing_spline_and_meets_its_limits():
+    """The O(n) smoothing spline is SciPy's make_smoothing_spline (the same
+    minimiser), interpolates as the natural cubic spline when lam -> 0 and
+    becomes the weighted least-squares line when lam -> infinity."""
+    from scipy.interpolate import CubicSpline, make_smoothing_spline
+
+    from imgmtf.estimate.resampling import penalised_spline
+    rng = np.random.default_rng(2)
+    x = -8.0 + 0.04 * np.arange(400) + rng.uniform(0, 0.02, 400)      # gaps of 0.02 to 0.06
+    y = np.tanh(x) + rng.normal(0, 0.02, x.size)
+    w = rng.uniform(0.5, 3.0, x.size)
+    at = np.linspace(x[0], x[-1], 1001)
+    for lam in (1e-4, 0.1, 10.0):
+        expected = make_smoothing_spline(x, y, w=w, lam=lam)(at)
+        np.testing.assert_allclose(penalised_spline(x, y, w, lam, at), expected, rtol=0, atol=1e-9)
+    natural = CubicSpline(x, y, bc_type="natural")(at)
+    np.testing.assert_allclose(penalised_spline(x, y, w, 1e-12, at), natural, rtol=0, atol=1e-6)
+    slope, intercept = np.polyfit(x, y, 1, w=np.sqrt(w))
+    np.testing.assert_allclose(penalised_spline(x, y, w, 1e12, at), slope * at + intercept, rtol=0, atol=1e-6)

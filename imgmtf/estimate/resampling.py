@@ -12,7 +12,7 @@ msg      modified Savitzky-Golay: a least-squares polynomial (order 4 by
          samples (Choi and Helder).
 sliding  the same local fit with a straight line (order 1): for a
          symmetric window this is the window's mean, a box filter.
-spline   a cubic smoothing spline (scipy.interpolate.make_smoothing_spline)
+spline   a cubic smoothing spline (Reinsch's algorithm, :func:`penalised_spline`)
          whose response falls to 1/2 at 2 cycles/pixel.
 iso      ISO 12233-style averaging into 1/4-pixel bins; empty bins are
          filled by linear interpolation.
@@ -259,7 +259,6 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
     lam from the data but costs about a second per profile.)  A stack of
     weight vectors costs one spline fit each.
     """
-    from scipy.interpolate import make_smoothing_spline  # half a second to import: only when asked
     if not cutoff_cy_px > 0:
         raise ParameterError(f"spline cut-off must be > 0 cycles/pixel, got {cutoff_cy_px}")
     grid = _grid(step, half_range)
@@ -276,8 +275,7 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
         present = counts > 0
         means = np.bincount(inverse, weights=sample_weights * values)[present] / counts[present]
         scale = sample_weights.size / sample_weights.sum()     # lam assumes unit weights
-        spline = make_smoothing_spline(ux[present], means, w=counts[present] * scale, lam=lam)
-        return np.where(inside, spline(grid), np.nan)
+        return np.where(inside, penalised_spline(ux[present], means, counts[present] * scale, lam, grid), np.nan)
     out = fit(w) if w.ndim == 1 else np.stack([fit(row) for row in w])
 
     def transfer(f):
@@ -352,6 +350,43 @@ def _interpolation_matrix(grid: np.ndarray, filled: np.ndarray) -> np.ndarray:
     matrix[filled] = 0.0
     matrix[np.nonzero(filled)[0], np.nonzero(filled)[0]] = 1.0
     return matrix
+
+
+def penalised_spline(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, at: np.ndarray) -> np.ndarray:
+    """The cubic smoothing spline g minimising sum w_i (y_i - g(x_i))^2 +
+    lam * integral g''(u)^2 du (natural: g'' = 0 at the ends), evaluated at
+    ``at`` (within [x_0, x_-1]); ``x`` strictly increasing, ``w`` > 0.
+
+    Reinsch's algorithm (Green and Silverman 1994, section 2.3): the
+    second derivatives gamma at the interior knots solve the symmetric
+    pentadiagonal system (R + lam Q' W^-1 Q) gamma = Q' y, and the knot
+    values are g = y - lam W^-1 Q gamma; O(n), where
+    scipy.interpolate.make_smoothing_spline (the same spline) loops over
+    the samples in Python.
+    """
+    from scipy.linalg import solveh_banded
+    h = np.diff(x)
+    inv_w = 1.0 / w
+    # Q's three non-zeros in each column a (rows a, a + 1, a + 2)
+    q0, q2 = 1.0 / h[:-1], 1.0 / h[1:]
+    q1 = -q0 - q2
+    d0, d1, d2 = inv_w[:-2], inv_w[1:-1], inv_w[2:]
+    banded = np.zeros((3, h.size - 1))
+    banded[2] = (h[:-1] + h[1:]) / 3.0 + lam * (d0 * q0 ** 2 + d1 * q1 ** 2 + d2 * q2 ** 2)
+    banded[1, 1:] = h[1:-1] / 6.0 + lam * (d1[:-1] * q1[:-1] * q0[1:] + d2[:-1] * q2[:-1] * q1[1:])
+    banded[0, 2:] = lam * d2[:-2] * q2[:-2] * q0[2:]
+    gamma = solveh_banded(banded, q0 * y[:-2] + q1 * y[1:-1] + q2 * y[2:])
+    q_gamma = np.zeros(x.size)
+    q_gamma[:-2] += q0 * gamma
+    q_gamma[1:-1] += q1 * gamma
+    q_gamma[2:] += q2 * gamma
+    g = y - lam * inv_w * q_gamma
+    curvature = np.concatenate([[0.0], gamma, [0.0]])
+    # the cubic between each pair of knots, from its end values and curvatures
+    i = np.clip(np.searchsorted(x, at, side="right") - 1, 0, x.size - 2)
+    left, right, span = at - x[i], x[i + 1] - at, h[i]
+    return ((left * g[i + 1] + right * g[i]) / span
+            - left * right / 6.0 * ((1.0 + left / span) * curvature[i + 1] + (1.0 + right / span) * curvature[i]))
 
 
 def _local_density(distance: np.ndarray, weights: np.ndarray) -> np.ndarray:
