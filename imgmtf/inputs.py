@@ -11,6 +11,7 @@ from .errors import ImageContentError, ParameterError
 
 MIN_SIZE_PX = 16
 MAX_ABS_DN = 1e15                 # no sensor records more; beyond, squares overflow
+MIN_RANGE_DN = 1e-6               # a smaller spread of values meets the fits' absolute tolerances
 # Rec. 709 luma weights (red, green, blue), applied to the stored values
 LUMA_WEIGHTS = (0.2126, 0.7152, 0.0722)
 MIN_BAR_WIDTH_PX = 0.2              # narrower, a bar's signal is below any noise
@@ -172,6 +173,10 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
     check_magnitude(values)
     if values.max() == values.min():
         raise ImageContentError("the image is flat: no contrast to measure")
+    if values.max() - values.min() < MIN_RANGE_DN:
+        raise ImageContentError(f"the pixel values span only {values.max() - values.min():.3g}: below "
+                                f"{MIN_RANGE_DN:g} the fits lose their precision; rescale the image "
+                                "(multiply it by a power of ten)")
     if mask is not None:
         data[~mask] = np.nan
     return data, (x0, y0)
@@ -190,8 +195,13 @@ def quantum(data: np.ndarray, dtype) -> float:
     """The DN step of the recorded values: 1 for integer types and for
     floats that hold only whole numbers, else 0 (not quantised).  Its
     rounding noise, quantum / sqrt(12), is the floor of any noise estimate."""
+    if np.issubdtype(np.dtype(dtype), np.integer):
+        return 1.0
     values = data[np.isfinite(data)]
-    if np.issubdtype(np.dtype(dtype), np.integer) or np.allclose(values, np.round(values), rtol=0, atol=1e-6):
+    whole = np.round(values)
+    # whole numbers spanning at least one step: values all within 1e-6 of 0
+    # (a float image in tiny units) are not counts
+    if values.size and np.allclose(values, whole, rtol=0, atol=1e-6) and whole.max() > whole.min():
         return 1.0
     return 0.0
 
