@@ -17,6 +17,7 @@ once before it propagates; the caller keeps what had completed.
 """
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import os
 import signal
@@ -36,6 +37,7 @@ _prestarted: list = []      # at most one pool started ahead by prestart_workers
 MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
+IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
 # what numerical libraries read, at load time, for their thread count
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
@@ -147,20 +149,29 @@ def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     start-up (Python and the numerical libraries' imports, 0.2-0.5 s) then
     overlaps the caller's own instead of following it.
 
-    Where processes can be forked from a fork server, the server imports
-    ``modules`` once, with one numerical-library thread (a process without
-    threads forks safely), and every worker forked from it starts with them
-    loaded: one import on one core rather than one per worker competing
-    with the caller's.  Elsewhere the workers are started now and each
-    imports them."""
+    Where processes can be forked from a fork server and this process has
+    not started one yet, it is started now importing ``modules`` once, with
+    one numerical-library thread (a process without threads forks safely),
+    and every worker forked from it starts with them loaded: one import on
+    one core rather than one per worker competing with the caller's.  A
+    process has one fork server, so this sets its preloaded modules and
+    thread count for the process's life: it is meant for a command-line
+    run such as ``imgmtf measure``.  Elsewhere the workers are started now
+    and each imports them."""
     if workers < 2 or _prestarted or not 1 <= workers <= MAX_WORKERS:
         return
-    if "forkserver" in multiprocessing.get_all_start_methods():
+    if "forkserver" in multiprocessing.get_all_start_methods() and not _fork_server_running():
         return _start_fork_server(modules)
     pool = _new_pool(workers)
     for _ in range(workers):
         pool.submit(_import_modules, tuple(modules))
     _prestarted.append((workers, pool))
+
+
+def _fork_server_running() -> bool:
+    from multiprocessing import forkserver
+    server = getattr(forkserver, "_forkserver", None)
+    return getattr(server, "_forkserver_pid", None) is not None
 
 
 def _start_fork_server(modules: Iterable[str]) -> None:
@@ -258,24 +269,34 @@ def _call(function, item, on_error):
 
 
 def _pool_completed(function, items, workers, on_error):
+    """(index, result) pairs from a pool of ``workers`` processes.  Only
+    ``IN_FLIGHT_PER_WORKER`` tasks per worker are submitted at a time, so
+    that each wait (and a stop's cancelling) looks at a few futures however
+    long the batch."""
     pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
-    futures = {}
+    queue = iter(enumerate(items))
+    in_flight: dict = {}
     finished = False
     try:
-        with signals_deferred():
-            futures = {pool.submit(function, item): i for i, item in enumerate(items)}
-        waiting = set(futures)
-        while waiting:
-            done, waiting = _wait_between_signals(waiting)
+        while True:
+            failed = []         # tasks the pool refused: it broke (a worker died)
+            with signals_deferred():
+                for index, item in itertools.islice(queue, IN_FLIGHT_PER_WORKER * workers - len(in_flight)):
+                    try:
+                        in_flight[pool.submit(function, item)] = index
+                    except BrokenProcessPool as exc:
+                        failed.append((index, exc))
+            for index, exc in failed:
+                yield index, _died(items[index], exc, on_error)
+            if not in_flight:
+                break
+            done, _ = _wait_between_signals(set(in_flight))
             for future in done:
-                index = futures[future]
+                index = in_flight.pop(future)
                 try:
                     result = future.result()
                 except BrokenProcessPool as exc:
-                    if on_error is None:
-                        raise
-                    result = on_error(items[index], RuntimeError(
-                        f"its worker process died ({exc}); a crash in a library, or out of memory"))
+                    result = _died(items[index], exc, on_error)
                 except Exception as exc:
                     if on_error is None:
                         raise
@@ -286,7 +307,16 @@ def _pool_completed(function, items, workers, on_error):
         if finished:
             pool.shutdown()
         else:
-            _stop(pool, futures)
+            _stop(pool, in_flight)
+
+
+def _died(item, exc: BrokenProcessPool, on_error):
+    """The result of a task whose worker died (or whose pool a dead worker
+    broke), through ``on_error``; without it the error goes on."""
+    if on_error is None:
+        raise exc
+    return on_error(item, RuntimeError(f"its worker process died ({exc}); a crash in a library, "
+                                       "or out of memory"))
 
 
 def _wait_between_signals(waiting: set) -> tuple[set, set]:

@@ -20,6 +20,16 @@ def test_processes_keep_input_order():
     assert list(run_tasks(math.sqrt, [16, 9, 4, 1, 0], workers=2)) == [4, 3, 2, 1, 0]
 
 
+def test_a_worker_that_dies_fails_its_tasks_and_the_rest_still_report():
+    # os._exit kills the worker running it: the pool breaks, and every task,
+    # those running and those not yet submitted, gets one result each
+    results = list(run_tasks(os._exit, [3] * 7, workers=2, on_error=lambda item, exc: str(exc)))
+    assert len(results) == 7 and all("its worker process died" in r for r in results)
+    from concurrent.futures.process import BrokenProcessPool
+    with pytest.raises(BrokenProcessPool):
+        list(run_tasks(os._exit, [3] * 3, workers=2))
+
+
 def test_bad_worker_count_and_unreachable_scheduler(monkeypatch):
     with pytest.raises(ParameterError):
         list(run_tasks(math.sqrt, [1, 4], workers=0))
@@ -65,26 +75,35 @@ def test_prestarted_workers_are_used_once_and_never_left_behind(monkeypatch):
 
 
 def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread(tmp_path):
-    """prestart_workers starts the fork server importing the modules once, and
-    with one numerical-library thread; the caller's environment is left as
-    it was.  (In a process of its own: a process has one fork server.)"""
+    """prestart_workers starts the fork server importing the modules once
+    (before the workers' fork), with one numerical-library thread (what the
+    probe saw when the server imported it); the caller's environment is left
+    as it was.  A fork server already running is left alone: prestarted
+    workers then import the modules themselves.  (In processes of their
+    own: a process has one fork server.)"""
     import subprocess
     import sys
     if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
         pytest.skip("no fork server on this platform")
     (tmp_path / "probe.py").write_text(
         "import os, sys\n"
+        "THREADS_AT_IMPORT, PID_AT_IMPORT = os.environ.get('OPENBLAS_NUM_THREADS'), os.getpid()\n"
         "def state(name):\n"
-        "    return name in sys.modules, os.environ.get('OPENBLAS_NUM_THREADS')\n")
-    code = ("import os, probe; from imgmtf.parallel import prestart_workers, run_tasks; "
-            "os.environ.pop('OPENBLAS_NUM_THREADS', None); "
-            "prestart_workers(2, ['probe', 'colorsys']); "
-            "print(list(run_tasks(probe.state, ['colorsys', 'wave'], workers=2)), "
-            "os.environ.get('OPENBLAS_NUM_THREADS'))")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "[(True, '1'), (False, '1')] None"
+        "    return name in sys.modules, PID_AT_IMPORT != os.getpid(), THREADS_AT_IMPORT\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]),
+           "OPENBLAS_NUM_THREADS": "7"}
+
+    def run(before=""):
+        code = ("import os, math; from imgmtf.parallel import prestart_workers, run_tasks; " + before +
+                "prestart_workers(2, ['probe', 'colorsys']); import probe; "
+                "print(list(run_tasks(probe.state, ['colorsys', 'wave'], workers=2)), "
+                "os.environ.get('OPENBLAS_NUM_THREADS'))")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+        assert out.returncode == 0, out.stderr
+        return out.stdout.strip()
+    assert run() == "[(True, True, '1'), (False, True, '1')] 7"
+    # a fork server started before (by another pool): the workers import
+    assert run("list(run_tasks(math.sqrt, [1, 4], workers=2)); ") == "[(True, False, '1'), (False, False, '1')] 7"
 
 
 def test_a_signal_inside_a_deferred_block_is_handled_after_it():
