@@ -286,8 +286,8 @@ def _pool_completed(function, items, workers, on_error):
                         in_flight[pool.submit(function, item)] = index
                     except BrokenProcessPool as exc:
                         failed.append((index, exc))
-            for index, exc in failed:
-                yield index, _died(items[index], exc, on_error)
+            for index, broken in failed:
+                yield index, _died(items[index], broken, on_error)
             if not in_flight:
                 break
             done, _ = _wait_between_signals(set(in_flight))
