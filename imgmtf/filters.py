@@ -55,6 +55,8 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1, mode: str
         raise ParameterError(f"correlate1d mode must be one of {', '.join(MODES)}, got {mode!r}")
     moved = np.moveaxis(np.asarray(values, float), axis, -1)
     half, n = weights.size // 2, moved.shape[-1]
+    if moved.size == 0:
+        return np.zeros(np.shape(values))
     if mode == "constant":      # (np.pad's general machinery costs more than the correlation)
         padded = np.zeros((*moved.shape[:-1], n + 2 * half))
         padded[..., half: half + n] = moved

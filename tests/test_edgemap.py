@@ -1,7 +1,8 @@
-"""The seed search's Canny edge map and Hough accumulator give exactly what
-scikit-image's give (they replace them to keep SciPy out of a measurement's
-start-up), and the hysteresis keeps exactly the weak chains touching a strong
-pixel."""
+"""The seed search's Canny edge map and Hough accumulator give what
+scikit-image's give on rendered chips, noise and photographs (they replace
+them to keep SciPy out of a measurement's start-up; only floating-point ties
+could part them), and the hysteresis keeps exactly the weak chains touching a
+strong pixel."""
 import numpy as np
 import pytest
 from skimage import data

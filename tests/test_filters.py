@@ -17,6 +17,10 @@ def test_matches_scipy(shape, axis, taps, mode):
     np.testing.assert_allclose(correlate1d(values, weights, axis, mode), expected, rtol=0, atol=1e-12)
 
 
+def test_an_empty_axis_gives_an_empty_result():
+    assert correlate1d(np.zeros((3, 0)), [1.0, 2.0, 1.0], mode="reflect").shape == (3, 0)
+
+
 def test_a_centred_impulse_gives_the_kernel_reversed_about_its_centre():
     out = correlate1d(np.eye(1, 9, 4)[0], [1.0, 2.0, 3.0, 4.0, 5.0])
     np.testing.assert_array_equal(out, [0, 0, 5, 4, 3, 2, 1, 0, 0])

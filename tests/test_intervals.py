@@ -83,10 +83,11 @@ def test_pulse_interval_covers_the_truth():
     assert chip.true_mtf50_cy_px() in r.mtf50_ci_cy_px
 
 
-@pytest.mark.parametrize("dof", [1, 2, 3, 4, 7, 30, 99, 1000, 20000])
+@pytest.mark.parametrize("dof", [1, 2, 3, 4, 7, 30, 99, 1000, 1001, 20000, 10 ** 6])
 def test_t_quantile_is_students(dof):
+    # the series up to 1000 degrees of freedom, the expansion in 1 / dof beyond
     from scipy.special import stdtrit
-    for p in (0.001, 0.05, 0.5, 0.6, 0.9, 0.975, 0.995, 0.9995):
+    for p in (1e-4, 0.001, 0.05, 0.5, 0.6, 0.9, 0.975, 0.995, 0.9995, 1 - 1e-4):
         assert t_quantile(p, dof) == pytest.approx(float(stdtrit(dof, p)), rel=1e-10, abs=1e-12)
 
 

@@ -94,3 +94,18 @@ def test_penalised_spline_is_scipys_smoothing_spline_and_meets_its_limits():
     np.testing.assert_allclose(penalised_spline(x, y, w, 1e-12, at), natural, rtol=0, atol=1e-6)
     slope, intercept = np.polyfit(x, y, 1, w=np.sqrt(w))
     np.testing.assert_allclose(penalised_spline(x, y, w, 1e12, at), slope * at + intercept, rtol=0, atol=1e-6)
+
+
+def test_penalised_spline_refuses_knots_too_close_and_the_resampler_merges_them():
+    from imgmtf.errors import ImageContentError
+    from imgmtf.estimate.resampling import penalised_spline
+    rng = np.random.default_rng(0)
+    x = np.sort(rng.uniform(-20, 20, 20000))
+    y = np.tanh(x) + rng.normal(0, 0.01, x.size)
+    x, y = np.insert(x, 10001, x[10000] + 1e-12), np.insert(y, 10001, y[10000])     # two knots 1e-12 apart
+    lam = x.size / 40 / (4 * np.pi) ** 4                # the resampler's weight for a 2 cy/px cut-off
+    with pytest.raises(ImageContentError, match="singular"):
+        penalised_spline(x, y, np.ones(x.size), lam, np.linspace(-19, 19, 5))
+    # the resampler takes samples within 1e-7 px as one knot
+    r = resample_profile(x, y, method="spline", half_range=10)
+    assert np.nanmax(np.abs(r.values - np.tanh(r.grid))) < 0.01

@@ -1,7 +1,7 @@
 """Find straight edges in an image chip: the seed for the sub-pixel fits.
 
-Canny edge pixels (scikit-image) vote in a Hough transform for lines; the
-strongest line is the edge.  A second line with comparable support, away
+Canny edge pixels (scikit-image's algorithm, :mod:`.edgemap`) vote in a
+Hough transform for lines; the strongest line is the edge.  A second line with comparable support, away
 from the first, means the chip holds two edges (or a bar).
 
 Angles follow :mod:`imgmtf.targets`: a line is x cos(theta) + y sin(theta)

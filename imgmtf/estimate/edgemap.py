@@ -4,9 +4,13 @@ The seed search (:mod:`.detection`) needs both on chips of at most 512 px a
 side.  They follow scikit-image's ``feature.canny`` (Gaussian smoothing that
 ignores masked pixels, Sobel gradients, bilinear non-maximum suppression,
 hysteresis over 8-connected pixels) and ``transform.hough_line`` (one vote
-per edge pixel and angle, at the rounded distance) exactly, the tests check
-it, without their imports: scikit-image's pull SciPy's ndimage and spatial,
-about a third of a second of every measurement's start-up.
+per edge pixel and angle, at the rounded distance), step for step: the tests
+find the same edge maps and accumulators on rendered chips, noise and
+photographs.  They can differ only where floating-point rounding breaks a tie
+differently (a non-maximum suppression between equal magnitudes, as on a
+noise-free step; a distance within one rounding error of a half pixel).  They
+exist to leave out scikit-image's imports, which pull in SciPy's ndimage and
+spatial: about a third of a second of every measurement's start-up.
 """
 from __future__ import annotations
 

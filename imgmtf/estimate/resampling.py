@@ -263,7 +263,9 @@ def smoothing_spline(distance, values, step: float, half_range: float, *,
         raise ParameterError(f"spline cut-off must be > 0 cycles/pixel, got {cutoff_cy_px}")
     grid = _grid(step, half_range)
     w = _weights(weights, distance.size)
-    ux, inverse = np.unique(distance, return_inverse=True)
+    # samples within 1e-7 px of each other are one knot: nearer ones leave
+    # the spline's banded system numerically singular
+    ux, inverse = np.unique(np.round(distance, 7), return_inverse=True)
     if ux.size < 5:
         raise ImageContentError("too few distinct profile samples for a spline")
     density = distance.size / (ux[-1] - ux[0])
@@ -356,6 +358,8 @@ def penalised_spline(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, at
     """The cubic smoothing spline g minimising sum w_i (y_i - g(x_i))^2 +
     lam * integral g''(u)^2 du (natural: g'' = 0 at the ends), evaluated at
     ``at`` (within [x_0, x_-1]); ``x`` strictly increasing, ``w`` > 0.
+    Raises ImageContentError where knots so close (under about 1e-8 of
+    the span) leave the system singular.
 
     Reinsch's algorithm (Green and Silverman 1994, section 2.3): the
     second derivatives gamma at the interior knots solve the symmetric
@@ -364,7 +368,7 @@ def penalised_spline(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, at
     scipy.interpolate.make_smoothing_spline (the same spline) loops over
     the samples in Python.
     """
-    from scipy.linalg import solveh_banded
+    from scipy.linalg import LinAlgError, solveh_banded
     h = np.diff(x)
     inv_w = 1.0 / w
     # Q's three non-zeros in each column a (rows a, a + 1, a + 2)
@@ -375,7 +379,11 @@ def penalised_spline(x: np.ndarray, y: np.ndarray, w: np.ndarray, lam: float, at
     banded[2] = (h[:-1] + h[1:]) / 3.0 + lam * (d0 * q0 ** 2 + d1 * q1 ** 2 + d2 * q2 ** 2)
     banded[1, 1:] = h[1:-1] / 6.0 + lam * (d1[:-1] * q1[:-1] * q0[1:] + d2[:-1] * q2[:-1] * q1[1:])
     banded[0, 2:] = lam * d2[:-2] * q2[:-2] * q0[2:]
-    gamma = solveh_banded(banded, q0 * y[:-2] + q1 * y[1:-1] + q2 * y[2:])
+    try:
+        gamma = solveh_banded(banded, q0 * y[:-2] + q1 * y[1:-1] + q2 * y[2:])
+    except LinAlgError as exc:
+        raise ImageContentError(f"the smoothing spline's system is singular ({exc}): knots too close "
+                                "together; use another method") from exc
     q_gamma = np.zeros(x.size)
     q_gamma[:-2] += q0 * gamma
     q_gamma[1:-1] += q1 * gamma

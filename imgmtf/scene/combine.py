@@ -208,7 +208,8 @@ def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray |
     4.0
     """
     bounds = np.asarray(intervals, float).reshape(-1, 2)
-    quantile = np.array([t_quantile(0.5 + confidence / 2, max(int(n) - 1, 1)) for n in rows])
+    quantile = np.array([t_quantile(0.5 + confidence / 2, max(int(n) - 1, 1) if math.isfinite(n) else 1)
+                         for n in np.asarray(rows, float)])
     sd = (bounds[:, 1] - bounds[:, 0]) / 2 / quantile
     if not (np.isfinite(sd).all() and (sd > 0).all()):
         return None
