@@ -162,3 +162,31 @@ def test_fieller_spread_of_a_read_width_matches_its_closed_form():
     # a spectrum that never leaves its noise below f0: no width is read at all
     assert reading.spread_px(np.full(freqs.size - 1, 1.0), t) == math.inf
     assert reading.width_change(slope * f0 * f0) == pytest.approx(1.0)
+
+
+def test_bar_reach_is_where_the_mean_profile_fades_plus_a_margin():
+    from imgmtf.estimate.pulse import REACH_MARGIN_PX, bar_reach_px
+    offsets = np.arange(-12.0, 12.5, 0.5)[None, :] + np.zeros((3, 1))
+    rect = np.where(np.abs(offsets) <= 2.0, 100.0, 0.0)               # the profile ends at 2 px
+    assert bar_reach_px(offsets, rect) == 2 + REACH_MARGIN_PX
+    gauss = np.exp(-0.5 * (offsets / 1.5) ** 2)                       # 5 % at 1.5 sqrt(2 ln 20) = 3.67 px
+    assert bar_reach_px(offsets, gauss) == math.ceil(3.5) + REACH_MARGIN_PX
+
+
+def test_row_centres_of_a_noisy_bar_are_centroids_over_its_own_reach():
+    # at SNR 25 a centroid over a 25 px window scatters by about 1 px a row;
+    # over the bar's reach (about 9 px) by about 0.2 px, what location_sd_px expects
+    from imgmtf.estimate.detection import robust_noise
+    from imgmtf.estimate.geometry import vertical_frame
+    from imgmtf.estimate.pulse import PulseKind, locate_pulse
+    scatter, expected = [], []
+    for seed in range(4):
+        chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.2, 1.5), (100, 60),
+                         noise_std_dn=40.0, seed=seed).image.astype(float)
+        line, _ = PulseKind(1.5).seed(chip, robust_noise(chip))
+        geometry = locate_pulse(*vertical_frame(chip, line))
+        resid = geometry.locations - (geometry.slope * geometry.rows + geometry.intercept)
+        scatter.append(float(np.std(resid[geometry.kept])))
+        expected.append(geometry.location_sd_px)
+    assert max(scatter) < 0.35
+    assert np.mean(scatter) == pytest.approx(np.mean(expected), rel=0.3)
