@@ -386,13 +386,12 @@ def bar_reach_px(offsets: np.ndarray, weight: np.ndarray, level: float = 0.05) -
     need to reach: the farthest distance at which the rows' mean profile
     (``weight`` at ``offsets`` from the line, half-pixel bins) stays above
     ``level`` of its peak, plus ``REACH_MARGIN_PX``."""
-    bins = np.rint(2.0 * offsets).astype(int).ravel()
-    bins -= bins.min()
+    half_px = np.rint(2.0 * offsets).astype(int).ravel()
+    bins = half_px - half_px.min()                       # distance 0 is bin -half_px.min()
     counts = np.bincount(bins)
     mean = np.bincount(bins, weights=weight.ravel()) / np.maximum(counts, 1)
-    half_px = np.nonzero((mean >= level * mean.max()) & (counts > 0))[0]
-    centre = -int(np.rint(2.0 * offsets).min())          # the bin of distance 0
-    reach = np.abs(half_px - centre).max() / 2.0
+    above = np.nonzero((mean >= level * mean.max()) & (counts > 0))[0]
+    reach = np.abs(above + half_px.min()).max() / 2.0
     return int(math.ceil(reach)) + REACH_MARGIN_PX
 
 
