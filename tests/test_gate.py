@@ -72,6 +72,16 @@ def test_saturation_by_type_limit_by_given_range_and_by_a_clip_no_one_declared()
     refused(noisy_clip, "saturated")
 
 
+def test_a_noise_free_bar_clipped_flat_is_refused_and_a_wide_bars_own_plateau_is_not():
+    # a clip meets the top steeply; a 5 px bar reaches its own flat top through a shoulder
+    for width, clip in ((1.5, 800.0), (5.0, 1100.0), (5.0, 1190.0)):
+        bar = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, width), (100, 80)).image
+        refused(np.minimum(bar.astype(float), clip), "saturated", measure=im.measure_pulse, width_px=width)
+    wide = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, 5.0), (100, 80))
+    result = im.measure_pulse(wide.image, width_px=5.0)
+    assert abs(result.mtf_nyquist - float(wide.true_mtf(0.5))) < 0.002
+
+
 def test_a_bent_edge_and_scattered_rows_are_not_straight():
     y, x = np.mgrid[0:100, 0:100].astype(float)
     r = np.hypot(x - 200, y - 50)

@@ -47,7 +47,8 @@ MIN_FILL_CLUSTERED = 0.5        # the share of fill pixels with a fill neighbour
 SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
 PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
 CLIP_REACH = 0.4                # a noise-free side holding its extreme this much sooner than the other: clipped
-FLAT_PEAK = 0.3                 # fraction of a noise-free bar's peak at exactly one value: clipped flat
+FLAT_PEAK = 0.3                 # fraction of a noise-free bar's peak at exactly one value: clipped flat...
+FLAT_SHOULDER = 0.02            # ...unless it is reached gradually, through samples this far below (of the height)
 MAX_MTF_EXCESS = 0.05           # MTF above 1 + this (plus 3 noise sd) refuses the chip
 EDGE_STEP_RATIO = 0.5           # |right - left| / largest excursion: above it a step, below a bar
 
@@ -262,18 +263,34 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
                 checks.append(_pile_up(name, values, mask, quantum))
     if bright_core is not None and bright_core.sum() >= 5:
         v = values[bright_core]
-        outward = 1.0 if v.mean() >= np.median(values[~bright_core]) else -1.0
+        background = float(np.median(values[~bright_core]))
+        outward = 1.0 if v.mean() >= background else -1.0
         extreme = v.max() if outward > 0 else v.min()
         if limits is not None and (extreme <= limits[0] or extreme >= limits[1]):
             checks.append(Check("saturated", False, f"the bar's peak reaches the saturation limit {extreme:g} DN: "
                                 "its true height is unknown", extreme, None))
         elif noise_free:
-            flat = float(np.mean(v == extreme))
-            checks.append(Check("saturated", flat <= FLAT_PEAK, f"{100 * flat:.0f} % of the bar's peak sits at "
-                                f"exactly {extreme:g} DN: its top is clipped flat", flat, FLAT_PEAK))
+            checks.append(_flat_top(v, extreme, outward, abs(extreme - background)))
         else:
             checks.append(_pile_up("peak", values, bright_core, quantum))
     return checks or [Check("saturated", True, "no side reaches a saturation limit")]
+
+
+def _flat_top(peak_values, extreme, outward, height) -> Check:
+    """A noise-free bar's peak clipped flat: much of it at exactly one value,
+    met steeply (few samples within ``FLAT_SHOULDER`` of the bar's height
+    below it).  A bar wider than its blur has a flat top of its own, but
+    reaches it gradually, through a shoulder of samples just below.
+    ``height``: the peak's height above the background (DN)."""
+    at_top = peak_values == extreme
+    below = outward * (extreme - peak_values)
+    shoulder = np.count_nonzero((below > 0) & (below <= FLAT_SHOULDER * height))
+    ratio = at_top.sum() / max(shoulder, 1)
+    clipped = at_top.mean() > FLAT_PEAK and ratio > PILE_UP
+    return Check("saturated", not clipped,
+                 f"{100 * at_top.mean():.0f} % of the bar's peak sits at exactly {extreme:g} DN, {ratio:.1f} x as "
+                 f"many samples as within {100 * FLAT_SHOULDER:g} % of its height below it: its top is clipped "
+                 "flat", ratio, PILE_UP)
 
 
 def _first_reach(distance, values, mask, centre) -> float:
