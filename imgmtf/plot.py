@@ -312,7 +312,7 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
     interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
     ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
-                label=f"MTF50 {_figure(result.mtf50_cy_px)} cy/px{interval50}")
+                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}{interval50}")
     top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
     ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
     if result.gsd_m:
@@ -331,9 +331,12 @@ def _once(ax, prefix: str, label: str) -> str:
     return "_nolegend_" if any(d.startswith(prefix) for d in drawn) else label
 
 
-def _figure(value: float) -> str:
-    """A figure as the plots print it; a bar's sinc can mask it (NaN)."""
-    return f"{value:.4f}" if np.isfinite(value) else "masked"
+def _figure(value: float, unit: str = "") -> str:
+    """A figure as the plots print it, with its unit; a bar's sinc can mask
+    it (NaN), and then it has none."""
+    if not np.isfinite(value):
+        return "masked by the bar's sinc"
+    return f"{value:.4f} {unit}" if unit else f"{value:.4f}"
 
 
 def plot_measurement(result, truth=None, title: str | None = None):
@@ -350,7 +353,7 @@ def plot_measurement(result, truth=None, title: str | None = None):
     plot_mtf(result, axes[1, 1], truth=truth)
     ci = result.mtf_nyquist_ci
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if np.isfinite(ci.low) else ""
-    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist)}{interval}, MTF50 {_figure(result.mtf50_cy_px)} cy/px, "
+    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist)}{interval}, MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}, "
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
     for i, warning in enumerate(result.warnings[:2]):
