@@ -221,21 +221,26 @@ def combined_curve(curves, intervals, rows, confidence: float = 0.95) -> np.ndar
     frequency grid) averaged with the weights their MTF at Nyquist earned
     (:func:`precision_weights` of its ``intervals``; equal without them),
     NaN-aware (a bar's masked frequencies)."""
-    curves = np.asarray(curves, float)
-    w = precision_weights(intervals, rows, confidence)
-    w = np.ones(curves.shape[0]) if w is None else w
-    weights = np.where(np.isfinite(curves), w[:, None], 0.0)
-    total = weights.sum(axis=0)
+    return _weighted_average(curves, precision_weights(intervals, rows, confidence))
+
+
+def _weighted_average(values, weights) -> np.ndarray:
+    """Mean over the first axis of ``values`` (None or NaN where a half-edge
+    has none) with ``weights`` (equal when None); NaN where none is finite."""
+    x = np.array([[math.nan if v is None else v for v in np.atleast_1d(row)] for row in values], float)
+    w = np.ones(x.shape[0]) if weights is None else np.asarray(weights, float)
+    w = np.where(np.isfinite(x), w[:, None], 0.0)
+    total = w.sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(total > 0, np.nansum(weights * np.nan_to_num(curves), axis=0) / total, np.nan)
+        return np.where(total > 0, np.sum(w * np.nan_to_num(x), axis=0) / total, np.nan)
 
 
 def _summary(group: list[Record], site: dict) -> Record:
     first = group[0]
     confidence = (first.params.get("intervals") or {}).get("confidence", 0.95)
     rows = [r.figures.get("rows_used") or 0 for r in group]
-    nyquist = combine([r.figures["mtf_nyquist"] for r in group],
-                      [_pair(r.figures.get("mtf_nyquist_ci")) for r in group], rows, confidence)
+    intervals = [_pair(r.figures.get("mtf_nyquist_ci")) for r in group]
+    nyquist = combine([r.figures["mtf_nyquist"] for r in group], intervals, rows, confidence)
     fifty = [r.figures.get("mtf50_cy_px") for r in group]
     mtf50 = (combine([math.nan if v is None else v for v in fifty],
                      [_pair(r.figures.get("mtf50_ci_cy_px")) for r in group], rows, confidence)
@@ -253,9 +258,9 @@ def _summary(group: list[Record], site: dict) -> Record:
     }
     # FWHM and RER have no interval of their own: averaged with the weights
     # the MTF at Nyquist earned, as the curve is
-    weights = precision_weights([_pair(r.figures.get("mtf_nyquist_ci")) for r in group], rows, confidence)
+    weights = precision_weights(intervals, rows, confidence)
     for key in ("fwhm_px", "rer"):
-        figures[key] = _weighted_mean([r.figures.get(key) for r in group], weights)
+        figures[key] = finite(float(_weighted_average([r.figures.get(key) for r in group], weights)[0]))
     snrs = [r.figures.get("snr") for r in group]
     figures["snr_min"] = finite(min((v for v in snrs if v is not None), default=math.nan))
     if figures["gsd_m"]:
@@ -266,8 +271,7 @@ def _summary(group: list[Record], site: dict) -> Record:
     frequencies = first.figures.get("frequencies_cy_px")
     curves = [r.figures.get("mtf") or [] for r in group]
     if frequencies and all(len(c) == len(frequencies) for c in curves):
-        curve = combined_curve([[math.nan if v is None else v for v in c] for c in curves],
-                               [_pair(r.figures.get("mtf_nyquist_ci")) for r in group], rows, confidence)
+        curve = _weighted_average(curves, weights)
         figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
     where = dict(site)
     if site["scope"] == "target":
@@ -276,15 +280,6 @@ def _summary(group: list[Record], site: dict) -> Record:
     return Record(first.path, first.band, first.target, first.method, "combined", figures=figures, site=where,
                   params={"intervals": first.params.get("intervals"), "track_azimuth_deg": track,
                           "scan": first.params.get("scan")}, run_utc=first.run_utc)
-
-
-def _weighted_mean(values, weights) -> float | None:
-    """Mean of the finite ``values`` (None where a half-edge has none) with
-    ``weights`` (equal when None); None when no value is finite."""
-    x = np.array([math.nan if v is None else v for v in values], float)
-    w = np.ones(x.size) if weights is None else np.asarray(weights, float)
-    ok = np.isfinite(x)
-    return finite(float(np.sum(w[ok] * x[ok]) / np.sum(w[ok]))) if ok.any() else None
 
 
 def _pair(interval) -> tuple[float, float]:
