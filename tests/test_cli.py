@@ -232,8 +232,9 @@ def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
 
 
 def test_workers_bound_is_the_pools():
-    from imgmtf import cli, parallel
-    assert cli.MAX_WORKERS == parallel.MAX_WORKERS
+    from imgmtf import parallel
+    from imgmtf.cli import options
+    assert options.MAX_WORKERS == parallel.MAX_WORKERS
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):
@@ -259,7 +260,7 @@ def test_a_batchs_parent_checks_its_options_without_the_estimators(tmp_path):
     # load in the workers, in parallel, not in its start-up
     import subprocess
     import sys
-    code = ("import sys; from imgmtf.cli import MethodName; from imgmtf.batch import MeasureSettings, "
+    code = ("import sys; from imgmtf.cli.options import MethodName; from imgmtf.batch import MeasureSettings, "
             "expand_inputs; MethodName().convert('spline', None, None); "
             "MeasureSettings('pulse', 'spline', pulse_width=(3.0, 'px')); "
             f"expand_inputs([{str(tmp_path)!r}]); "
@@ -320,8 +321,8 @@ def test_text_table_names_units_and_fits_long_paths(run, chip, tmp_path):
     assert "cy/px" in units and "deg" in units and "px" in units
     assert header.index("normal") == first.index("6.00") + len("6.00") - len("normal")   # columns line up
     assert "band" not in header                                   # no band asked for: no band column
-    from imgmtf.cli import _snr
-    assert [_snr(v) for v in (199.4, 99999.0, 136212.0, None)] == ["  199", "99999", " 136k", "    -"]
+    from imgmtf.cli.tables import snr_cell
+    assert [snr_cell(v) for v in (199.4, 99999.0, 136212.0, None)] == ["  199", "99999", " 136k", "    -"]
 
 
 def test_help_explains_methods_and_lists_every_command_in_full(run):

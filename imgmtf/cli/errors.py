@@ -1,0 +1,66 @@
+"""How the CLI reports: a deliberate imgmtf error as one line and exit 1,
+an interrupt as exit 130 or 143, an internal error as one line (its
+traceback with ``IMGMTF_DEBUG=1``); the hint it adds to a refusal."""
+from __future__ import annotations
+
+import os
+import sys
+from contextlib import contextmanager
+
+import click
+
+from ..errors import ImgmtfError
+
+
+@contextmanager
+def reported_errors():
+    """Turn a deliberate imgmtf error into one line on stderr and exit 1; an
+    interrupt into one line and exit 130 (Ctrl-C) or 143 (SIGTERM); any
+    other exception into a one-line internal error and exit 1 (its
+    traceback with IMGMTF_DEBUG=1)."""
+    try:
+        yield
+    except ImgmtfError as exc:
+        click.echo(f"imgmtf: error: {one_line(exc)}{force_hint(exc.reason)}", err=True)
+        sys.exit(1)
+    except KeyboardInterrupt as exc:
+        click.echo("imgmtf: interrupted", err=True)
+        sys.exit(interrupt_code(exc))
+    except (BrokenPipeError, click.ClickException):
+        raise                     # click exits quietly when stdout's reader has gone (| head), or with 2
+    except Exception as exc:
+        if os.environ.get("IMGMTF_DEBUG"):
+            raise
+        click.echo(f"imgmtf: internal error: {type(exc).__name__}: {one_line(exc)} "
+                   "(please report it; IMGMTF_DEBUG=1 shows where)", err=True)
+        sys.exit(1)
+
+
+def force_hint(reason) -> str:
+    """What the CLI adds to a quality-gate refusal: the flag that overrules it."""
+    from ..estimate.gate import FORCIBLE
+    return " (--force measures it anyway)" if reason in FORCIBLE else ""
+
+
+def one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def interrupt_code(exc: BaseException) -> int:
+    return getattr(exc, "exit_code", 130)
+
+
+@contextmanager
+def closing(generator):
+    """Close a task generator when its loop ends, however: an interrupt
+    then stops the workers at once rather than when they are collected."""
+    try:
+        yield generator
+    finally:
+        close = getattr(generator, "close", None)
+        if close:
+            close()
+
+
+def signal_name(exc: BaseException) -> str:
+    return str(exc) if getattr(exc, "signum", None) else "SIGINT"

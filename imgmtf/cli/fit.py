@@ -1,0 +1,71 @@
+"""``imgmtf fit``: fit the sensor model's stages to edges."""
+from __future__ import annotations
+
+import json
+
+import click
+
+from ..errors import ParameterError
+from .errors import reported_errors
+from .files import check_figure_file, check_output_file, save_figure
+from .options import FiniteFloat, parse_roi
+from .tables import print_fit
+
+
+@click.command(short_help="Fit the sensor model to edges: its MTF in every direction.")
+@click.argument("paths", nargs=-1, required=True, type=click.Path())
+@click.option("--stages", metavar="NAMES",
+              help="comma-separated stages to fit: optics, detector, motion, electronics, diffraction, "
+                   "defocus, olpf, jitter (default: those of --sensor, else the paper's four)")
+@click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False),
+              help="sensor TOML giving starting (and held) values, e.g. a known detector or wavelength")
+@click.option("--hold", metavar="PARAMS",
+              help="comma-separated parameters held at their starting values: a stage (detector) or "
+                   "stage.parameter (detector.width_x_m)")
+@click.option("--gsd", type=FiniteFloat(0, min_open=True),
+              help="GSD in metres (default: the files', else 1: parameters in px)")
+@click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
+@click.option("--roi", callback=parse_roi,
+              help="X,Y,W,H window in pixels read from every file (default: the whole image)")
+@click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+              show_default=True, help="confidence of the intervals")
+@click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True,
+              help="json: one object with the parameters, directions and a record per edge")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
+              help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
+def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence, out_path, fmt, plot_path):
+    """Fit the sensor's stages to the edges of one or more images (one edge
+    each; across- and along-track edges together constrain both axes), and
+    read the MTF in every direction off the fitted model."""
+    from ..batch import expand_inputs
+    from ..estimate.fit import fit_sensor
+    from ..sensor.model import Sensor
+    with reported_errors():
+        files = expand_inputs(paths, recursive)
+        if not files:
+            raise ParameterError(f"no image files in {', '.join(paths)}")
+        if plot_path:
+            check_figure_file(plot_path)
+        if out_path:
+            check_output_file(out_path)
+        start = Sensor.from_toml(sensor_path) if sensor_path else None
+        result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
+                            roi=roi, confidence=confidence)
+        written = []
+        if out_path:
+            from ..version import __version__
+            result.sensor.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(files)} edge(s): "
+                                                     f"{', '.join(e.source for e in result.edges)}")
+            written.append(out_path)
+        if plot_path:
+            from ..plot import plot_fit
+            save_figure(plot_fit(result), plot_path)
+            written.append(plot_path)
+    if fmt == "json":
+        click.echo(json.dumps({**result.to_dict(), "written": written}))
+        return
+    print_fit(result)
+    for path in written:
+        click.echo(f"wrote {path}")

@@ -1,0 +1,136 @@
+"""``imgmtf measure``: the MTF of the edge or bar in each file."""
+from __future__ import annotations
+
+import sys
+from contextlib import ExitStack
+
+import click
+
+from ..errors import ParameterError
+from .errors import closing, interrupt_code, reported_errors, signal_name
+from .files import check_figure_file, check_output_file
+from .options import (
+    FiniteFloat,
+    MethodOption,
+    interval_options,
+    interval_settings,
+    length_option,
+    parallel_options,
+    parse_band,
+    parse_pair,
+    parse_roi,
+)
+from .tables import TextRows
+
+# what a process measuring files loads, NumPy's lazily loaded parts included:
+# imported once by the workers' fork server rather than by each worker's first
+# file (batch imports the estimators only where it measures, so that a batch's
+# parent, which collects records, stays light)
+MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", "numpy.fft", "numpy.ma",
+                     "numpy.polynomial")
+
+
+
+@click.command(short_help="Measure the MTF of the edge or bar in image files or folders.")
+@click.argument("paths", nargs=-1, required=True, type=click.Path())
+@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--pulse-width", callback=length_option("px"),
+              help="bar width: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
+                   "estimated from the profile when omitted")
+@click.option("--method", cls=MethodOption)
+@click.option("--roi", callback=parse_roi,
+              help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
+@click.option("--band", callback=parse_band,
+              help="1-based band, or 'all' for one result per band "
+                   "(default: the only band, or the luminance of RGB)")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False),
+              help="also write a CSV summary (each row as its file completes)")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
+@click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
+@click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--force", is_flag=True,
+              help="measure even where a quality check fails (fill, saturation, a second target, "
+                   "non-uniform sides...): every failed check becomes a warning")
+@click.option("--saturation", callback=parse_pair, metavar="LO,HI",
+              help="DN range the sensor records (default: an integer file's type range); "
+                   "sides at or beyond it are saturated")
+@click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
+              help="the ground track's direction in the image, degrees clockwise from up (default: "
+                   "rows along track, as in L0/L1 products; unknown for map-projected files)")
+@click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
+@interval_options
+@parallel_options
+def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
+            force, saturation, track_azimuth, progress, interval_method, replicates, confidence, workers,
+            scheduler):
+    """Measure the MTF of the edge (or bar) in each image file, or in every
+    image of a folder.  With --format json, one JSON object per line (JSON
+    Lines) per file and band; a file that cannot be measured gives an error
+    line and the rest go on (exit status 1 if any failed).  Rows are printed
+    and written to the CSV as each file completes; on Ctrl-C or SIGTERM the
+    rows measured so far are kept (exit status 130 or 143)."""
+    if plot_path and plot_dir:
+        raise click.UsageError("give --plot or --plot-dir, not both")
+    if pulse_width and kind != "pulse":
+        raise click.UsageError("--pulse-width applies to --target pulse only")
+    with reported_errors():
+        from ..parallel import InputOrder, prestart_workers, signals_deferred
+        if scheduler is None and not plot_path:
+            prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
+        from ..batch import MeasureSettings, expand_inputs, measure_files
+        from ..records import CsvWriter, JsonLinesWriter, utc_now
+        settings = MeasureSettings(kind, method, band, roi, pulse_width,
+                                   interval_settings(interval_method, replicates, confidence), force=force,
+                                   saturation=saturation, track_azimuth_deg=track_azimuth)
+        files = expand_inputs(paths, recursive)
+        if not files:
+            raise ParameterError(f"no image files in {', '.join(paths)}")
+        if plot_path and len(files) > 1:
+            raise ParameterError("--plot takes a single input; use --plot-dir for several")
+        if plot_path:
+            check_figure_file(plot_path)
+        if csv_path:
+            check_output_file(csv_path)
+        run_utc = utc_now()
+        if plot_path:
+            from ..batch import measure_file
+            completed = iter([(0, measure_file(files[0], settings, plot_path, run_utc=run_utc))])
+        else:
+            completed = measure_files(files, settings, workers=workers, scheduler=scheduler,
+                                      plot_dir=plot_dir, progress=progress, run_utc=run_utc,
+                                      ordered=False)
+        stdout = (JsonLinesWriter(sys.stdout) if fmt == "json"
+                  else TextRows(kind, path_width=max(map(len, files)), bands=band is not None))
+        order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
+        with ExitStack() as outputs:
+            writers = [stdout]
+            if csv_path:
+                writers.append(outputs.enter_context(CsvWriter(csv_path)))
+            if fmt == "text":
+                stdout.header(confidence)
+
+            def emit(batches):
+                for batch in batches:
+                    for record in batch:
+                        with signals_deferred():    # a row reaches every output or none
+                            for writer in writers:
+                                writer.write(record)
+                            counts["ok" if record.ok else "error"] += 1
+            try:
+                with closing(completed):
+                    for index, batch in completed:
+                        emit(order.push(index, batch))
+            except KeyboardInterrupt as exc:
+                emit(order.pending())            # measured, though after a file still running
+                interrupted = exc
+    total = counts["ok"] + counts["error"]
+    if interrupted is not None:
+        kept = f"; rows kept in {csv_path}" if csv_path else ""
+        click.echo(f"imgmtf: interrupted ({signal_name(interrupted)}): {total} result(s) of "
+                   f"{len(files)} file(s) reported{kept}", err=True)
+        sys.exit(interrupt_code(interrupted))
+    if total > 1 and fmt == "text":
+        click.echo(f"{counts['ok']} measured, {counts['error']} failed"
+                   + (f"; summary in {csv_path}" if csv_path else ""), err=True)
+    sys.exit(1 if counts["error"] else 0)

@@ -1,0 +1,165 @@
+"""Option types, parsing callbacks and the option groups several commands
+share (kept free of numerical imports: ``imgmtf --help`` reads them)."""
+from __future__ import annotations
+
+import math
+
+import click
+
+MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
+
+
+class FiniteFloat(click.FloatRange):
+    """A float option that refuses NaN and infinities (FloatRange lets NaN
+    through every bound)."""
+
+    name = "number"
+
+    def _describe_range(self) -> str:
+        """The bounds for the help ("finite" when there are none, rather
+        than click's "x<=None")."""
+        return "finite" if self.min is None and self.max is None else super()._describe_range()
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number
+
+
+class MethodName(click.ParamType):
+    """A resampling method name, checked against the method registry when
+    the option is used (the registry imports SciPy: ``imgmtf --help`` does
+    not pay for it)."""
+
+    name = "method"
+
+    @staticmethod
+    def names() -> list[str]:
+        from ..estimate.resampling import METHODS
+        return list(METHODS)
+
+    def get_metavar(self, param, ctx=None) -> str:
+        return "[" + "|".join(self.names()) + "]"
+
+    def convert(self, value, param, ctx):
+        if value in self.names():
+            return value
+        self.fail(f"{value!r} is not one of {', '.join(map(repr, self.names()))}", param, ctx)
+
+    def shell_complete(self, ctx, param, incomplete):
+        from click.shell_completion import CompletionItem
+        return [CompletionItem(n) for n in self.names() if n.startswith(incomplete)]
+
+
+class MethodOption(click.Option):
+    """``--method``: its help lists what each registered method does, read
+    from the registry when the help is shown (not at start-up)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("type", MethodName())
+        kwargs.setdefault("default", "msg")
+        kwargs.setdefault("show_default", True)
+        super().__init__(*args, **kwargs)
+
+    def get_help_record(self, ctx):
+        from ..estimate.resampling import METHODS
+        self.help = ("how the profile's samples are smoothed and resampled before the MTF (each "
+                     "method's own blur is divided out): "
+                     + "; ".join(f"{m.name}: {m.description}" for m in METHODS.values()))
+        return super().get_help_record(ctx)
+
+
+def length_option(default_unit: str):
+    """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit), the value
+    finite and > 0."""
+    def parse(ctx, param, value):
+        if value is None:
+            return None
+        text = value.strip().lower()
+        unit = next((u for u in ("px", "m") if text.endswith(u)), None)
+        number = text[: -len(unit)] if unit else text
+        try:
+            length = float(number)
+        except ValueError:
+            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}") from None
+        if not math.isfinite(length):
+            raise click.BadParameter(f"expected a finite width, got {value!r}")
+        return length, unit or default_unit
+    return parse
+
+
+def parse_pair(ctx, param, value):
+    """Click callback: "LO,HI" -> (lo, hi), two finite numbers, lo < hi."""
+    if value is None:
+        return None
+    try:
+        low, high = (float(v) for v in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"expected LO,HI (two numbers), got {value!r}") from None
+    if not (math.isfinite(low) and math.isfinite(high) and low < high):
+        raise click.BadParameter(f"expected finite LO < HI, got {value!r}")
+    return low, high
+
+
+def parse_roi(ctx, param, value):
+    if value is None:
+        return None
+    try:
+        parts = tuple(int(p) for p in value.split(","))
+    except ValueError:
+        parts = ()
+    if len(parts) != 4:
+        raise click.BadParameter(f"expected X,Y,W,H (four integers), got {value!r}")
+    from ..inputs import MIN_SIZE_PX
+    if parts[2] < MIN_SIZE_PX or parts[3] < MIN_SIZE_PX or parts[0] < 0 or parts[1] < 0:
+        raise click.BadParameter(f"expected X, Y >= 0 and W, H >= {MIN_SIZE_PX} px (the smallest chip "
+                                 f"measured), got {value!r}")
+    return parts
+
+def parse_band(ctx, param, value):
+    if value is None or value.lower() == "all":
+        return value and "all"
+    try:
+        band = int(value)
+    except ValueError:
+        raise click.BadParameter(f"expected a 1-based band number or 'all', got {value!r}") from None
+    if band < 1:
+        raise click.BadParameter(f"bands are numbered from 1, got {value!r}")
+    return band
+
+
+def parallel_options(command):
+    """--workers and --scheduler, shared by the batch commands."""
+    command = click.option("--scheduler", metavar="ADDRESS",
+                           help="run on a Dask distributed cluster (tcp://host:8786), or 'local' "
+                                "for a local Dask cluster of --workers processes; needs imgmtf[dask]")(command)
+    return click.option("--workers", type=click.IntRange(1, MAX_WORKERS), default=1, show_default=True,
+                        help="parallel worker processes, each on one thread")(command)
+
+
+def interval_options(command):
+    """--intervals, --bootstrap and --confidence, shared by measure and scan."""
+    command = click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True),
+                           default=0.95, show_default=True, help="confidence of the intervals")(command)
+    command = click.option("--bootstrap", "replicates", type=click.IntRange(min=0), metavar="N",
+                           help="intervals from a bootstrap of N row resamplings (20 to 5000; slower); "
+                                "0: no intervals")(command)
+    return click.option("--intervals", "interval_method", type=click.Choice(["influence", "bootstrap", "none"]),
+                        show_default="influence",
+                        help="confidence intervals: linearised row influence (about the cost of one fit), "
+                             "a bootstrap over rows, or none")(command)
+
+
+def interval_settings(method: str | None, replicates: int | None, confidence: float):
+    """The interval settings the options ask for: --bootstrap N means a
+    bootstrap of N replicates (0: none); an --intervals that says otherwise
+    is a usage error, not silently overruled."""
+    from ..estimate.intervals import Intervals
+    if replicates is not None:
+        implied = "bootstrap" if replicates else "none"
+        if method not in (None, implied):
+            raise click.UsageError(f"--bootstrap {replicates} asks for {implied} intervals, "
+                                   f"--intervals {method} for others: give one")
+        method = implied
+    return Intervals(method or "influence", confidence, **({"replicates": replicates} if replicates else {}))

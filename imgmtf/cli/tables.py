@@ -1,0 +1,153 @@
+"""The text the commands print: the measure table's rows, the scan table and
+the fit report (figures in px units, '-' where undefined)."""
+from __future__ import annotations
+
+import click
+
+from .errors import force_hint
+
+
+class TextRows:
+    """The text table of ``measure``, one row per record as it comes: the
+    path column as wide as the longest input, the band column when bands
+    were asked for."""
+
+    def __init__(self, kind: str, path_width: int = 32, bands: bool = False):
+        self.kind, self.bands = kind, bands
+        self.path_width = max(path_width, 4)
+
+    def header(self, confidence: float) -> None:
+        last = "RER" if self.kind == "edge" else "W"
+        first = f"{'path':<{self.path_width}}" + (f" {'band':>4}" if self.bands else "")
+        blank = " " * len(first)
+        click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
+                   f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last:>6}")
+        click.echo(f"{blank} {'deg':>7} {'deg':>5} {'':>7} {'':>5} {'':>7} {'':>17} "
+                   f"{'cy/px':>7} {'px':>6} {'' if self.kind == 'edge' else 'px':>6}")
+
+    def write(self, record) -> None:
+        click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands))
+
+
+def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False) -> str:
+    """One record as rows of the text table: figures in px units, a
+    ground line in metres when the GSD is known, then its warnings."""
+    first = f"{record['path']:<{path_width}}"
+    if bands:
+        band = record["band"]
+        first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
+    indent = " " * len(first)
+    if record["status"] == "error":
+        return f"{first} error: {record['error']}{force_hint(record.get('reason'))}"
+    last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
+    lo, hi = record.get("mtf_nyquist_ci") or (None, None)
+    interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
+    direction = record.get("direction") or "-"
+    direction = SHORT_DIRECTIONS.get(direction, direction)
+    cells = [f"{first} {num_cell(record.get('normal_angle_deg'), 7, 2)} "
+             f"{num_cell(record.get('tilt_deg'), 5, 1)} {direction:>7} "
+             f"{snr_cell(record.get('snr'))} {num_cell(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
+             f"{num_cell(record.get('mtf50_cy_px'), 7, 4)} {num_cell(record.get('fwhm_px'), 6, 3)} "
+             f"{num_cell(last, 6, 3)}"]
+    if record.get("gsd_m"):
+        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
+                     f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
+    cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
+    return "\n".join(cells)
+
+
+def ground_cell(value) -> str:
+    """A figure in metres to 4 significant digits; '-' where it is not
+    defined (a bar's MTF50 behind its sinc's zero)."""
+    return "-" if value is None else f"{value:.4g}"
+
+
+def snr_cell(value) -> str:
+    """The SNR in the table's 5 characters: to the unit up to 99999, then
+    in thousands (a noise-free chip's can reach millions)."""
+    if value is None:
+        return f"{'-':>5}"
+    return f"{value:5.0f}" if value < 99999.5 else f"{value / 1000:4.0f}k"
+
+
+def num_cell(value, width: int, decimals: int) -> str:
+    return f"{value:{width}.{decimals}f}" if value is not None else f"{'-':>{width}}"
+
+
+def print_fit(result) -> None:
+    edges = result.edges
+    click.echo(f"fit of {', '.join(s.name for s in result.sensor.stages)} to {len(edges)} edge(s), "
+               f"GSD {result.sensor.gsd_m:g} m; reduced chi-square {result.reduced_chi_square:.3g}")
+    click.echo(f"{'parameter':<28} {'value':>11} {'std err':>10} {'unit':<5} status")
+    for p in result.parameters:
+        se = f"{p.standard_error:10.4g}" if p.status == "fitted" else f"{'-':>10}"
+        click.echo(f"{p.key:<28} {p.value:11.5g} {se} {p.unit:<5} {p.status}{': ' + p.note if p.note else ''}")
+    for a, b, r in result.correlations:
+        click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
+                   "better than each")
+    pct = f"{100 * result.confidence:g}%"
+    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+               f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
+    for e in edges:
+        lo, hi = e.mtf_nyquist_ci
+        click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {SHORT_DIRECTIONS.get(e.direction, e.direction):>7} "
+                   f"{e.constrains:>6} {e.mtf_nyquist:7.4f} "
+                   f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
+                   f"{100 * e.misfit_fraction:6.2f}%")
+    click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
+    for name, d in result.directions.items():
+        lo, hi = d["mtf_nyquist_ci"]
+        click.echo(f"{name:<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
+                   f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
+    for warning in result.warnings:
+        click.echo(f"warning: {warning}")
+
+
+def print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
+    if fmt == "json":
+        from ..records import to_json
+        for r in (*records, *summaries):
+            click.echo(to_json(r))
+        return
+    accepted = sum(r.ok for r in records)
+    click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
+               f"{kind}s, {accepted} accepted")
+    click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
+               f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
+    click.echo(f"{'':>4} {'':>4} {'':>3} {'':>7} {'deg':>7} {'px':>5} {'':>5} {'':>7} {'':>15} {'cy/px':>7}")
+    for record in records:
+        r = record.to_dict()
+        head = (f"{r['id']:>4} {r.get('rank') or '':>4} {r.get('target_id') or '':>3} "
+                f"{SHORT_DIRECTIONS.get(r.get('direction'), r.get('direction') or '-'):>7} "
+                f"{num_cell(r.get('normal_angle_deg'), 7, 2)} {r['length_px']:5.0f}")
+        if record.ok:
+            roi = ",".join(str(v) for v in r["roi"])
+            click.echo(f"{head} {num_cell(r.get('snr'), 5, 0)} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
+                       f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
+            for warning in r.get("warnings") or []:
+                click.echo(f"{'':>{len(head)}} warning: {warning}")
+        else:       # the scene's name heads the table: the message need not repeat it
+            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
+    if summaries:
+        click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
+                   "the half-edges disagree beyond their intervals):")
+        click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
+                   f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'FWHM':>6} {'consist.':>8}")
+        for summary in summaries:
+            r = summary.to_dict()
+            click.echo(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
+                       f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} "
+                       f"{num_cell(r['normal_angle_deg'], 7, 2)} "
+                       f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
+                       f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
+                       f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('consistency'), 8, 2)}")
+    for path in written:
+        click.echo(f"wrote {path}")
+
+
+SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
+
+
+def interval_cell(pair) -> str:
+    lo, hi = pair or (None, None)
+    return f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
