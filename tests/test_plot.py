@@ -54,6 +54,6 @@ def test_a_scan_overview_takes_scan_scenes_records_as_they_come():
 
 
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():
-    from imgmtf.plot import _figure
+    from imgmtf.plot.measurement import _figure
     assert _figure(0.36431, "cy/px") == "0.3643 cy/px" and _figure(0.2667) == "0.2667"
     assert _figure(float("nan"), "cy/px") == "masked by the bar's sinc"

@@ -1,0 +1,172 @@
+"""Figures of one measurement (edge or bar): locations, profile, LSF, MTF."""
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..estimate.spectrum import NYQUIST
+from ._common import check_truth, expect, figure_axes, title_once
+
+
+def _view_px(result) -> float:
+    """Half-width (px) of a profile view that shows the LSF's core and the
+    start of its tails."""
+    return float(min(max(6.0, 2.5 * result.lsf_half_width_px), np.abs(result.samples_x_px).max()))
+
+
+def plot_locations(result, ax=None):
+    """Per-row sub-pixel target locations and the fitted line (paper Fig.
+    5a), at equal scale in both axes so that the tilt looks as it is; the
+    rows' RMS scatter about the line is in the legend."""
+    expect(result, "result")
+    fig, ax = figure_axes(ax)
+    g = result.geometry
+    kept = g.kept
+    fitted = g.slope * g.rows + g.intercept
+    rms = float(np.sqrt(np.mean((g.locations[kept] - fitted[kept]) ** 2)))
+
+    def image_xy(along, across):
+        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it
+        return (along, across) if g.transposed else (across, along)
+    line = "column" if g.transposed else "row"
+    ax.plot(*image_xy(g.rows[kept], g.locations[kept]), "o", ms=3, mfc="none",
+            label=f"{line} {result.target} location (scatter {rms:.3f} px RMS)")
+    if (~kept).any():
+        ax.plot(*image_xy(g.rows[~kept], g.locations[~kept]), "x", color="C3",
+                label=f"rejected ({(~kept).sum()})")
+    ax.plot(*image_xy(g.rows, fitted), "-", color="C1", label="least-squares line")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.invert_yaxis()
+    ax.set(xlabel="column (px)", ylabel="row (px)")
+    title_once(ax, f"{result.target.capitalize()}: normal at {result.normal_angle_deg:.2f} deg, "
+               f"tilt {result.tilt_deg:.2f} deg")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_profile(result, ax=None):
+    """Over-sampled profile samples and the resampled profile: the ESF of an
+    edge (paper Fig. 5b) or the PRF of a pulse, normalised; the LSF window's
+    flat core is shaded, its taper lighter."""
+    expect(result, "result")
+    fig, ax = figure_axes(ax)
+    if result.target == "edge":
+        lo, hi = result.levels_dn
+        x, profile, name = result.esf_x_px, result.esf, "ESF"
+    else:
+        lo, hi = result.background_dn, result.peak_dn
+        x, profile, name = result.prf_x_px, result.prf, f"PRF, bar {result.pulse_width_px:.2f} px"
+    ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
+            color="0.6", label="pixels")
+    ax.plot(x, profile, "-", color="C0", label=f"{result.method} profile")
+    _window_bands(ax, result)
+    view = _view_px(result)
+    ax.set(xlim=(-view, view), xlabel="distance from the line along the normal (px)", ylabel="normalised DN")
+    title_once(ax, f"{name} (SNR {result.snr:.0f})")
+    ax.legend(fontsize="small", loc="best")
+    return fig
+
+
+def _window_bands(ax, result):
+    centre = 0.0
+    core, taper = result.lsf_half_width_px, result.params.get("lsf_taper_px", 0.0)
+    ax.axvspan(centre - core, centre + core, color="C2", alpha=0.08, lw=0, label="LSF window core (data)")
+    for sign in (-1, 1):
+        ax.axvspan(centre + sign * core, centre + sign * (core + taper), color="C2", alpha=0.04, lw=0,
+                   label="taper to the tail model" if sign > 0 else None)
+
+
+def plot_lsf(result, ax=None):
+    """The recovered LSF with its full width at half maximum marked."""
+    expect(result, "result")
+    fig, ax = figure_axes(ax)
+    x, lsf = result.lsf_x_px, result.lsf
+    ax.plot(x, lsf, color="C0", label="LSF")
+    peak = float(lsf.max())
+    centre = float(x[np.argmax(lsf)])
+    ax.hlines(peak / 2, centre - result.fwhm_px / 2, centre + result.fwhm_px / 2, color="C3",
+              label=f"FWHM {result.fwhm_px:.3f} px" + (f" ({result.fwhm_m:.3g} m)" if result.gsd_m else ""))
+    view = max(4.0, 2.5 * result.fwhm_px)
+    ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
+    title_once(ax, "Line spread function")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str | None = None):
+    """The MTF along the normal with MTF at Nyquist and MTF50 marked with
+    their confidence intervals, the frequencies beyond the noise limit
+    shaded, and ``truth(f)`` (cycles/pixel) overlaid when known."""
+    expect(result, "result")
+    check_truth(truth)
+    fig, ax = figure_axes(ax)
+    f = result.frequencies_cy_px
+    line, = ax.plot(f, result.mtf, color=color, label=label or "measured")
+    c = line.get_color()
+    if truth is not None:
+        ax.plot(f, truth(f), "--", color="0.2", lw=1.0, label="true")
+    if np.isfinite(result.noise_limit_cy_px) and result.noise_limit_cy_px < f.max():
+        ax.axvspan(result.noise_limit_cy_px, f.max(), color="0.5", alpha=0.1, lw=0,
+                   label=_once(ax, "below 3 x its noise",
+                               f"below 3 x its noise (from {result.noise_limit_cy_px:.2f} cy/px)"))
+    ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8, label=_once(ax, "Nyquist", "Nyquist, 0.5 cy/px"))
+    ci = result.mtf_nyquist_ci
+    yerr = ([[result.mtf_nyquist - ci.low], [ci.high - result.mtf_nyquist]] if np.isfinite(ci.low) else None)
+    interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""
+    ax.errorbar([NYQUIST], [result.mtf_nyquist], yerr=yerr, fmt="o", color=c, capsize=3, ms=4,
+                label=f"MTF@Nyquist {_figure(result.mtf_nyquist)}{interval}")
+    ci50 = result.mtf50_ci_cy_px
+    xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
+    interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
+    ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
+                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}{interval50}")
+    top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
+    ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
+    if result.gsd_m:
+        gsd = result.gsd_m
+        ax.secondary_xaxis("top", functions=(lambda x: x / gsd, lambda x: x * gsd)).set_xlabel(
+            "frequency (cy/m)")
+    title_once(ax, "MTF")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def _once(ax, prefix: str, label: str) -> str:
+    """``label``, unless a label starting with ``prefix`` is already in the
+    axes' legend (several measurements drawn on one axes)."""
+    drawn = ax.get_legend_handles_labels()[1]
+    return "_nolegend_" if any(d.startswith(prefix) for d in drawn) else label
+
+
+def _figure(value: float, unit: str = "") -> str:
+    """A figure as the plots print it, with its unit; a bar's sinc can mask
+    it (NaN), and then it has none."""
+    if not np.isfinite(value):
+        return "masked by the bar's sinc"
+    return f"{value:.4f} {unit}" if unit else f"{value:.4f}"
+
+
+def plot_measurement(result, truth=None, title: str | None = None):
+    """Target locations, profile (ESF or PRF), LSF and MTF of one
+    measurement, headed by ``title`` (the file) and the figures a report
+    quotes; ``truth(f)`` overlays a known MTF."""
+    expect(result, "result")
+    check_truth(truth)
+    fig = Figure(figsize=(12, 8.5), layout="constrained")
+    axes = fig.subplots(2, 2)
+    plot_locations(result, axes[0, 0])
+    plot_profile(result, axes[0, 1])
+    plot_lsf(result, axes[1, 0])
+    plot_mtf(result, axes[1, 1], truth=truth)
+    ci = result.mtf_nyquist_ci
+    interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if np.isfinite(ci.low) else ""
+    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist)}{interval}, MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}, "
+               f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
+               f"{result.rows_used} rows, method {result.method}")
+    for i, warning in enumerate(result.warnings[:2]):
+        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(result.warnings)}: {warning}", 170,
+                                           placeholder=" [...]")
+    fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
+    return fig

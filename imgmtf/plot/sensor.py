@@ -1,0 +1,80 @@
+"""Figures of the sensor model: its PSF, LSFs and every stage's MTF."""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..estimate.spectrum import NYQUIST
+from ._common import expect, figure_axes
+
+
+def _view_radius_m(sensor) -> float:
+    """Half-width (m) of the view that shows the PSF's core and shoulders."""
+    return 1.5 * max(sensor.fwhm_m("across"), sensor.fwhm_m("along"), sensor.gsd_m)
+
+
+def plot_psf(sensor, ax=None, oversampling: int = 20):
+    """The system PSF image (paper Fig. 2a), axes in metres, its core and
+    shoulders shown in a square of 3 FWHM."""
+    expect(sensor, "sensor")
+    fig, ax = figure_axes(ax)
+    psf = sensor.psf(oversampling)
+    half = psf.data.shape[0] // 2 * psf.step_m
+    image = ax.imshow(psf.data / psf.data.max(), extent=(-half, half, half, -half), cmap="magma",
+                      interpolation="nearest")
+    r = _view_radius_m(sensor)
+    ax.set(xlim=(-r, r), ylim=(r, -r), title="System PSF (peak = 1)", xlabel="across track x (m)",
+           ylabel="along track y (m)")
+    fig.colorbar(image, ax=ax, shrink=0.8)
+    return fig
+
+
+def plot_sensor_lsf(sensor, ax=None):
+    """Across- and along-track LSFs with their FWHM (paper Fig. 2b, c)."""
+    expect(sensor, "sensor")
+    fig, ax = figure_axes(ax)
+    for direction in ("across", "along"):
+        x, lsf = sensor.lsf(direction)
+        ax.plot(x, lsf / lsf.max(), label=f"{direction} track, FWHM {sensor.fwhm_m(direction):.3f} m")
+    ax.axhline(0.5, color="0.6", lw=0.8, ls=":")
+    r = 2 * _view_radius_m(sensor)
+    ax.set(xlim=(-r, r), title="Line spread functions", xlabel="distance (m)", ylabel="normalised LSF")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
+    """The system MTF with its value at Nyquist (paper Fig. 3): across and
+    along track, or in one ``direction`` with each stage's MTF beside it."""
+    expect(sensor, "sensor")
+    fig, ax = figure_axes(ax)
+    f = np.linspace(0, 1.0, 401)
+    if direction is None:
+        for d in ("across", "along"):
+            ax.plot(f, sensor.mtf(f, d), label=f"{d} track, MTF@Nyquist {sensor.mtf_nyquist(d):.4f}")
+        title = "System MTF"
+    else:
+        for i, (name, part) in enumerate(sensor.components().items()):
+            ax.plot(f, part.mtf(f, direction), lw=1.0, ls=("--", "-.", ":")[i % 3], color=f"C{i + 1}",
+                    label=f"{name}: {part.mtf_nyquist(direction):.4f}")
+        ax.plot(f, sensor.mtf(f, direction), color="k", lw=2.0,
+                label=f"system: {sensor.mtf_nyquist(direction):.4f}")
+        title = f"MTF {direction} track (at Nyquist)"
+    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
+    ax.set(title=title, xlabel="frequency (cycles/pixel)", ylabel="MTF", ylim=(0, 1.02), xlim=(0, 1))
+    ax.legend(fontsize="small")
+    return fig
+
+
+def plot_sensor(sensor):
+    """PSF, LSFs, and each stage's MTF beside the system's across and along
+    track (the paper's Figs. 2-3)."""
+    expect(sensor, "sensor")
+    fig = Figure(figsize=(17, 4), layout="constrained")
+    axes = fig.subplots(1, 4)
+    plot_psf(sensor, axes[0])
+    plot_sensor_lsf(sensor, axes[1])
+    plot_sensor_mtf(sensor, axes[2], "across")
+    plot_sensor_mtf(sensor, axes[3], "along")
+    fig.suptitle(f"Sensor, GSD {sensor.gsd_m:g} m: {', '.join(s.name for s in sensor.stages)}")
+    return fig
