@@ -20,8 +20,8 @@ from statistics import NormalDist
 import numpy as np
 
 from ..errors import ParameterError
+from ..estimate.geometry import direction_label
 from ..estimate.intervals import t_quantile
-from ..estimate.pipeline import direction_label
 from ..estimate.results import finite
 from ..records import Record
 

@@ -30,7 +30,7 @@ from ..batch import pulse_width_px, with_figure
 from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
-from ..estimate.pipeline import direction_label
+from ..estimate.geometry import direction_label
 from ..inputs import saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from ..parallel import run_tasks
