@@ -36,6 +36,7 @@ _LAZY = {
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
+    "fit_targets": "scene.targetfit",
     "run_selftest": "selftest",
 }
 
