@@ -99,7 +99,7 @@ class Raster:
 
 def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                   provenance: dict | None = None, crs: str | None = None,
-                  origin_m: tuple[float, float] = (0.0, 0.0)) -> None:
+                  origin_m: tuple[float, float] = (0.0, 0.0), tags: dict[str, str] | None = None) -> None:
     """Write an 8/16-bit chip as a GeoTIFF that carries its GSD and how it
     was made.
 
@@ -126,6 +126,9 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
         a map.
     origin_m : (float, float), optional
         Map x, y of the top-left corner, m (with ``crs``).
+    tags : dict of str, optional
+        More metadata items of the default domain (``ACQUISITION_DATETIME``,
+        ``PLATFORM``...), as a product's reader finds them.
 
     Raises
     ------
@@ -144,7 +147,7 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
     >>> raster.gsd_m, raster.provenance["target"]["angle_deg"]
     (0.5, 6.0)
     """
-    tags = {}
+    tags = {key: str(value) for key, value in (tags or {}).items()}
     if provenance:
         tags["IMGMTF"] = json.dumps(provenance, sort_keys=True)
         target = provenance.get("target", {})
