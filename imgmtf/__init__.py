@@ -37,6 +37,8 @@ _LAZY = {
     "Record": "records",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
+    "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",
+    "write_acquisition": "campaign.store", "read_layer": "campaign.store",
 }
 
 __all__ = [
