@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
+from imgmtf._stats import t_quantile
 from imgmtf.campaign.trend import TREND_COLUMNS, fit_line, trends, write_trend_csv, years_since
 from imgmtf.errors import ParameterError
-from imgmtf.estimate.intervals import t_quantile
 
 T975 = {2: 4.302652729911275, 3: 3.182446305284263, 4: 2.7764451051977987}
 

@@ -130,7 +130,7 @@ def fit_line(t, y, sd=None, confidence: float = 0.95) -> Line:
     dof = t.size - 2
     if dof < 1:
         return Line(intercept, slope, math.nan, math.nan, math.nan, "inverse-variance" if weighted else "equal")
-    from ..estimate.intervals import t_quantile
+    from .._stats import t_quantile
     chi2 = float(np.sum(w * (y - intercept - slope * t) ** 2))
     scale = max(1.0, chi2 / dof) if weighted else chi2 / dof
     half = t_quantile(0.5 + confidence / 2, dof) * math.sqrt(scale / spread)
@@ -199,7 +199,8 @@ def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
             if bounds:
                 sd = np.array([_half_width(p, bounds) / z for p in usable])
             line = fit_line(years_since(times, first), [p[figure] for p in usable], sd, confidence)
-            out.append(Trend(**dict(zip(GROUP_KEYS, key)), figure=figure, n_acquisitions=len({p["acquisition_id"] for p in usable}),
+            group = dict(zip(GROUP_KEYS, key))
+            out.append(Trend(**group, figure=figure, n_acquisitions=len({p["acquisition_id"] for p in usable}),
                              n_points=len(usable), first_utc=times[0], last_utc=times[-1],
                              value_at_first=float(line.intercept + line.slope * years_since([times[0]], first)[0]),
                              slope_per_year=line.slope, slope_ci_low=line.low, slope_ci_high=line.high,
