@@ -38,6 +38,8 @@ _LAZY = {
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "fit_targets": "scene.targetfit",
     "run_selftest": "selftest",
+    "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",
+    "write_acquisition": "campaign.store", "read_layer": "campaign.store",
 }
 
 __all__ = [

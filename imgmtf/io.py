@@ -274,6 +274,28 @@ def raster_info(path: str | Path) -> RasterInfo:
                           src.transform, src.crs.to_wkt() if src.crs else None)
 
 
+def raster_metadata(path: str | Path, band: int | None = None) -> dict[str, dict[str, str]]:
+    """A raster file's metadata items as GDAL reports them, by domain:
+    ``"default"`` (the dataset's own items and TIFF tags such as
+    ``TIFFTAG_DATETIME``), ``"imagery"`` (GDAL's IMAGERY domain:
+    ``SATELLITEID``, ``ACQUISITIONDATETIME`` from a product's sidecar files)
+    and ``"band"`` (the band's own items, with its description as
+    ``DESCRIPTION`` when it has one; band 1 when ``band`` is None).
+
+    Raises
+    ------
+    ImageReadError
+        The file cannot be opened.
+    """
+    with _opened(path) as src:
+        index = band if isinstance(band, int) and 1 <= band <= src.count else 1
+        band_items = dict(src.tags(index))
+        if src.descriptions[index - 1]:
+            band_items["DESCRIPTION"] = src.descriptions[index - 1]
+        imagery = dict(src.tags(ns="IMAGERY")) if "IMAGERY" in (src.tag_namespaces() or []) else {}
+        return {"default": dict(src.tags()), "imagery": imagery, "band": band_items}
+
+
 def read_raster(path: str | Path, band: int | None = None, window=None,
                 out_shape: tuple[int, int] | None = None) -> Raster:
     """Read one band of an image file (anything GDAL reads: GeoTIFF, PNG,

@@ -38,6 +38,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
@@ -60,7 +61,6 @@ from .intervals import (
     influence_sd,
     influence_sds,
     linearised_interval,
-    t_quantile,
 )
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
