@@ -86,6 +86,9 @@ class Acquisition:
     sources : dict
         Where each fact came from: ``option``, ``metadata``, ``product name``
         or ``TIFF tag``.
+    overview : str or None
+        A figure of the whole scene (a scan's ``overview.png``), which the
+        campaign report shows beside the acquisition.
     imgmtf_version, run_utc : str
         Provenance of the run.
     """
@@ -104,6 +107,7 @@ class Acquisition:
     band: int | str | None = None
     settings: dict = field(default_factory=dict)
     sources: dict = field(default_factory=dict)
+    overview: str | None = None
     imgmtf_version: str = __version__
     run_utc: str = ""
 

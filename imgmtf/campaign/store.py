@@ -14,7 +14,9 @@ Layers
 ``targets``
     The summaries per target or scene and direction, combined (``method``
     ``combined``) or fitted (``fit``): MTF at Nyquist, MTF50, FWHM and RER
-    with intervals (a Point at the target's centre).
+    with intervals (a Point at the target's centre); a fit's
+    ``constrained`` (0 when no edge lay near that axis: the value is the
+    other axis's, tied) and ``misfit``.
 ``store_info`` (a table without geometry)
     ``schema_version`` and who created the store.
 
@@ -57,8 +59,8 @@ SUMMARY_METHODS = ("combined", "fit")
 _ACQUISITION_COLUMNS = {
     "acquisition_id": "str", "path": "str", "sha256": "str", "band": "str", "acquired_utc": "str",
     "platform": "str", "instrument": "str", "band_name": "str", "gsd_m": "float", "level": "str",
-    "product_id": "str", "site": "str", "settings": "str", "sources": "str", "imgmtf_version": "str",
-    "run_utc": "str",
+    "product_id": "str", "site": "str", "settings": "str", "sources": "str", "overview": "str",
+    "imgmtf_version": "str", "run_utc": "str",
 }
 _REPEATED = {"acquisition_id": "str", "acquired_utc": "str", "platform": "str", "instrument": "str",
              "band_name": "str"}
@@ -74,9 +76,9 @@ _EDGE_COLUMNS = {
     "y1_px": "float", "roi_px": "str", "plot": "str", "record": "str",
 }
 _TARGET_COLUMNS = {
-    **_REPEATED, "scope": "str", "target_id": "int", "method": "str", **_FIGURES, "n_edges": "int",
-    "consistency": "float", "snr_min": "float", "edge_ids": "str", "x_px": "float", "y_px": "float",
-    "plot": "str", "record": "str",
+    **_REPEATED, "scope": "str", "target_id": "int", "method": "str", "status": "str", "reason": "str",
+    **_FIGURES, "n_edges": "int", "consistency": "float", "constrained": "int", "misfit": "int",
+    "snr_min": "float", "edge_ids": "str", "x_px": "float", "y_px": "float", "plot": "str", "record": "str",
 }
 SCHEMA: dict[str, dict[str, str]] = {"acquisitions": _ACQUISITION_COLUMNS, "edges": _EDGE_COLUMNS,
                                      "targets": _TARGET_COLUMNS}
@@ -287,7 +289,8 @@ def _target_row(acquisition: Acquisition, record: Record, geo: _Georeference) ->
     if method not in SUMMARY_METHODS:
         raise ParameterError(f"a target's summary must be one of {', '.join(SUMMARY_METHODS)}, got {method!r}")
     row = _common(acquisition, record)
-    row.update({key: flat.get(key) for key in ("n_edges", "consistency", "snr_min", "x_px", "y_px")})
+    row.update({key: flat.get(key) for key in ("status", "reason", "n_edges", "consistency", "constrained",
+                                               "misfit", "snr_min", "x_px", "y_px")})
     row["method"] = method
     row["edge_ids"] = json.dumps(flat["edge_ids"], default=_jsonable) if flat.get("edge_ids") is not None else None
     centre = [(flat["x_px"] + 0.5, flat["y_px"] + 0.5)] if flat.get("x_px") is not None else []

@@ -155,10 +155,11 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
     """The targets layer's rows that make each trend, by (platform, band
     name, direction, method): per acquisition its scene-wide rows, or its
     targets' rows when it has no scene-wide one; rows without an
-    acquisition time are left out."""
+    acquisition time, and fits of a direction no edge constrained, are
+    left out."""
     groups: dict[tuple, dict[str, list[Mapping]]] = {}
     for row in rows:
-        if not row.get("acquired_utc") or row.get("mtf_nyquist") is None:
+        if not row.get("acquired_utc") or row.get("mtf_nyquist") is None or row.get("constrained") == 0:
             continue
         key = tuple(row.get(k) for k in GROUP_KEYS)
         groups.setdefault(key, {}).setdefault(row["acquisition_id"], []).append(row)
@@ -170,6 +171,17 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
             points += scene or members
         out[key] = sorted(points, key=lambda r: parse_utc(r["acquired_utc"]))
     return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
+
+
+def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> list[Mapping]:
+    """The rows a campaign's trends are made of: the targets layer's rows,
+    and for an acquisition that has none (``imgmtf measure --campaign``)
+    its measured edges (status ``ok``), each a point of method ``edge``."""
+    targets = list(targets)
+    summarised = {row.get("acquisition_id") for row in targets}
+    chips = [{**row, "method": "edge", "scope": "edge"} for row in edges
+             if row.get("acquisition_id") not in summarised and row.get("status") == "ok"]
+    return [*targets, *chips]
 
 
 def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
