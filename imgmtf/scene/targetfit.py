@@ -57,15 +57,15 @@ def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES) -> list[Re
     list of Record
         Per target (``scope`` "target", ``target_id``), then for the scene
         (``scope`` "scene", only with two targets or more), an
-        "across-track" and an "along-track" record with ``status``
-        "fitted" and ``summary`` "fit": ``mtf_nyquist`` and
+        "across-track" and an "along-track" record (each only when some
+        half-edge lies nearer that axis than the other: the model does not
+        extrapolate) with ``status`` "fitted" and ``summary`` "fit": ``mtf_nyquist`` and
         ``mtf_nyquist_ci``, ``mtf50_cy_px`` and ``mtf50_ci_cy_px`` (cy/px),
         ``fwhm_px``, ``rer``, the model's MTF curve, ``n_edges``,
         ``edge_ids``, ``stages``, ``parameters`` (fitted values, m),
         ``reduced_chi_square``, ``misfit`` (the model does not fit; a
-        warning says why), ``misfit_p`` (the smallest p-value of the
-        half-edges' residual structure) and ``constrained`` (some edge
-        lies nearer this axis than the other).  A fit that fails gives one
+        warning says why) and ``misfit_p`` (the smallest p-value of the
+        half-edges' residual structure).  A fit that fails gives one
         record per target with ``status`` "rejected" and the reason.
         Empty for a pulse scan, a scene with no accepted half-edge, or an
         unknown track direction.
@@ -180,7 +180,9 @@ def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Rec
     used = [r for r, e in members if not isinstance(e, ImgmtfError)]
     lost = [f"half-edge {r.site.get('id')} could not be measured again for the fit: {' '.join(str(e).split())}"
             for r, e in members if isinstance(e, ImgmtfError)]
-    return [_direction_row(fit, direction, used, where, stages, lost) for direction in ("across", "along")]
+    # an axis no edge lies nearer to is the model's extrapolation (tied or held parameters): no row
+    return [_direction_row(fit, direction, used, where, stages, lost) for direction in ("across", "along")
+            if fit.directions[direction]["constrained"]]
 
 
 def _direction_row(fit, direction: str, records: list[Record], site: dict, stages, lost: list[str]) -> Record:
@@ -205,7 +207,6 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
         "mtf50_cy_px": finite(figures_of["mtf50_cy_px"]),
         "mtf50_ci_cy_px": [finite(v) for v in figures_of["mtf50_cy_px_ci"]],
         "fwhm_px": finite(fwhm_px), "rer": finite(relative_edge_response(grid, esf, _half_point(grid, esf))),
-        "constrained": bool(figures_of["constrained"]),
         "stages": [s.name for s in sensor.stages],
         "parameters": {p.key: finite(p.value) for p in fit.parameters if p.status == "fitted"},
         "reduced_chi_square": finite(fit.reduced_chi_square), "misfit": bool(fit.misfit),
@@ -233,8 +234,8 @@ def _warnings(fit, site: dict, ids: list):
         yield (f"the sensor model ({', '.join(s.name for s in fit.sensor.stages)}) does not fit {what}'s "
                "half-edges: its across/along-track figures may be biased")
     for warning in fit.warnings:
-        if warning.startswith("no GSD in the inputs"):
-            continue            # the scan's rows say so already; lengths here are px
+        if warning.startswith("no GSD in the inputs") or "MTF is an extrapolation" in warning:
+            continue            # the scan's rows say so already (lengths here are px); no row extrapolates
         for k, edge_id in enumerate(ids, 1):
             if warning.startswith(f"edge {k}: "):
                 warning = f"half-edge {edge_id}: " + warning.removeprefix(f"edge {k}: ")
