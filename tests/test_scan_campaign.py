@@ -142,3 +142,16 @@ def test_ctrl_c_during_a_scan_of_many_scenes_keeps_every_finished_acquisition(tm
     stored = {row["path"] for row in read_layer(store, "acquisitions")}
     assert stored == reported and 1 <= len(stored) < 8
     assert not [p for p in os.listdir(tmp_path) if p.startswith(".imgmtf-store-")]
+
+
+def test_a_landsat_product_scanned_without_options_is_dated_and_named_by_its_file_name(tmp_path):
+    scene = SyntheticCampaign(acquisitions=2, size_px=128).render(0)
+    path = tmp_path / "LC09_L1TP_181040_20211121_20211122_02_T1_B8.TIF"
+    im.write_geotiff(path, scene.image, gsd_m=15.0)
+    store = str(tmp_path / "site.gpkg")
+    result = CliRunner().invoke(main, ["scan", str(path), "--campaign", store, "--fit-stages", "none"])
+    assert result.exit_code == 0, result.output
+    [row] = read_layer(store, "acquisitions")
+    assert (row["platform"], row["instrument"], row["acquired_utc"], row["band_name"]) == \
+        ("Landsat 9", "OLI-2", "2021-11-21", "B8")
+    assert "no acquisition time" not in result.output

@@ -158,6 +158,7 @@ def print_target_fits(fitted) -> None:
     click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
     warned: set[str] = set()
+    hinted = False
     for summary in fitted:
         r = summary.to_dict()
         head = f"{r['scope']:>6} {r.get('target_id') or '':>3}"
@@ -174,6 +175,9 @@ def print_target_fits(fitted) -> None:
             if warning not in warned:           # across and along share their fit's warnings
                 warned.add(warning)
                 click.echo(f"{'':>10} warning: {warning}")
+                if "does not fit" in warning and not hinted:
+                    hinted = True
+                    click.echo(f"{'':>10} (--fit-stages fits other stages; the combined rows assume no model)")
 
 
 SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
