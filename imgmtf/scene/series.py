@@ -172,7 +172,7 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
             return SceneOutcome(path, tuple(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
         if settings.target == "edge" and stages:
-            summaries += fit_targets(records, stages=stages)
+            summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
     except ImgmtfError as exc:
         message = " ".join(str(exc).split())
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",

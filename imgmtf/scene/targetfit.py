@@ -37,7 +37,8 @@ DEFAULT_STAGES = "optics,detector"
 _DIRECTIONS = {"across": "across-track", "along": "along-track"}
 
 
-def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES) -> list[Record]:
+def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES, workers: int = 1,
+                scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
     """Fit the sensor model to each target's accepted half-edges (and to
     the scene's, when it has several targets): two summary records per
     fit, across- and along-track.
@@ -51,6 +52,8 @@ def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES) -> list[Re
     stages : str or list of str
         The stages fitted (:func:`imgmtf.fit_sensor`), default
         "optics,detector".
+    workers, scheduler, progress
+        As for :func:`imgmtf.parallel.run_tasks`: one fit per task.
 
     Returns
     -------
@@ -92,15 +95,16 @@ def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES) -> list[Re
                 and r.site.get("target_id") is not None and r.site.get("roi_polygon_px")]
     if not accepted or track_of(accepted[0]) is None:
         return []
-    measured = _measured(accepted)
+    from ..parallel import run_tasks
     targets = sorted({int(r.site["target_id"]) for r in accepted})
-    out: list[Record] = []
-    for target in targets:
-        members = [(r, e) for r, e in zip(accepted, measured) if r.site["target_id"] == target]
-        out += _fit_rows(members, {"scope": "target", "target_id": target}, stages)
-    if len(targets) > 1:
-        out += _fit_rows(list(zip(accepted, measured)), {"scope": "scene"}, stages)
-    return out
+    # each task measures its half-edges again itself (an EdgeResult does not travel between processes)
+    tasks = [([r for r in accepted if r.site["target_id"] == target], {"scope": "target", "target_id": target},
+              stages) for target in targets]
+    if len(targets) > 1:        # the scene's fit, the longest, first: the targets' fill the other workers
+        tasks.insert(0, (accepted, {"scope": "scene"}, stages))
+    fitted = list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                            description="fitting targets"))
+    return [row for rows in fitted[1:] + fitted[:1] for row in rows] if len(targets) > 1 else fitted[0]
 
 
 def track_of(record: Record) -> float | None:
@@ -134,7 +138,7 @@ def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon) -> np.nda
 def _measured(records: list[Record]) -> list[Any]:
     """Each accepted half-edge measured again on its masked ROI (no
     intervals: the fit needs its samples and geometry), its normal turned
-    into the sensor's frame; an ImgmtfError instead where that fails."""
+    into the sensor's frame; why not (a message) where that fails."""
     from ..estimate.edge import measure_edge
     from ..inputs import saturation_levels
     from ..io import read_raster
@@ -149,7 +153,7 @@ def _measured(records: list[Record]) -> list[Any]:
             result = measure_edge(raster.data, mask=mask, method=record.method, gsd_m=raster.gsd_m,
                                   saturation=saturation, dtype=raster.dtype, intervals=False)
         except ImgmtfError as exc:
-            out.append(exc)
+            out.append(" ".join(str(exc).split()))
             continue
         out.append(replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0)))
     return out
@@ -162,24 +166,29 @@ def _turned(normal_deg: float, track_deg: float) -> float:
     return angle - 180.0 if angle > 90.0 else angle
 
 
+def _fit_task(task) -> list[Record]:
+    records, site, stages = task
+    return _fit_rows(list(zip(records, _measured(records))), site, stages)
+
+
 def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
     from ..estimate.fit import fit_sensor
     records = [r for r, _ in members]
     first = records[0]
-    edges = [e for _, e in members if not isinstance(e, ImgmtfError)]
+    edges = [e for _, e in members if not isinstance(e, str)]
     where = _where(records, site)
     try:
         if not edges:
-            raise next(e for _, e in members)
+            raise ImgmtfError(f"no half-edge could be measured again: {members[0][1]}", reason="unsuitable")
         fit = fit_sensor(edges, stages=stages, confidence=_confidence(first))
     except ImgmtfError as exc:
         what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
         return [Record(first.path, first.band, "edge", first.method, "rejected", exc.reason,
                        f"{first.path}: the sensor model could not be fitted to {what}: {' '.join(str(exc).split())}",
                        figures={"summary": "fit"}, site=where, params=_params(first, stages), run_utc=first.run_utc)]
-    used = [r for r, e in members if not isinstance(e, ImgmtfError)]
-    lost = [f"half-edge {r.site.get('id')} could not be measured again for the fit: {' '.join(str(e).split())}"
-            for r, e in members if isinstance(e, ImgmtfError)]
+    used = [r for r, e in members if not isinstance(e, str)]
+    lost = [f"half-edge {r.site.get('id')} could not be measured again for the fit: {e}"
+            for r, e in members if isinstance(e, str)]
     # an axis no edge lies nearer to is the model's extrapolation (tied or held parameters): no row
     return [_direction_row(fit, direction, used, where, stages, lost) for direction in ("across", "along")
             if fit.directions[direction]["constrained"]]
