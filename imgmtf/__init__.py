@@ -36,7 +36,7 @@ _LAZY = {
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
-    "fit_targets": "scene.targetfit",
+    "fit_targets": "scene.targetfit", "scan_scenes": "scene.series",
     "run_selftest": "selftest",
     "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",
     "write_acquisition": "campaign.store", "read_layer": "campaign.store",
