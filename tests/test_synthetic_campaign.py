@@ -39,7 +39,8 @@ def test_a_campaign_out_of_range_is_refused(bad):
 
 
 def test_a_written_campaign_carries_its_tags_and_truth_and_the_fit_recovers_it(tmp_path):
-    campaign = SyntheticCampaign(acquisitions=2, size_px=128, interval_days=730.0, degradation=0.1, seed=2)
+    # cut out of their scenes (an L0R chip's 0-fill): the four inner half-edges, a quick fit
+    campaign = SyntheticCampaign(acquisitions=2, size_px=128, interval_days=730.0, degradation=0.1, seed=2, fill=True)
     paths = write_campaign(tmp_path, campaign, platform="SAT-9", instrument="CAM", band_name="B1")
     assert [p.name for p in paths] == ["site_20200601T033000.tif", "site_20220601T033000.tif"]
     truth = json.loads((tmp_path / "truth.json").read_text())

@@ -27,7 +27,7 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
 #: the options that describe one chip, and those that describe a campaign: each refused with the other
 CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std", "ground_noise", "oversampling",
              "sensor_path", "out")
-CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "platform", "instrument",
+CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
                  "band_name")
 CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says otherwise
 
@@ -72,13 +72,15 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
               help="campaign: the optics' blur grows by this fraction of its starting width each year")
 @click.option("--snr", type=FiniteFloat(0, min_open=True), default=180.0, show_default=True,
               help="campaign: the smallest step between the target's quadrants over the noise")
+@click.option("--fill", is_flag=True,
+              help="campaign: every pixel outside the target 0, as in an L0R chip (its inner half-edges only)")
 @click.option("--platform", default="SYNTHSAT-1", show_default=True, help="campaign: PLATFORM tag of every scene")
 @click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
 @click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
 @click.pass_context
 def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
-             degradation, snr, platform, instrument, band_name):
+             degradation, snr, fill, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
     (or a PNG); or, with --campaign DIR, a calibration campaign:
     DIR/site_<time>.tif, one scene per acquisition (a four-quadrant target
@@ -94,7 +96,7 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
             raise click.UsageError(f"{_flag(ctx, clash[0])} makes a single chip: not with --campaign")
         with reported_errors():
             _campaign(campaign_dir, acquisitions, start, interval_days, degradation,
-                      size if "size" in given else CAMPAIGN_SIZE_PX, snr, int(bits), seed or 0, gsd,
+                      size if "size" in given else CAMPAIGN_SIZE_PX, snr, int(bits), seed or 0, gsd, fill,
                       platform, instrument, band_name)
         return
     clash = [name for name in CAMPAIGN_ONLY if name in given]
@@ -157,12 +159,12 @@ def _flag(ctx, name: str) -> str:
     return next(p.opts[0] for p in ctx.command.params if p.name == name)
 
 
-def _campaign(folder, acquisitions, start, interval_days, degradation, size_px, snr, bits, seed, gsd,
+def _campaign(folder, acquisitions, start, interval_days, degradation, size_px, snr, bits, seed, gsd, fill,
               platform, instrument, band_name) -> None:
     from ..sensor.series import SyntheticCampaign
     from ..synthetic import write_campaign
     campaign = SyntheticCampaign(acquisitions, start, interval_days, degradation, snr=snr, size_px=size_px,
-                                 bits=bits, seed=seed, gsd_m=1.0 if gsd is None else gsd)
+                                 bits=bits, seed=seed, gsd_m=1.0 if gsd is None else gsd, fill=fill)
     paths = write_campaign(folder, campaign, platform=platform, instrument=instrument, band_name=band_name)
     click.echo(f"{'scene':<28} {'acquired (UTC)':<21} {'true MTF@Nyq across':>19} {'along':>7}")
     for k, path in enumerate(paths):

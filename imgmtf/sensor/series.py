@@ -63,6 +63,9 @@ class SyntheticCampaign:
         Of the noise and of each target's placement.
     gsd_m : float
         Ground sample distance, m.
+    fill : bool
+        Set every pixel outside the target to 0, as an L0R chip cuts a
+        target out of its scene: only its four inner half-edges remain.
 
     Raises
     ------
@@ -88,6 +91,7 @@ class SyntheticCampaign:
     bits: int = 16
     seed: int = 0
     gsd_m: float = 1.0
+    fill: bool = False
 
     def __post_init__(self):
         if not (isinstance(self.acquisitions, int) and self.acquisitions >= 2):
@@ -144,7 +148,7 @@ class SyntheticCampaign:
             raise ParameterError(f"acquisition {k} is not one of 0 to {self.acquisitions - 1}")
         field = FIELD_16_DN if self.bits == 16 else FIELD_8_DN
         scene = render_quadrants(self.sensor(k), (self.size_px, self.size_px), self.target(k), field_dn=field,
-                                 noise_std_dn=self.noise_std_dn(), seed=self.seed * 100003 + k)
+                                 fill=self.fill, noise_std_dn=self.noise_std_dn(), seed=self.seed * 100003 + k)
         if self.bits == 8:
             image = np.clip(scene.image, 0, 255).astype(np.uint8)
             scene = QuadrantScene(image, scene.target, scene.sensor, scene.fill, scene.noise_std_dn, scene.seed,
@@ -176,7 +180,7 @@ class SyntheticCampaign:
         return {"acquisitions": self.acquisitions, "start_utc": self.start_utc, "interval_days": self.interval_days,
                 "degradation_per_year": self.degradation, "optics_sigma_px": list(self.optics_sigma_px),
                 "snr": self.snr, "size_px": self.size_px, "bits": self.bits, "seed": self.seed,
-                "gsd_m": self.gsd_m}
+                "gsd_m": self.gsd_m, "fill": self.fill}
 
 
 def _start(text: str) -> datetime:
