@@ -59,9 +59,13 @@ def test_a_scene_that_says_not_when_is_stored_with_one_note(tmp_path):
     for path in paths:
         im.write_geotiff(path, scene.image)                 # no ACQUISITION_DATETIME
     store = str(tmp_path / "site.gpkg")
-    result = CliRunner().invoke(main, ["scan", *map(str, paths), "--campaign", store, "--fit-stages", "none"])
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["scan", *map(str, paths), "--campaign", store, "--fit-stages", "none",
+                                       "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert result.output.count("no acquisition time for 2 scene(s)") == 1 and "give --acquired TIME" in result.output
+    # several scenes: a folder of outputs each, named after its file
+    assert sorted(p.name for p in out.iterdir()) == ["a", "b"] and (out / "b" / "targets.csv").exists()
     # the same pixels in two files are one acquisition (its id is the content's, band's and settings')
     assert layer_counts(store)["acquisitions"] == 1
     given = CliRunner().invoke(main, ["scan", str(paths[0]), "--campaign", store, "--fit-stages", "none",
