@@ -37,6 +37,9 @@ _LAZY = {
     "Record": "records",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
+    "design_filter": "restore.design", "RestorationFilter": "restore.design",
+    "restore_file": "restore.apply", "RestoredFile": "restore.apply",
+    "restoration_report": "restore.report", "RestorationReport": "restore.report",
 }
 
 __all__ = [
