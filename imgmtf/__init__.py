@@ -39,6 +39,7 @@ _LAZY = {
     "run_selftest": "selftest",
     "design_filter": "restore.design", "RestorationFilter": "restore.design",
     "restore_file": "restore.apply", "RestoredFile": "restore.apply",
+    "restore_image": "restore.restoration", "Restoration": "restore.restoration",
     "restoration_report": "restore.report", "RestorationReport": "restore.report",
 }
 

@@ -105,6 +105,28 @@ def edge_responses(restoration: RestorationFilter, direction: str,
     return x, response.esf(x), np.asarray(after)
 
 
+def tradeoff(sensor, target_nyquist: float, noise_gains, *, kernel_size: int | None = None,
+             direction: str = "across") -> tuple[np.ndarray, np.ndarray]:
+    """``(noise_gain, achieved_mtf_nyquist)``: what a target costs as the
+    noise-gain limit tightens, one design per limit in ``noise_gains``
+    (a limit the target does not reach gives the unlimited design).
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.restore.report import tradeoff
+    >>> gains, mtf = tradeoff(Sensor(), 0.4, [1.1, 1.2, 10.0])
+    >>> [round(float(g), 2) for g in gains], [round(float(m), 3) for m in mtf]
+    ([1.1, 1.2, 1.35], [0.308, 0.352, 0.398])
+    """
+    from .design import design_filter
+    designs = [design_filter(sensor, target_nyquist, max_noise_gain=g, kernel_size=kernel_size)
+               for g in noise_gains]
+    return (np.array([d.noise_gain for d in designs]),
+            np.array([float(np.abs(d.system_transfer(0.5, direction) * d.axis_transfer(0.5, direction)))
+                      for d in designs]))
+
+
 def _axis_figures(restoration: RestorationFilter, direction: str) -> AxisFigures:
     curves = axis_curves(restoration, direction, np.linspace(0.0, 0.5, 501))
     _, at_half, after_half = edge_responses(restoration, direction, np.array([-0.5, 0.5]))
