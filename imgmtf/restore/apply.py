@@ -34,6 +34,8 @@ from ..inputs import as_array, check_number, saturation_levels
 #: tile sides allowed, px: a tile and its halo stay far below one read's 16 Mpx
 TILE_RANGE_PX = (64, 2048)
 DEFAULT_TILE_PX = 1024
+#: output rows convolved at once: FFT working copies of about this many rows
+STRIP_ROWS = 256
 #: side of the overview a band's fill value (its median) is read from, px
 OVERVIEW_PX = 512
 
@@ -66,9 +68,16 @@ def restore_array(image, taps: np.ndarray, *, fill: float | None = None) -> np.n
 
 def convolve_padded(padded: np.ndarray, taps: np.ndarray) -> np.ndarray:
     """The part of ``padded`` * ``taps`` that needs no further padding
-    (shape less the kernel's side less 1 in each axis)."""
+    (shape less the kernel's side less 1 in each axis), by FFT convolution
+    of strips of :data:`STRIP_ROWS` output rows: the transforms' working
+    copies are a strip's, not the whole array's."""
     from scipy.signal import fftconvolve
-    return fftconvolve(padded, taps, mode="valid")
+    side = taps.shape[0]
+    out = np.empty((padded.shape[0] - side + 1, padded.shape[1] - side + 1))
+    for start in range(0, out.shape[0], STRIP_ROWS):
+        stop = min(start + STRIP_ROWS, out.shape[0])
+        out[start:stop] = fftconvolve(padded[start: stop + side - 1], taps, mode="valid")
+    return out
 
 
 @dataclass(frozen=True)
@@ -135,16 +144,17 @@ class OutputType:
         if self.saturation is not None:
             low, high = self.saturation
             kept = valid & ((original <= low) | (original >= high))
-        values = np.where(kept, original, restored)
+        values = np.where(kept, original, restored)       # the one tile-sized copy; the rest in place
         limits = self.limits()
         clipped = 0
         if limits is not None:
-            outside = valid & ~kept & ((values < limits[0]) | (values > limits[1]))
-            clipped = int(outside.sum())
-            values = np.clip(np.rint(np.where(valid, values, limits[0])), *limits)
+            values[~valid] = limits[0]
+            clipped = int(np.count_nonzero(valid & ~kept & ((values < limits[0]) | (values > limits[1]))))
+            np.rint(values, out=values)
+            np.clip(values, *limits, out=values)
         if self.nodata is not None:
-            values = np.where(valid, values, self.nodata)
-        return values.astype(self.dtype), clipped, int(kept.sum())
+            values[~valid] = self.nodata
+        return values.astype(self.dtype), clipped, int(np.count_nonzero(kept))
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,8 +190,10 @@ def restore_tile(task: TileTask) -> TileResult:
     if task.taps is None:
         restored = core
     else:
-        values = np.where(np.isfinite(data), data, task.fill)
-        restored = convolve_padded(np.pad(values, task.tile.pads, mode="symmetric"), task.taps)
+        padded = np.pad(data, task.tile.pads, mode="symmetric")
+        padded[~np.isfinite(padded)] = task.fill
+        restored = convolve_padded(padded, task.taps)
+        del padded
     samples, clipped, saturated = task.output.convert(restored, core)
     return TileResult(task.band, task.tile.core, samples, clipped, saturated, int(np.isfinite(core).sum()))
 
