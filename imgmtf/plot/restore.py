@@ -93,7 +93,7 @@ def plot_restore_tradeoff(sensor, targets=(0.2, 0.3, 0.4, 0.5), *, kernel_size: 
     fig, ax = figure_axes(ax, size=(5.6, 4.0))
     for i, target in enumerate(targets):
         free = design_filter(sensor, target, kernel_size=kernel_size).noise_gain
-        limits = np.linspace(1.0, free, 12) if free > 1.0 else np.array([free])
+        limits = np.linspace(1.0, free, 8) if free > 1.0 else np.array([free])
         gains, mtf = tradeoff(sensor, target, limits, kernel_size=kernel_size)
         ax.plot(gains, mtf, "o-", ms=3, color=f"C{i}", label=f"target {target:g}")
     ax.plot([1.0], [sensor.mtf_nyquist("across")], "k*", ms=10, label="sensor alone")

@@ -333,7 +333,7 @@ class _DesignGrid:
                 low = middle
             else:
                 high = middle
-            if high - low < 1e-6:
+            if high - low < 1e-4:          # K to 0.01 %: the gain to about 1e-5
                 break
         return math.exp(high)
 
