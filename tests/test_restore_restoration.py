@@ -58,3 +58,14 @@ def test_baotou_a_model_that_does_not_fit_asks_an_absurd_filter(tmp_path):
     assert limited.filter.noise_gain == pytest.approx(2.0, abs=1e-4)
     assert max(a.achieved_mtf_nyquist for a in limited.report.axes.values()) < 0.005
     assert np.isfinite(im.read_raster(tmp_path / "l.tif").data).all()
+
+
+def test_pure_noise_needs_the_signal_given(tmp_path):
+    noise = np.random.default_rng(0).normal(1000.0, 10.0, (80, 80))
+    im.write_geotiff(tmp_path / "noise.tif", np.rint(noise).astype(np.uint16))
+    with pytest.raises(im.ImageContentError, match="no signal above its noise"):
+        im.restore_image(tmp_path / "noise.tif", SCALED, tmp_path / "r.tif", target_nyquist=0.3)
+    done = im.restore_image(tmp_path / "noise.tif", SCALED, tmp_path / "r.tif", target_nyquist=0.3,
+                            signal_std_dn=400.0)
+    assert done.noise_source == "given and measured"
+    assert done.filter.noise_std_dn == pytest.approx(10.0, rel=0.05)

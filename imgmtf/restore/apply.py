@@ -387,12 +387,12 @@ def measure_noise(path: str | Path, *, band: int = 1, window_px: int = 1024) -> 
     to ``window_px`` square at full resolution: the noise from the median
     absolute difference of neighbouring pixels (at least the quantisation's
     1/sqrt(12) DN), the signal as the standard deviation of the window less
-    that noise.
+    that noise (0 when the window holds nothing but noise).
 
     Raises
     ------
     ImageReadError, ImageContentError
-        The file cannot be read, or the window is flat or all nodata.
+        The file cannot be read, or the window is all nodata.
     """
     from ..estimate.detection import robust_noise
     from ..inputs import quantum
@@ -405,8 +405,4 @@ def measure_noise(path: str | Path, *, band: int = 1, window_px: int = 1024) -> 
     if values.size < 4:
         raise ImageContentError(f"{path}: too few valid pixels in the central {w} x {h} px to measure the noise")
     noise = max(robust_noise(data), quantum(data, raster.dtype) / math.sqrt(12.0))
-    signal = math.sqrt(max(float(values.var()) - noise ** 2, 0.0))
-    if signal == 0.0:
-        raise ImageContentError(f"{path}: the central {w} x {h} px hold no signal above the noise "
-                                f"({noise:.3g} DN): give the scene's contrast (--signal-std)")
-    return noise, signal
+    return noise, math.sqrt(max(float(values.var()) - noise ** 2, 0.0))

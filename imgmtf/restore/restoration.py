@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..errors import ImageContentError
 from ..sensor.model import Sensor
 from .apply import DEFAULT_TILE_PX, RestoredFile, measure_noise, restore_file
 from .design import RestorationFilter, design_filter
@@ -91,6 +92,9 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
     sources = {"given" if v is not None else "measured" for v in (noise_std_dn, signal_std_dn)}
     if noise_std_dn is None or signal_std_dn is None:
         noise, signal = measure_noise(path, band=_first_band(info))
+        if signal_std_dn is None and signal == 0.0:
+            raise ImageContentError(f"{path}: the image's centre holds no signal above its noise ({noise:.3g} DN) "
+                                    "to weigh the noise against: give the scene's contrast (--signal-std)")
         noise_std_dn = noise if noise_std_dn is None else noise_std_dn
         signal_std_dn = signal if signal_std_dn is None else signal_std_dn
     restoration = design_filter(sensor, target_nyquist, noise_std_dn=noise_std_dn, signal_std_dn=signal_std_dn,
