@@ -139,3 +139,17 @@ def test_noise_and_signal_are_measured(tmp_path):
     # a quantised noise-free image has at least the rounding noise
     write(tmp_path / "q.tif", np.tile(np.arange(64.0), (64, 1)) * 10, "uint16")
     assert measure_noise(tmp_path / "q.tif")[0] == pytest.approx(1 / math.sqrt(12))
+
+
+def test_float_nan_stays_nan_and_a_chips_truth_is_not_carried_over(filt, tmp_path):
+    data = scene().astype(np.float32)
+    data[5:9, 5:9] = np.nan
+    write(tmp_path / "in.tif", data, "float32")
+    im.restore_file(tmp_path / "in.tif", filt, tmp_path / "out.tif", tile_px=64)
+    out = im.read_raster(tmp_path / "out.tif").data
+    assert np.isnan(out[5:9, 5:9]).all() and np.isfinite(out).sum() == data.size - 16
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 64)
+    im.write_geotiff(tmp_path / "chip.tif", chip.image, provenance=chip.provenance())
+    im.restore_file(tmp_path / "chip.tif", filt, tmp_path / "chip_r.tif")
+    restored = im.read_raster(tmp_path / "chip_r.tif")
+    assert restored.provenance is None and "sensor" in json.loads(restored.tags["IMGMTF_SOURCE"])

@@ -7,7 +7,9 @@ large the scene.  Tiles run on local workers or a Dask cluster
 (:func:`imgmtf.parallel.run_tasks`) and are written as they complete to a
 tiled GeoTIFF that keeps the input's georeference, data type, nodata, tags,
 band descriptions and colour interpretation, and that appears whole or not
-at all (:mod:`imgmtf.atomic`).
+at all (:mod:`imgmtf.atomic`).  A chip's ``IMGMTF`` provenance tag (how it
+was rendered, hence its true MTF) is kept as ``IMGMTF_SOURCE``: it no longer
+describes the restored pixels.
 
 Integer output is rounded and clipped to its type's range; the clipped
 fraction is counted.  Input pixels at the saturation levels (an integer
@@ -154,6 +156,8 @@ class OutputType:
             np.clip(values, *limits, out=values)
         if self.nodata is not None:
             values[~valid] = self.nodata
+        elif limits is None:
+            values[~valid] = np.nan          # a float image's NaN stay NaN
         return values.astype(self.dtype), clipped, int(np.count_nonzero(kept))
 
 
@@ -345,6 +349,10 @@ def restore_file(path: str | Path, restoration, out: str | Path, *, tile_px: int
                     if result.band not in alpha:
                         for key in counts:
                             counts[key] += getattr(result, key)
+                # a chip's rendering provenance (its sensor, its true MTF) no longer describes the
+                # restored pixels: it is kept under another name, so that measure draws no false truth
+                if "IMGMTF" in tags:
+                    tags["IMGMTF_SOURCE"] = tags.pop("IMGMTF")
                 dst.update_tags(**tags, IMGMTF_RESTORE=json.dumps(provenance, sort_keys=True))
                 for band in range(1, info.count + 1):
                     if band_tags[band - 1]:

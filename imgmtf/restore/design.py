@@ -285,6 +285,7 @@ def design_filter(sensor: Sensor, target_nyquist: float, *, noise_std_dn: float 
     if limit is not None and _gain(taps) > limit:
         regulariser = grid.regulariser_for_gain(regulariser, limit)
         taps, limited = grid.taps(regulariser), True
+    taps.flags.writeable = False         # the filter is frozen, its taps with it
     return RestorationFilter(taps, sensor, gsd, target, regulariser, noise, signal, limit, kernel_size, limited)
 
 
@@ -299,6 +300,7 @@ class _DesignGrid:
             self.h = sensor.transfer(f[None, :] / gsd_m, f[:, None] / gsd_m)
             g = target_transfer(f, target)
             self.t = g[None, :] * g[:, None]
+            # the smallest regulariser's taps reach furthest: a grid they fit fits every design
             taps = self._full_taps(MIN_REGULARISER)
             if _border_fraction(taps) < CROP_TOLERANCE:
                 break
