@@ -25,7 +25,10 @@ Measured:
 3. the uint16 result against the whole-image restoration rounded and
    clipped alike: the number of pixels that differ.
 
-usage: python bench/restore_memory.py [--cache DIR] [--tile PX] [--workers N]
+The restoration runs in the command's own process (one worker): with workers
+the tiles' memory is theirs, one tile in flight and one queued each.
+
+usage: python bench/restore_memory.py [--cache DIR] [--tile PX]
 """
 from __future__ import annotations
 
@@ -94,7 +97,7 @@ def peak_kib(code: str) -> tuple[int, float, str]:
     return int(line.split()[1]), seconds, done.stdout
 
 
-def restore_command(scene: Path, out: Path, tile: int, workers: int) -> list[str]:
+def restore_command(scene: Path, out: Path, tile: int, workers: int = 1) -> list[str]:
     return ["imgmtf", "restore", str(scene), "--sensor", str(out.parent / "generic.toml"), "--target-nyquist",
             str(TARGET), "--noise-std", str(NOISE_DN), "--signal-std", str(SIGNAL_DN), "--out", str(out),
             "--tile", str(tile), "--workers", str(workers), "--format", "json", "--no-progress"]
@@ -104,7 +107,6 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()))
     parser.add_argument("--tile", type=int, default=1024)
-    parser.add_argument("--workers", type=int, default=1)
     args = parser.parse_args()
     u16, f32 = build_scene(args.cache)
     work = Path(tempfile.mkdtemp(prefix="restore_bench_"))
@@ -119,17 +121,17 @@ def main() -> None:
     tile_mib = (args.tile + 2 * r) ** 2 * 8 / 2**20
     print(f"filter {restoration.taps.shape[0]} x {restoration.taps.shape[0]} taps (halo {r} px), noise gain "
           f"{restoration.noise_gain:.3f}; tiles {args.tile} px ({tile_mib:.1f} MiB each as float64 with the "
-          f"halo), {args.workers} worker(s); imports alone peak at {baseline / 1024:.0f} MiB")
+          f"halo), in-process (one worker); imports alone peak at {baseline / 1024:.0f} MiB")
     for name, path in (("2048 x 2048", quarter), (f"{SIZE} x {SIZE}", u16)):
         peak, seconds, stdout = peak_kib(_PEAK.format(argv=restore_command(path, work / f"r_{path.stem}.tif",
-                                                                           args.tile, args.workers)))
+                                                                           args.tile, 1)))
         held = (peak - baseline) / 1024
         whole_mib = (SIZE if path == u16 else SIZE // 2) ** 2 * 8 / 2**20
         print(f"{name} uint16 in {json.loads(stdout)['tiles']} tiles: {seconds:.1f} s; peak {peak / 1024:.0f} MiB: "
               f"the restoration held {held:.0f} MiB = {held / tile_mib:.1f} tiles' worth = "
               f"{held / whole_mib:.2f} x the whole image as float64")
 
-    _, seconds32, _ = peak_kib(_PEAK.format(argv=restore_command(f32, work / "r32.tif", args.tile, args.workers)))
+    _, seconds32, _ = peak_kib(_PEAK.format(argv=restore_command(f32, work / "r32.tif", args.tile, 1)))
     data = im.read_raster(f32).data
     whole = restoration(data)
     tiled = im.read_raster(work / "r32.tif").data
