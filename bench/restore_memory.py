@@ -97,10 +97,10 @@ def peak_kib(code: str) -> tuple[int, float, str]:
     return int(line.split()[1]), seconds, done.stdout
 
 
-def restore_command(scene: Path, out: Path, tile: int, workers: int = 1) -> list[str]:
+def restore_command(scene: Path, out: Path, tile: int) -> list[str]:
     return ["imgmtf", "restore", str(scene), "--sensor", str(out.parent / "generic.toml"), "--target-nyquist",
             str(TARGET), "--noise-std", str(NOISE_DN), "--signal-std", str(SIGNAL_DN), "--out", str(out),
-            "--tile", str(tile), "--workers", str(workers), "--format", "json", "--no-progress"]
+            "--tile", str(tile), "--format", "json", "--no-progress"]
 
 
 def main() -> None:
@@ -124,14 +124,14 @@ def main() -> None:
           f"halo), in-process (one worker); imports alone peak at {baseline / 1024:.0f} MiB")
     for name, path in (("2048 x 2048", quarter), (f"{SIZE} x {SIZE}", u16)):
         peak, seconds, stdout = peak_kib(_PEAK.format(argv=restore_command(path, work / f"r_{path.stem}.tif",
-                                                                           args.tile, 1)))
+                                                                           args.tile)))
         held = (peak - baseline) / 1024
         whole_mib = (SIZE if path == u16 else SIZE // 2) ** 2 * 8 / 2**20
         print(f"{name} uint16 in {json.loads(stdout)['tiles']} tiles: {seconds:.1f} s; peak {peak / 1024:.0f} MiB: "
               f"the restoration held {held:.0f} MiB = {held / tile_mib:.1f} tiles' worth = "
               f"{held / whole_mib:.2f} x the whole image as float64")
 
-    _, seconds32, _ = peak_kib(_PEAK.format(argv=restore_command(f32, work / "r32.tif", args.tile, 1)))
+    _, seconds32, _ = peak_kib(_PEAK.format(argv=restore_command(f32, work / "r32.tif", args.tile)))
     data = im.read_raster(f32).data
     whole = restoration(data)
     tiled = im.read_raster(work / "r32.tif").data
