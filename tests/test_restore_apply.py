@@ -1,6 +1,7 @@
 """Tiled application of a restoration filter to raster files."""
 import json
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -8,7 +9,7 @@ import rasterio
 from rasterio.transform import Affine
 
 import imgmtf as im
-from imgmtf.restore.apply import OutputType, measure_noise, plan_tiles, restore_array
+from imgmtf.restore.apply import OutputType, TileTask, measure_noise, plan_tiles, restore_array, restore_tile
 from imgmtf.sensor.stages import Detector, GaussianOptics
 
 
@@ -98,11 +99,14 @@ def test_integer_clip_avoids_a_nodata_value_at_the_range_end():
     assert samples.tolist() == [[1, 7, 255]] and clipped == 2
 
 
-def test_workers_give_the_same_file(filt, tmp_path):
+def test_a_tile_task_travels_to_a_worker_and_back_unchanged(filt, tmp_path):
+    # what run_tasks sends a worker process or a Dask cluster: a pickled task, a pickled result
     write(tmp_path / "in.tif", scene(), "uint16")
-    im.restore_file(tmp_path / "in.tif", filt, tmp_path / "a.tif", tile_px=64)
-    im.restore_file(tmp_path / "in.tif", filt, tmp_path / "b.tif", tile_px=64, workers=2)
-    assert np.array_equal(im.read_raster(tmp_path / "a.tif").data, im.read_raster(tmp_path / "b.tif").data)
+    tile = plan_tiles(261, 203, 64, filt.radius_px)[6]
+    task = TileTask(str(tmp_path / "in.tif"), 1, tile, filt.taps, 1500.0, OutputType("uint16", None, (0.0, 65535.0)))
+    here = restore_tile(task)
+    there = pickle.loads(pickle.dumps(restore_tile(pickle.loads(pickle.dumps(task)))))
+    assert there.core == here.core == tile.core and np.array_equal(there.samples, here.samples)
 
 
 def test_unreadable_inputs_and_bad_options_are_refused(filt, tmp_path):
