@@ -34,7 +34,7 @@ def plot_restored_mtf(restoration, direction: str = "across", ax=None):
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
     top = max(1.05, float(c["filter"].max()) * 1.05)
     ax.set(xlim=(0, 1), ylim=(min(0.0, float(c["filter"].min()) * 1.05), top),
-           xlabel=f"frequency {'across' if direction == 'across' else 'along'} track (cycles/pixel)",
+           xlabel=f"frequency {'across' if direction == 'across' else 'along'} track (cy/px)",
            ylabel="MTF, filter gain")
     title_once(ax, f"{direction.capitalize()} track")
     ax.legend(fontsize="x-small", title="at Nyquist", title_fontsize="x-small", loc="upper center",
