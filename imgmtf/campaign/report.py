@@ -35,8 +35,8 @@ body { font: 15px/1.45 system-ui, -apple-system, "Segoe UI", sans-serif; margin:
 h1 { font-size: 1.5em; margin-top: 0.8em; } h2 { font-size: 1.2em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
 table { border-collapse: collapse; margin: 8px 0; font-size: 0.92em; }
 th, td { border: 1px solid #d0d0d0; padding: 3px 7px; text-align: left; vertical-align: top; }
-th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
-tr.drift td { background: #fff0ee; } .note { color: #555; font-size: 0.92em; }
+th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+tr.drift td { background: #fff0ee; } .note { color: #555; font-size: 0.92em; } .time { white-space: nowrap; }
 img { max-width: 100%; height: auto; } img.thumb { width: 360px; margin: 2px; border: 1px solid #ddd; }
 .figure { margin: 10px 0 24px; } code { font-size: 0.95em; }
 """
@@ -202,9 +202,11 @@ def _trend_table(found: Sequence[Trend]) -> list[str]:
         interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
                     else "too few points")
         cells = [_text(t.platform), _text(t.band_name), _text(t.direction), _text(t.method), t.figure,
-                 str(t.n_acquisitions), _text(t.first_utc), _text(t.last_utc)]
+                 str(t.n_acquisitions)]
+        times = [_text(t.first_utc), _text(t.last_utc)]
         numbers = [_text(t.value_at_first), f"{t.slope_per_year:+.4g}", interval, "yes" if t.drift else "no"]
-        row = "".join(f"<td>{c}</td>" for c in cells) + "".join(f'<td class="num">{c}</td>' for c in numbers)
+        row = ("".join(f"<td>{c}</td>" for c in cells) + "".join(f'<td class="time">{c}</td>' for c in times)
+               + "".join(f'<td class="num">{c}</td>' for c in numbers))
         out.append(f'<tr class="{"drift" if t.drift else ""}">{row}</tr>')
     out.append("</table>")
     return out
@@ -237,7 +239,7 @@ def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: l
                  _text(a.get("gsd_m")), _text(a.get("level")), _text(a.get("product_id")),
                  f"<code>{_text(a.get('path'))}</code>", f"<code>{_text((a.get('sha256') or '')[:12])}</code>",
                  str(n_edges), results]
-        out.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
+        out.append(f'<tr><td class="time">{cells[0]}</td>' + "".join(f"<td>{c}</td>" for c in cells[1:]) + "</tr>")
         figures += _acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine)
     out.append("</table>")
     if figures:

@@ -53,6 +53,11 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
     label, bounds = TREND_FIGURES[figure]
     fig, ax = figure_axes(ax, (6.0, 3.6))
     usable = [r for r in rows if r.get("acquired_utc") and r.get(figure) is not None]
+    if not usable:
+        ax.text(0.5, 0.5, "none in these results", transform=ax.transAxes, ha="center", va="center", color="0.4")
+        ax.set(xticks=[], yticks=[])
+        title_once(ax, label)
+        return fig
     times = [parse_utc(r["acquired_utc"]).replace(tzinfo=None) for r in usable]
     values = np.array([r[figure] for r in usable], float)
     if bounds and usable:
