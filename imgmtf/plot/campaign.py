@@ -98,7 +98,7 @@ def plot_campaign(rows: Sequence[Mapping], trends: Sequence = (), *, requirement
     method) against time (:func:`plot_trend` each): MTF at Nyquist (with
     the requirement and the pre-launch value), MTF50, FWHM and RER;
     ``trends`` the group's :class:`~imgmtf.campaign.trend.Trend` per figure."""
-    fig = Figure(figsize=(12.0, 6.4), layout="constrained")
+    fig = Figure(figsize=(13.5, 6.6), layout="constrained")
     axes = fig.subplots(2, 2).ravel()
     by_figure = {t.figure: t for t in trends}
     for ax, figure in zip(axes, TREND_FIGURES):
