@@ -164,3 +164,12 @@ def test_fit_adds_one_acquisition_with_its_across_and_along_rows(tmp_path):
     other = chip(tmp_path / "later.tif", -84.0, "2024-01-01")
     mixed = CliRunner().invoke(main, ["fit", files[0], other, "--campaign", store])
     assert mixed.exit_code == 1 and "different acquisitions" in mixed.output
+
+
+def test_a_fit_that_misfits_is_marked(store):
+    rows = [dict(r) for r in read_layer(store, "targets") if r["direction"] == "along-track"]
+    rows[1]["misfit"] = 1
+    ax = plot_trend(rows).axes[0]
+    crosses = [line for line in ax.lines if line.get_marker() == "x"]
+    assert len(crosses) == 1 and len(crosses[0].get_xdata()) == 1
+    assert "the model misfits: may be biased" in [t.get_text() for t in ax.get_legend().get_texts()]

@@ -239,6 +239,7 @@ def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: l
             f"{_text(t.get('method'))}: {_text(t.get('mtf_nyquist'))}"
             + (f" [{_text(t.get('mtf_nyquist_ci_low'))}, {_text(t.get('mtf_nyquist_ci_high'))}]"
                if t.get("mtf_nyquist_ci_low") is not None else "")
+            + (' <strong>misfit</strong>' if t.get("misfit") else "")
             for t in mine)
         n_edges = sum(e.get("acquisition_id") == ident for e in edges)
         when = _when(a.get("acquired_utc")) or "<em>no time</em>"

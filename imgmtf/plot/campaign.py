@@ -28,7 +28,8 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
     ----------
     rows : sequence of mapping
         Rows of a campaign store's ``targets`` layer (one group: a platform,
-        band, direction and method), with ``acquired_utc``.
+        band, direction and method), with ``acquired_utc``; a fit whose
+        ``misfit`` is set is marked with a cross.
     figure : str
         ``mtf_nyquist``, ``mtf50_cy_px``, ``fwhm_px`` or ``rer``.
     trend : imgmtf.campaign.trend.Trend, optional
@@ -69,6 +70,10 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
                     capsize=3, label="acquisition (95 % interval)", zorder=3)
     else:
         ax.plot(times, values, "o", ms=4, color="C0", label="acquisition", zorder=3)
+    misfit = [t for t, r in zip(times, usable) if r.get("misfit")]
+    if misfit:
+        ax.plot(misfit, [r[figure] for r in usable if r.get("misfit")], "x", ms=9, color="C3", zorder=4,
+                label="the model misfits: may be biased")
     if trend is not None:
         span = np.array([trend.first_utc, trend.last_utc])
         ends = [parse_utc(t).replace(tzinfo=None) for t in span]
