@@ -26,11 +26,12 @@ from typing import Any
 import numpy as np
 
 from ..atomic import ensure_folder
-from ..batch import pulse_width_px, with_figure
+from ..batch import pulse_width_px
 from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
 from ..estimate.geometry import direction_label
+from ..figures import with_figure
 from ..inputs import saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from ..parallel import run_tasks
