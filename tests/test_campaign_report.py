@@ -109,7 +109,11 @@ def test_trend_figures_draw_points_line_requirement_and_baseline(store):
         plot_trend(rows, "mtf10")
 
 
-def test_the_report_command(store, tmp_path):
+def test_the_report_command(tmp_path):
+    store = tmp_path / "small.gpkg"                       # one direction: one figure to draw
+    for k in range(3):
+        write_acquisition(store, Acquisition(f"a{k}", "s.tif", "0" * 64, f"{2020 + k}-01-01T00:00:00Z", "Simsat-1",
+                                             None, "pan"), [], [fit_row("across-track", 0.30 + SLOPE * k)])
     result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "out"), "--requirement", "0.2"])
     assert result.exit_code == 0, result.output
     assert "drift: Simsat-1, band pan, across-track, fit: MTF at Nyquist -0.0200/year" in result.output
