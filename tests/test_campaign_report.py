@@ -177,3 +177,18 @@ def test_a_fit_that_misfits_is_marked(store):
     crosses = [line for line in ax.lines if line.get_marker() == "x"]
     assert len(crosses) == 1 and len(crosses[0].get_xdata()) == 1
     assert "the model misfits: may be biased" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_the_page_embeds_the_latest_acquisitions_figures_only(tmp_path):
+    from imgmtf.campaign.report import MAX_ACQUISITIONS_WITH_FIGURES
+    figure = tmp_path / "overview.png"
+    imgmtf.write_png(figure, np.zeros((8, 8), np.uint8))
+    store = tmp_path / "many.gpkg"
+    count = MAX_ACQUISITIONS_WITH_FIGURES + 2
+    for k in range(count):
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2000 + k}-01-01", overview=str(figure)),
+                          [], [])
+    page = open(write_report(store, tmp_path / "out").report_html, encoding="utf-8").read()
+    assert page.count("<img ") == MAX_ACQUISITIONS_WITH_FIGURES
+    assert "2 earlier ones" in page and f"{2000 + count - 1}-01-01: s{count - 1}.tif" in page
+    assert "2000-01-01: s0.tif" not in page

@@ -27,7 +27,8 @@ from ..version import __version__
 from .store import read_layer
 from .trend import GROUP_KEYS, Trend, campaign_rows, trend_points, trends, write_trend_csv
 
-MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are named)
+MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are counted)
+MAX_ACQUISITIONS_WITH_FIGURES = 12   # the latest acquisitions whose figures the page embeds (a page, not an archive)
 
 _STYLE = """
 body { font: 15px/1.45 system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0 auto; max-width: 1240px;
@@ -251,10 +252,15 @@ def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: l
                  f"<code>{_text(a.get('path'))}</code>", f"<code>{_text((a.get('sha256') or '')[:12])}</code>",
                  str(n_edges), results]
         out.append(f'<tr><td class="time">{cells[0]}</td>' + "".join(f"<td>{c}</td>" for c in cells[1:]) + "</tr>")
-        figures += _acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine)
+        figures.append(_acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine))
     out.append("</table>")
-    if figures:
-        out += ["<h2>Figures of each acquisition</h2>", *figures]
+    shown = [f for f in figures[::-1] if f][:MAX_ACQUISITIONS_WITH_FIGURES][::-1]     # the latest
+    if shown:
+        left = sum(bool(f) for f in figures) - len(shown)
+        out += ["<h2>Figures of each acquisition</h2>",
+                *((f'<p class="note">The latest {len(shown)} acquisitions\' figures; {left} earlier ones have '
+                   "theirs beside their files.</p>",) if left else ()),
+                *(part for f in shown for part in f)]
     return out
 
 
