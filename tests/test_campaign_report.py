@@ -109,7 +109,11 @@ def test_trend_figures_draw_points_line_requirement_and_baseline(store):
         plot_trend(rows, "mtf10")
 
 
-def test_the_report_command(store, tmp_path):
+def test_the_report_command(tmp_path):
+    store = tmp_path / "small.gpkg"                       # one direction: one figure to draw
+    for k in range(3):
+        write_acquisition(store, Acquisition(f"a{k}", "s.tif", "0" * 64, f"{2020 + k}-01-01T00:00:00Z", "Simsat-1",
+                                             None, "pan"), [], [fit_row("across-track", 0.30 + SLOPE * k)])
     result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "out"), "--requirement", "0.2"])
     assert result.exit_code == 0, result.output
     assert "drift: Simsat-1, band pan, across-track, fit: MTF at Nyquist -0.0200/year" in result.output
@@ -164,3 +168,27 @@ def test_fit_adds_one_acquisition_with_its_across_and_along_rows(tmp_path):
     other = chip(tmp_path / "later.tif", -84.0, "2024-01-01")
     mixed = CliRunner().invoke(main, ["fit", files[0], other, "--campaign", store])
     assert mixed.exit_code == 1 and "different acquisitions" in mixed.output
+
+
+def test_a_fit_that_misfits_is_marked(store):
+    rows = [dict(r) for r in read_layer(store, "targets") if r["direction"] == "along-track"]
+    rows[1]["misfit"] = 1
+    ax = plot_trend(rows).axes[0]
+    crosses = [line for line in ax.lines if line.get_marker() == "x"]
+    assert len(crosses) == 1 and len(crosses[0].get_xdata()) == 1
+    assert "the model misfits: may be biased" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_the_page_embeds_the_latest_acquisitions_figures_only(tmp_path):
+    from imgmtf.campaign.report import MAX_ACQUISITIONS_WITH_FIGURES
+    figure = tmp_path / "overview.png"
+    imgmtf.write_png(figure, np.zeros((8, 8), np.uint8))
+    store = tmp_path / "many.gpkg"
+    count = MAX_ACQUISITIONS_WITH_FIGURES + 2
+    for k in range(count):
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2000 + k}-01-01", overview=str(figure)),
+                          [], [])
+    page = open(write_report(store, tmp_path / "out").report_html, encoding="utf-8").read()
+    assert page.count("<img ") == MAX_ACQUISITIONS_WITH_FIGURES
+    assert "2 earlier ones" in page and f"{2000 + count - 1}-01-01: s{count - 1}.tif" in page
+    assert "2000-01-01: s0.tif" not in page

@@ -105,3 +105,16 @@ def test_trend_csv_has_the_documented_columns(tmp_path):
     assert {"platform", "band_name", "direction", "method", "n_acquisitions", "first_utc", "last_utc",
             "slope_per_year", "slope_ci_low", "slope_ci_high", "drift"} <= set(TREND_COLUMNS)
     assert [(r["figure"], r["drift"]) for r in got] == [("mtf_nyquist", "True"), ("fwhm_px", "True")]
+
+
+def test_a_targets_two_oblique_directions_make_two_trends():
+    rows = []
+    for k in range(3):
+        rows.append(row(k, f"{2020 + k}-01-01", 0.30 - 0.01 * k, direction="oblique", method="combined",
+                        normal_angle_deg=16.8 + 0.1 * k))
+        rows.append(row(k, f"{2020 + k}-01-01", 0.20 - 0.02 * k, direction="oblique", method="combined",
+                        normal_angle_deg=-73.2 - 0.1 * k))
+    found = {t.direction: t for t in trends(rows) if t.figure == "mtf_nyquist"}
+    assert set(found) == {"oblique (normal 17 deg)", "oblique (normal -73 deg)"}
+    assert found["oblique (normal 17 deg)"].slope_per_year == pytest.approx(-0.01, rel=0.01)
+    assert found["oblique (normal -73 deg)"].slope_per_year == pytest.approx(-0.02, rel=0.01)

@@ -12,7 +12,7 @@ def fit_summaries(fit, path: str, band=None, *, plot: str | None = None, run_utc
     (``summary`` "fit", ``scope`` "scene", ``status`` "fitted"), one per
     direction some edge constrains: the model's MTF at Nyquist and MTF50
     (cy/px) with their intervals, the number of edges on that axis and
-    whether the model misfits.  A direction no edge constrains is left out:
+    whether the model misfits, and the model's FWHM (px).  A direction no edge constrains is left out:
     its value is the other axis's, tied, not a measurement.
 
     Examples
@@ -34,6 +34,7 @@ def fit_summaries(fit, path: str, band=None, *, plot: str | None = None, run_utc
                      "mtf_nyquist": figures["mtf_nyquist"], "mtf_nyquist_ci": list(figures["mtf_nyquist_ci"]),
                      "mtf50_cy_px": figures.get("mtf50_cy_px"), "mtf50_ci_cy_px": list(figures.get("mtf50_cy_px_ci")
                                                                                         or (None, None)),
+                     "fwhm_px": fit.sensor.fwhm_m(axis) / fit.sensor.gsd_m,
                      "n_edges": len(edges), "constrained": True, "misfit": fit.misfit,
                      "gsd_m": edges[0].gsd_m if edges else None, "warnings": list(fit.warnings)},
             site={"scope": "scene"}, plot=plot,

@@ -27,7 +27,8 @@ from ..version import __version__
 from .store import read_layer
 from .trend import GROUP_KEYS, Trend, campaign_rows, trend_points, trends, write_trend_csv
 
-MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are named)
+MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are counted)
+MAX_ACQUISITIONS_WITH_FIGURES = 12   # the latest acquisitions whose figures the page embeds (a page, not an archive)
 
 _STYLE = """
 body { font: 15px/1.45 system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0 auto; max-width: 1240px;
@@ -35,8 +36,9 @@ body { font: 15px/1.45 system-ui, -apple-system, "Segoe UI", sans-serif; margin:
 h1 { font-size: 1.5em; margin-top: 0.8em; } h2 { font-size: 1.2em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
 table { border-collapse: collapse; margin: 8px 0; font-size: 0.92em; }
 th, td { border: 1px solid #d0d0d0; padding: 3px 7px; text-align: left; vertical-align: top; }
-th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
-tr.drift td { background: #fff0ee; } .note { color: #555; font-size: 0.92em; }
+th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+tr.drift td { background: #fff0ee; } table.trend td, .time { white-space: nowrap; }
+.note { color: #555; font-size: 0.92em; }
 img { max-width: 100%; height: auto; } img.thumb { width: 360px; margin: 2px; border: 1px solid #ddd; }
 .figure { margin: 10px 0 24px; } code { font-size: 0.95em; }
 """
@@ -165,7 +167,7 @@ def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: li
              + (f" Pre-launch values from <code>{html.escape(baseline)}</code>: across-track "
                 f"{prelaunch['across-track']:.4f}, along-track {prelaunch['along-track']:.4f}." if baseline else "")
              + "</p>"]
-    parts += _trend_table(found)
+    parts += _trend_table(found, "Drift of the MTF at Nyquist", ("mtf_nyquist",))
     by_group: dict[tuple, list[Trend]] = {}
     for trend in found:
         by_group.setdefault(tuple(getattr(trend, k) for k in GROUP_KEYS), []).append(trend)
@@ -176,10 +178,11 @@ def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: li
     for key, group in groups.items():
         direction = key[2]
         fig = plot_campaign(group, by_group.get(key, []), requirement=requirement,
-                            baseline=prelaunch.get(direction), title=_group_title(key))
+                            baseline=prelaunch.get(direction))
         title = html.escape(_group_title(key))
-        parts.append(f'<div class="figure"><h3>{title}</h3><img src="{_png(fig)}" width="1080" height="576" '
+        parts.append(f'<div class="figure"><h3>{title}</h3><img src="{_png(fig)}" width="1215" height="594" '
                      f'alt="MTF at Nyquist, MTF50, FWHM and RER against time: {title}"></div>')
+    parts += _trend_table(found, "Drift of MTF50, FWHM and RER", ("mtf50_cy_px", "fwhm_px", "rer"))
     parts += _acquisition_table(acquisitions, points, edges)
     body = "\n".join(parts)
     return (f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
@@ -188,21 +191,31 @@ def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: li
             f"</head>\n<body>\n{body}\n</body>\n</html>\n")
 
 
-def _trend_table(found: Sequence[Trend]) -> list[str]:
-    out = ["<h2>Drift</h2>"]
-    if not found:
+def _when(text) -> str:
+    """An ISO 8601 UTC time as a table shows it: to the minute, no T or Z."""
+    if not text:
+        return ""
+    return html.escape(text[:16].replace("T", " ") if "T" in text else text)
+
+
+def _trend_table(found: Sequence[Trend], title: str, figures: Sequence[str]) -> list[str]:
+    """The drifts of ``figures`` as a table headed ``title``."""
+    chosen = [t for t in found if t.figure in figures]
+    out = [f"<h2>{html.escape(title)}</h2>"]
+    if not chosen:
         return [*out, '<p class="note">No group has acquisitions at two times yet.</p>']
     out.append('<p class="note">Slope of a weighted least-squares line per year (365.25 days), with its '
-               f"{100 * found[0].confidence:g} % interval; a drift when the interval excludes 0. Also in "
+               f"{100 * chosen[0].confidence:g} % interval; a drift when the interval excludes 0. All in "
                "<code>trend.csv</code>.</p>")
-    head = ("platform", "band", "direction", "method", "figure", "acquisitions", "first", "last",
-            "value at first", "slope per year", "interval", "drift")
-    out.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
-    for t in found:
+    head = ("platform", "band", "direction", "method", *(("figure",) if len(figures) > 1 else ()),
+            "acquisitions", "first (UTC)", "last (UTC)", "value at first", "slope per year", "interval", "drift")
+    out.append('<table class="trend"><tr>' + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
+    for t in chosen:
         interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
                     else "too few points")
-        cells = [_text(t.platform), _text(t.band_name), _text(t.direction), _text(t.method), t.figure,
-                 str(t.n_acquisitions), _text(t.first_utc), _text(t.last_utc)]
+        cells = [_text(t.platform), _text(t.band_name), _text(t.direction), _text(t.method),
+                 *((t.figure,) if len(figures) > 1 else ()), str(t.n_acquisitions), _when(t.first_utc),
+                 _when(t.last_utc)]
         numbers = [_text(t.value_at_first), f"{t.slope_per_year:+.4g}", interval, "yes" if t.drift else "no"]
         row = "".join(f"<td>{c}</td>" for c in cells) + "".join(f'<td class="num">{c}</td>' for c in numbers)
         out.append(f'<tr class="{"drift" if t.drift else ""}">{row}</tr>')
@@ -227,9 +240,10 @@ def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: l
             f"{_text(t.get('method'))}: {_text(t.get('mtf_nyquist'))}"
             + (f" [{_text(t.get('mtf_nyquist_ci_low'))}, {_text(t.get('mtf_nyquist_ci_high'))}]"
                if t.get("mtf_nyquist_ci_low") is not None else "")
+            + (' <strong>misfit</strong>' if t.get("misfit") else "")
             for t in mine)
         n_edges = sum(e.get("acquisition_id") == ident for e in edges)
-        when = _text(a.get("acquired_utc")) or "<em>no time</em>"
+        when = _when(a.get("acquired_utc")) or "<em>no time</em>"
         source = json.loads(a["sources"]).get("acquired_utc") if a.get("sources") else None
         if source and a.get("acquired_utc"):
             when += f'<br><span class="note">from {html.escape(source)}</span>'
@@ -237,11 +251,16 @@ def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: l
                  _text(a.get("gsd_m")), _text(a.get("level")), _text(a.get("product_id")),
                  f"<code>{_text(a.get('path'))}</code>", f"<code>{_text((a.get('sha256') or '')[:12])}</code>",
                  str(n_edges), results]
-        out.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-        figures += _acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine)
+        out.append(f'<tr><td class="time">{cells[0]}</td>' + "".join(f"<td>{c}</td>" for c in cells[1:]) + "</tr>")
+        figures.append(_acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine))
     out.append("</table>")
-    if figures:
-        out += ["<h2>Figures of each acquisition</h2>", *figures]
+    shown = [f for f in figures[::-1] if f][:MAX_ACQUISITIONS_WITH_FIGURES][::-1]     # the latest
+    if shown:
+        left = sum(bool(f) for f in figures) - len(shown)
+        out += ["<h2>Figures of each acquisition</h2>",
+                *((f'<p class="note">The latest {len(shown)} acquisitions\' figures; {left} earlier ones have '
+                   "theirs beside their files.</p>",) if left else ()),
+                *(part for f in shown for part in f)]
     return out
 
 

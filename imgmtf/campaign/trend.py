@@ -35,6 +35,7 @@ FIGURES = {
     "rer": None,
 }
 GROUP_KEYS = ("platform", "band_name", "direction", "method")
+ACROSS_ALONG = ("across-track", "along-track")
 TREND_COLUMNS = (*GROUP_KEYS, "figure", "n_acquisitions", "n_points", "first_utc", "last_utc",
                  "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence", "weights",
                  "consistency", "drift")
@@ -156,11 +157,13 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
     name, direction, method): per acquisition its scene-wide rows, or its
     targets' rows when it has no scene-wide one; rows without an
     acquisition time, and fits of a direction no edge constrained, are
-    left out."""
+    left out.  Oblique (or unknown) directions are told apart by their
+    normals (:func:`imgmtf.scene.combine.normal_families`): their label
+    becomes ``oblique (normal 17 deg)``."""
+    usable = [r for r in rows if r.get("acquired_utc") and r.get("mtf_nyquist") is not None
+              and r.get("constrained") != 0]
     groups: dict[tuple, dict[str, list[Mapping]]] = {}
-    for row in rows:
-        if not row.get("acquired_utc") or row.get("mtf_nyquist") is None or row.get("constrained") == 0:
-            continue
+    for row in _by_normal(usable):
         key = tuple(row.get(k) for k in GROUP_KEYS)
         groups.setdefault(key, {}).setdefault(row["acquisition_id"], []).append(row)
     out = {}
@@ -171,6 +174,30 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
             points += scene or members
         out[key] = sorted(points, key=lambda r: parse_utc(r["acquired_utc"]))
     return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
+
+
+def _by_normal(rows: list[Mapping]) -> list[Mapping]:
+    """``rows`` with each oblique or unknown direction labelled by its
+    family of normals, so that a target's two oblique directions make two
+    trends, not one."""
+    from ..scene.combine import normal_families
+
+    plain = [r for r in rows if r.get("direction") in ACROSS_ALONG or r.get("normal_angle_deg") is None]
+    out = list(plain)
+    rest: dict[tuple, list[Mapping]] = {}
+    for row in rows:
+        if not any(row is r for r in plain):
+            rest.setdefault(tuple(row.get(k) for k in GROUP_KEYS), []).append(row)
+    for members in rest.values():
+        normals = np.array([r["normal_angle_deg"] for r in members], float)
+        families = normal_families(normals)
+        for family in np.unique(families):
+            chosen = np.mod(normals[families == family], 180.0)
+            mean = float(np.degrees(np.angle(np.mean(np.exp(2j * np.radians(chosen))))) / 2)
+            for row, f in zip(members, families):
+                if f == family:
+                    out.append({**row, "direction": f"{row['direction']} (normal {mean:.0f} deg)"})
+    return out
 
 
 def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> list[Mapping]:

@@ -82,19 +82,25 @@ class CampaignWriter:
             self.untimed.append(path)
         return acquisition
 
-    def add_fit(self, files: list[str], fit, settings: dict, band=None, plot: str | None = None):
-        """A sensor fit of ``files``, the chips of one acquisition, with its
-        across- and along-track rows; the files' own acquisition times must
-        agree (a fit across acquisitions is no point of a trend)."""
-        from ..campaign.acquisitions import file_sha256, read_acquisition
-        from ..campaign.fitted import fit_summaries
+    def check_one_acquisition(self, files: list[str], band=None) -> None:
+        """Refuse, before any fitting, files whose own acquisition times
+        differ (a fit across acquisitions is no point of a trend), unless
+        --acquired names the time."""
+        from ..campaign.acquisitions import read_acquisition
         from ..errors import ParameterError
-        if not self.acquired:
-            times = {f: read_acquisition(f, band=band).acquired_utc for f in files}
-            if len(set(times.values())) > 1:
-                listed = ", ".join(f"{f}: {t or 'no time'}" for f, t in times.items())
-                raise ParameterError(f"the files fitted are of different acquisitions ({listed}); fit each "
-                                     "acquisition's chips on their own, or give --acquired")
+        if self.acquired or len(files) < 2:
+            return
+        times = {f: read_acquisition(f, band=band).acquired_utc for f in files}
+        if len(set(times.values())) > 1:
+            listed = ", ".join(f"{f}: {t or 'no time'}" for f, t in times.items())
+            raise ParameterError(f"the files fitted are of different acquisitions ({listed}); fit each "
+                                 "acquisition's chips on their own, or give --acquired")
+
+    def add_fit(self, files: list[str], fit, settings: dict, band=None, plot: str | None = None):
+        """A sensor fit of ``files``, the chips of one acquisition
+        (:meth:`check_one_acquisition`), with its across- and along-track rows."""
+        from ..campaign.acquisitions import file_sha256
+        from ..campaign.fitted import fit_summaries
         settings = {**settings, "files": [file_sha256(f) for f in files]}
         rows = fit_summaries(fit, files[0], band, plot=plot, run_utc=self.run_utc)
         return self.add(files[0], band, settings, targets=rows)

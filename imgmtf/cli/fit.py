@@ -58,6 +58,8 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             check_output_file(out_path)
         store = CampaignWriter.opened(campaign, acquired=acquired, platform=platform, instrument=instrument,
                                       band_name=band_name)
+        if store:
+            store.check_one_acquisition(files, band)
         start = Sensor.from_toml(sensor_path) if sensor_path else None
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
                             roi=roi, confidence=confidence)

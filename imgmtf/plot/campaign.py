@@ -28,7 +28,8 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
     ----------
     rows : sequence of mapping
         Rows of a campaign store's ``targets`` layer (one group: a platform,
-        band, direction and method), with ``acquired_utc``.
+        band, direction and method), with ``acquired_utc``; a fit whose
+        ``misfit`` is set is marked with a cross.
     figure : str
         ``mtf_nyquist``, ``mtf50_cy_px``, ``fwhm_px`` or ``rer``.
     trend : imgmtf.campaign.trend.Trend, optional
@@ -53,6 +54,11 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
     label, bounds = TREND_FIGURES[figure]
     fig, ax = figure_axes(ax, (6.0, 3.6))
     usable = [r for r in rows if r.get("acquired_utc") and r.get(figure) is not None]
+    if not usable:
+        ax.text(0.5, 0.5, "none in these results", transform=ax.transAxes, ha="center", va="center", color="0.4")
+        ax.set(xticks=[], yticks=[])
+        title_once(ax, label)
+        return fig
     times = [parse_utc(r["acquired_utc"]).replace(tzinfo=None) for r in usable]
     values = np.array([r[figure] for r in usable], float)
     if bounds and usable:
@@ -64,6 +70,10 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
                     capsize=3, label="acquisition (95 % interval)", zorder=3)
     else:
         ax.plot(times, values, "o", ms=4, color="C0", label="acquisition", zorder=3)
+    misfit = [t for t, r in zip(times, usable) if r.get("misfit")]
+    if misfit:
+        ax.plot(misfit, [r[figure] for r in usable if r.get("misfit")], "x", ms=9, color="C3", zorder=4,
+                label="the model misfits: may be biased")
     if trend is not None:
         span = np.array([trend.first_utc, trend.last_utc])
         ends = [parse_utc(t).replace(tzinfo=None) for t in span]
@@ -93,7 +103,7 @@ def plot_campaign(rows: Sequence[Mapping], trends: Sequence = (), *, requirement
     method) against time (:func:`plot_trend` each): MTF at Nyquist (with
     the requirement and the pre-launch value), MTF50, FWHM and RER;
     ``trends`` the group's :class:`~imgmtf.campaign.trend.Trend` per figure."""
-    fig = Figure(figsize=(12.0, 6.4), layout="constrained")
+    fig = Figure(figsize=(13.5, 6.6), layout="constrained")
     axes = fig.subplots(2, 2).ravel()
     by_figure = {t.figure: t for t in trends}
     for ax, figure in zip(axes, TREND_FIGURES):
