@@ -39,6 +39,10 @@ _LAZY = {
     "run_selftest": "selftest",
     "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",
     "write_acquisition": "campaign.store", "read_layer": "campaign.store",
+    "design_filter": "restore.design", "RestorationFilter": "restore.design",
+    "restore_file": "restore.apply", "RestoredFile": "restore.apply",
+    "restore_image": "restore.restoration", "Restoration": "restore.restoration",
+    "restoration_report": "restore.report", "RestorationReport": "restore.report",
 }
 
 __all__ = [
