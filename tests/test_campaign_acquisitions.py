@@ -32,10 +32,16 @@ def scene(path, tags=None, gsd_m=10.0, value=0):
       "level": "L2SP"}),
     ("LC09_L1TP_181040_20211121_20211122_02_T1_B10.TIF", {"platform": "Landsat 9", "instrument": "TIRS-2"}),
     ("LE07_L1TP_127032_20010301_20200917_02_T1_B8.TIF", {"platform": "Landsat 7", "instrument": "ETM+"}),
+    ("LC09_L1TP_181040_20211121_20230505_02_T1_B5_rad_crop_2.tif",     # a user's crop keeps the name's facts
+     {"platform": "Landsat 9", "band_name": "B5", "acquired_utc": "2021-11-21",
+      "product_id": "LC09_L1TP_181040_20211121_20230505_02_T1"}),
+    ("LC08_L1TP_044034_20200101_20200823_02_T1_QA_PIXEL.TIF", {"band_name": "QA_PIXEL"}),
     ("T32TNR_20240619T101559_B04_10m.tif",
      {"platform": "Sentinel-2", "instrument": "MSI", "acquired_utc": "2024-06-19T10:15:59Z", "band_name": "B04",
       "site": "MGRS 32TNR", "level": "L2A"}),
     ("T32TNR_20250619T101559_B04.jp2", {"platform": "Sentinel-2", "band_name": "B04", "level": None}),
+    ("T32TNR_20250619T101559_B04_10m_mtf_roi.tiff", {"platform": "Sentinel-2", "band_name": "B04", "level": "L2A",
+                                                    "acquired_utc": "2025-06-19T10:15:59Z"}),
     ("S2B_MSIL1C_20250619T101559_N0511_R065_T32TNR_20250619T121212.SAFE/GRANULE/x/IMG_DATA/"
      "T32TNR_20250619T101559_B08.jp2",
      {"platform": "Sentinel-2B", "level": "L1C", "band_name": "B08", "acquired_utc": "2025-06-19T10:15:59Z",

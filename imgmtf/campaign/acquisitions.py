@@ -45,9 +45,10 @@ _LANDSAT_SENSORS = {"C": "OLI", "O": "OLI", "T": "TIRS", "E": "ETM+", "M": "MSS"
 _LANDSAT_SECOND_GENERATION = {"OLI": "OLI-2", "TIRS": "TIRS-2"}     # Landsat 9's instruments
 _LANDSAT = re.compile(r"(?P<sensor>L[COTEM])(?P<mission>\d{2})_(?P<level>L[12][A-Z]{2})_"
                       r"(?P<path>\d{3})(?P<row>\d{3})_(?P<acquired>\d{8})_(?P<processed>\d{8})_"
-                      r"(?P<collection>\d{2})_(?P<tier>T1|T2|RT)(?:_(?P<band>[A-Z0-9_]+?))?(?=\.|$)")
+                      r"(?P<collection>\d{2})_(?P<tier>T1|T2|RT)"
+                      r"(?:_(?P<band>(?:SR_|ST_)?B\d{1,2}|QA_[A-Z]+(?:_[A-Z]+)*))?(?=[._]|$)")
 _SENTINEL2_TILE = re.compile(r"T(?P<tile>\d{2}[A-Z]{3})_(?P<acquired>\d{8}T\d{6})_(?P<band>B\d[\dA]|TCI|AOT|WVP|SCL)"
-                             r"(?:_(?P<resolution>\d+m))?(?=\.|$)")
+                             r"(?:_(?P<resolution>\d+m))?(?=[._]|$)")
 _SENTINEL2_SAFE = re.compile(r"(?P<unit>S2[A-D])_MSI(?P<level>L1C|L2A)_(?P<acquired>\d{8}T\d{6})_N\d{4}_R\d{3}_"
                              r"T(?P<tile>\d{2}[A-Z]{3})_\d{8}T\d{6}(?:\.SAFE)?$")
 

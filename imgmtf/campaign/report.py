@@ -223,35 +223,54 @@ def _trend_table(found: Sequence[Trend], title: str, figures: Sequence[str]) -> 
     return out
 
 
+# the acquisitions table's columns: heading, and the acquisition's key (None: built apart)
+_ACQUISITION_COLUMNS = (("acquired (UTC)", None), ("platform", "platform"), ("instrument", "instrument"),
+                        ("band", "band_name"), ("GSD (m)", "gsd_m"), ("level", "level"), ("product", "product_id"),
+                        ("site", "site"), ("file", None), ("SHA-256", None), ("edges", None),
+                        ("MTF at Nyquist [95 % interval]", None))
+
+
+def _mtf(value) -> str:
+    return "" if value is None else f"{value:.4f}"
+
+
+def _result_line(row: Mapping) -> str:
+    """One result of an acquisition: where, which direction, how, its MTF at Nyquist."""
+    where = f"target {row['target_id']}" if row.get("target_id") is not None else _text(row.get("scope"))
+    interval = (f" [{_mtf(row.get('mtf_nyquist_ci_low'))}, {_mtf(row.get('mtf_nyquist_ci_high'))}]"
+                if row.get("mtf_nyquist_ci_low") is not None else "")
+    misfit = " <strong>misfit</strong>" if row.get("misfit") else ""
+    direction = _text(row.get("direction"))
+    if row.get("direction") not in ("across-track", "along-track") and row.get("normal_angle_deg") is not None:
+        direction += f" {row['normal_angle_deg']:.1f} deg"
+    return (f'<span class="time">{where}, {direction}, {_text(row.get("method"))}: '
+            f"{_mtf(row.get('mtf_nyquist'))}{interval}{misfit}</span>")
+
+
 def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: list[dict]) -> list[str]:
     out = ["<h2>Acquisitions</h2>"]
     if not acquisitions:
         return [*out, '<p class="note">The store holds no acquisition.</p>']
-    head = ("acquired (UTC)", "platform", "instrument", "band", "GSD (m)", "level", "product", "file",
-            "SHA-256", "edges", "results (MTF at Nyquist)")
-    out.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
+    # a fact no acquisition knows gets no column
+    columns = [(h, k) for h, k in _ACQUISITION_COLUMNS if k is None or any(a.get(k) is not None for a in acquisitions)]
+    out.append("<table><tr>" + "".join(f"<th>{h}</th>" for h, _ in columns) + "</tr>")
     ordered = sorted(acquisitions, key=lambda a: (a.get("acquired_utc") or "~", a.get("path") or ""))
     figures = []
     for a in ordered:
         ident = a["acquisition_id"]
         mine = [t for t in points if t.get("acquisition_id") == ident]
-        results = "<br>".join(
-            f"{_text(t.get('scope'))} {_text(t.get('target_id'))} {_text(t.get('direction'))} "
-            f"{_text(t.get('method'))}: {_text(t.get('mtf_nyquist'))}"
-            + (f" [{_text(t.get('mtf_nyquist_ci_low'))}, {_text(t.get('mtf_nyquist_ci_high'))}]"
-               if t.get("mtf_nyquist_ci_low") is not None else "")
-            + (' <strong>misfit</strong>' if t.get("misfit") else "")
-            for t in mine)
-        n_edges = sum(e.get("acquisition_id") == ident for e in edges)
         when = _when(a.get("acquired_utc")) or "<em>no time</em>"
         source = json.loads(a["sources"]).get("acquired_utc") if a.get("sources") else None
         if source and a.get("acquired_utc"):
             when += f'<br><span class="note">from {html.escape(source)}</span>'
-        cells = [when, _text(a.get("platform")), _text(a.get("instrument")), _text(a.get("band_name")),
-                 _text(a.get("gsd_m")), _text(a.get("level")), _text(a.get("product_id")),
-                 f"<code>{_text(a.get('path'))}</code>", f"<code>{_text((a.get('sha256') or '')[:12])}</code>",
-                 str(n_edges), results]
-        out.append(f'<tr><td class="time">{cells[0]}</td>' + "".join(f"<td>{c}</td>" for c in cells[1:]) + "</tr>")
+        path = str(a.get("path") or "")
+        built = {"acquired (UTC)": f'<td class="time">{when}</td>',
+                 "file": f'<td title="{html.escape(path)}"><code>{html.escape(Path(path).name)}</code></td>',
+                 "SHA-256": f"<td><code>{_text((a.get('sha256') or '')[:12])}</code></td>",
+                 "edges": f'<td class="num">{sum(e.get("acquisition_id") == ident for e in edges)}</td>',
+                 "MTF at Nyquist [95 % interval]": "<td>" + "<br>".join(_result_line(t) for t in mine) + "</td>"}
+        out.append("<tr>" + "".join(built[h] if k is None else f"<td>{_text(a.get(k))}</td>" for h, k in columns)
+                   + "</tr>")
         figures.append(_acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine))
     out.append("</table>")
     shown = [f for f in figures[::-1] if f][:MAX_ACQUISITIONS_WITH_FIGURES][::-1]     # the latest

@@ -147,8 +147,7 @@ def write_acquisition(store_path: str | Path, acquisition: Acquisition, edges: S
             "edges": [_edge_row(acquisition, r, geo) for r in edges],
             "targets": [_target_row(acquisition, r, geo) for r in targets]}
     ensure_store(store)
-    folder = store.parent if str(store.parent) else Path(".")
-    with tempfile.TemporaryDirectory(prefix=".imgmtf-store-", dir=_writable(folder, store)) as scratch:
+    with _scratch(store) as scratch:
         staged = Path(scratch) / "rows.gpkg"
         _write_layers(staged, rows)
         _retrying(store, lambda: _replace_rows(store, staged, acquisition.acquisition_id))
@@ -167,8 +166,7 @@ def ensure_store(store_path: str | Path) -> None:
     store = Path(store_path)
     if store.exists():
         return
-    folder = store.parent if str(store.parent) else Path(".")
-    with tempfile.TemporaryDirectory(prefix=".imgmtf-store-", dir=_writable(folder, store)) as scratch:
+    with _scratch(store) as scratch:
         fresh = Path(scratch) / "new.gpkg"
         _write_layers(fresh, {layer: [] for layer in LAYERS})
         _write_info(fresh)
@@ -357,10 +355,14 @@ def _write_info(path: Path) -> None:
                           for k, v in items.items()])
 
 
-def _writable(folder: Path, store: Path) -> str:
-    if not folder.is_dir():
-        raise FileWriteError(f"{store}: cannot write: folder {folder} does not exist")
-    return str(folder)
+def _scratch(store: Path) -> tempfile.TemporaryDirectory:
+    """A temporary folder beside the store (one file system: the new store is linked from it)."""
+    if not store.parent.is_dir():
+        raise FileWriteError(f"{store}: cannot write: folder {store.parent} does not exist")
+    try:
+        return tempfile.TemporaryDirectory(prefix=".imgmtf-store-", dir=store.parent)
+    except OSError as exc:
+        raise FileWriteError(f"{store}: cannot write in {store.parent}: {exc.strerror or exc}") from None
 
 
 def _connect(store: Path) -> sqlite3.Connection:

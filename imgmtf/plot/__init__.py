@@ -1,8 +1,8 @@
 """Figures, one module per subject: the sensor model, a measurement, a sensor
-fit, a scene scan, a campaign's trends, a restoration and the paper's study.  Each
-function draws on ``ax`` (a new figure when None) and returns the figure; nothing
-here touches pyplot's global state, so the figures render with the Agg canvas
-whatever the session's backend."""
+fit, a scene scan, a campaign's trends, a restoration and the paper's study.
+Each function draws on ``ax`` (a new figure when None) and returns the figure;
+nothing here touches pyplot's global state, so the figures render with the Agg
+canvas whatever the session's backend."""
 from .campaign import plot_campaign, plot_trend
 from .fit import plot_fit, plot_fit_edge, plot_fit_residuals
 from .measurement import plot_locations, plot_lsf, plot_measurement, plot_mtf, plot_profile
