@@ -29,8 +29,8 @@ def t_quantile(probability: float, dof: int) -> float:
     ParameterError
         ``probability`` outside (0, 1) or ``dof`` not a positive integer.
 
-    Example
-    -------
+    Examples
+    --------
     >>> round(t_quantile(0.975, 10), 6)
     2.228139
     """

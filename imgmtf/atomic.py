@@ -45,8 +45,8 @@ def atomic_output(path: str | Path, *, keep_partial: bool = False) -> Iterator[s
     FileWriteError
         The folder does not exist or is not writable, or the rename fails.
 
-    Example
-    -------
+    Examples
+    --------
     >>> with atomic_output("summary.csv") as partial:   # doctest: +SKIP
     ...     Path(partial).write_text("a,b\\n1,2\\n")
     """

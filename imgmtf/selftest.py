@@ -88,8 +88,8 @@ def run_selftest(sensor: Sensor = Sensor(), size_px: int = 100, method: str = "m
     ParameterError
         An unknown method or a bad size.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> rows = imgmtf.run_selftest()
     >>> all(row.ok for row in rows), rows[0].name

@@ -121,8 +121,8 @@ def acquisition_id(sha256: str, band, settings: dict) -> str:
     """The stable identity of a file's band measured with ``settings``: the
     first 16 hex digits of the SHA-256 of all three (settings as sorted JSON).
 
-    Example
-    -------
+    Examples
+    --------
     >>> acquisition_id("ab" * 32, 1, {"method": "ESF"})
     'b922266771bf3903'
     """

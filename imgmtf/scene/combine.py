@@ -50,8 +50,8 @@ def normal_families(normals_deg) -> np.ndarray:
     ``FAMILY_SPREAD_DEG`` of each other, families separated by gaps of at
     least ``FAMILY_GAP_DEG`` where the normals allow.
 
-    Example
-    -------
+    Examples
+    --------
     >>> normal_families([16.8, -73.2, 17.1, 106.9, 45.0]).tolist()
     [0, 1, 0, 1, 2]
     """
@@ -103,8 +103,8 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
     ValueError
         No finite value to combine.
 
-    Example
-    -------
+    Examples
+    --------
     >>> c = combine([0.26, 0.27], [(0.25, 0.27), (0.25, 0.29)], [40, 40])
     >>> round(c.value, 4), c.weights
     (0.262, 'inverse-variance')
@@ -161,8 +161,8 @@ def summarise_scan(records: list[Record]) -> list[Record]:
     ParameterError
         ``records`` is not a collection of Records.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.scene.measure import scan_scene                   # doctest: +SKIP
     >>> [(r.site["scope"], r.figures["direction"], r.figures["mtf50_cy_px"])
     ...  for r in summarise_scan(scan_scene("baotou.tif"))]                 # doctest: +SKIP
@@ -201,8 +201,8 @@ def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray |
     interval's half-width over its Student-t quantile (``rows`` - 1
     degrees of freedom); None when an interval is missing or empty.
 
-    Example
-    -------
+    Examples
+    --------
     >>> w = precision_weights([(0.25, 0.27), (0.25, 0.29)], [40, 40])
     >>> round(float(w[0] / w[1]), 3)                 # half the width: four times the weight
     4.0

@@ -59,8 +59,8 @@ class Segment:
     orientation (its gradient on one hand).  ``width_px`` is 0 for an edge
     and the separation of its sides for a bar.
 
-    Example
-    -------
+    Examples
+    --------
     >>> s = Segment(10.0, 0.0, 12.0, 80.0)
     >>> round(s.length_px, 2), round(s.tilt_deg, 2), round(s.normal_angle_deg, 2)
     (80.02, 1.43, -1.43)
@@ -288,8 +288,8 @@ def merge_segments(pieces: np.ndarray) -> np.ndarray:
     length-weighted centre, along their mean direction, spanning all their
     ends.  Returns the segments (rows), longest first.
 
-    Example
-    -------
+    Examples
+    --------
     >>> merged = merge_segments(np.array([[10, 0, 11, 40], [11.1, 42, 12.2, 80], [30, 0, 30.5, 50]], float))
     >>> len(merged), round(float(np.hypot(*(merged[0, 2:] - merged[0, :2]))))
     (2, 80)
@@ -526,8 +526,8 @@ def pair_bars(segments: list[Segment]) -> tuple[list[int], list[tuple[int, int, 
     its two sides and the bar as one segment along its centre line (over
     their overlap) with ``width_px`` the separation.
 
-    Example
-    -------
+    Examples
+    --------
     >>> lone, bars = pair_bars([Segment(10, 0, 12, 80), Segment(13, 0, 15, 80), Segment(40, 0, 41, 80)])
     >>> lone, [(i, j, round(bar.width_px, 2)) for i, j, bar in bars]
     ([2], [(0, 1, 3.0)])

@@ -37,8 +37,8 @@ def to_geojson(records: Sequence[Record], info: RasterInfo, summaries: Sequence[
     ``imgmtf_coordinates`` member says so).  Every feature's properties
     carry the pixel coordinates and the record's figures.
 
-    Example
-    -------
+    Examples
+    --------
     >>> geo = to_geojson(records, raster_info("scene.tif"), summarise_scan(records))   # doctest: +SKIP
     >>> geo["features"][0]["geometry"]["type"]                                      # doctest: +SKIP
     'LineString'

@@ -29,8 +29,8 @@ def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
     differ from it by more than ``FILL_BOUNDARY`` of the window's contrast,
     where a dark side clipped at 0 meets values close to 0.
 
-    Example
-    -------
+    Examples
+    --------
     >>> w = np.full((20, 20), 900.0); w[:, :6] = 300.0; w[:, 12:] = 0.0
     >>> int(fill_mask(w, "uint16").sum())
     160

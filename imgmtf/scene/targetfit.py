@@ -118,8 +118,8 @@ def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon) -> np.nda
     in the scene) whose centres lie inside a convex ``polygon`` (corners x,
     y in scene pixels, in either order round it).
 
-    Example
-    -------
+    Examples
+    --------
     >>> roi_mask((3, 4), (10, 20), [[10, 20], [12, 20], [12, 22], [10, 22]]).sum()
     np.int64(9)
     """

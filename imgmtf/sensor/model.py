@@ -84,8 +84,8 @@ class Sensor:
         that is not one of the above, both ``stages`` and keywords, or no
         stage at all.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf import Sensor
     >>> round(Sensor().mtf_nyquist("across"), 4)
     0.2665
@@ -409,8 +409,8 @@ class SampledPSF:
     step_m : float
         The sample spacing, metres on the ground.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf import Sensor
     >>> psf = Sensor().psf(oversampling=10)
     >>> psf.step_m, round(float(psf.data.sum()), 6), psf.data.shape[0] % 2

@@ -30,8 +30,8 @@ class GroundNoise:
         ``layers`` not a positive integer, or a negative or non-finite
         variance.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> from imgmtf import GroundNoise
     >>> field = GroundNoise().sample((400, 400), np.random.default_rng(0))   # sub-pixel cells

@@ -60,8 +60,8 @@ class Chip:
     clipped_fraction : float
         Fraction of pixels that hit 0 or the top of the range.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100)
     >>> round(float(chip.true_mtf(0.5)), 4), round(chip.true_mtf50_cy_px(), 4), round(chip.true_fwhm_px(), 4)
@@ -144,8 +144,8 @@ class Renderer:
         A bad size, depth, oversampling or GSD, or a sensor whose blur would
         need more than 16 M grid cells at this GSD.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.Renderer(imgmtf.Sensor(), 40)(imgmtf.Target("edge", 6.0))
     >>> chip.image.shape, chip.image.dtype.name
@@ -274,8 +274,8 @@ def render(sensor: Sensor, target: Target, shape: int | tuple[int, int] = 50, *,
         A bad sensor, target, size, depth, oversampling, GSD, noise level
         or seed.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100, noise_std_dn=5.0, seed=1)
     >>> chip.image.shape, chip.image.dtype.name, round(float(chip.true_mtf(0.5)), 4)

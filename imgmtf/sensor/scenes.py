@@ -107,8 +107,8 @@ def texture(shape: tuple[int, int], std_dn: float, seed: int | None = None,
     Gaussian-smoothed white noise at each of ``scales_px`` (smoothing
     sigma, px), equally strong, summed.
 
-    Example
-    -------
+    Examples
+    --------
     >>> t = texture((64, 64), 100.0, seed=1)
     >>> t.shape, round(float(t.std()))
     ((64, 64), 100)
@@ -150,8 +150,8 @@ def render_quadrants(sensor: Sensor, shape: tuple[int, int], target: QuadrantTar
     ParameterError
         A bad shape, field or noise level.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
     >>> scene = render_quadrants(imgmtf.Sensor(), (101, 101), QuadrantTarget((50.0, 50.0)), fill=True)

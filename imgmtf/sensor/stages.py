@@ -26,8 +26,8 @@ one class in this file with the :func:`register` decorator; the fit
 (:mod:`imgmtf.estimate.fit`) reads what it needs to fit it from the fields'
 ``FitSpec`` metadata.
 
-Example
--------
+Examples
+--------
 >>> from imgmtf.sensor.stages import GaussianOptics, stage_from_dict
 >>> optics = GaussianOptics(sigma_x_m=0.39, sigma_y_m=0.39)
 >>> round(float(optics.transfer(0.5, 0.0, 1.0)), 4)
@@ -176,8 +176,8 @@ def stage_from_dict(values: dict) -> Stage:
         Not a table, an unknown stage name, unknown parameters or bad
         values (each named).
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import stage_from_dict
     >>> stage_from_dict({"stage": "detector", "width_x_m": 1.0, "width_y_m": 1.0})
     Detector(width_x_m=1.0, width_y_m=1.0)
@@ -212,8 +212,8 @@ class GaussianOptics(Stage):
     ParameterError
         A parameter that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import GaussianOptics
     >>> round(float(GaussianOptics(0.39, 0.39).transfer(0.5, 0.0, 1.0)), 4)   # at 0.5 cy/m across
     0.4721
@@ -249,8 +249,8 @@ class Detector(Stage):
     ParameterError
         A parameter that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Detector
     >>> round(float(Detector(1.0, 1.0).transfer(0.5, 0.0, 1.0)), 4)         # 2 / pi at Nyquist
     0.6366
@@ -285,8 +285,8 @@ class Motion(Stage):
     ParameterError
         A parameter that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Motion
     >>> stage = Motion(0.25)
     >>> float(stage.transfer(0.5, 0.0, 1.0)), round(float(stage.transfer(0.0, 0.5, 1.0)), 4)
@@ -322,8 +322,8 @@ class Electronics(Stage):
     ParameterError
         A cut-off that is not > 0 or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Electronics
     >>> round(float(Electronics(1.4).transfer(0.5, 0.0, 1.0)), 4)
     0.8869
@@ -375,8 +375,8 @@ class Diffraction(Stage):
     ParameterError
         A parameter that is not > 0 or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Diffraction
     >>> stage = Diffraction(f_number=8.0, wavelength_m=550e-9, pixel_pitch_m=5e-6)
     >>> round(stage.cutoff_cy_m(gsd_m=1.0), 4)                   # cy/m on the ground at a 1 m GSD
@@ -431,8 +431,8 @@ class Defocus(Stage):
     ParameterError
         A radius that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Defocus
     >>> round(float(Defocus(0.5).transfer(0.5, 0.0, 1.0)), 4)
     0.7217
@@ -468,8 +468,8 @@ class OLPF(Stage):
     ParameterError
         A split that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import OLPF
     >>> round(float(OLPF(1.0).transfer(0.5, 0.0, 1.0)), 12)      # a 1-px split nulls Nyquist
     0.0
@@ -506,8 +506,8 @@ class Jitter(Stage):
     ParameterError
         A parameter that is negative, not finite or not a number.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf.sensor.stages import Jitter
     >>> round(float(Jitter(0.0, 0.2).transfer(0.0, 0.5, 1.0)), 4)
     0.8209

@@ -57,8 +57,8 @@ class Target:
         An unknown kind, a value that is not a finite number, an angle
         outside (-90, 90], a pulse without width or an edge with one.
 
-    Example
-    -------
+    Examples
+    --------
     >>> from imgmtf import Target
     >>> Target("pulse", angle_deg=84.0, width_px=1.5).kind
     'pulse'
