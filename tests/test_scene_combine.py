@@ -1,4 +1,5 @@
 """Combining half-edges: precision weights, disagreement, direction families."""
+import dataclasses
 import math
 
 import numpy as np
@@ -81,10 +82,15 @@ def test_one_summary_per_target_and_direction_and_per_scene():
     assert first.figures["rer"] is None and "fwhm_m" not in first.figures      # none given, no GSD
 
 
-def test_the_combined_curve_weights_each_curve_as_its_nyquist_interval_earns():
-    from imgmtf.scene.combine import combined_curve
-    curves = [[1.0, 0.5, math.nan], [1.0, 0.3, 0.2]]
-    out = combined_curve(curves, [interval(0.5, 0.01, 30), interval(0.3, 0.02, 30)], [30, 30])
-    assert out == pytest.approx([1.0, (4 * 0.5 + 0.3) / 5, 0.2])      # a masked value leaves the other
-    equal = combined_curve(curves, [(math.nan, math.nan)] * 2, [30, 30])
-    assert equal[1] == pytest.approx(0.4)
+def test_the_summary_curve_weights_each_curve_as_its_nyquist_interval_earns():
+    def with_curve(record, curve):
+        return dataclasses.replace(record, figures={**record.figures, "frequencies_cy_px": [0.0, 0.25, 0.5],
+                                                    "mtf": curve})
+
+    weighted = [with_curve(edge(1, 5.0, 0.5, 0.01, 1), [1.0, 0.5, None]),      # a bar's masked frequency
+                with_curve(edge(2, 6.0, 0.3, 0.02, 1), [1.0, 0.3, 0.2])]
+    summary = summarise_scan(weighted)[0]
+    assert summary.figures["frequencies_cy_px"] == [0.0, 0.25, 0.5]
+    assert summary.figures["mtf"] == pytest.approx([1.0, (4 * 0.5 + 0.3) / 5, 0.2])   # a masked value leaves the other
+    plain = [dataclasses.replace(r, figures={**r.figures, "mtf_nyquist_ci": [None, None]}) for r in weighted]
+    assert summarise_scan(plain)[0].figures["mtf"][1] == pytest.approx(0.4)     # no intervals: equal weights

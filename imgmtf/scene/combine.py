@@ -216,14 +216,6 @@ def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray |
     return 1.0 / sd ** 2
 
 
-def combined_curve(curves, intervals, rows, confidence: float = 0.95) -> np.ndarray:
-    """The MTF curves of several half-edges (rows of ``curves``, on one
-    frequency grid) averaged with the weights their MTF at Nyquist earned
-    (:func:`precision_weights` of its ``intervals``; equal without them),
-    NaN-aware (a bar's masked frequencies)."""
-    return _weighted_average(curves, precision_weights(intervals, rows, confidence))
-
-
 def _weighted_average(values, weights) -> np.ndarray:
     """Mean over the first axis of ``values`` (None or NaN where a half-edge
     has none) with ``weights`` (equal when None); NaN where none is finite."""
