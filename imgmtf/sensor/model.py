@@ -420,12 +420,6 @@ class SampledPSF:
     data: np.ndarray
     step_m: float
 
-    @property
-    def coordinates_m(self) -> np.ndarray:
-        """Positions of the samples along either axis, metres from the origin."""
-        n = self.data.shape[0]
-        return (np.arange(n) - n // 2) * self.step_m
-
 
 def direction_angle(direction: str) -> float:
     """Angle (deg from the column axis) of the edge whose normal points in
