@@ -8,7 +8,7 @@ Corrections applied (each divides the measured modulus):
 * central difference, LSF_i = (E_(i+1) - E_(i-1)) / (2 D):
   transfer sin(2 pi f D) / (2 pi f D) = sinc(2 f D);
 * the resampling method's own blur, its transfer H_method(f)
-  (:mod:`imgmtf.resampling`): sinc(f B) for bins of B px, the equivalent
+  (:mod:`imgmtf.estimate.resampling`): sinc(f B) for bins of B px, the equivalent
   kernel of a local polynomial, 1 / (1 + (f / f_c)^4) for the spline;
 * the LSF window is flat (1) over the LSF's core and only tapers beyond
   it, so it needs no correction; it removes the noise of the flat tails.
