@@ -35,9 +35,12 @@ def write_campaign(folder: str | Path, campaign: SyntheticCampaign | None = None
 
     Parameters
     ----------
-    folder : the output folder.
-    campaign : what to render (default: six yearly acquisitions).
-    platform, instrument, band_name : written in each file's tags.
+    folder : str or pathlib.Path
+        The output folder.
+    campaign : SyntheticCampaign, optional
+        What to render (default: six yearly acquisitions).
+    platform, instrument, band_name : str, optional
+        Written in each file's tags (default "SYNTHSAT-1", "PAN", "PAN").
 
     Returns
     -------

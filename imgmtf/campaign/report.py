@@ -80,12 +80,13 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     baseline : str or pathlib.Path, optional
         A sensor TOML whose across- and along-track MTF at Nyquist are the
         pre-launch values drawn against those directions.
-    confidence : float
-        Of the drift intervals.
+    confidence : float, optional
+        Confidence level of the drift intervals (default 0.95).
 
     Returns
     -------
     ReportFiles
+        The paths of ``trend.csv`` and ``report.html``, and the drifts found.
 
     Raises
     ------

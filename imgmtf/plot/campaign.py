@@ -36,11 +36,13 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
         The drift fitted to them, drawn as a line with its slope per year.
     requirement, baseline : float, optional
         The requirement and the pre-launch value (horizontal lines).
-    ax : matplotlib Axes, optional
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
 
     Returns
     -------
     matplotlib.figure.Figure
+        The figure holding ``ax``.
 
     Raises
     ------

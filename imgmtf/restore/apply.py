@@ -268,14 +268,21 @@ def restore_file(path: str | Path, restoration, out: str | Path, *, tile_px: int
     saturation : (float, float), optional
         DN levels at or beyond which input pixels are kept as they were
         (default: an integer type's range; none for floats).
-    workers, scheduler, progress
-        As :func:`imgmtf.parallel.run_tasks`.
+    workers : int, optional
+        Local worker processes (default 1: none, the work runs here).
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"`` for a local
+        Dask cluster (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show a progress bar on stderr (default: when stderr is a terminal).
     run_utc : str, optional
         The run's start (UTC, ISO 8601) for the provenance tag.
 
     Returns
     -------
     RestoredFile
+        What was written: the output's path, size, type, tiles and the
+        fractions of pixels clipped, saturated or without data.
 
     Raises
     ------

@@ -243,6 +243,7 @@ def design_filter(sensor: Sensor, target_nyquist: float, *, noise_std_dn: float 
     Returns
     -------
     RestorationFilter
+        The filter: its kernel (``taps``) and the regulariser it took.
 
     Raises
     ------

@@ -19,7 +19,31 @@ GSD_TOLERANCE = 1e-3
 @dataclass(frozen=True, eq=False)
 class Restoration:
     """What :func:`restore_image` did: the filter, its figures of merit,
-    the file written, where the noise figures came from and any warnings."""
+    the file written, where the noise figures came from and any warnings.
+
+    Attributes
+    ----------
+    filter : RestorationFilter
+        The filter designed (:func:`imgmtf.design_filter`).
+    report : RestorationReport
+        Its figures of merit per axis (:func:`imgmtf.restoration_report`).
+    file : RestoredFile
+        The file written (:func:`imgmtf.restore_file`).
+    noise_source : str
+        ``"measured"`` (from the image), ``"given"`` or ``"given and measured"``.
+    warnings : tuple of str
+        What the caller should know (a file's GSD unlike the sensor's).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> sensor = imgmtf.Sensor()
+    >>> imgmtf.write_geotiff("edge.tif", imgmtf.render(sensor, imgmtf.Target("edge", 6.0), 64).image)
+    >>> done = imgmtf.restore_image("edge.tif", sensor, "sharp.tif", target_nyquist=0.35,
+    ...                             noise_std_dn=1.0, signal_std_dn=100.0)
+    >>> done.noise_source, done.file.out, done.warnings
+    ('given', 'sharp.tif', ())
+    """
 
     filter: RestorationFilter
     report: RestorationReport
@@ -45,25 +69,47 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
 
     Parameters
     ----------
-    path, out : str or pathlib.Path
-        The image (anything GDAL reads) and the GeoTIFF to write.
+    path : str or pathlib.Path
+        The image (anything GDAL reads).
     sensor : Sensor
         The system to compensate (``imgmtf fit --out``).
-    target_nyquist, max_noise_gain, kernel_size
-        As :func:`imgmtf.design_filter`.
+    out : str or pathlib.Path
+        The GeoTIFF to write.
+    target_nyquist : float
+        The restored MTF at Nyquist (0.5 cy/px), in (0, 1]
+        (:func:`imgmtf.design_filter`).
     noise_std_dn, signal_std_dn : float, optional
         The noise and the scene's contrast (DN); each measured from the
         first band's central window when not given
         (:func:`imgmtf.restore.apply.measure_noise`).
+    max_noise_gain : float, optional
+        Upper bound (>= 1) of the filter's white-noise gain
+        (:func:`imgmtf.design_filter`).
+    kernel_size : int, optional
+        Side (odd, 3 to 63 px) of a spatial kernel; None for the FFT form.
     gsd_m : float, optional
         The image's pixel, m (default the file's, else the sensor's); a
         file's GSD that differs from the sensor's is warned about.
-    tile_px, saturation, workers, scheduler, progress, run_utc
-        As :func:`imgmtf.restore_file`.
+    tile_px : int, optional
+        Tile side, px (64 to 2048; :func:`imgmtf.restore_file`).
+    saturation : (float, float), optional
+        DN levels at or beyond which input pixels are kept as they were
+        (default: an integer type's range; none for floats).
+    workers : int, optional
+        Local worker processes (default 1: none, the work runs here).
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"`` for a local
+        Dask cluster (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show a progress bar on stderr (default: when stderr is a terminal).
+    run_utc : str, optional
+        The run's start (UTC, ISO 8601) for the provenance tag.
 
     Returns
     -------
     Restoration
+        The filter, its figures of merit, the file written and where the
+        noise figures came from.
 
     Raises
     ------

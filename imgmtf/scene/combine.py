@@ -82,11 +82,15 @@ def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
 
     Parameters
     ----------
-    values : the estimates.
-    intervals : their (low, high) confidence intervals (NaN when none).
-    rows : the rows each estimate used (the degrees of freedom of its
+    values : sequence of float
+        The estimates (NaN for none).
+    intervals : sequence of (float, float)
+        Their (low, high) confidence intervals (NaN when none).
+    rows : sequence of int
+        The rows each estimate used (the degrees of freedom of its
         Student-t interval).
-    confidence : the intervals' confidence, and the combined one's.
+    confidence : float, optional
+        The intervals' confidence, and the combined one's (default 0.95).
 
     Returns
     -------

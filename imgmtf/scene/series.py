@@ -82,18 +82,32 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
 
     Parameters
     ----------
-    paths : the scenes.
-    settings : how to scan (:class:`imgmtf.scene.settings.ScanSettings`).
-    stages : the stages fitted to each target's half-edges (None: no fit).
-    store : a campaign GeoPackage (created when missing): each scene's
+    paths : sequence of str
+        The scenes.
+    settings : ScanSettings, optional
+        How to scan (:class:`imgmtf.ScanSettings`; default its defaults).
+    stages : str, optional
+        The stages fitted to each target's half-edges, comma-separated
+        (default "optics,detector"; None: no fit).
+    store : str, optional
+        A campaign GeoPackage (created when missing): each scene's
         accepted half-edges and its summaries, written in one transaction
         as the scene completes (:func:`imgmtf.campaign.store.write_acquisition`).
-    facts : what the files may not say, for every scene: ``acquired``,
+    facts : mapping of str to str, optional
+        What the files may not say, for every scene: ``acquired``,
         ``platform``, ``instrument``, ``band_name``
         (:func:`imgmtf.campaign.acquisitions.read_acquisition`).
-    workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
-    figures_dirs : scene -> a folder for its accepted half-edges' figures.
-    overviews : scene -> where its overview figure is written (by
+    workers : int, optional
+        Local worker processes (default 1: none, the work runs here).
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"`` for a local
+        Dask cluster (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show a progress bar on stderr (default: when stderr is a terminal).
+    figures_dirs : mapping of str to str, optional
+        Scene -> a folder for its accepted half-edges' figures.
+    overviews : mapping of str to str, optional
+        Scene -> where its overview figure is written (by
         :func:`imgmtf.scene.export.write_outputs`), recorded with its
         acquisition so that a campaign report shows it.
 

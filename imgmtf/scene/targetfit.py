@@ -52,8 +52,14 @@ def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES, workers: i
     stages : str or list of str
         The stages fitted (:func:`imgmtf.fit_sensor`), default
         "optics,detector".
-    workers, scheduler, progress
-        As for :func:`imgmtf.parallel.run_tasks`: one fit per task.
+    workers : int, optional
+        Local worker processes (default 1: none, the work runs here);
+        one fit per task.
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"`` for a local
+        Dask cluster (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show a progress bar on stderr (default: when stderr is a terminal).
 
     Returns
     -------

@@ -71,11 +71,13 @@ class Sensor:
     stages : sequence of Stage, optional
         The chain (:mod:`imgmtf.sensor.stages`).  Without it the paper's
         four stages are built from the keywords below.
-    optics_sigma_x_m, optics_sigma_y_m, detector_width_x_m, detector_width_y_m, motion_m : float
-        The generic sensor's parameters, metres (default 0.39, 0.39, 1, 1,
-        0.25); a stage whose parameters are all 0 is left out.
-    electronics_cutoff_cy_m : float
-        Butterworth cut-off D0, cycles per metre (default 1.4; 0 for none).
+    **keywords : float
+        The generic sensor's parameters: ``optics_sigma_x_m``,
+        ``optics_sigma_y_m``, ``detector_width_x_m``, ``detector_width_y_m``
+        and ``motion_m``, metres (default 0.39, 0.39, 1, 1, 0.25), and
+        ``electronics_cutoff_cy_m``, the Butterworth cut-off D0, cycles per
+        metre (default 1.4; 0 for none); a stage whose parameters are all 0
+        is left out.
 
     Raises
     ------

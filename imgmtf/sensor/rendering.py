@@ -117,7 +117,8 @@ class Renderer:
 
     Each pixel is the sensor's exact edge response along the target's
     normal at the pixel centre's distance from it (no scene grid, no
-    border), plus noise, rounded and clipped to ``bits``.
+    border), plus noise, rounded and clipped to ``bits``.  Calling it takes
+    the target and, keyword-only, the noise and its seed (:meth:`__call__`).
 
     Parameters
     ----------
@@ -133,10 +134,6 @@ class Renderer:
         field (default 20).
     bits : {8, 16}, optional
         The output integer depth (default 16).
-
-    Calling it takes the target and, keyword-only, ``noise_std_dn``
-    (white system noise, DN), ``ground_noise`` (a :class:`GroundNoise`)
-    and ``seed`` (an integer >= 0, for reproducible noise).
 
     Raises
     ------
@@ -182,6 +179,30 @@ class Renderer:
 
     def __call__(self, target: Target, *, noise_std_dn: float = 0.0,
                  ground_noise: GroundNoise | None = None, seed: int | None = None) -> Chip:
+        """Render ``target`` into a chip.
+
+        Parameters
+        ----------
+        target : Target
+            The edge or bar.
+        noise_std_dn : float, optional
+            White system noise added after sampling, DN (default 0).
+        ground_noise : GroundNoise, optional
+            Ground noise added to the scene before the PSF.
+        seed : int, optional
+            Seed of the noise (>= 0), for a reproducible chip.
+
+        Returns
+        -------
+        Chip
+            The image and how it was made, with its true MTF.
+
+        Raises
+        ------
+        ParameterError
+            A bad target, noise level or seed, or a ground-noise grid over
+            the size limit.
+        """
         if not isinstance(target, Target):
             raise ParameterError(f"target must be an imgmtf.Target, got {target!r}")
         if ground_noise is not None and not isinstance(ground_noise, GroundNoise):

@@ -130,20 +130,28 @@ def render_quadrants(sensor: Sensor, shape: tuple[int, int], target: QuadrantTar
 
     Parameters
     ----------
-    sensor : the sensor (its GSD is the pixel size).
-    shape : (rows, cols) of the image.
-    target : the target.
-    field_dn : the field around the target: a level (DN) or an image of
-        ``shape`` (a :func:`texture` plus a level), already as blurred as
+    sensor : Sensor
+        The sensor (its GSD is the pixel size).
+    shape : (int, int)
+        The image's (rows, cols), px.
+    target : QuadrantTarget
+        The target.
+    field_dn : float or numpy.ndarray, optional
+        The field around the target: a level (DN, default 3000) or an image
+        of ``shape`` (a :func:`texture` plus a level), already as blurred as
         it should look.
-    fill : set every pixel whose centre lies outside the target's square
-        to 0, as an L0R product cuts a target out of its scene.
-    noise_std_dn : white system noise (DN), added before rounding.
-    seed : the noise's seed.
+    fill : bool, optional
+        Set every pixel whose centre lies outside the target's square to 0,
+        as an L0R product cuts a target out of its scene (default False).
+    noise_std_dn : float, optional
+        White system noise (DN), added before rounding (default 0).
+    seed : int, optional
+        The noise's seed.
 
     Returns
     -------
     QuadrantScene
+        The 16-bit image with the target and sensor it was rendered from.
 
     Raises
     ------
