@@ -92,6 +92,13 @@ class Acquisition:
         campaign report shows beside the acquisition.
     imgmtf_version, run_utc : str
         Provenance of the run.
+
+    Examples
+    --------
+    >>> from imgmtf.campaign.acquisitions import Acquisition
+    >>> a = Acquisition("a1", "scene.tif", "00", "2024-05-01", platform="SYNTHSAT-1", gsd_m=2.0)
+    >>> a.platform, a.acquired_utc, a.band
+    ('SYNTHSAT-1', '2024-05-01', None)
     """
 
     acquisition_id: str

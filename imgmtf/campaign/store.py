@@ -184,12 +184,33 @@ def read_layer(store_path: str | Path, layer: str) -> list[dict[str, Any]]:
 
     A store of an older schema reads too: the columns it lacks are None.
 
+    Parameters
+    ----------
+    store_path : str or pathlib.Path
+        The campaign store (a GeoPackage).
+    layer : str
+        One of :data:`LAYERS`: ``acquisitions``, ``edges`` or ``targets``.
+
+    Returns
+    -------
+    list of dict
+        One per row, in the store's order.
+
     Raises
     ------
     StoreError
         The file is missing or is not a campaign store.
     ParameterError
         ``layer`` is not one of :data:`LAYERS`.
+
+    Examples
+    --------
+    >>> from imgmtf.campaign.acquisitions import Acquisition
+    >>> from imgmtf.records import Record
+    >>> chip = Record("edge.tif", 1, "edge", "ESF", "ok", figures={"mtf_nyquist": 0.21, "roi": [0, 0, 64, 64]})
+    >>> write_acquisition("site.gpkg", Acquisition("a1", "edge.tif", "00", "2024-05-01"), [chip], [])
+    >>> [row["acquired_utc"] for row in read_layer("site.gpkg", "acquisitions")]
+    ['2024-05-01']
     """
     import fiona
     from fiona.errors import FionaError

@@ -226,6 +226,14 @@ class RestoredFile:
         Fraction of the pixels that are nodata (kept).
     input_sha256 : str
         The input file's SHA-256.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> imgmtf.write_geotiff("edge.tif", imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100).image)
+    >>> done = imgmtf.restore_file("edge.tif", imgmtf.design_filter(imgmtf.Sensor(), 0.3), "restored.tif")
+    >>> done.out, (done.width, done.height), done.bands, done.clipped_fraction
+    ('restored.tif', (100, 100), (1,), 0.0)
     """
 
     path: str
