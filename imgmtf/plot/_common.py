@@ -2,10 +2,11 @@
 when none are, a title that defers to the caller's."""
 from __future__ import annotations
 
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
 
 
-def expect(value, kind: str) -> None:
+def expect(value: object, kind: str) -> None:
     """Refuse, with a ParameterError, a ``value`` that is not what the figure
     draws: a measurement ("result"), a sensor ("sensor") or a fit ("fit")."""
     from ..errors import ParameterError
@@ -19,7 +20,7 @@ def expect(value, kind: str) -> None:
         raise ParameterError(f"this figure draws {what}, got {type(value).__name__}")
 
 
-def check_truth(truth) -> None:
+def check_truth(truth: object) -> None:
     """Refuse a ``truth`` that is not a function of frequency (cy/px) or None."""
     if truth is not None and not callable(truth):
         from ..errors import ParameterError
@@ -28,14 +29,16 @@ def check_truth(truth) -> None:
         raise ParameterError(f"truth must be a function of frequency in cy/px, got {type(truth).__name__}{hint}")
 
 
-def figure_axes(ax, size=(5.0, 3.6)):
+def figure_axes(ax: Axes | None, size: tuple[float, float] = (5.0, 3.6)) -> tuple[Figure | SubFigure, Axes]:
+    """``ax``'s figure (a SubFigure when ``ax`` lies in one) and ``ax``, or a
+    new figure of ``size`` (inches) and its axes."""
     if ax is None:
         fig = Figure(figsize=size, layout="constrained")
         return fig, fig.add_subplot()
     return ax.figure, ax
 
 
-def title_once(ax, text: str) -> None:
+def title_once(ax: Axes, text: str) -> None:
     """Title the axes unless the caller already has."""
     if not ax.get_title():
         ax.set_title(text)

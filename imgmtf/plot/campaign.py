@@ -4,12 +4,17 @@ pre-launch value and the drift line."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.dates import AutoDateLocator, ConciseDateFormatter
-from matplotlib.figure import Figure
+from matplotlib.figure import Figure, SubFigure
 
 from ._common import figure_axes, title_once
+
+if TYPE_CHECKING:
+    from ..campaign.trend import Trend
 
 # figure -> (axis label, its interval's columns in the targets layer)
 TREND_FIGURES = {
@@ -20,8 +25,9 @@ TREND_FIGURES = {
 }
 
 
-def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=None,
-               requirement: float | None = None, baseline: float | None = None, ax=None):
+def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend: Trend | None = None,
+               requirement: float | None = None, baseline: float | None = None,
+               ax: Axes | None = None) -> Figure | SubFigure:
     """One figure of merit against acquisition time.
 
     Parameters
@@ -30,24 +36,33 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
         Rows of a campaign store's ``targets`` layer (one group: a platform,
         band, direction and method), with ``acquired_utc``; a fit whose
         ``misfit`` is set is marked with a cross.
-    figure : str
-        ``mtf_nyquist``, ``mtf50_cy_px``, ``fwhm_px`` or ``rer``.
+    figure : {"mtf_nyquist", "mtf50_cy_px", "fwhm_px", "rer"}, optional
+        The figure of merit (default the MTF at Nyquist).
     trend : imgmtf.campaign.trend.Trend, optional
         The drift fitted to them, drawn as a line with its slope per year.
     requirement, baseline : float, optional
-        The requirement and the pre-launch value (horizontal lines).
+        The requirement and the pre-launch value (horizontal lines), in the
+        figure's unit.
     ax : matplotlib.axes.Axes, optional
         The axes to draw on (default a new figure's).
 
     Returns
     -------
-    matplotlib.figure.Figure
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
         The figure holding ``ax``.
 
     Raises
     ------
     ParameterError
         An unknown ``figure``.
+
+    Examples
+    --------
+    >>> from imgmtf.plot import plot_trend
+    >>> rows = [{"acquired_utc": "2021-06-01", "mtf_nyquist": 0.27},
+    ...         {"acquired_utc": "2022-06-01", "mtf_nyquist": 0.26}]
+    >>> plot_trend(rows, requirement=0.2).axes[0].get_ylabel()
+    'MTF at Nyquist'
     """
     from ..campaign.trend import parse_utc, years_since
     from ..errors import ParameterError
@@ -61,7 +76,8 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
         ax.set(xticks=[], yticks=[])
         title_once(ax, label)
         return fig
-    times = [parse_utc(r["acquired_utc"]).replace(tzinfo=None) for r in usable]
+    # datetimes, which matplotlib's date converter plots but its type stubs do not list
+    times: list[Any] = [parse_utc(r["acquired_utc"]).replace(tzinfo=None) for r in usable]
     values = np.array([r[figure] for r in usable], float)
     if bounds and usable:
         low = np.array([np.nan if r.get(bounds[0]) is None else r[bounds[0]] for r in usable], float)
@@ -78,7 +94,7 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
                 label="the model misfits: may be biased")
     if trend is not None:
         span = np.array([trend.first_utc, trend.last_utc])
-        ends = [parse_utc(t).replace(tzinfo=None) for t in span]
+        ends: list[Any] = [parse_utc(t).replace(tzinfo=None) for t in span]
         years = years_since(list(span), trend.first_utc)
         interval = (f" [{trend.slope_ci_low:+.4f}, {trend.slope_ci_high:+.4f}]"
                     if np.isfinite(trend.slope_ci_low) else "")
@@ -99,12 +115,36 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend=No
     return fig
 
 
-def plot_campaign(rows: Sequence[Mapping], trends: Sequence = (), *, requirement: float | None = None,
-                  baseline: float | None = None, title: str = ""):
+def plot_campaign(rows: Sequence[Mapping], trends: Sequence[Trend] = (), *, requirement: float | None = None,
+                  baseline: float | None = None, title: str = "") -> Figure:
     """The four figures of merit of one group (platform, band, direction,
     method) against time (:func:`plot_trend` each): MTF at Nyquist (with
-    the requirement and the pre-launch value), MTF50, FWHM and RER;
-    ``trends`` the group's :class:`~imgmtf.campaign.trend.Trend` per figure."""
+    the requirement and the pre-launch value), MTF50, FWHM and RER.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        Rows of a campaign store's ``targets`` layer for one group, with
+        ``acquired_utc``.
+    trends : sequence of imgmtf.campaign.trend.Trend, optional
+        The group's drift per figure of merit.
+    requirement, baseline : float, optional
+        The MTF at Nyquist required and the pre-launch value.
+    title : str, optional
+        The figure's title (default none).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Four panels: MTF at Nyquist, MTF50 (cy/px), FWHM (px) and RER.
+
+    Examples
+    --------
+    >>> from imgmtf.plot import plot_campaign
+    >>> rows = [{"acquired_utc": "2021-06-01", "mtf_nyquist": 0.27, "mtf50_cy_px": 0.36, "fwhm_px": 1.2, "rer": 0.6}]
+    >>> len(plot_campaign(rows, requirement=0.2, title="SYNTHSAT-1 PAN").axes)
+    4
+    """
     fig = Figure(figsize=(13.5, 6.6), layout="constrained")
     axes = fig.subplots(2, 2).ravel()
     by_figure = {t.figure: t for t in trends}

@@ -2,14 +2,22 @@
 target), the restored edge response, and the sharpness-noise trade-off."""
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
 
 from ..estimate.spectrum import NYQUIST
 from ._common import figure_axes, title_once
 
+if TYPE_CHECKING:
+    from ..restore.design import RestorationFilter
+    from ..sensor.model import Sensor
 
-def _expect_filter(restoration) -> None:
+
+def _expect_filter(restoration: object) -> None:
     from ..restore.design import RestorationFilter
     if not isinstance(restoration, RestorationFilter):
         from ..errors import ParameterError
@@ -17,10 +25,39 @@ def _expect_filter(restoration) -> None:
                              f"got {type(restoration).__name__}")
 
 
-def plot_restored_mtf(restoration, direction: str = "across", ax=None):
+def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
+                      ax: Axes | None = None) -> Figure | SubFigure:
     """Along one axis: the sensor's MTF, the filter's transfer, the restored
     MTF and the target, to twice Nyquist (the filter's transfer repeats
-    every 1 cy/px), with the values at Nyquist in the legend."""
+    every 1 cy/px), with the values at Nyquist in the legend.
+
+    Parameters
+    ----------
+    restoration : RestorationFilter
+        The filter (:func:`imgmtf.design_filter`).
+    direction : {"across", "along"}, optional
+        The axis: across track (x, the default) or along track (y).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``restoration`` is not a RestorationFilter.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor, design_filter
+    >>> from imgmtf.plot import plot_restored_mtf
+    >>> fig = plot_restored_mtf(design_filter(Sensor(), 0.3, kernel_size=7), "along")
+    >>> fig.axes[0].get_xlabel()
+    'frequency along track (cy/px)'
+    """
     _expect_filter(restoration)
     from ..restore.report import axis_curves
     fig, ax = figure_axes(ax)
@@ -42,10 +79,36 @@ def plot_restored_mtf(restoration, direction: str = "across", ax=None):
     return fig
 
 
-def plot_restored_edge(restoration, ax=None):
+def plot_restored_edge(restoration: RestorationFilter, ax: Axes | None = None) -> Figure | SubFigure:
     """The edge response before and after restoration across and along
     track (0 dark, 1 bright), in pixels from the edge, with the RER and
-    overshoot of each."""
+    overshoot of each.
+
+    Parameters
+    ----------
+    restoration : RestorationFilter
+        The filter (:func:`imgmtf.design_filter`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``restoration`` is not a RestorationFilter.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor, design_filter
+    >>> from imgmtf.plot import plot_restored_edge
+    >>> fig = plot_restored_edge(design_filter(Sensor(), 0.3, kernel_size=7))
+    >>> len(fig.axes[0].lines)            # before and after, each axis, and the 0 and 1 levels
+    6
+    """
     _expect_filter(restoration)
     from ..restore.report import edge_responses, restoration_report
     fig, ax = figure_axes(ax)
@@ -64,9 +127,33 @@ def plot_restored_edge(restoration, ax=None):
     return fig
 
 
-def plot_restoration(restoration):
+def plot_restoration(restoration: RestorationFilter) -> Figure:
     """The restoration's figure: the MTF across and along track and the
-    edge response before and after."""
+    edge response before and after.
+
+    Parameters
+    ----------
+    restoration : RestorationFilter
+        The filter (:func:`imgmtf.design_filter`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three panels: :func:`plot_restored_mtf` across and along track and
+        :func:`plot_restored_edge`.
+
+    Raises
+    ------
+    ParameterError
+        ``restoration`` is not a RestorationFilter.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor, design_filter
+    >>> from imgmtf.plot import plot_restoration
+    >>> len(plot_restoration(design_filter(Sensor(), 0.3, kernel_size=7)).axes)
+    3
+    """
     _expect_filter(restoration)
     fig = Figure(figsize=(14.0, 5.0), layout="constrained")
     axes = fig.subplots(1, 3)
@@ -80,10 +167,41 @@ def plot_restoration(restoration):
     return fig
 
 
-def plot_restore_tradeoff(sensor, targets=(0.2, 0.3, 0.4, 0.5), *, kernel_size: int | None = None, ax=None):
+def plot_restore_tradeoff(sensor: Sensor, targets: Iterable[float] = (0.2, 0.3, 0.4, 0.5), *,
+                          kernel_size: int | None = None, ax: Axes | None = None) -> Figure | SubFigure:
     """Achieved MTF at Nyquist (across track) against the filter's noise
     gain, one curve per target as the noise-gain limit tightens; the sensor's
-    own MTF at Nyquist (noise gain 1) marked."""
+    own MTF at Nyquist (noise gain 1) marked.
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The system to compensate.
+    targets : iterable of float, optional
+        Target MTFs at Nyquist (0.5 cy/px), each in (0, 1]; one curve each.
+    kernel_size : int, optional
+        Side (odd, 3 to 63 px) of a spatial kernel; None for the FFT form.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``sensor`` is not a Sensor, or a target out of range.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.plot import plot_restore_tradeoff
+    >>> fig = plot_restore_tradeoff(Sensor(), (0.3, 0.4), kernel_size=7)
+    >>> len(fig.axes[0].lines)            # a curve per target and the sensor alone
+    3
+    """
     from ..restore.design import design_filter
     from ..restore.report import tradeoff
     from ..sensor.model import Sensor
