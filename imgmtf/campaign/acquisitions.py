@@ -124,7 +124,7 @@ class Acquisition:
         return json_safe(asdict(self))
 
 
-def acquisition_id(sha256: str, band, settings: dict) -> str:
+def acquisition_id(sha256: str, band: int | str | None, settings: dict) -> str:
     """The stable identity of a file's band measured with ``settings``: the
     first 16 hex digits of the SHA-256 of all three (settings as sorted JSON).
 

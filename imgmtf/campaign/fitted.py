@@ -2,12 +2,18 @@
 store keeps: the model's MTF across and along track."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..records import Record, utc_now
+
+if TYPE_CHECKING:
+    from ..estimate.fit import SensorFit
 
 _DIRECTIONS = {"across": ("across-track", 0.0), "along": ("along-track", 90.0)}
 
 
-def fit_summaries(fit, path: str, band=None, *, plot: str | None = None, run_utc: str | None = None) -> list[Record]:
+def fit_summaries(fit: SensorFit, path: str, band: int | str | None = None, *, plot: str | None = None,
+                  run_utc: str | None = None) -> list[Record]:
     """The across- and along-track rows of a sensor fit of ``path``'s edges
     (``summary`` "fit", ``scope`` "scene", ``status`` "fitted"), one per
     direction some edge constrains: the model's MTF at Nyquist and MTF50

@@ -41,12 +41,15 @@ import tempfile
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from ..records import Record, json_safe
 from ..version import __version__
 from .acquisitions import Acquisition
+
+if TYPE_CHECKING:
+    from ..io import RasterInfo
 
 SCHEMA_VERSION = 1
 LAYERS = ("acquisitions", "edges", "targets")
@@ -95,7 +98,7 @@ class StoreError(ImgmtfError):
 
 
 def write_acquisition(store_path: str | Path, acquisition: Acquisition, edges: Sequence[Record],
-                      targets: Sequence[Record], *, info=None) -> None:
+                      targets: Sequence[Record], *, info: RasterInfo | None = None) -> None:
     """Write one acquisition's rows into a campaign store, in one transaction.
 
     Creates the GeoPackage when it is missing; replaces every row of the

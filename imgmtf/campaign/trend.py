@@ -22,6 +22,7 @@ from datetime import UTC, datetime
 from statistics import NormalDist
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..atomic import atomic_output
 from ..errors import FileWriteError, ParameterError
@@ -85,7 +86,7 @@ class Trend:
         return self.value_at_first + self.slope_per_year * np.asarray(years, float)
 
 
-def fit_line(t, y, sd=None, confidence: float = 0.95) -> Line:
+def fit_line(t: ArrayLike, y: ArrayLike, sd: ArrayLike | None = None, confidence: float = 0.95) -> Line:
     """Weighted least-squares line through (``t``, ``y``).
 
     Parameters

@@ -111,7 +111,8 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,
     return TargetGeometry(float(slope), float(intercept), y, x, keep, transposed, location_sd_px)
 
 
-def row_windows(image: np.ndarray, centre_x: np.ndarray, half_window: int):
+def row_windows(image: np.ndarray, centre_x: np.ndarray,
+                half_window: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each row's pixels within ``half_window`` of ``centre_x``: (cols,
     values, inside), arrays of n_rows x (2 half_window + 1), ``inside``
     False where the window leaves the image or meets a left-out (NaN)
@@ -149,7 +150,8 @@ def check_angle(geometry: TargetGeometry, name: str) -> None:
                                     f"to 45 deg for sub-pixel sampling {advice}", reason="angle")
 
 
-def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
+def profile_samples(work: np.ndarray, geometry: TargetGeometry,
+                    name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Every pixel of the kept rows as a profile sample: ``(d, v, row,
     half_range)``, the signed distance (px) to the line, the value, the
     sample's row (vertical frame), and the distance D within which samples

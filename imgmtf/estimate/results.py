@@ -5,9 +5,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..version import __version__
 from .geometry import TargetGeometry
@@ -105,7 +106,7 @@ class MTFResult:
     def fwhm_m(self) -> float | None:
         return self.fwhm_px * self.gsd_m if self.gsd_m else None
 
-    def mtf_at(self, f_cy_px) -> np.ndarray:
+    def mtf_at(self, f_cy_px: ArrayLike) -> np.ndarray:
         """The corrected MTF at frequencies ``f_cy_px`` (cy/px): even in f,
         NaN beyond the transform's reach (4 cy/px) and near a divisor's zeros."""
         if self.mtf_function is None:
@@ -142,7 +143,7 @@ class MTFResult:
         return out
 
 
-def finite(value):
+def finite(value: Any) -> float | None:
     """A float rounded to 6 decimals for JSON, None for None/NaN/inf."""
     if value is None:
         return None

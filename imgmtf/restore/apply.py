@@ -27,11 +27,16 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import FileWriteError, ImageContentError, ParameterError
 from ..inputs import as_array, check_number, saturation_levels
+
+if TYPE_CHECKING:
+    from .design import RestorationFilter
 
 #: tile sides allowed, px: a tile and its halo stay far below one read's 16 Mpx
 TILE_RANGE_PX = (64, 2048)
@@ -42,7 +47,7 @@ STRIP_ROWS = 256
 OVERVIEW_PX = 512
 
 
-def restore_array(image, taps: np.ndarray, *, fill: float | None = None) -> np.ndarray:
+def restore_array(image: ArrayLike, taps: np.ndarray, *, fill: float | None = None) -> np.ndarray:
     """Convolve a 2-D image with ``taps``, its borders mirrored
     (half-sample symmetric); NaN pixels hold ``fill`` (default: the median
     of the others) while filtering and are NaN in the result.
@@ -255,7 +260,7 @@ class RestoredFile:
                 "nodata_fraction": self.nodata_fraction, "input_sha256": self.input_sha256}
 
 
-def restore_file(path: str | Path, restoration, out: str | Path, *, tile_px: int = DEFAULT_TILE_PX,
+def restore_file(path: str | Path, restoration: RestorationFilter, out: str | Path, *, tile_px: int = DEFAULT_TILE_PX,
                  saturation: tuple[float, float] | None = None, workers: int = 1, scheduler: str | None = None,
                  progress: bool | None = None, run_utc: str | None = None) -> RestoredFile:
     """Restore every band of an image file (anything GDAL reads) with a

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..atomic import atomic_output
 from ..errors import FileWriteError, ParameterError
@@ -55,7 +56,7 @@ _MAX_REGULARISER = 1e6
 _BISECTION_STEPS = 60
 
 
-def target_transfer(f_cy_px, target_nyquist: float) -> np.ndarray:
+def target_transfer(f_cy_px: ArrayLike, target_nyquist: float) -> np.ndarray:
     """The 1-D target transfer ``g(f) = V ** ((f / 0.5) ** 2)``: 1 at zero
     frequency, ``V`` at Nyquist (0.5 cy/px), smooth and never above 1.
 
@@ -136,7 +137,7 @@ class RestorationFilter:
         """``"fft"`` or ``"spatial"`` (a kernel of ``kernel_size``)."""
         return "fft" if self.kernel_size is None else "spatial"
 
-    def transfer(self, fx, fy) -> np.ndarray:
+    def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
         """The filter's (real, periodic) transfer at (``fx``, ``fy``) cy/px."""
         fx, fy = np.broadcast_arrays(np.asarray(fx, float), np.asarray(fy, float))
         offsets = np.arange(self.taps.shape[0]) - self.radius_px
@@ -145,14 +146,14 @@ class RestorationFilter:
         cy = np.cos(2 * np.pi * fy[..., None] * offsets)
         return np.einsum("...i,ij,...j->...", cy, self.taps, cx)
 
-    def axis_transfer(self, f_cy_px, direction: str = "across") -> np.ndarray:
+    def axis_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """The filter's transfer along one axis: across track (fx, fy = 0) or
         along track (fy, fx = 0), at ``f_cy_px`` cy/px."""
         f = np.asarray(f_cy_px, float)
         zero = np.zeros_like(f)
         return self.transfer(f, zero) if _axis(direction) == "x" else self.transfer(zero, f)
 
-    def system_transfer(self, f_cy_px, direction: str = "across") -> np.ndarray:
+    def system_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """The sensor's transfer along one axis at ``f_cy_px`` cy/px of this pixel."""
         f = np.asarray(f_cy_px, float) / self.gsd_m
         zero = np.zeros_like(f)

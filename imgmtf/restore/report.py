@@ -17,11 +17,13 @@ form, per axis (across track: x, columns; along track: y, rows):
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..sensor.model import DIRECTIONS, direction_angle
+from ..sensor.model import DIRECTIONS, Sensor, direction_angle
 from .design import RestorationFilter, target_transfer
 
 #: where the ringing is read: this far from the edge, px
@@ -103,7 +105,7 @@ def restoration_report(restoration: RestorationFilter) -> RestorationReport:
                              {d: _axis_figures(restoration, d) for d in DIRECTIONS})
 
 
-def axis_curves(restoration: RestorationFilter, direction: str, f_cy_px) -> dict[str, np.ndarray]:
+def axis_curves(restoration: RestorationFilter, direction: str, f_cy_px: ArrayLike) -> dict[str, np.ndarray]:
     """The transfers along one axis at ``f_cy_px``: ``system`` (the sensor's
     MTF), ``filter`` (the filter's transfer), ``restored`` (their product's
     magnitude) and ``target``."""
@@ -115,7 +117,7 @@ def axis_curves(restoration: RestorationFilter, direction: str, f_cy_px) -> dict
 
 
 def edge_responses(restoration: RestorationFilter, direction: str,
-                   x_px=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   x_px: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(x_px, before, after)``: the edge response across an edge whose
     normal points along ``direction``, from 0 (dark) to 1 (bright), before
     and after restoration, at signed distances ``x_px`` (default: a grid
@@ -133,7 +135,7 @@ def edge_responses(restoration: RestorationFilter, direction: str,
     return x, response.esf(x), np.asarray(after)
 
 
-def tradeoff(sensor, target_nyquist: float, noise_gains, *, kernel_size: int | None = None,
+def tradeoff(sensor: Sensor, target_nyquist: float, noise_gains: Iterable[float], *, kernel_size: int | None = None,
              direction: str = "across") -> tuple[np.ndarray, np.ndarray]:
     """``(noise_gain, achieved_mtf_nyquist)``: what a target costs as the
     noise-gain limit tightens, one design per limit in ``noise_gains``

@@ -16,8 +16,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from statistics import NormalDist
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._stats import t_quantile
 from ..errors import ParameterError
@@ -44,7 +46,7 @@ class Combined:
     weights: str
 
 
-def normal_families(normals_deg) -> np.ndarray:
+def normal_families(normals_deg: ArrayLike) -> np.ndarray:
     """Direction families of edge normals (deg, any range; 180 deg apart
     is one direction): a label per normal, normals of one family within
     ``FAMILY_SPREAD_DEG`` of each other, families separated by gaps of at
@@ -77,7 +79,7 @@ def normal_families(normals_deg) -> np.ndarray:
     return renumber[labels]
 
 
-def combine(values, intervals, rows, confidence: float = 0.95) -> Combined:
+def combine(values: ArrayLike, intervals: ArrayLike, rows: ArrayLike, confidence: float = 0.95) -> Combined:
     """Combine estimates of one figure weighted by precision.
 
     Parameters
@@ -200,7 +202,7 @@ def _family_records(members: list[tuple[Record, int]], site: dict) -> list[Recor
     return out
 
 
-def precision_weights(intervals, rows, confidence: float = 0.95) -> np.ndarray | None:
+def precision_weights(intervals: ArrayLike, rows: ArrayLike, confidence: float = 0.95) -> np.ndarray | None:
     """Each estimate's weight 1 / sd^2, its standard deviation the
     interval's half-width over its Student-t quantile (``rows`` - 1
     degrees of freedom); None when an interval is missing or empty.
@@ -243,7 +245,7 @@ def _summary(group: list[Record], site: dict) -> Record:
              if any(v is not None for v in fifty) else None)
     normal = _mean_normal([r.figures["normal_angle_deg"] for r in group])
     track = first.params.get("track_azimuth_deg")
-    figures = {
+    figures: dict[str, Any] = {
         "summary": "combined", "direction": direction_label(normal, track), "normal_angle_deg": round(normal, 3),
         "n_edges": len(group), "edge_ids": [r.site.get("id") for r in group],
         "mtf_nyquist": finite(nyquist.value), "mtf_nyquist_ci": [finite(nyquist.low), finite(nyquist.high)],

@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from itertools import pairwise
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -195,7 +196,7 @@ def check_scene_size(info: RasterInfo) -> None:
             reason="too-large")
 
 
-def display_levels(path, band, info: RasterInfo) -> tuple[float, float]:
+def display_levels(path: str | Path, band: int | None, info: RasterInfo) -> tuple[float, float]:
     """The 0.5 and 99.5 percentiles of a decimated read of the whole scene,
     fill (0, NaN) and saturated pixels (at an integer type's limits) left
     out so that neither can squash the rest of the scene into a few levels;

@@ -81,7 +81,7 @@ def _geometry(points: list) -> dict | None:
     return None
 
 
-def write_outputs(records: Sequence[Record], info: RasterInfo, out_dir: str, overview_band=None,
+def write_outputs(records: Sequence[Record], info: RasterInfo, out_dir: str, overview_band: int | None = None,
                   summaries: Sequence[Record] = ()) -> list[str]:
     """``targets.csv``, ``targets.geojson`` and ``overview.png`` of a scan
     in ``out_dir`` (each written atomically); their paths.

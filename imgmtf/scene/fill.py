@@ -5,6 +5,7 @@ scene, and every ROI keeps clear of them."""
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from ..estimate import gate
 
@@ -21,7 +22,7 @@ def fill_screen(fill_fraction: float) -> tuple[str, str] | None:
     return None
 
 
-def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
+def fill_mask(window: np.ndarray, dtype: DTypeLike) -> np.ndarray:
     """The fill and nodata pixels of a window of the scene: NaN (declared
     nodata), and every region at one fill value (0, an integer type's
     limits) whose boundary is hard, as the gate tells fill from a clipped

@@ -165,7 +165,8 @@ def _scan_task(item) -> SceneOutcome:
     return scan_one(path, settings, stages, facts, progress=False, figures_dir=figures_dir, overview=overview)
 
 
-def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STAGES, facts=None, *, workers: int = 1,
+def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STAGES,
+             facts: Mapping[str, str | None] | None = None, *, workers: int = 1,
              scheduler: str | None = None, progress: bool | None = None,
              figures_dir: str | None = None, overview: str | None = None) -> SceneOutcome:
     """One scene scanned, its targets combined and fitted, and (with

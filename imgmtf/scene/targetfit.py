@@ -22,10 +22,12 @@ and no fit rows.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ImgmtfError, ParameterError
 from ..estimate.results import finite
@@ -37,7 +39,7 @@ DEFAULT_STAGES = "optics,detector"
 _DIRECTIONS = {"across": "across-track", "along": "along-track"}
 
 
-def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES, workers: int = 1,
+def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_STAGES, workers: int = 1,
                 scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
     """Fit the sensor model to each target's accepted half-edges (and to
     the scene's, when it has several targets): two summary records per
@@ -119,7 +121,7 @@ def track_of(record: Record) -> float | None:
     return None if track is None else float(track)
 
 
-def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon) -> np.ndarray:
+def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon: ArrayLike) -> np.ndarray:
     """Pixels of a window (``shape``, its top-left pixel at ``origin`` x, y
     in the scene) whose centres lie inside a convex ``polygon`` (corners x,
     y in scene pixels, in either order round it).

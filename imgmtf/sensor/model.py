@@ -27,10 +27,12 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Iterable
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ConfigError, FileWriteError, ParameterError
 from ..inputs import check_number
@@ -98,7 +100,7 @@ class Sensor:
     gsd_m: float
     stages: tuple[Stage, ...]
 
-    def __init__(self, gsd_m: float = 1.0, stages=None, **keywords):
+    def __init__(self, gsd_m: float = 1.0, stages: Iterable[Stage] | None = None, **keywords: float):
         gsd = check_gsd("sensor gsd_m", gsd_m)
         if stages is None:
             stages = _paper_stages(keywords)
@@ -115,7 +117,7 @@ class Sensor:
         object.__setattr__(self, "stages", stages)
 
     # -- transfer functions -------------------------------------------------
-    def transfer(self, fx, fy) -> np.ndarray:
+    def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
         """System transfer function at (``fx``, ``fy``) cycles per metre:
         the product of the stages' (1 at zero)."""
         out = np.ones(np.broadcast(np.asarray(fx), np.asarray(fy)).shape)
@@ -123,7 +125,7 @@ class Sensor:
             out = out * stage.transfer(fx, fy, self.gsd_m)
         return out
 
-    def normal_transfer(self, f_cy_px, angle_deg: float, gsd_m: float | None = None) -> np.ndarray:
+    def normal_transfer(self, f_cy_px: ArrayLike, angle_deg: float, gsd_m: float | None = None) -> np.ndarray:
         """Transfer along the normal of an edge tilted ``angle_deg`` from the
         column axis, at ``f_cy_px`` cycles per pixel of ``gsd_m`` (default the
         sensor's): T(f cos a / gsd, f sin a / gsd).  This is the MTF an ideal
@@ -133,7 +135,7 @@ class Sensor:
         f = np.asarray(f_cy_px, float) / gsd
         return self.transfer(f * math.cos(a), f * math.sin(a))
 
-    def mtf(self, f_cy_px, direction: str = "across") -> np.ndarray:
+    def mtf(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """MTF across track (x) or along track (y) at ``f_cy_px`` cycles/pixel."""
         return np.abs(self.normal_transfer(f_cy_px, direction_angle(direction)))
 
@@ -347,11 +349,11 @@ class Sensor:
         except ParameterError as exc:
             raise ConfigError(f"{path}: {exc}") from None
 
-    def _gsd(self, gsd_m) -> float:
+    def _gsd(self, gsd_m: float | None) -> float:
         return self.gsd_m if gsd_m is None else check_gsd("gsd_m", gsd_m)
 
 
-def check_gsd(name: str, gsd_m) -> float:
+def check_gsd(name: str, gsd_m: object) -> float:
     """``gsd_m`` as a float in :data:`GSD_RANGE_M`, else a ParameterError naming ``name``."""
     check_number(name, gsd_m, positive=True)
     return check_number(name, gsd_m, low=GSD_RANGE_M[0], high=GSD_RANGE_M[1])
@@ -371,7 +373,7 @@ class LineResponse:
     lsf_remainder: np.ndarray
     reference: tuple[str, float]
 
-    def esf(self, d_px) -> np.ndarray:
+    def esf(self, d_px: ArrayLike) -> np.ndarray:
         """Edge response at signed distances ``d_px`` (cubic Hermite between
         grid samples, whose slopes are the LSF)."""
         d = np.asarray(d_px, float)
@@ -389,7 +391,7 @@ class LineResponse:
         from scipy.special import ndtr
         return value + ndtr(d / width)
 
-    def lsf(self, d_px) -> np.ndarray:
+    def lsf(self, d_px: ArrayLike) -> np.ndarray:
         """Line spread function (1/px) at signed distances ``d_px``."""
         d = np.asarray(d_px, float)
         grid = self.start_px + self.step_px * np.arange(self.lsf_remainder.size)
@@ -431,7 +433,7 @@ def direction_angle(direction: str) -> float:
     return 0.0 if direction == "across" else 90.0
 
 
-def check_angle(angle_deg) -> float:
+def check_angle(angle_deg: object) -> float:
     """``angle_deg`` as a finite float, else a :class:`ParameterError`."""
     if isinstance(angle_deg, (bool, np.bool_)) or not isinstance(angle_deg, (int, float, np.integer, np.floating)) \
             or not math.isfinite(angle_deg):

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ParameterError
 from ..metrics import first_crossing, fwhm
@@ -79,7 +80,7 @@ class Chip:
     seed: int | None
     clipped_fraction: float
 
-    def true_mtf(self, f_cy_px) -> np.ndarray:
+    def true_mtf(self, f_cy_px: ArrayLike) -> np.ndarray:
         """The sensor's MTF along the target's normal at ``f_cy_px``
         (cycles per pixel of this chip): what an ideal estimator returns."""
         return np.abs(self.sensor.normal_transfer(f_cy_px, self.target.angle_deg, self.gsd_m))

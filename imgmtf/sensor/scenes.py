@@ -18,6 +18,7 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ParameterError
 from ..metrics import first_crossing
@@ -92,7 +93,7 @@ class QuadrantScene:
     seed: int | None
     provenance: dict = field(default_factory=dict)
 
-    def true_mtf(self, f_cy_px, normal_angle_deg: float) -> np.ndarray:
+    def true_mtf(self, f_cy_px: ArrayLike, normal_angle_deg: float) -> np.ndarray:
         """The sensor's MTF (cycles/pixel) along a normal at ``normal_angle_deg``."""
         return np.abs(self.sensor.normal_transfer(f_cy_px, normal_angle_deg))
 

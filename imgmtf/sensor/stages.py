@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ParameterError
 from ..inputs import check_number
@@ -109,13 +110,39 @@ class Stage:
                                      f"{f.metadata['unit']}, got {value:g}".rstrip())
             object.__setattr__(self, f.name, value)
 
-    def transfer(self, fx, fy, gsd_m: float) -> np.ndarray:
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
+        """The stage's transfer function, real and 1 at zero frequency.
+
+        Parameters
+        ----------
+        fx, fy : array_like
+            Spatial frequencies across track (x, image columns) and along
+            track (y, image rows), cy/m on the ground; broadcast together.
+        gsd_m : float
+            The sensor's ground sample distance, m (what maps focal-plane
+            lengths to the ground; stages given in ground metres ignore it).
+
+        Returns
+        -------
+        numpy.ndarray
+            The transfer at each (``fx``, ``fy``), of their broadcast shape.
+
+        Examples
+        --------
+        >>> from imgmtf.sensor.stages import Detector
+        >>> Detector(1.0, 1.0).transfer([0.0, 1.0], 0.0, 1.0).round(6)     # zero at 1 / width
+        array([1., 0.])
+        """
         raise NotImplementedError
 
     def support_radius_m(self, gsd_m: float) -> float:
+        """A radius (m) outside which the stage's PSF is negligible on a
+        sampled grid at ``gsd_m`` (see the module docstring)."""
         raise NotImplementedError
 
     def tail_length_m(self, gsd_m: float) -> float:
+        """The length b (m) of the Cauchy tail b / (pi x^2) of the stage's
+        LSF at ``gsd_m``; 0 when its tails fall faster than any power."""
         return 0.0
 
     # -- parameters ---------------------------------------------------------
@@ -224,11 +251,11 @@ class GaussianOptics(Stage):
     sigma_x_m: float = _param(0.39, "m", FitSpec(axis="x", rank=1))
     sigma_y_m: float = _param(0.39, "m", FitSpec(axis="y", pair="sigma_x_m", rank=1))
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         fx, fy = np.asarray(fx, float), np.asarray(fy, float)
         return np.exp(-2.0 * np.pi**2 * (self.sigma_x_m**2 * fx**2 + self.sigma_y_m**2 * fy**2))
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         return _gaussian_radius(max(self.sigma_x_m, self.sigma_y_m))
 
 
@@ -261,10 +288,10 @@ class Detector(Stage):
     width_x_m: float = _param(1.0, "m", FitSpec(axis="x", upper_px=3.0, rank=6))
     width_y_m: float = _param(1.0, "m", FitSpec(axis="y", upper_px=3.0, pair="width_x_m", rank=6))
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         return np.sinc(np.asarray(fx, float) * self.width_x_m) * np.sinc(np.asarray(fy, float) * self.width_y_m)
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         return math.hypot(self.width_x_m, self.width_y_m) / 2.0
 
 
@@ -297,11 +324,11 @@ class Motion(Stage):
     title: ClassVar[str] = "along-track motion"
     length_m: float = _param(0.25, "m", FitSpec(axis="y", upper_px=3.0, rank=2))
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         fy = np.asarray(fy, float)
         return np.broadcast_to(np.sinc(fy * self.length_m), np.broadcast(np.asarray(fx), fy).shape)
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         return self.length_m / 2.0
 
 
@@ -334,11 +361,11 @@ class Electronics(Stage):
     cutoff_cy_m: float = _param(1.4, "cy/m", FitSpec(kind="frequency", upper_px=3.0, rank=4),
                                 positive=True, allow_inf=True)
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         fx, fy = np.asarray(fx, float), np.asarray(fy, float)
         return 1.0 / (1.0 + (fx**2 + fy**2) / self.cutoff_cy_m**2)
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         # the PSF is 2 pi D0^2 K0(2 pi D0 r); the energy outside r is u K1(u),
         # u = 2 pi D0 r, below sqrt(pi u / 2) exp(-u) (1 + 3 / 8u): solve for 1e-9
         if math.isinf(self.cutoff_cy_m):
@@ -393,24 +420,24 @@ class Diffraction(Stage):
         """Incoherent cut-off on the ground, cycles per metre."""
         return self.pixel_pitch_m / (self.wavelength_m * self.f_number * gsd_m)
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         v = np.minimum(np.hypot(np.asarray(fx, float), np.asarray(fy, float)) / self.cutoff_cy_m(gsd_m), 1.0)
         return (2.0 / np.pi) * (np.arccos(v) - v * np.sqrt(1.0 - v * v))
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         # energy outside r: J0^2 + J1^2 of x = pi r f_c ~ 2 / (pi x) = 2 / (pi^2 r f_c);
         # the 1 % core, 20 lambda N; the line responses add the tails in closed form
         return 2.0 / (math.pi**2 * 0.01 * self.cutoff_cy_m(gsd_m))
 
-    def tail_length_m(self, gsd_m):
+    def tail_length_m(self, gsd_m: float) -> float:
         # T = 1 - (4 / pi) f / f_c + O(f^3) = 1 - 2 pi b |f|
         return 2.0 / (math.pi**2 * self.cutoff_cy_m(gsd_m))
 
-    def fit_coordinates(self, gsd_m):
+    def fit_coordinates(self, gsd_m: float) -> dict[str, float]:
         # the blur length 1 / f_c in pixels: the MTF responds linearly to it (the cusp)
         return {"f_number": self.wavelength_m * self.f_number / self.pixel_pitch_m}
 
-    def with_fit_coordinates(self, coordinates, gsd_m):
+    def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> Stage:
         u = max(coordinates["f_number"], 1e-6)
         return type(self)(u * self.pixel_pitch_m / self.wavelength_m, self.wavelength_m, self.pixel_pitch_m)
 
@@ -442,13 +469,13 @@ class Defocus(Stage):
     title: ClassVar[str] = "defocus disk"
     radius_m: float = _param(0.5, "m", FitSpec(rank=2))
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         from scipy.special import j1
         z = 2.0 * np.pi * self.radius_m * np.hypot(np.asarray(fx, float), np.asarray(fy, float))
         safe = np.where(z == 0, 1.0, z)
         return np.where(z == 0, 1.0, 2.0 * j1(safe) / safe)
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         return self.radius_m
 
 
@@ -480,11 +507,11 @@ class OLPF(Stage):
     has_width: ClassVar[bool] = False
     split_m: float = _param(0.5, "m", FitSpec(upper_px=2.0, rank=5))
 
-    def transfer(self, fx, fy, gsd_m):
+    def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         d = self.split_m
         return np.cos(np.pi * d * np.asarray(fx, float)) * np.cos(np.pi * d * np.asarray(fy, float))
 
-    def support_radius_m(self, gsd_m):
+    def support_radius_m(self, gsd_m: float) -> float:
         return self.split_m / math.sqrt(2.0)
 
 

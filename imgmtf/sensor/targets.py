@@ -18,6 +18,7 @@ response along the normal, the pulse's the difference of two edges'
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -98,7 +99,7 @@ class Target:
         a = math.radians(self.angle_deg)
         return (x - center[0]) * math.cos(a) + (y - center[1]) * math.sin(a) - self.offset_px
 
-    def image_values(self, d_px: np.ndarray, esf) -> np.ndarray:
+    def image_values(self, d_px: np.ndarray, esf: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
         """DN of the target seen through a sensor whose edge response along
         this target's normal is ``esf(d)`` (rising from 0 to 1), at signed
         distances ``d_px`` (px) from the edge (the pulse's centre line)."""
