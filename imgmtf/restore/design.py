@@ -159,7 +159,7 @@ class RestorationFilter:
         zero = np.zeros_like(f)
         return self.sensor.transfer(f, zero) if _axis(direction) == "x" else self.sensor.transfer(zero, f)
 
-    def __call__(self, image, *, fill: float | None = None) -> np.ndarray:
+    def __call__(self, image: ArrayLike, *, fill: float | None = None) -> np.ndarray:
         """Restore a whole 2-D image (float64 DN out; the borders mirrored,
         NaN pixels filled with ``fill``, default the median, while filtering
         and NaN again in the output).
