@@ -138,7 +138,19 @@ class RestorationFilter:
         return "fft" if self.kernel_size is None else "spatial"
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
-        """The filter's (real, periodic) transfer at (``fx``, ``fy``) cy/px."""
+        """The filter's (real, periodic) transfer at (``fx``, ``fy``) cy/px.
+
+        Parameters
+        ----------
+        fx, fy : array_like
+            Frequencies across track (x) and along track (y), cy/px;
+            broadcast together.
+
+        Returns
+        -------
+        numpy.ndarray
+            The transfer, of their broadcast shape (1 at zero).
+        """
         fx, fy = np.broadcast_arrays(np.asarray(fx, float), np.asarray(fy, float))
         offsets = np.arange(self.taps.shape[0]) - self.radius_px
         # taps are even in x and in y: the transfer is a sum of cosines, separable per term
@@ -148,13 +160,39 @@ class RestorationFilter:
 
     def axis_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """The filter's transfer along one axis: across track (fx, fy = 0) or
-        along track (fy, fx = 0), at ``f_cy_px`` cy/px."""
+        along track (fy, fx = 0), at ``f_cy_px`` cy/px.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies, cy/px.
+        direction : {"across", "along"}, optional
+            The axis (default across track).
+
+        Returns
+        -------
+        numpy.ndarray
+            The transfer at each frequency.
+        """
         f = np.asarray(f_cy_px, float)
         zero = np.zeros_like(f)
         return self.transfer(f, zero) if _axis(direction) == "x" else self.transfer(zero, f)
 
     def system_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
-        """The sensor's transfer along one axis at ``f_cy_px`` cy/px of this pixel."""
+        """The sensor's transfer along one axis at ``f_cy_px`` cy/px of this pixel.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies, cy/px of the filter's pixel (``gsd_m``).
+        direction : {"across", "along"}, optional
+            The axis (default across track).
+
+        Returns
+        -------
+        numpy.ndarray
+            The sensor's transfer at each frequency.
+        """
         f = np.asarray(f_cy_px, float) / self.gsd_m
         zero = np.zeros_like(f)
         return self.sensor.transfer(f, zero) if _axis(direction) == "x" else self.sensor.transfer(zero, f)
@@ -184,6 +222,11 @@ class RestorationFilter:
         """Write the taps for a ground segment: ``.npy`` (NumPy) or ``.txt``
         (text, one row of taps per line, the design as ``#`` comments),
         atomically.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, ``.npy`` or ``.txt``.
 
         Raises
         ------

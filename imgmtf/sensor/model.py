@@ -119,7 +119,19 @@ class Sensor:
     # -- transfer functions -------------------------------------------------
     def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
         """System transfer function at (``fx``, ``fy``) cycles per metre:
-        the product of the stages' (1 at zero)."""
+        the product of the stages' (1 at zero).
+
+        Parameters
+        ----------
+        fx, fy : array_like
+            Frequencies across track (x) and along track (y), cy/m on the
+            ground; broadcast together.
+
+        Returns
+        -------
+        numpy.ndarray
+            The transfer, of their broadcast shape.
+        """
         out = np.ones(np.broadcast(np.asarray(fx), np.asarray(fy)).shape)
         for stage in self.stages:
             out = out * stage.transfer(fx, fy, self.gsd_m)
@@ -129,35 +141,98 @@ class Sensor:
         """Transfer along the normal of an edge tilted ``angle_deg`` from the
         column axis, at ``f_cy_px`` cycles per pixel of ``gsd_m`` (default the
         sensor's): T(f cos a / gsd, f sin a / gsd).  This is the MTF an ideal
-        slanted-edge estimator returns for that edge."""
+        slanted-edge estimator returns for that edge.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies along the normal, cy/px.
+        angle_deg : float
+            The edge's tilt from the column axis, deg (0: a vertical edge,
+            its normal across track).
+        gsd_m : float, optional
+            The pixel, m (default the sensor's).
+
+        Returns
+        -------
+        numpy.ndarray
+            The transfer at each frequency (real; 1 at zero).
+        """
         gsd = self._gsd(gsd_m)
         a = math.radians(check_angle(angle_deg))
         f = np.asarray(f_cy_px, float) / gsd
         return self.transfer(f * math.cos(a), f * math.sin(a))
 
     def mtf(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
-        """MTF across track (x) or along track (y) at ``f_cy_px`` cycles/pixel."""
+        """MTF across track (x) or along track (y) at ``f_cy_px`` cycles/pixel.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies, cy/px.
+        direction : {"across", "along"}, optional
+            Across track (x, the default) or along track (y).
+
+        Returns
+        -------
+        numpy.ndarray
+            The MTF at each frequency.
+        """
         return np.abs(self.normal_transfer(f_cy_px, direction_angle(direction)))
 
     def mtf_nyquist(self, direction: str = "across") -> float:
-        """MTF at the Nyquist frequency, 0.5 cycles/pixel."""
+        """MTF at the Nyquist frequency, 0.5 cycles/pixel.
+
+        Parameters
+        ----------
+        direction : {"across", "along"}, optional
+            Across track (x, the default) or along track (y).
+
+        Returns
+        -------
+        float
+            The MTF at 0.5 cy/px.
+        """
         return float(self.mtf(0.5, direction))
 
     def mtf50_cy_px(self, direction: str = "across") -> float:
         """Frequency (cycles/pixel) where the MTF first falls to 0.5 (NaN if
-        it does not below 2 cy/px)."""
+        it does not below 2 cy/px).
+
+        Parameters
+        ----------
+        direction : {"across", "along"}, optional
+            Across track (x, the default) or along track (y).
+
+        Returns
+        -------
+        float
+            MTF50, cy/px.
+        """
         f = np.linspace(0.0, 2.0, 8001)
         return first_crossing(f, self.mtf(f, direction), 0.5)
 
     # -- spatial functions --------------------------------------------------
     def tail_length_m(self) -> float:
         """Length b (m) of the system LSF's Cauchy tail b / (pi x^2), from
-        its stages (0 when no stage has a power-law tail)."""
+        its stages (0 when no stage has a power-law tail).
+
+        Returns
+        -------
+        float
+            b, m.
+        """
         return sum(stage.tail_length_m(self.gsd_m) for stage in self.stages)
 
     def support_radius_m(self) -> float:
         """A radius (m) outside which the sampled PSF is negligible: the sum
-        of the stages' radii, at least one GSD."""
+        of the stages' radii, at least one GSD.
+
+        Returns
+        -------
+        float
+            The radius, m.
+        """
         return max(sum(stage.support_radius_m(self.gsd_m) for stage in self.stages), self.gsd_m)
 
     def line_response(self, angle_deg: float, gsd_m: float | None = None, *, reach_px: float = 0.0,
@@ -166,6 +241,25 @@ class Sensor:
         ``angle_deg`` from the column axis, in pixels of ``gsd_m`` (default
         the sensor's), exact at any distance; the fine grid behind them
         covers ``reach_px`` on each side plus the PSF's support.
+
+        Parameters
+        ----------
+        angle_deg : float
+            The edge's tilt from the column axis, deg.
+        gsd_m : float, optional
+            The pixel, m (default the sensor's).
+        reach_px : float, optional
+            Distance from the edge, px, the grid must cover beyond the PSF's
+            support (default 0).
+        step_px : float, optional
+            The grid's step, px (default 1/64; finer where a Cauchy tail
+            needs it).
+
+        Returns
+        -------
+        LineResponse
+            The edge and line spread functions, callable at any signed
+            distance (px) from the edge.
 
         Raises
         ------
@@ -202,7 +296,24 @@ class Sensor:
         """LSF along the normal of an edge tilted ``angle_deg`` from the
         column axis: ``(x_px, lsf)``, positions in pixels of ``gsd_m`` and the
         LSF in 1/px (it integrates to 1 less its tail beyond the grid), on a
-        grid of ``samples_per_px`` per pixel over four PSF radii."""
+        grid of ``samples_per_px`` per pixel over four PSF radii.
+
+        Parameters
+        ----------
+        angle_deg : float
+            The edge's tilt from the column axis, deg.
+        gsd_m : float, optional
+            The pixel, m (default the sensor's).
+        samples_per_px : int, optional
+            The grid's density, samples per px (default 400).
+
+        Returns
+        -------
+        x_px : numpy.ndarray
+            Positions along the normal, px, centred on 0.
+        lsf : numpy.ndarray
+            The LSF there, 1/px.
+        """
         gsd = self._gsd(gsd_m)
         half = 4 * self.support_radius_m() / gsd
         response = self.line_response(angle_deg, gsd, reach_px=half, step_px=1.0 / samples_per_px)
@@ -212,12 +323,36 @@ class Sensor:
 
     def lsf(self, direction: str = "across") -> tuple[np.ndarray, np.ndarray]:
         """Line spread function across or along track: ``(x_m, lsf)``,
-        positions in metres centred on 0 and the LSF in 1/m."""
+        positions in metres centred on 0 and the LSF in 1/m.
+
+        Parameters
+        ----------
+        direction : {"across", "along"}, optional
+            Across track (x, the default) or along track (y).
+
+        Returns
+        -------
+        x_m : numpy.ndarray
+            Positions, m on the ground, centred on 0.
+        lsf : numpy.ndarray
+            The LSF there, 1/m.
+        """
         x, values = self.normal_lsf(direction_angle(direction))
         return x * self.gsd_m, values / self.gsd_m
 
     def fwhm_m(self, direction: str = "across") -> float:
-        """FWHM of the line spread function across or along track (metres)."""
+        """FWHM of the line spread function across or along track (metres).
+
+        Parameters
+        ----------
+        direction : {"across", "along"}, optional
+            Across track (x, the default) or along track (y).
+
+        Returns
+        -------
+        float
+            The FWHM, m on the ground.
+        """
         return fwhm(*self.lsf(direction))
 
     def psf(self, oversampling: int = 20, tolerance: float = 1e-7,
@@ -235,6 +370,23 @@ class Sensor:
         which less than ``tolerance`` of the energy lies; samples are
         renormalised to sum to 1.  A diffraction stage's tails beyond its
         99 % core are left out of this grid (not out of the line responses).
+
+        Parameters
+        ----------
+        oversampling : int, optional
+            Samples per GSD in each axis (default 20).
+        tolerance : float, optional
+            Fraction of the energy the trimmed grid may leave out (default
+            1e-7).
+        gsd_m : float, optional
+            The pixel, m (default the sensor's).
+        deconvolve_cell : bool, optional
+            Divide out the sub-pixel cell's box transfer (default False).
+
+        Returns
+        -------
+        SampledPSF
+            The samples, summing to 1, and their spacing, m.
 
         Raises
         ------
@@ -269,7 +421,13 @@ class Sensor:
 
     def components(self) -> dict[str, Sensor]:
         """Each stage alone, as a sensor of the same GSD, keyed by stage
-        name (a repeated name gets " 2", " 3", ...)."""
+        name (a repeated name gets " 2", " 3", ...).
+
+        Returns
+        -------
+        dict of str to Sensor
+            One sensor per stage, in the chain's order.
+        """
         out: dict[str, Sensor] = {}
         for stage in self.stages:
             key, k = stage.name, 1
@@ -281,7 +439,13 @@ class Sensor:
 
     # -- files --------------------------------------------------------------
     def to_dict(self) -> dict:
-        """``{"gsd_m": ..., "stages": [{"stage": name, ...}, ...]}``."""
+        """The sensor as plain values, JSON and TOML ready.
+
+        Returns
+        -------
+        dict
+            ``{"gsd_m": ..., "stages": [{"stage": name, ...}, ...]}``.
+        """
         return {"gsd_m": self.gsd_m, "stages": [stage.to_dict() for stage in self.stages]}
 
     @classmethod
@@ -289,6 +453,17 @@ class Sensor:
         """The sensor from :meth:`to_dict`'s form, or from the generic
         sensor's keywords (the old ``[sensor]`` table); missing keywords take
         the paper's defaults.
+
+        Parameters
+        ----------
+        values : dict
+            ``{"gsd_m": ..., "stages": [...]}``, or the keywords of
+            :class:`Sensor`.
+
+        Returns
+        -------
+        Sensor
+            The sensor they describe.
 
         Raises
         ------
@@ -308,7 +483,20 @@ class Sensor:
 
     def to_toml(self, path: str | Path, comment: str = "") -> None:
         """Write the sensor as TOML: ``gsd_m`` and an array of ``[[stages]]``
-        tables, each naming its ``stage``; ``comment`` lines go on top."""
+        tables, each naming its ``stage``; ``comment`` lines go on top.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write (replaced if it exists).
+        comment : str, optional
+            Lines written as TOML comments above the values.
+
+        Raises
+        ------
+        FileWriteError
+            The file cannot be written.
+        """
         lines = [f"# {line}" for line in comment.splitlines()]
         lines += ["# imgmtf sensor: metres on the ground, cycles/metre for frequencies",
                   f"# stages: {', '.join(STAGES)}", f"gsd_m = {_toml_number(self.gsd_m)}"]
@@ -325,6 +513,16 @@ class Sensor:
         """Read a sensor from TOML: ``gsd_m`` and ``[[stages]]`` tables as
         :meth:`to_toml` writes them, or the old form, the generic sensor's
         keywords at the top level or in a ``[sensor]`` table.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The TOML file.
+
+        Returns
+        -------
+        Sensor
+            The sensor it describes.
 
         Raises
         ------

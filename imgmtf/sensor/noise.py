@@ -52,13 +52,41 @@ class GroundNoise:
         return asdict(self)
 
     def sample(self, shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
-        """The composite noise field on a sub-pixel grid of ``shape`` (DN)."""
+        """The composite noise field on a sub-pixel grid of ``shape`` (DN).
+
+        Parameters
+        ----------
+        shape : (int, int)
+            The grid's (rows, cols), sub-pixel cells.
+        rng : numpy.random.Generator
+            The source of the noise.
+
+        Returns
+        -------
+        numpy.ndarray
+            The sum of the layers, DN.
+        """
         return sum((self.layer(k, shape, rng) for k in range(1, self.layers + 1)),
                    np.zeros(shape))
 
     def layer(self, grain: int, shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
         """One layer: white Gaussian noise constant over ``grain`` x ``grain``
-        cells, its grid shifted by a random offset in each axis."""
+        cells, its grid shifted by a random offset in each axis.
+
+        Parameters
+        ----------
+        grain : int
+            The side of the layer's constant blocks, sub-pixel cells.
+        shape : (int, int)
+            The grid's (rows, cols), sub-pixel cells.
+        rng : numpy.random.Generator
+            The source of the noise.
+
+        Returns
+        -------
+        numpy.ndarray
+            The layer, DN.
+        """
         rows, cols = shape
         coarse = rng.normal(0.0, math.sqrt(self.layer_variance_dn2),
                             (rows // grain + 2, cols // grain + 2))

@@ -82,7 +82,18 @@ class Chip:
 
     def true_mtf(self, f_cy_px: ArrayLike) -> np.ndarray:
         """The sensor's MTF along the target's normal at ``f_cy_px``
-        (cycles per pixel of this chip): what an ideal estimator returns."""
+        (cycles per pixel of this chip): what an ideal estimator returns.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies along the normal, cy/px.
+
+        Returns
+        -------
+        numpy.ndarray
+            The true MTF at each frequency (1 at zero).
+        """
         return np.abs(self.sensor.normal_transfer(f_cy_px, self.target.angle_deg, self.gsd_m))
 
     def true_fwhm_px(self) -> float:

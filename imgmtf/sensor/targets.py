@@ -95,14 +95,41 @@ class Target:
         return asdict(self)
 
     def signed_distance(self, x: np.ndarray, y: np.ndarray, center: tuple[float, float]) -> np.ndarray:
-        """Signed distance (px) of points (x, y) from the edge (pulse centre line)."""
+        """Signed distance (px) of points (x, y) from the edge (pulse centre line).
+
+        Parameters
+        ----------
+        x, y : numpy.ndarray
+            The points' columns and rows, px.
+        center : (float, float)
+            The (x, y) point, px, the target is placed about.
+
+        Returns
+        -------
+        numpy.ndarray
+            The distances, px, along the normal (cos a, sin a): an edge is
+            ``high_dn`` where they are positive.
+        """
         a = math.radians(self.angle_deg)
         return (x - center[0]) * math.cos(a) + (y - center[1]) * math.sin(a) - self.offset_px
 
     def image_values(self, d_px: np.ndarray, esf: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
         """DN of the target seen through a sensor whose edge response along
         this target's normal is ``esf(d)`` (rising from 0 to 1), at signed
-        distances ``d_px`` (px) from the edge (the pulse's centre line)."""
+        distances ``d_px`` (px) from the edge (the pulse's centre line).
+
+        Parameters
+        ----------
+        d_px : numpy.ndarray
+            Signed distances from the edge, px.
+        esf : callable
+            The edge response ``esf(d)``, d in px.
+
+        Returns
+        -------
+        numpy.ndarray
+            The target's values there, DN.
+        """
         if self.kind == "edge":
             inside = esf(d_px)
         else:
