@@ -1,7 +1,8 @@
 """Every example a user reads runs, so that none can drift from the code.
 
 * README.md and docs/*.md: each document's fenced blocks run in order in a
-  fresh folder holding the sample ``data/``: ``console`` blocks through the
+  fresh folder holding the sample ``data/`` (the README's Python examples as
+  ``python -m doctest README.md`` runs them): ``console`` blocks through the
   CLI (each ``$ imgmtf ...`` line, its exit status 0 unless the line ends
   with a ``# exit status N`` comment, and the output shown beneath it, where
   ``...`` stands for any text, as in a doctest; a command shown without
@@ -108,7 +109,7 @@ def test_every_example_of_the_document_runs(document, sample_folder):
         where = f"{document}:{line}"
         if language == "console":
             run_console(body, where)
-        elif language == "python":
+        elif language == "python" and document != "README.md":     # README: python -m doctest, below
             run_python(body, globs, where)
         elif language == "toml":
             path = sample_folder / f"block{line}.toml"
@@ -118,6 +119,15 @@ def test_every_example_of_the_document_runs(document, sample_folder):
             continue
         ran += 1
     assert ran or document != "README.md"
+
+
+def test_python_m_doctest_passes_on_the_readme(sample_folder):
+    """The README's Python examples as `python -m doctest README.md` runs
+    them: the whole file one docstring, no option flags (a fence right under
+    an output line becomes part of the expected output there)."""
+    failures, tried = doctest.testfile(str(ROOT / "README.md"), module_relative=False, verbose=False,
+                                       report=True, optionflags=0)
+    assert tried and not failures
 
 
 def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
