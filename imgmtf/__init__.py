@@ -37,6 +37,7 @@ _LAZY = {
     "Record": "records",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
+    "QualityError": "estimate.gate", "TwoTargetsError": "estimate.gate",
 }
 
 __all__ = [
