@@ -15,7 +15,7 @@ import numpy as np
 
 from .atomic import atomic_output, ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
-from .estimate.intervals import Intervals
+from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
 from .inputs import check_width, saturation_levels
 from .io import raster_info, read_raster
@@ -36,7 +36,10 @@ class MeasureSettings:
         RGB luminance.
     roi : (x, y, width, height) window read from every file (px).
     pulse_width : (value, "px" or "m"), or None to estimate it.
-    intervals : confidence-interval settings (linearised by default).
+    intervals : confidence-interval settings (linearised by default): an
+        :class:`~imgmtf.Intervals`, or what ``--intervals`` takes
+        ("influence", "bootstrap", "none"), or a number of bootstrap
+        replicates (0: none).
     force : measure even where a quality check fails (each a warning).
     saturation : (low, high) DN the sensor records; None for an integer
         file's type range (floats: none declared).
@@ -56,6 +59,7 @@ class MeasureSettings:
     track_azimuth_deg: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "intervals", as_intervals(self.intervals))
         if self.target not in ("edge", "pulse"):
             raise ParameterError(f"target must be 'edge' or 'pulse', got {self.target!r}")
         if self.pulse_width is not None and self.target != "pulse":

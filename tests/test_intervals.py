@@ -98,3 +98,20 @@ def test_t_quantile_closed_forms_and_bad_arguments():
     for p, dof in ((0.0, 5), (1.0, 5), (0.9, 0), (0.9, 2.5)):
         with pytest.raises(ParameterError):
             t_quantile(p, dof)
+
+
+def test_the_words_the_cli_takes_name_intervals_in_python_too():
+    """intervals="bootstrap" wherever --intervals bootstrap is taken: the
+    estimators, a batch's and a scan's settings; an unknown word is refused."""
+    from imgmtf.batch import MeasureSettings
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.6, 6.0), 6.0, (60, 60), noise_std=2.0, seed=3)
+    by_word = im.measure_edge(chip, intervals="bootstrap")
+    assert by_word.params["intervals"] == im.measure_edge(chip, intervals=im.Intervals("bootstrap")).params["intervals"]
+    assert by_word.mtf_nyquist_ci == im.measure_edge(chip, intervals=im.Intervals("bootstrap")).mtf_nyquist_ci
+    assert math.isnan(im.measure_edge(chip, intervals="none").mtf_nyquist_ci.low)
+    assert MeasureSettings(intervals="bootstrap").intervals == im.Intervals("bootstrap")
+    assert im.ScanSettings(intervals="none").intervals == im.Intervals("none")
+    with pytest.raises(ParameterError, match="'bootstrapp'"):
+        im.measure_edge(chip, intervals="bootstrapp")
+    with pytest.raises(ParameterError, match="'influense'"):
+        MeasureSettings(intervals="influense")

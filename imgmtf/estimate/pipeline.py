@@ -129,8 +129,10 @@ class Settings:
     lsf_window_factor : float or None
         That half-width in units of the 10-90 % rise (edges); None adapts
         it to the SNR.
-    intervals : Intervals
-        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`).
+    intervals : Intervals or str or int
+        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`),
+        or a method's name as ``--intervals`` takes it ("influence",
+        "bootstrap", "none"), or a number of bootstrap replicates (0: none).
     force : bool
         Measure even when a quality check fails (each failure becomes a
         warning) instead of refusing.

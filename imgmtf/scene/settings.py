@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 from ..batch import MeasureSettings
 from ..errors import ParameterError
-from ..estimate.intervals import Intervals
+from ..estimate.intervals import Intervals, as_intervals
 from ..inputs import check_number
 
 MIN_TILE_PX = 256
@@ -61,6 +61,7 @@ class ScanSettings:
     track_azimuth_deg: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
         for name in ("min_length_px", "max_length_px"):
             object.__setattr__(self, name, check_number(name, getattr(self, name)))
         for name in ("margin_px", "tile_px"):
