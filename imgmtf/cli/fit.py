@@ -6,7 +6,7 @@ import json
 import click
 
 from ..errors import ParameterError
-from .errors import reported_errors
+from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
 from .options import FiniteFloat, parse_roi
 from .tables import print_fit
@@ -28,7 +28,7 @@ from .tables import print_fit
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels read from every file (default: the whole image)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
-@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+@click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the intervals")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True,
@@ -40,9 +40,12 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model."""
     from ..batch import expand_inputs
-    from ..estimate.fit import fit_sensor
+    from ..estimate.fit import check_names, fit_sensor
     from ..sensor.model import Sensor
     with reported_errors():
+        start = Sensor.from_toml(sensor_path) if sensor_path else None
+        with option_errors():
+            check_names(stages, hold or (), start)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
@@ -50,7 +53,6 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             check_figure_file(plot_path)
         if out_path:
             check_output_file(out_path)
-        start = Sensor.from_toml(sensor_path) if sensor_path else None
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
                             roi=roi, confidence=confidence)
         written = []

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from .errors import interrupt_code, reported_errors, signal_name
+from .errors import interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
     FiniteFloat,
     MethodName,
@@ -30,7 +30,7 @@ from .tables import print_scan
 @click.option("--margin", type=click.IntRange(6, 1000), default=12, show_default=True,
               help="ROI extent either side of the target, px")
 @click.option("--pulse-width", callback=length_option("px"),
-              help="bar width (px or m) for every bar; estimated per bar when omitted")
+              help="bar width (0.2 to 10 px; px or m) for every bar; estimated per bar when omitted")
 @click.option("--method", type=MethodName(), default="msg", show_default=True)
 @click.option("--band", type=click.IntRange(min=1),
               help="1-based band (default: the only band, or the luminance of RGB)")
@@ -73,9 +73,11 @@ def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band,
         from ..scene.export import write_outputs
         from ..scene.measure import scan_scene
         from ..scene.settings import ScanSettings
-        settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
-                                pulse_width=pulse_width, saturation=saturation, track_azimuth_deg=track_azimuth,
-                                intervals=interval_settings(interval_method, replicates, confidence))
+        with option_errors():
+            settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
+                                    pulse_width=pulse_width, saturation=saturation,
+                                    track_azimuth_deg=track_azimuth,
+                                    intervals=interval_settings(interval_method, replicates, confidence))
         if out_dir:
             ensure_folder(out_dir)
         info = raster_info(scene)
