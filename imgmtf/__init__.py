@@ -34,7 +34,7 @@ _LAZY = {
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
-    "Record": "records",
+    "Record": "records", "measure_file": "batch", "MeasureSettings": "batch",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
     "QualityError": "estimate.gate", "TwoTargetsError": "estimate.gate",

@@ -17,7 +17,7 @@ from .atomic import atomic_output, ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
-from .inputs import check_width, saturation_levels
+from .inputs import check_width, parse_length, saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
 from .records import Record, utc_now
@@ -35,7 +35,8 @@ class MeasureSettings:
     band : 1-based band, "all" for every band, None for the only band or
         RGB luminance.
     roi : (x, y, width, height) window read from every file (px).
-    pulse_width : (value, "px" or "m"), or None to estimate it.
+    pulse_width : (value, "px" or "m"), a number of px, a string as the
+        CLI takes it ("1.4", "1.4px", "18.3m"), or None to estimate it.
     intervals : confidence-interval settings (linearised by default): an
         :class:`~imgmtf.Intervals`, or what ``--intervals`` takes
         ("influence", "bootstrap", "none"), or a number of bootstrap
@@ -60,6 +61,8 @@ class MeasureSettings:
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
+        if self.pulse_width is not None:
+            object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
         if self.target not in ("edge", "pulse"):
             raise ParameterError(f"target must be 'edge' or 'pulse', got {self.target!r}")
         if self.pulse_width is not None and self.target != "pulse":
@@ -110,11 +113,62 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
     return out
 
 
-def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = None, *,
-                 run_utc: str | None = None) -> list[Record]:
-    """Every requested band of one file measured: one record each (an error
-    record when the file or a band cannot be measured, whatever the
-    failure).  ``run_utc`` stamps the records (default: now)."""
+def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
+                 *, run_utc: str | None = None, **options) -> list[Record]:
+    """Measure one image file as ``imgmtf measure FILE`` does: every
+    requested band, one record each, the same records (and numbers) that
+    ``imgmtf measure --format json FILE`` prints.
+
+    The file's GSD (figures on the ground), its data type (saturation
+    limits), its geometry (the track's direction) and, for an RGB(A) photo,
+    its luminance are taken from the file, as the CLI takes them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The image file (GeoTIFF, JP2, NITF, PNG, JPEG: anything GDAL reads).
+    settings : MeasureSettings, optional
+        How to measure; or give its fields as keywords (``target``,
+        ``method``, ``band``, ``roi``, ``pulse_width``, ``intervals``,
+        ``force``, ``saturation``, ``track_azimuth_deg``), which take what
+        the CLI's options take (``intervals="bootstrap"``,
+        ``pulse_width="1.5m"``, ``band="all"``).
+    plot_path : str, optional
+        Also save the measurement figure here (``measure --plot``).
+    run_utc : str, optional
+        The time stamp of the records (default: now).
+
+    Returns
+    -------
+    list of Record
+        One per band measured (one for a single-band file or a photo's
+        luminance); a file or band that cannot be measured gives an error
+        record (``status`` "error", its ``reason`` and message), never an
+        exception, as in a batch.
+
+    Raises
+    ------
+    ParameterError
+        Settings out of range, or both ``settings`` and keywords.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 64, gsd_m=0.5, seed=1)
+    >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=chip.gsd_m)
+    >>> [record] = imgmtf.measure_file("chip.tif", intervals="bootstrap")
+    >>> record.status, record.get("gsd_m"), record.get("params")["intervals"]["method"]
+    ('ok', 0.5, 'bootstrap')
+    >>> imgmtf.measure_file("missing.tif")
+    [Record('missing.tif', error, unreadable: missing.tif: no such file)]
+    """
+    if settings is None:
+        settings = MeasureSettings(**options)
+    elif options:
+        raise ParameterError(f"give settings or keyword options ({', '.join(options)}), not both")
+    elif not isinstance(settings, MeasureSettings):
+        raise ParameterError(f"settings must be a MeasureSettings, got {type(settings).__name__}")
+    path = os.fspath(path)
     run_utc = run_utc or utc_now()
     try:
         info = raster_info(path)

@@ -92,20 +92,16 @@ class MethodOption(click.Option):
 
 def length_option(default_unit: str):
     """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit), the value
-    finite and > 0."""
+    finite (:func:`imgmtf.inputs.parse_length`, which the API uses too)."""
     def parse(ctx, param, value):
         if value is None:
             return None
-        text = value.strip().lower()
-        unit = next((u for u in ("px", "m") if text.endswith(u)), None)
-        number = text[: -len(unit)] if unit else text
+        from ..errors import ParameterError
+        from ..inputs import parse_length
         try:
-            length = float(number)
-        except ValueError:
-            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}") from None
-        if not math.isfinite(length):
-            raise click.BadParameter(f"expected a finite width, got {value!r}")
-        return length, unit or default_unit
+            return parse_length(value, default_unit)
+        except ParameterError as exc:
+            raise click.BadParameter(str(exc)) from None
     return parse
 
 
