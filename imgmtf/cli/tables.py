@@ -71,7 +71,12 @@ def snr_cell(value) -> str:
 
 
 def num_cell(value, width: int, decimals: int) -> str:
-    return f"{value:{width}.{decimals}f}" if value is not None else f"{'-':>{width}}"
+    """A figure to ``decimals`` places right-aligned in ``width``; '-' where
+    undefined; never a signed zero ("-0.00" reads as 0.00)."""
+    if value is None:
+        return f"{'-':>{width}}"
+    text = f"{value:.{decimals}f}"
+    return f"{text.removeprefix('-') if float(text) == 0 else text:>{width}}"
 
 
 def print_fit(result) -> None:

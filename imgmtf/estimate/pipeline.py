@@ -729,6 +729,8 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
                             "give the width if it is known, or use the default (influence) intervals")
         nyquist_ci, mtf50_ci = _bootstrap_intervals(
             settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
+    # an MTF (a modulus) and a frequency are never negative: ends below 0 are raised to 0 (docs/method.md)
+    nyquist_ci, mtf50_ci = nyquist_ci.clipped_at_zero(), mtf50_ci.clipped_at_zero()
 
     figures = dict(
         normal_angle_deg=_normal_angle(geometry), tilt_deg=geometry.tilt_deg,
