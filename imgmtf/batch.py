@@ -176,29 +176,31 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
     except Exception as exc:               # the safety net: a record, never an abort
         return [settings.failed(path, settings.band, exc, run_utc)]
     skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
+    # what the file's reading adds to its first record's warnings (and to its figure's count of them)
+    skipped_note = ([f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured"]
+                    if skipped else [])
     records = []
-    for band in bands:
+    for index, band in enumerate(bands):
+        file_notes = skipped_note if index == 0 else []
         try:
             raster = read_raster(path, band, window=settings.roi)
             result = measure_raster(raster, settings)
             summary = result.to_dict(curves=True)
         except Exception as exc:
-            records.append(settings.failed(path, band, exc, run_utc))
+            failed = settings.failed(path, band, exc, run_utc)
+            records.append(failed.with_(figures={"warnings": file_notes}) if file_notes else failed)
             continue
+        if raster.band == "luminance":
+            # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
+            file_notes = [*file_notes, "measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded "
+                          "as stored (not linearised)" + (", alpha ignored" if info.alpha_bands else "")]
+        summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         if plot_path:
-            record = with_figure(record, functools.partial(_measurement_figure, result, raster),
+            record = with_figure(record, functools.partial(_measurement_figure, result, raster,
+                                                           summary["warnings"]),
                                  _band_plot_path(plot_path, band, len(bands)))
         records.append(record)
-    notes = []
-    if skipped:
-        notes.append(f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured")
-    if any(r.band == "luminance" for r in records):
-        # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
-        notes.append("measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded as stored "
-                     "(not linearised)" + (", alpha ignored" if info.alpha_bands else ""))
-    if notes and records:
-        records[0] = records[0].with_(figures={"warnings": [*records[0].get("warnings", []), *notes]})
     return records
 
 
@@ -281,12 +283,13 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result, raster):
-    """The measurement figure, titled with the file (and band), with the
+def _measurement_figure(result, raster, warnings):
+    """The measurement figure, titled with the file (and band), counting
+    every warning its record carries (the file's own among them), with the
     true MTF when the file is a chip imgmtf simulated."""
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
-    return plot_measurement(result, truth=true_mtf(raster), title=title)
+    return plot_measurement(result, truth=true_mtf(raster), title=title, warnings=warnings)
 
 
 def true_mtf(raster):

@@ -56,4 +56,56 @@ def test_a_scan_overview_takes_scan_scenes_records_as_they_come():
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():
     from imgmtf.plot.measurement import _figure
     assert _figure(0.36431, "cy/px") == "0.3643 cy/px" and _figure(0.2667) == "0.2667"
-    assert _figure(float("nan"), "cy/px") == "masked by the bar's sinc"
+    assert _figure(float("nan"), "cy/px", "masked by the bar's sinc") == "masked by the bar's sinc"
+    assert _figure(float("nan"), "cy/px") == "undefined"
+
+
+def test_a_missing_figure_is_labelled_by_its_cause():
+    """A bar's sinc masks only a bar's figure; a forced edge whose MTF never
+    falls to 0.5 says so, not that a sinc masked it."""
+    from dataclasses import replace
+
+    from imgmtf.plot.measurement import missing_cause, plot_measurement
+    edge = _measured(6.0)
+    no_fifty = replace(edge, mtf50_cy_px=float("nan"), mtf=np.maximum(edge.mtf, 0.55),
+                       warnings=("mtf-undefined: MTF50 cannot be read off (measured anyway: forced)",))
+    assert missing_cause(no_fifty, "mtf50") == "undefined: the MTF stays above 0.5 up to 1 cy/px"
+    header = plot_measurement(no_fifty).get_suptitle()
+    assert "MTF50 undefined: the MTF stays above 0.5" in header and "sinc" not in header
+    bar = im.measure_pulse(im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, width_px=3.0), 80,
+                                     noise_std_dn=1.0, seed=2).image, width_px=3.0)
+    masked = replace(bar, mtf50_cy_px=float("nan"), mtf=np.where(bar.frequencies_cy_px < 0.3, 0.8, np.nan))
+    assert missing_cause(masked, "mtf50") == "masked by the bar's sinc"
+    assert missing_cause(masked, "mtf_nyquist") == "masked by the bar's sinc"
+    assert missing_cause(replace(edge, mtf=np.where(edge.frequencies_cy_px < 0.3, 0.8, np.nan)),
+                         "mtf_nyquist") == "undefined"
+
+
+def test_the_header_counts_every_warning_and_drops_none_unsaid():
+    from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    result = _measured(6.0)
+    warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
+    header = plot_measurement(result, warnings=warnings).get_suptitle()
+    assert f"warning 1 of {len(warnings)}: note 0" in header and "note 2" in header
+    assert "and 2 more warning(s)" in header and "note 3" not in header
+    assert "warning" not in plot_measurement(result).get_suptitle()
+
+
+def test_measures_figure_counts_the_files_own_warnings(tmp_path, monkeypatch):
+    """A photo measured on its luminance: the figure's header counts the
+    luminance warning the text table prints beside the SNR one."""
+    from pathlib import Path
+
+    import imgmtf.plot
+    from imgmtf.batch import measure_file
+    drawn = {}
+    real = imgmtf.plot.plot_measurement
+
+    def spy(result, **kwargs):
+        drawn.update(kwargs)
+        return real(result, **kwargs)
+    monkeypatch.setattr(imgmtf.plot, "plot_measurement", spy)
+    photo = Path(__file__).parent.parent / "data" / "x2084_y0616_F2.png"
+    [record] = measure_file(photo, plot_path=str(tmp_path / "f2.png"))
+    assert record.plot and len(record.get("warnings")) == 2
+    assert drawn["warnings"] == record.get("warnings") and "luminance" in drawn["warnings"][-1]
