@@ -109,3 +109,10 @@ def test_measures_figure_counts_the_files_own_warnings(tmp_path, monkeypatch):
     [record] = measure_file(photo, plot_path=str(tmp_path / "f2.png"))
     assert record.plot and len(record.get("warnings")) == 2
     assert drawn["warnings"] == record.get("warnings") and "luminance" in drawn["warnings"][-1]
+
+
+def test_the_scan_legend_lists_ids_in_runs_and_counts_the_common_reasons():
+    from imgmtf.plot.scan import MAX_LISTED, _legend_label
+    group = [{"id": i} for i in (3, 4, 9, 10, 12, 13, 14, 15, 16)]
+    assert _legend_label("angle", group) == "angle (9)\n3-4, 9-10, 12-16"
+    assert _legend_label("too-short", [{"id": i} for i in range(MAX_LISTED + 1)]) == f"too-short ({MAX_LISTED + 1})"

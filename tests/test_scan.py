@@ -78,18 +78,29 @@ def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_rec
     summaries = [s.to_dict() for s in summarise_scan(scan_records)]
     rows = [r.to_dict() for r in scan_records]
     # records as scan_scene returns them draw as their dicts do
-    assert len(plot_scan(np.zeros((128, 256)), 2.0, scan_records, summarise_scan(scan_records)).axes[0].texts) == 4
+    as_records = plot_scan(np.zeros((128, 256)), 2.0, scan_records, summarise_scan(scan_records)).axes[0].texts
     fig = plot_scan(np.zeros((128, 256)), 2.0, rows, summaries)
     ax = fig.axes[0]
+    assert len(as_records) == len(ax.texts)
     reasons = {r["reason"] for r in rows if r["status"] == "rejected"}
     lines = [c for c in ax.collections if isinstance(c, LineCollection) and not isinstance(c, PolyCollection)]
     assert len(lines) == len(reasons) + 1 and not ax.patches          # one collection per reason, no boxes
     assert len([c for c in ax.collections if isinstance(c, PolyCollection)]) == 1
-    # the targets labelled, and each accepted half-edge by its id
-    assert sorted(t.get_text().split()[0] for t in ax.texts) == ["1", "2", "T1", "T2"]
+    # every candidate carries its id (few per reason here), as the table lists them; the targets their figures
+    labels = sorted(t.get_text().split()[0] for t in ax.texts)
+    assert labels == sorted([str(r["id"]) for r in rows] + [f"T{s['target_id']}" for s in summaries
+                                                            if s["scope"] == "target"], key=str)
+    # the accepted drawn above the rejected, both outlined so that they read on black and on white
+    accepted_line = lines[-1]
+    assert all(accepted_line.get_zorder() > c.get_zorder() for c in lines[:-1])
+    assert all(c.get_path_effects() for c in lines)
     assert ax.get_xlabel() == "column (px)" and ax.get_ylabel() == "row (px)"
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "accepted (2)" in legend and f"angle ({sum(r['reason'] == 'angle' for r in rows)})" in legend
+    n_angle = sum(r["reason"] == "angle" for r in rows)
+    assert legend[0].startswith("accepted (2)\n") and any(t.startswith(f"angle ({n_angle})") for t in legend)
+    # the legend lies outside the image, on its right
+    fig.canvas.draw()
+    assert ax.get_legend().get_window_extent().x0 > ax.get_window_extent().x1
     x0, y0, x1, y1 = ax.get_position().extents          # the image fills its axes: no blank band
     assert (x1 - x0) * fig.get_figwidth() / ((y1 - y0) * fig.get_figheight()) == pytest.approx(2.0)
 
