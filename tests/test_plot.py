@@ -116,3 +116,19 @@ def test_the_scan_legend_lists_ids_in_runs_and_counts_the_common_reasons():
     group = [{"id": i} for i in (3, 4, 9, 10, 12, 13, 14, 15, 16)]
     assert _legend_label("angle", group) == "angle (9)\n3-4, 9-10, 12-16"
     assert _legend_label("too-short", [{"id": i} for i in range(MAX_LISTED + 1)]) == f"too-short ({MAX_LISTED + 1})"
+
+
+def test_locations_are_drawn_where_the_image_has_them():
+    """Measured through an ROI, the edge's locations are drawn in the
+    image's pixel coordinates, not the ROI's (a scan's edge figures: the
+    scene's)."""
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0, 200.0, 1200.0), 100, noise_std_dn=2.0, seed=1)
+    whole, part = im.measure_edge(chip.image), im.measure_edge(chip.image, roi=(20, 10, 60, 80))
+    lines = []
+    for result in (whole, part):
+        ax = Figure().subplots()
+        plot_locations(result, ax)
+        lines.append(next(ln for ln in ax.get_lines() if ln.get_label() == "least-squares line"))
+    (xw, yw), (xp, yp) = [(ln.get_xdata(), ln.get_ydata()) for ln in lines]
+    assert yp.min() == 10 and yp.max() == 89 and 20 < xp.min() < xp.max() < 80
+    assert np.interp(50.0, yp, xp) == __import__("pytest").approx(np.interp(50.0, yw, xw), abs=0.05)

@@ -18,18 +18,22 @@ def _view_px(result) -> float:
 
 def plot_locations(result, ax=None):
     """Per-row sub-pixel target locations and the fitted line (paper Fig.
-    5a), at equal scale in both axes so that the tilt looks as it is; the
-    rows' RMS scatter about the line is in the legend."""
+    5a), at equal scale in both axes so that the tilt looks as it is, in
+    the pixel coordinates of the image measured (its ROI's offset added:
+    a file's with ``imgmtf measure --roi``, a scene's for a scan's edge);
+    the rows' RMS scatter about the line is in the legend."""
     expect(result, "result")
     fig, ax = figure_axes(ax)
     g = result.geometry
     kept = g.kept
     fitted = g.slope * g.rows + g.intercept
     rms = float(np.sqrt(np.mean((g.locations[kept] - fitted[kept]) ** 2)))
+    x0, y0 = result.roi[:2]
 
     def image_xy(along, across):
-        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it
-        return (along, across) if g.transposed else (across, along)
+        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it,
+        # where the image has it
+        return (along + x0, across + y0) if g.transposed else (across + x0, along + y0)
     line = "column" if g.transposed else "row"
     ax.plot(*image_xy(g.rows[kept], g.locations[kept]), "o", ms=3, mfc="none",
             label=f"{line} {result.target} location (scatter {rms:.3f} px RMS)")
