@@ -310,6 +310,15 @@ def true_mtf(raster):
     return lambda f_cy_px: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
 
 
+def file_truth(path: str, band=None, window=None):
+    """:func:`true_mtf` of the chip in file ``path`` (None for a file
+    imgmtf did not simulate, or one it cannot read)."""
+    try:
+        return true_mtf(read_raster(path, band, window=window))
+    except ImgmtfError:
+        return None
+
+
 def with_figure(record: Record, make_figure, path: str) -> Record:
     """``record`` with the figure ``make_figure()`` builds saved to
     ``path`` (its ``plot``), or, when that fails, a warning saying why: a

@@ -132,3 +132,37 @@ def test_locations_are_drawn_where_the_image_has_them():
     (xw, yw), (xp, yp) = [(ln.get_xdata(), ln.get_ydata()) for ln in lines]
     assert yp.min() == 10 and yp.max() == 89 and 20 < xp.min() < xp.max() < 80
     assert np.interp(50.0, yp, xp) == __import__("pytest").approx(np.interp(50.0, yw, xw), abs=0.05)
+
+
+def test_the_fit_figure_draws_the_models_interval_and_the_truth_with_short_titles(tmp_path):
+    """fit.png: the model's interval drawn (and magnified about Nyquist),
+    the truth of a simulated chip beside it, titles short enough not to
+    run into each other, the frequency in cy/px as everywhere else."""
+    from click.testing import CliRunner
+
+    import imgmtf.plot
+    from imgmtf.batch import file_truth
+    from imgmtf.cli import main
+    from imgmtf.plot import plot_fit
+    folder = tmp_path / "a_long_folder_name_as_real_data_have"
+    folder.mkdir()
+    paths = [folder / "scene_2024_05_01_T10_across_track_edge.tif", folder / "along.tif"]
+    for path, angle in zip(paths, ("5", "84")):
+        assert CliRunner().invoke(main, ["simulate", "--angle", angle, "--size", "60", "--noise-std", "5",
+                                         "--seed", "1", "--out", str(path)]).exit_code == 0
+    fit = im.fit_sensor([str(p) for p in paths], stages="optics")
+    truths = [file_truth(str(p)) for p in paths]
+    assert all(truths) and file_truth(str(tmp_path / "missing.tif")) is None
+    fig = plot_fit(fit, truths=truths)
+    ax = fig.axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert any(label.startswith("true: 0.26") for label in labels)
+    assert any(label.startswith("model's 95 % interval") for label in labels)
+    assert ax.get_xlabel() == "frequency along the normal (cy/px)"
+    assert ax.get_title().splitlines()[0] == "scene_2024_...ack_edge.tif" and "folder" not in ax.get_title()
+    inset = ax.child_axes[0]
+    assert inset.get_xlim() == (0.47, 0.53) and inset.collections          # the band, magnified
+    fig.canvas.draw()
+    boxes = [a.title.get_window_extent() for a in fig.axes[:2]]
+    assert boxes[0].x1 < boxes[1].x0                                           # titles apart
+    assert imgmtf.plot.plot_fit is plot_fit

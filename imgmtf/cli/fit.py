@@ -62,8 +62,11 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
                                                      f"{', '.join(e.source for e in result.edges)}")
             written.append(out_path)
         if plot_path:
+            from ..batch import file_truth
             from ..plot import plot_fit
-            save_figure(plot_fit(result), plot_path)
+            # the truth of each chip imgmtf simulated (its GeoTIFF says how), drawn beside the model
+            truths = [file_truth(edge.source, band, roi) for edge in result.edges]
+            save_figure(plot_fit(result, truths=truths), plot_path)
             written.append(plot_path)
     if fmt == "json":
         click.echo(json.dumps({**result.to_dict(), "written": written}))

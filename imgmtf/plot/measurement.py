@@ -46,7 +46,8 @@ def plot_locations(result, ax=None):
     ax.set(xlabel="column (px)", ylabel="row (px)")
     title_once(ax, f"{result.target.capitalize()}: normal at {result.normal_angle_deg:.2f} deg, "
                f"tilt {result.tilt_deg:.2f} deg")
-    ax.legend(fontsize="small")
+    # the line may run anywhere in these axes: its legend goes under them, off the data
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -95,7 +96,7 @@ def plot_lsf(result, ax=None):
     view = max(4.0, 2.5 * result.fwhm_px)
     ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
     title_once(ax, "Line spread function")
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="upper right")           # over a tail, clear of the peak
     return fig
 
 
