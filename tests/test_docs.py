@@ -119,6 +119,21 @@ def test_every_example_of_the_document_runs(document, sample_folder):
             continue
         ran += 1
     assert ran or document != "README.md"
+    assert_ignored(sample_folder)
+
+
+def assert_ignored(folder: Path) -> None:
+    """Every file or folder the examples wrote, run from the repository's
+    root as a newcomer runs them, is one .gitignore covers."""
+    import shutil
+    import subprocess
+    written = [p.name + "/" * p.is_dir() for p in folder.iterdir()
+               if p.name != "data" and not p.name.startswith("block")]
+    if not written or not shutil.which("git") or not (ROOT / ".git").exists():
+        return
+    ignored = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", *written],
+                             capture_output=True, text=True).stdout.split()
+    assert sorted(set(written) - set(ignored)) == [], "examples write files .gitignore does not cover"
 
 
 def test_python_m_doctest_passes_on_the_readme(sample_folder):
@@ -128,6 +143,7 @@ def test_python_m_doctest_passes_on_the_readme(sample_folder):
     failures, tried = doctest.testfile(str(ROOT / "README.md"), module_relative=False, verbose=False,
                                        report=True, optionflags=0)
     assert tried and not failures
+    assert_ignored(sample_folder)
 
 
 def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
