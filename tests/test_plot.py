@@ -166,3 +166,23 @@ def test_the_fit_figure_draws_the_models_interval_and_the_truth_with_short_title
     boxes = [a.title.get_window_extent() for a in fig.axes[:2]]
     assert boxes[0].x1 < boxes[1].x0                                           # titles apart
     assert imgmtf.plot.plot_fit is plot_fit
+
+
+def test_a_quick_runs_threshold_figure_says_na_as_its_report_does():
+    from imgmtf.plot import plot_threshold
+    found = {"msg": {"threshold": 200.0, "fractions": {100: 0.9, 200: 1.0}}}
+    quick = plot_threshold(found, 0.05, 0.95, 8, thresholds=False).axes[0].get_legend_handles_labels()[1]
+    full = plot_threshold(found, 0.05, 0.95, 100).axes[0].get_legend_handles_labels()[1]
+    assert quick[0] == "msg: threshold n/a (too few chips)" and full[0] == "msg: threshold SNR 200"
+
+
+def test_the_sensor_figures_legends_lie_off_the_curves():
+    """The LSF panel's legend is not where the FWHM is read (the half
+    maximum): it lies under the axes, as the MTF panels' do."""
+    from imgmtf.plot import plot_sensor
+    fig = plot_sensor(im.Sensor())
+    fig.canvas.draw()
+    for ax in fig.axes[1:4]:
+        assert ax.get_legend().get_window_extent().y1 < ax.get_window_extent().y0
+    assert fig.axes[2].get_xlabel() == "frequency (cy/px)"
+    assert min(ax.get_tightbbox().x0 for ax in fig.axes) >= 0          # nothing cut at the left edge
