@@ -116,7 +116,7 @@ def plot_threshold(found, relative, fraction, chips_per_level: int, thresholds: 
         ax.fill_between(snrs, centre - half, centre + half, color=f"C{i}", alpha=0.12, lw=0)
         ax.semilogx(snrs, p, "o-", ms=3, color=f"C{i}", label=f"{method}: {reached}")
     ax.axhline(fraction, color="0.5", ls="--", lw=0.8, label=f"criterion: {100 * fraction:g} %")
-    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist "
+    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist\n"
                  f"({chips_per_level} chips per SNR; bands: 95 % intervals)",
            xlabel="SNR (step / noise std)", ylabel="fraction of estimates", ylim=(0, 1.02))
     ax.title.set_fontsize("medium")
