@@ -207,3 +207,10 @@ if __name__ == "__main__":
     for name in DOCUMENTS:
         update_console_outputs(name)
         print(f"updated {name}")
+
+
+def test_the_readme_explains_every_reason_the_gate_gives():
+    from imgmtf.estimate.gate import FORCIBLE
+    table = [line for line in (ROOT / "README.md").read_text().splitlines() if line.startswith("| `")]
+    listed = {code for line in table for code in re.findall(r"`([a-z-]+)`", line.split("|")[1])}
+    assert sorted(FORCIBLE - listed) == []
