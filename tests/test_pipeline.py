@@ -7,7 +7,8 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.estimate.pipeline import direction_label, make_settings
+from imgmtf.estimate.geometry import direction_label
+from imgmtf.estimate.pipeline import make_settings
 
 from conftest import (
     defocus_transfer,

@@ -1,34 +1,9 @@
-"""Scan screens: fill against clipping, and the quick look's contrast and
-uniformity, each with a case that trips it and one that passes."""
+"""Scan screens: the geometry and the quick look's contrast and uniformity,
+each with a case that trips it and one that passes."""
 import numpy as np
 import pytest
 
-from imgmtf.scene.screen import fill_mask, fill_screen, quick_look
-
-
-def test_zero_fill_with_a_hard_boundary_is_fill_a_dark_side_clipped_at_zero_is_not():
-    rng = np.random.default_rng(0)
-    window = 900.0 + rng.normal(0, 5, (40, 40))
-    window[:, 25:] = 0.0
-    assert fill_mask(window, "uint16")[:, 25:].all() and not fill_mask(window, "uint16")[:, :25].any()
-    # an 8-bit dark side clipped at 0 meets values close to 0: saturation, not fill
-    clipped = np.clip(np.round(np.linspace(-20, 200, 40))[None, :].repeat(40, 0) + rng.normal(0, 2, (40, 40)), 0, 255)
-    assert not fill_mask(np.round(clipped), "uint8").any()
-
-
-def test_nodata_and_a_negative_sentinel_are_fill_a_saturated_side_is_not():
-    window = np.where(np.arange(30)[None, :] < 15, 300.0, 900.0).repeat(30, 0)
-    window[:5] = np.nan
-    window[-5:] = -9999.0
-    fill = fill_mask(window, "float32")
-    assert fill[:5].all() and fill[-5:].all() and not fill[5:-5].any()
-    saturated = np.where(np.arange(30)[None, :] < 15, 300.0, 65535.0).repeat(30, 0)
-    saturated[:, 14:17] = [20000.0, 40000.0, 60000.0]            # the blurred rise up to the clip
-    assert not fill_mask(saturated, "uint16").any()
-
-
-def test_a_segment_with_fill_along_half_its_length_is_a_fill_boundary():
-    assert fill_screen(0.5)[0] == "fill" and fill_screen(0.3) is None
+from imgmtf.scene.screen import quick_look
 
 
 def band(levels=(300.0, 1500.0), noise=6.0, ramp=0.0, texture=0.0, seed=0, half=12, length=60):

@@ -25,7 +25,7 @@ def load_sensor(path: str | None):
 
 
 def save_figure(fig, path: str | Path) -> None:
-    from ..batch import save_figure
+    from ..figures import save_figure
     save_figure(lambda: fig, str(path))
 
 

@@ -59,7 +59,7 @@ from ..inputs import check_number
 from ..metrics import first_crossing
 from ..sensor.model import DIRECTIONS, PAPER_STAGES, Sensor, direction_angle
 from ..sensor.stages import STAGES, Stage
-from .pipeline import direction_label
+from .geometry import direction_label
 
 if TYPE_CHECKING:
     from .edge import EdgeResult

@@ -182,3 +182,30 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry, name: str):
             f"{gap:.2f} px (at most {MAX_SAMPLE_GAP_PX} allowed): too few rows, or an angle "
             "whose phases repeat every 1-3 rows (near 45, 26.6, 18.4 deg)")
     return d, v, row, half_range
+
+
+DIRECTION_TOLERANCE_DEG = 10.0
+
+
+def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) -> str:
+    """"along-track" when the normal lies within 10 deg of the ground
+    track, "across-track" within 10 deg of its perpendicular, "oblique"
+    otherwise, "unknown" without a track.
+
+    ``track_azimuth_deg`` is the track's direction clockwise from the
+    image's up (0: rows along track); the normal angle is measured from
+    +x towards +y (down), so the track lies at azimuth - 90 on that scale.
+
+    Examples
+    --------
+    >>> direction_label(5.0, 0.0), direction_label(84.0, 0.0), direction_label(30.0, 0.0)
+    ('across-track', 'along-track', 'oblique')
+    """
+    if track_azimuth_deg is None:
+        return "unknown"
+    offset = abs((normal_angle_deg - (track_azimuth_deg - 90.0) + 90.0) % 180.0 - 90.0)
+    if offset <= DIRECTION_TOLERANCE_DEG:
+        return "along-track"
+    if offset >= 90.0 - DIRECTION_TOLERANCE_DEG:
+        return "across-track"
+    return "oblique"

@@ -38,12 +38,21 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
 from . import gate
 from .detection import Line, robust_noise
-from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, check_angle, profile_samples, row_windows, vertical_frame
+from .geometry import (
+    EDGE_FIT_HALF_WINDOW_PX,
+    TargetGeometry,
+    check_angle,
+    direction_label,
+    profile_samples,
+    row_windows,
+    vertical_frame,
+)
 from .intervals import (
     Interval,
     Intervals,
@@ -52,7 +61,6 @@ from .intervals import (
     influence_sd,
     influence_sds,
     linearised_interval,
-    t_quantile,
 )
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
@@ -788,33 +796,6 @@ def _normal_angle(geometry: TargetGeometry) -> float:
         return vertical
     angle = 90.0 - vertical
     return angle - 180.0 if angle > 90.0 else angle
-
-
-DIRECTION_TOLERANCE_DEG = 10.0
-
-
-def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) -> str:
-    """"along-track" when the normal lies within 10 deg of the ground
-    track, "across-track" within 10 deg of its perpendicular, "oblique"
-    otherwise, "unknown" without a track.
-
-    ``track_azimuth_deg`` is the track's direction clockwise from the
-    image's up (0: rows along track); the normal angle is measured from
-    +x towards +y (down), so the track lies at azimuth - 90 on that scale.
-
-    Examples
-    --------
-    >>> direction_label(5.0, 0.0), direction_label(84.0, 0.0), direction_label(30.0, 0.0)
-    ('across-track', 'along-track', 'oblique')
-    """
-    if track_azimuth_deg is None:
-        return "unknown"
-    offset = abs((normal_angle_deg - (track_azimuth_deg - 90.0) + 90.0) % 180.0 - 90.0)
-    if offset <= DIRECTION_TOLERANCE_DEG:
-        return "along-track"
-    if offset >= 90.0 - DIRECTION_TOLERANCE_DEG:
-        return "across-track"
-    return "oblique"
 
 
 def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,

@@ -174,7 +174,8 @@ class _Labels:
         box = ax.get_position()
         # scene px per typographic point, from the axes' width on the figure
         self.px_per_pt = extent_w / max(box.width * ax.figure.get_figwidth() * 72.0, 1e-9)
-        self.ax, self.placed = ax, []
+        self.ax = ax
+        self.placed: list[tuple[float, float]] = []
 
     def add(self, record, face, text_colour, zorder: int, weight: str = "normal") -> None:
         if record.get("id") is None:

@@ -19,9 +19,9 @@ from statistics import NormalDist
 
 import numpy as np
 
+from .._stats import t_quantile
 from ..errors import ParameterError
-from ..estimate.intervals import t_quantile
-from ..estimate.pipeline import direction_label
+from ..estimate.geometry import direction_label
 from ..estimate.results import finite
 from ..records import Record
 

@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import ImgmtfError
 from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
-from .screen import FILL_SIDE_PX, fill_mask
+from .fill import FILL_SIDE_PX, fill_mask
 from .settings import ScanSettings
 
 # Scenes larger than this are refused: detection reads every tile, and 1 Gpx

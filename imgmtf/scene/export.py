@@ -14,8 +14,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..atomic import atomic_output, ensure_folder
-from ..batch import save_figure
 from ..errors import FileWriteError
+from ..figures import save_figure
 from ..io import RasterInfo, read_raster
 from ..records import SCAN_CSV_COLUMNS, Record, json_safe, write_csv
 from ..version import __version__

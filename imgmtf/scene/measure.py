@@ -26,11 +26,12 @@ from typing import Any
 import numpy as np
 
 from ..atomic import ensure_folder
-from ..batch import pulse_width_px, with_figure
+from ..batch import pulse_width_px
 from ..errors import ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
-from ..estimate.pipeline import direction_label
+from ..estimate.geometry import direction_label
+from ..figures import with_figure
 from ..inputs import saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from ..parallel import run_tasks
@@ -44,7 +45,8 @@ from .detect import (
     parallel_clearance,
     split_at_junctions,
 )
-from .screen import FILL_SIDE_PX, fill_mask, fill_screen, geometry_screen, quick_look
+from .fill import FILL_SIDE_PX, fill_mask, fill_screen, grown
+from .screen import geometry_screen, quick_look
 from .settings import ScanSettings
 
 JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its target meets
@@ -424,7 +426,6 @@ def _clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
     leaves too short, ``too-short`` otherwise.  ``t``, ``d``, ``xs``, ``ys``
     describe the ROI's pixels; ``fill`` is the fill of the window they
     index (its top-left pixel at the smallest ``xs``, ``ys``)."""
-    from .screen import _grown
     bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
     k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
     bad = np.zeros(bins, bool)
@@ -435,7 +436,7 @@ def _clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
         boundary = fill_screen(float(np.mean(np.bincount(k[near_fill], minlength=bins) > 0)))
         if boundary:
             return boundary
-        by_fill = np.bincount(k[_grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
+        by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
         bad |= by_fill
     for p in partners:
         bad |= np.bincount(k[_distance_to_segment(xs, ys, p) <= JUNCTION_CLEARANCE_PX], minlength=bins) > 0

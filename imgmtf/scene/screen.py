@@ -2,10 +2,10 @@
 
 Three kinds, from cheapest on:
 
-1. fill (:func:`fill_mask`, :func:`fill_screen`): the pixels of the scene
-   that are fill or nodata, found as detection reads its tiles; a segment
-   with fill beside it is a boundary of the fill (reason ``fill``) and is
-   never measured, and every other ROI stops short of fill;
+1. fill (:mod:`imgmtf.scene.fill`): the pixels of the scene that are fill
+   or nodata, found as detection reads its tiles; a segment with fill
+   beside it is a boundary of the fill (reason ``fill``) and is never
+   measured, and every other ROI stops short of fill;
 2. geometry (:func:`geometry_screen`), unread: a line shorter than
    ``min_length_px``, or tilted less than ``MIN_ANGLE_DEG`` from an image
    axis or more than ``MAX_ANGLE_DEG``;
@@ -32,17 +32,6 @@ if TYPE_CHECKING:
 
 QUICK_LOOK_SLACK = 1.0          # the quick look rejects what fails the gate's limits this many times over
 SIDE_START_PX = 4.0             # a side's level is read this far from the target at least (px)
-FILL_SIDE_PX = 3.0              # fill this close to a segment along half of it: a boundary of the fill
-MIN_FILL_PIXELS = 8             # fewer pixels at a fill value are not a fill region
-
-
-def fill_screen(fill_fraction: float) -> tuple[str, str] | None:
-    """``fill`` when fill or nodata lies beside a segment along half its
-    length or more: a boundary of the fill, never an edge of the scene."""
-    if fill_fraction >= 0.5:
-        return "fill", (f"a boundary of fill or nodata along {100 * fill_fraction:.0f} % of its length "
-                        "(not an edge of the scene)")
-    return None
 
 
 def geometry_screen(half: HalfEdge, settings: ScanSettings) -> tuple[str, str] | None:
@@ -63,50 +52,6 @@ def geometry_screen(half: HalfEdge, settings: ScanSettings) -> tuple[str, str] |
         return "angle", (f"{segment.tilt_deg:.2f} deg from the image axis: too close to 45 deg "
                          f"for sub-pixel sampling (needs {MIN_ANGLE_DEG:g} to {MAX_ANGLE_DEG:g} deg)")
     return None
-
-
-def fill_mask(window: np.ndarray, dtype) -> np.ndarray:
-    """The fill and nodata pixels of a window of the scene: NaN (declared
-    nodata), and every region at one fill value (0, an integer type's
-    limits) whose boundary is hard, as the gate tells fill from a clipped
-    side (:func:`imgmtf.estimate.gate.fill_check`): the pixels around it
-    differ from it by more than ``FILL_BOUNDARY`` of the window's contrast,
-    where a dark side clipped at 0 meets values close to 0.
-
-    Example
-    -------
-    >>> w = np.full((20, 20), 900.0); w[:, :6] = 300.0; w[:, 12:] = 0.0
-    >>> int(fill_mask(w, "uint16").sum())
-    160
-    """
-    nodata = ~np.isfinite(window)
-    values = window[~nodata] if nodata.any() else window.ravel()
-    fill = nodata.copy()
-    if values.size == 0:
-        return fill
-    low, high = float(values.min()), float(values.max())
-    for value in gate.fill_values(values, dtype):
-        if not (value == low or value == high):     # a fill value is the least or the greatest
-            continue
-        at = window == value
-        count = int(at.sum())
-        if count < MIN_FILL_PIXELS or count == values.size:
-            continue
-        contrast = gate.fill_contrast(value, values[values != value])
-        if contrast <= 0:
-            continue
-        border = _grown(at, 1) & ~at & ~nodata
-        if border.any() and np.median(np.abs(window[border] - value)) > gate.FILL_BOUNDARY * contrast:
-            fill |= at
-    return fill
-
-
-def _grown(mask: np.ndarray, px: int) -> np.ndarray:
-    """``mask`` dilated by a square of ``px`` pixels each way."""
-    if px <= 0 or not mask.any():
-        return mask.copy()
-    import cv2
-    return cv2.dilate(mask.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)).astype(bool)
 
 
 def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, noise_dn: float, half_width_px: float,
