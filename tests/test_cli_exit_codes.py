@@ -107,7 +107,7 @@ CONTRADICTIONS = [
     ("simulate", ["--out", "a.tif", "--target", "pulse", "--pulse-width", "60", "--size", "50"],
      "wider than the chip"),
     ("simulate", ["--out", "a.tif", "--offset", "100", "--size", "50"], "outside the 50 x 50 px chip"),
-    ("simulate", ["--out", "a.tif", "--ground-noise", "--size", "4096", "--oversampling", "100"],
+    ("simulate", ["--out", "a.tif", "--ground-noise", "--size", "100", "--oversampling", "50"],
      "render a smaller chip or lower the oversampling"),
     ("fit", ["a.tif", "--stages", "optics", "--hold", "detector"], "cannot hold 'detector'"),
     ("fit", ["a.tif", "--hold", "optics.width_m"], "cannot hold 'optics.width_m'"),

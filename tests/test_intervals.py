@@ -88,9 +88,9 @@ def test_the_words_the_cli_takes_name_intervals_in_python_too():
     estimators, a batch's and a scan's settings; an unknown word is refused."""
     from imgmtf.batch import MeasureSettings
     chip = exact_edge_chip(gaussian_pixel_transfer(0.6, 6.0), 6.0, (60, 60), noise_std=2.0, seed=3)
-    by_word = im.measure_edge(chip, intervals="bootstrap")
-    assert by_word.params["intervals"] == im.measure_edge(chip, intervals=im.Intervals("bootstrap")).params["intervals"]
-    assert by_word.mtf_nyquist_ci == im.measure_edge(chip, intervals=im.Intervals("bootstrap")).mtf_nyquist_ci
+    by_word, by_settings = (im.measure_edge(chip, intervals=i) for i in ("bootstrap", im.Intervals("bootstrap")))
+    assert by_word.params["intervals"] == by_settings.params["intervals"]
+    assert by_word.mtf_nyquist_ci == by_settings.mtf_nyquist_ci
     assert math.isnan(im.measure_edge(chip, intervals="none").mtf_nyquist_ci.low)
     assert MeasureSettings(intervals="bootstrap").intervals == im.Intervals("bootstrap")
     assert im.ScanSettings(intervals="none").intervals == im.Intervals("none")
