@@ -38,6 +38,10 @@ _LAZY = {
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "run_selftest": "selftest",
     "QualityError": "estimate.gate", "TwoTargetsError": "estimate.gate",
+    "design_filter": "restore.design", "RestorationFilter": "restore.design",
+    "restore_file": "restore.apply", "RestoredFile": "restore.apply",
+    "restore_image": "restore.restoration", "Restoration": "restore.restoration",
+    "restoration_report": "restore.report", "RestorationReport": "restore.report",
 }
 
 __all__ = [

@@ -1,0 +1,125 @@
+"""``imgmtf restore``: the issue's acceptance run, outputs and refusals."""
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import imgmtf as im
+from imgmtf.cli import main
+from imgmtf.sensor.stages import Detector, GaussianOptics
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def chip(tmp_path_factory):
+    """An edge chip: 16-bit, Gaussian sigma 0.6 px and pixel, SNR 300, 160 x 160 px."""
+    folder = tmp_path_factory.mktemp("restore")
+    sensor = im.Sensor(1.0, [GaussianOptics(0.6, 0.6), Detector(1.0, 1.0)])
+    rendered = im.render(sensor, im.Target("edge", 5.0, 200.0, 1200.0), 160, noise_std_dn=1000 / 300, seed=4)
+    path = folder / "chip.tif"
+    im.write_geotiff(path, rendered.image, provenance=rendered.provenance())
+    sensor.to_toml(folder / "true.toml")
+    return path
+
+
+def test_fit_restore_measure_meets_the_target_and_the_noise_gain_holds(chip, tmp_path):
+    fitted = tmp_path / "s.toml"
+    assert run("fit", chip, "--stages", "optics,detector", "--out", fitted).exit_code == 0
+    result = run("restore", chip, "--sensor", fitted, "--target-nyquist", 0.25, "--out", tmp_path / "r.tif",
+                 "--format", "json")
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    assert report["status"] == "ok" and report["written"] == [str(tmp_path / "r.tif")]
+    assert report["axes"]["across"]["achieved_mtf_nyquist"] == pytest.approx(0.25, abs=0.005)
+    measured = json.loads(run("measure", "--format", "json", tmp_path / "r.tif").stdout)
+    assert measured["mtf_nyquist"] == pytest.approx(0.25, abs=0.03)
+    f, mtf = np.array(measured["frequencies_cy_px"]), np.array(measured["mtf"])
+    assert mtf[f <= 0.5].max() < 1.10
+    # a flat noise image restored alike (the same filter: the chip's noise and contrast given)
+    noise = np.random.default_rng(5).normal(1000.0, 20.0, (300, 300))
+    im.write_geotiff(tmp_path / "flat.tif", np.rint(noise).astype(np.uint16))
+    design = report["filter"]
+    result = run("restore", tmp_path / "flat.tif", "--sensor", fitted, "--target-nyquist", 0.25,
+                 "--noise-std", repr(design["noise_std_dn"]), "--signal-std", repr(design["signal_std_dn"]),
+                 "--out", tmp_path / "flat_r.tif", "--format", "json")
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["noise_gain"] == pytest.approx(report["noise_gain"], rel=1e-9)
+    before = im.read_raster(tmp_path / "flat.tif").data[40:-40, 40:-40]
+    after = im.read_raster(tmp_path / "flat_r.tif").data[40:-40, 40:-40]
+    # the issue asks for 25 %; white noise gives the closed form to its sampling scatter
+    assert after.std() / before.std() == pytest.approx(report["noise_gain"], rel=0.05)
+
+
+def test_text_report_kernel_and_figure(chip, tmp_path):
+    result = run("restore", chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
+                 "--kernel-size", 9, "--max-noise-gain", 1.5, "--kernel", tmp_path / "k.npy",
+                 "--plot", tmp_path / "r.png", "--out", tmp_path)
+    assert result.exit_code == 0, result.output
+    assert "9 x 9 kernel" in result.stdout and "limited to 1.5" in result.stdout
+    assert "warning: the noise-gain limit 1.5 won over the target" in result.stdout
+    taps = np.load(tmp_path / "k.npy")
+    assert taps.shape == (9, 9) and np.sqrt((taps ** 2).sum()) == pytest.approx(1.5, abs=1e-3)
+    assert (tmp_path / "chip_restored.tif").exists() and (tmp_path / "r.png").stat().st_size > 20_000
+
+
+def test_a_batch_keeps_going_past_a_bad_file(chip, tmp_path):
+    bad = tmp_path / "bad.tif"
+    bad.write_text("junk")
+    result = run("restore", bad, chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
+                 "--out", tmp_path / "out", "--format", "json")
+    assert result.exit_code == 1
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [r["status"] for r in rows] == ["error", "ok"] and rows[0]["reason"] == "unreadable"
+    assert (tmp_path / "out" / "chip_restored.tif").exists() and not (tmp_path / "out" / "bad_restored.tif").exists()
+
+
+@pytest.mark.parametrize("options, words", [
+    (["--target-nyquist", "0"], "--target-nyquist"),
+    (["--target-nyquist", "1.5"], "--target-nyquist"),
+    (["--target-nyquist", "nan"], "not a finite number"),
+    (["--target-nyquist", "0.3", "--kernel-size", "8"], "must be odd"),
+    (["--target-nyquist", "0.3", "--kernel-size", "1"], "--kernel-size"),
+    (["--target-nyquist", "0.3", "--max-noise-gain", "0.5"], "--max-noise-gain"),
+    (["--target-nyquist", "0.3", "--tile", "10"], "--tile"),
+    (["--target-nyquist", "0.3", "--noise-std", "-1"], "--noise-std"),
+    (["--target-nyquist", "0.3", "--saturation", "9,1"], "LO < HI"),
+    ([], "Missing option '--target-nyquist'"),
+])
+def test_bad_options_exit_2(chip, tmp_path, options, words):
+    result = run("restore", chip, "--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", *options)
+    assert result.exit_code == 2 and words in result.output
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda p: p / "missing.tif", "no such file"),
+    (lambda p: (p / "notes.tif").write_text("junk") and p / "notes.tif", "not an image GDAL can read"),
+    (lambda p: p, "no image files"),
+])
+def test_unreadable_inputs_exit_1(chip, tmp_path, make, words):
+    result = run("restore", make(tmp_path), "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
+                 "--out", tmp_path / "r.tif")
+    assert result.exit_code == 1 and words in result.output and "Traceback" not in result.output
+
+
+def test_bad_sensor_and_outputs_exit_1(chip, tmp_path):
+    (tmp_path / "bad.toml").write_text("gsd_m = [")
+    common = [chip, "--target-nyquist", 0.3]
+    cases = [
+        (["--sensor", tmp_path / "bad.toml", "--out", tmp_path / "r.tif"], "malformed TOML"),
+        (["--sensor", tmp_path / "none.toml", "--out", tmp_path / "r.tif"], "cannot read sensor file"),
+        (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "no" / "r.tif"], "does not exist"),
+        (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", "--kernel", tmp_path / "k.csv"],
+         ".npy (NumPy) or .txt"),
+        (["--sensor", chip.parent / "true.toml", "--out", chip], "overwrite its own input"),
+        (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", "--plot", tmp_path / "r.xyz"],
+         "a figure is written as"),
+    ]
+    for options, words in cases:
+        result = run("restore", *common, *options)
+        assert result.exit_code == 1 and words in result.output, (options, result.output)
+    assert run("restore", chip, chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
+               "--out", tmp_path / "r.tif").exit_code == 1
