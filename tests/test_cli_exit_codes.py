@@ -13,7 +13,8 @@ from imgmtf.cli.main import COMMANDS
 #: what each command needs besides the option under test (inputs are never
 #: read: the option fails first)
 REQUIRED = {"measure": ["x.tif"], "scan": ["x.tif"], "fit": ["x.tif"], "simulate": ["--out", "x.tif"],
-            "reproduce": ["--out", "out"], "sensor": [], "selftest": []}
+            "reproduce": ["--out", "out"], "sensor": [], "selftest": [],
+            "restore": ["x.tif", "--sensor", "s.toml", "--target-nyquist", "0.4", "--out", "o.tif"]}
 
 
 def out_of_range(kind: click.ParamType) -> list[str]:
