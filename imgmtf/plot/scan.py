@@ -156,12 +156,11 @@ def _legend_label(name: str, group) -> str:
     ids = sorted(r["id"] for r in group if r.get("id") is not None)
     if not ids or len(ids) > MAX_LISTED:
         return label
-    runs, start = [], ids[0]
-    for previous, current in zip(ids, [*ids[1:], None]):
-        if current != previous + 1 if current is not None else True:
-            runs.append(f"{start}" if start == previous else f"{start}-{previous}")
-            start = current
-    return label + "\n" + "\n".join(textwrap.wrap(": " + ", ".join(runs), 26)).removeprefix(": ")
+    # consecutive ids as one run: the run starts where an id does not follow its predecessor
+    starts = [i for i in range(len(ids)) if i == 0 or ids[i] != ids[i - 1] + 1]
+    ends = [*(s - 1 for s in starts[1:]), len(ids) - 1]
+    runs = [f"{ids[s]}" if s == e else f"{ids[s]}-{ids[e]}" for s, e in zip(starts, ends)]
+    return label + "\n" + "\n".join(textwrap.wrap(", ".join(runs), 26))
 
 
 class _Labels:
