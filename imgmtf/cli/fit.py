@@ -69,7 +69,8 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             save_figure(plot_fit(result, truths=truths), plot_path)
             written.append(plot_path)
     if fmt == "json":
-        from ..records import json_safe           # NaN as null, no -0.0: as measure's and scan's JSON
+        from ..records import json_safe
+        # NaN as null, no -0.0: as measure's and scan's JSON
         click.echo(json.dumps(json_safe({**result.to_dict(), "written": written})))
         return
     print_fit(result)
