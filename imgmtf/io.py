@@ -99,7 +99,7 @@ class Raster:
 
 def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
                   provenance: dict | None = None, crs: str | None = None,
-                  origin_m: tuple[float, float] = (0.0, 0.0)) -> None:
+                  origin_m: tuple[float, float] = (0.0, 0.0), tags: dict[str, str] | None = None) -> None:
     """Write an 8/16-bit chip as a GeoTIFF that carries its GSD and how it
     was made.
 
@@ -126,6 +126,9 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
         a map.
     origin_m : (float, float), optional
         Map x, y of the top-left corner, m (with ``crs``).
+    tags : dict of str, optional
+        More metadata items of the default domain (``ACQUISITION_DATETIME``,
+        ``PLATFORM``...), as a product's reader finds them.
 
     Raises
     ------
@@ -144,7 +147,7 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
     >>> raster.gsd_m, raster.provenance["target"]["angle_deg"]
     (0.5, 6.0)
     """
-    tags = {}
+    tags = {key: str(value) for key, value in (tags or {}).items()}
     if provenance:
         tags["IMGMTF"] = json.dumps(provenance, sort_keys=True)
         target = provenance.get("target", {})
@@ -269,6 +272,28 @@ def raster_info(path: str | Path) -> RasterInfo:
         return RasterInfo(str(path), src.width, src.height, src.count,
                           tuple(c.name for c in src.colorinterp), src.dtypes[0], _gsd_m(src),
                           src.transform, src.crs.to_wkt() if src.crs else None)
+
+
+def raster_metadata(path: str | Path, band: int | None = None) -> dict[str, dict[str, str]]:
+    """A raster file's metadata items as GDAL reports them, by domain:
+    ``"default"`` (the dataset's own items and TIFF tags such as
+    ``TIFFTAG_DATETIME``), ``"imagery"`` (GDAL's IMAGERY domain:
+    ``SATELLITEID``, ``ACQUISITIONDATETIME`` from a product's sidecar files)
+    and ``"band"`` (the band's own items, with its description as
+    ``DESCRIPTION`` when it has one; band 1 when ``band`` is None).
+
+    Raises
+    ------
+    ImageReadError
+        The file cannot be opened.
+    """
+    with _opened(path) as src:
+        index = band if isinstance(band, int) and 1 <= band <= src.count else 1
+        band_items = dict(src.tags(index))
+        if src.descriptions[index - 1]:
+            band_items["DESCRIPTION"] = src.descriptions[index - 1]
+        imagery = dict(src.tags(ns="IMAGERY")) if "IMAGERY" in (src.tag_namespaces() or []) else {}
+        return {"default": dict(src.tags()), "imagery": imagery, "band": band_items}
 
 
 def read_raster(path: str | Path, band: int | None = None, window=None,

@@ -37,7 +37,7 @@ from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
 from .version import __version__
 
-OK_STATUSES = ("ok", "accepted", "combined")
+OK_STATUSES = ("ok", "accepted", "combined", "fitted")
 INTERNAL = "internal"
 
 # keys of an estimate's dict that are the record's own fields
@@ -67,7 +67,9 @@ class Record:
         The resampling method.
     status : str
         ``ok``/``error`` (measure), ``accepted``/``rejected`` (a scan
-        candidate), ``combined`` (a scan's summary of a target or scene).
+        candidate), ``combined`` or ``fitted`` (a scan's summary of a
+        target or scene: its half-edges combined, or the sensor model
+        fitted to them).
     reason : str or None
         Machine-readable code of a failure (``unreadable``, ``two-targets``,
         ``saturated``...; None when ok).
@@ -235,11 +237,17 @@ CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # Birge ratio of their MTF at Nyquist), the lowest SNR among them
 # (``snr_min``) and a target's centre (``x_px``, ``y_px``); its ``fwhm_px``
 # and ``rer`` are its half-edges' averaged with the weights of the MTF at
-# Nyquist
+# Nyquist.  ``summary`` tells a combination along a measured normal
+# (``combined``) from the sensor model fitted to the half-edges and read
+# across and along track (``fit``, :mod:`imgmtf.scene.targetfit`), whose
+# rows add the ``stages`` fitted, their ``reduced_chi_square``, whether the
+# model does not fit (``misfit``, with the smallest p-value of the
+# half-edges' residual structure, ``misfit_p``)
 SCAN_COLUMNS = (
     "id", "rank", "scope", "target_id", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "line_length_px",
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation", "verdict_by",
-    "n_edges", "edge_ids", "consistency", "weights", "snr_min", "x_px", "y_px",
+    "summary", "n_edges", "edge_ids", "consistency", "weights", "snr_min", "x_px", "y_px",
+    "stages", "reduced_chi_square", "misfit", "misfit_p",
 )
 
 # a scan's CSV: id and rank first, then the summary, the site's columns, the curve

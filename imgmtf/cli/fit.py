@@ -6,6 +6,7 @@ import json
 import click
 
 from ..errors import ParameterError
+from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
 from .options import FiniteFloat, parse_roi
@@ -35,10 +36,15 @@ from .tables import print_fit
               help="json: one object with the parameters, directions and a record per edge")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
-def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence, out_path, fmt, plot_path):
+@campaign_options
+def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence, out_path, fmt, plot_path,
+        campaign, acquired, platform, instrument, band_name):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
-    read the MTF in every direction off the fitted model."""
+    read the MTF in every direction off the fitted model.  With
+    --campaign, the files are the chips of one acquisition: it is added to
+    the store with the model's across- and along-track rows (those some
+    edge constrains)."""
     from ..batch import expand_inputs
     from ..estimate.fit import check_names, fit_sensor
     from ..sensor.model import Sensor
@@ -53,6 +59,10 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             check_figure_file(plot_path)
         if out_path:
             check_output_file(out_path)
+        store = CampaignWriter.opened(campaign, acquired=acquired, platform=platform, instrument=instrument,
+                                      band_name=band_name)
+        if store:
+            store.check_one_acquisition(files, band)
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
                             roi=roi, confidence=confidence)
         written = []
@@ -68,6 +78,11 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             truths = [file_truth(edge.source, band, roi) for edge in result.edges]
             save_figure(plot_fit(result, truths=truths), plot_path)
             written.append(plot_path)
+        if store:
+            settings = {"command": "fit", "stages": stages, "sensor": sensor_path, "hold": hold, "gsd_m": gsd,
+                        "band": band, "roi": roi, "confidence": confidence}
+            store.add_fit(files, result, settings, band=band, plot=plot_path)
+            store.summary()
     if fmt == "json":
         from ..records import json_safe
         # NaN as null, no -0.0: as measure's and scan's JSON

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from . import fit, measure, reproduce, restore, scan, selftest, sensor, simulate
+from . import fit, measure, report, reproduce, restore, scan, selftest, sensor, simulate
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -20,6 +20,6 @@ def main(ctx):
 #: every command, a module of its own beside this one: a new command is one
 #: module and one entry here
 COMMANDS = (simulate.simulate, sensor.sensor_command, fit.fit, measure.measure, scan.scan,
-            reproduce.reproduce, selftest.selftest, restore.restore)
+            report.report, reproduce.reproduce, selftest.selftest, restore.restore)
 for _command in COMMANDS:
     main.add_command(_command)

@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import sys
 from contextlib import ExitStack
+from dataclasses import asdict
 
 import click
 
 from ..errors import ParameterError
+from .campaign import CampaignWriter, campaign_options
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .files import check_figure_file, check_output_file
 from .options import (
@@ -61,15 +63,18 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
+@campaign_options
 def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
             force, saturation, track_azimuth, progress, interval_method, replicates, confidence, workers,
-            scheduler):
+            scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
     line and the rest go on (exit status 1 if any failed).  Rows are printed
     and written to the CSV as each file completes; on Ctrl-C or SIGTERM the
-    rows measured so far are kept (exit status 130 or 143)."""
+    rows measured so far are kept (exit status 130 or 143).  With
+    --campaign, each file (and band) measured is an acquisition added to
+    the store with its chip's row as it completes."""
     if plot_path and plot_dir:
         raise click.UsageError("give --plot or --plot-dir, not both")
     if pulse_width and kind != "pulse":
@@ -95,6 +100,11 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         if csv_path:
             check_output_file(csv_path)
         run_utc = utc_now()
+        store = CampaignWriter.opened(campaign, acquired=acquired, platform=platform, instrument=instrument,
+                                      band_name=band_name, run_utc=run_utc)
+        if store:
+            from ..records import json_safe
+            campaign_settings = {"command": "measure", **json_safe(asdict(settings))}
         if plot_path:
             from ..batch import measure_file
             completed = iter([(0, measure_file(files[0], settings, plot_path, run_utc=run_utc))])
@@ -119,6 +129,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
                             for writer in writers:
                                 writer.write(record)
                             counts["ok" if record.ok else "error"] += 1
+                            if store and record.ok:
+                                store.add(record.path, record.band, campaign_settings, edges=[record])
             try:
                 with closing(completed):
                     for index, batch in completed:
@@ -127,6 +139,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
                 emit(order.pending())            # measured, though after a file still running
                 interrupted = exc
     total = counts["ok"] + counts["error"]
+    if store:
+        store.summary()
     if interrupted is not None:
         kept = f"; rows kept in {csv_path}" if csv_path else ""
         click.echo(f"imgmtf: interrupted ({signal_name(interrupted)}): {total} result(s) of "

@@ -1,4 +1,5 @@
-"""``imgmtf scan``: find, measure and combine every edge or bar in a scene."""
+"""``imgmtf scan``: find, measure, combine and fit every edge or bar in one
+scene or many, optionally into a campaign store."""
 from __future__ import annotations
 
 import sys
@@ -6,7 +7,8 @@ from pathlib import Path
 
 import click
 
-from .errors import interrupt_code, option_errors, reported_errors, signal_name
+from ..errors import ParameterError
+from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
     FiniteFloat,
     MethodName,
@@ -18,9 +20,11 @@ from .options import (
 )
 from .tables import print_scan
 
+DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without importing it for --help
+
 
 @click.command(short_help="Find, measure and combine every edge or bar in a scene.")
-@click.argument("scene", type=click.Path())
+@click.argument("scenes", nargs=-1, required=True, type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
               help="shortest straight line worth measuring, px (a checkerboard's inner line counts whole, "
@@ -39,65 +43,152 @@ from .tables import print_scan
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
                    "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
+@click.option("--fit-stages", default=DEFAULT_STAGES, show_default=True, metavar="STAGES",
+              help="the sensor model's stages fitted to each target's half-edges for its across- and "
+                   "along-track MTF (imgmtf fit's names, comma-separated); 'none' for no fit")
+@click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
-              help="write targets.csv, targets.geojson and overview.png here")
+              help="write targets.csv, targets.geojson and overview.png here (with several scenes, in a "
+                   "sub-folder per scene, named after its file)")
 @click.option("--edge-figures", is_flag=True,
               help="with --out: also one measurement figure per accepted half-edge (locations, profile, LSF, "
                    "MTF), DIR/edges/edge<id>.png")
+@click.option("--campaign", "store", type=click.Path(dir_okay=False), metavar="STORE.gpkg",
+              help="add each scene's acquisition, accepted half-edges and summaries to this campaign store "
+                   "(a GeoPackage, created when missing) as the scene completes; a scene scanned again "
+                   "with the same settings replaces its rows")
+@click.option("--acquired", metavar="TIME",
+              help="with --campaign: when the scene was taken (ISO 8601, UTC unless an offset is given), "
+                   "where neither its metadata nor its product name says; one scene only")
+@click.option("--platform", help="with --campaign: the platform (satellite), where the file does not say")
+@click.option("--instrument", help="with --campaign: the instrument, where the file does not say")
+@click.option("--band-name", help="with --campaign: the band's name, where the file does not say")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
-def scan(scene, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         out_dir, edge_figures, fmt, progress, interval_method, replicates, confidence, workers, scheduler):
-    """Find every straight edge (or bar) in SCENE, split at junctions into
-    half-edges (checkerboards, four-quadrant and cross targets), measure
-    each on its own ROI, say why the others were rejected, and combine the
-    accepted half-edges of each target and of the scene into one result
-    per direction.  Exit status 1 when none is usable; on Ctrl-C or SIGTERM
-    the candidates measured so far are reported and written (130 or 143)."""
+def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
+         fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
+         progress, interval_method, replicates, confidence, workers, scheduler):
+    """Find every straight edge (or bar) in each SCENE (files, or folders of
+    images), split at junctions into half-edges (checkerboards,
+    four-quadrant and cross targets), measure each on its own ROI, say why
+    the others were rejected, combine the accepted half-edges of each
+    target and of the scene into one result per measured direction, and
+    fit the sensor model to each target's half-edges for its across- and
+    along-track MTF.  With --campaign, each scene's results go into a
+    campaign store as it completes.  Exit status 1 when a scene cannot be
+    scanned or has no usable target; on Ctrl-C or SIGTERM the results so
+    far are reported and kept (130 or 143): every scene finished is in the
+    store."""
     if pulse_width and kind != "pulse":
         raise click.UsageError("--pulse-width applies to --target pulse only")
     if max_length < min_length:
         raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
     if edge_figures and not out_dir:
         raise click.UsageError("--edge-figures writes into the --out folder: give --out DIR")
-    interrupted = None
+    facts = {"acquired": acquired, "platform": platform, "instrument": instrument, "band_name": band_name}
+    if not store and any(v is not None for v in facts.values()):
+        flag = next(f"--{k.replace('_', '-')}" for k, v in facts.items() if v is not None)
+        raise click.UsageError(f"{flag} describes the acquisitions of a campaign store: give --campaign STORE.gpkg")
+    interrupted, outcomes = None, []
     with reported_errors():
+        from ..batch import expand_inputs
         from ..parallel import prestart_workers
-        if scheduler is None:
-            prestart_workers(workers, ["imgmtf.scene.measure"])     # their imports overlap detection
-        from ..atomic import ensure_folder
-        from ..io import raster_info
-        from ..scene.combine import summarise_scan
-        from ..scene.export import write_outputs
-        from ..scene.measure import scan_scene
+        from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
-        with option_errors():
+        with option_errors():           # a malformed option: exit 2, before any work
+            stages = _stages(fit_stages)
             settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
                                     pulse_width=pulse_width, saturation=saturation,
                                     track_azimuth_deg=track_azimuth,
                                     intervals=interval_settings(interval_method, replicates, confidence))
+            if acquired is not None:
+                from ..campaign.acquisitions import parse_time
+                parse_time(acquired, "--acquired")
+        paths = expand_inputs(scenes, recursive)
+        if not paths:
+            raise ParameterError(f"no image files in {', '.join(scenes)}")
+        if acquired is not None and len(paths) > 1:
+            raise click.UsageError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
+                                   "scan them one at a time, or let their metadata or product names say when")
+        if scheduler is None:
+            prestart_workers(workers, ["imgmtf.scene.measure", "imgmtf.scene.targetfit"])
+        folders: dict[str, str] = {}
         if out_dir:
+            from ..atomic import ensure_folder
             ensure_folder(out_dir)
-        info = raster_info(scene)
+            taken: set[str] = set()
+            folders = {p: out_dir if len(paths) == 1 else outputs_folder(out_dir, p, taken) for p in paths}
+        completed = scan_scenes(paths, settings, stages=stages, store=store,
+                                facts=facts if store else None, workers=workers, scheduler=scheduler,
+                                progress=progress,
+                                figures_dirs={p: str(Path(f) / "edges") for p, f in folders.items()}
+                                if edge_figures else None)
         try:
-            records = scan_scene(scene, settings, workers=workers, scheduler=scheduler, progress=progress,
-                                 figures_dir=str(Path(out_dir) / "edges") if edge_figures else None)
+            with closing(completed):
+                for outcome in completed:
+                    outcomes.append(outcome)
+                    _report(outcome, kind, band, folders.get(outcome.path), fmt)
         except KeyboardInterrupt as exc:
-            records, interrupted = getattr(exc, "records", None), exc
-            if records is None:
-                raise
-        summaries = summarise_scan(records)
-        written = write_outputs(records, info, out_dir, band, summaries) if out_dir else []
-        print_scan(scene, info, kind, records, summaries, written, fmt)
+            interrupted = exc
+    _closing_notes(outcomes, paths, store, kind, fmt)
     if interrupted is not None:
-        measured = sum(r.reason != "interrupted" for r in records)
-        click.echo(f"imgmtf: interrupted ({signal_name(interrupted)}): {measured} of {len(records)} "
-                   "candidates screened or measured, the rest marked interrupted"
+        cut = next((o for o in outcomes if o.interrupted), None)
+        if cut is not None:
+            measured = sum(r.reason != "interrupted" for r in cut.records)
+            what = (f"{measured} of {len(cut.records)} candidates screened or measured, the rest marked "
+                    "interrupted; the scene was not stored" if store else
+                    f"{measured} of {len(cut.records)} candidates screened or measured, the rest marked interrupted")
+        else:
+            what = f"{len(outcomes)} of {len(paths)} scenes scanned"
+            what += f", each in {store}" if store else ""
+        click.echo(f"imgmtf: interrupted ({signal_name(interrupted)}): {what}"
                    + (f"; written to {out_dir}" if out_dir else ""), err=True)
         sys.exit(interrupt_code(interrupted))
-    if not any(r.ok for r in records):
-        click.echo(f"imgmtf: error: {scene}: no usable {kind} found "
-                   f"({len(records)} candidates, all rejected)", err=True)
-        sys.exit(1)
+    sys.exit(0 if all(o.ok for o in outcomes) else 1)
+
+
+def _stages(text: str) -> str | None:
+    """The stages to fit, checked now (None: no fit)."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if names == ["none"]:
+        return None
+    from ..sensor.stages import STAGES
+    unknown = [n for n in names if n not in STAGES]
+    if unknown or not names:
+        raise ParameterError(f"--fit-stages: unknown stage {unknown[0] if unknown else text!r}; known: "
+                             f"{', '.join(STAGES)}, or none")
+    return ",".join(names)
+
+
+def _report(outcome, kind, band, folder, fmt) -> None:
+    """One scene's tables (or JSON rows), and its outputs written."""
+    if outcome.error:
+        click.echo(f"imgmtf: error: {outcome.error}", err=True)
+        return
+    from ..io import raster_info
+    from ..scene.export import write_outputs
+    info = raster_info(outcome.path)
+    written = write_outputs(outcome.records, info, folder, band, outcome.summaries) if folder else []
+    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt)
+    if not any(r.ok for r in outcome.records) and not outcome.interrupted:
+        click.echo(f"imgmtf: error: {outcome.path}: no usable {kind} found "
+                   f"({len(outcome.records)} candidates, all rejected)", err=True)
+
+
+def _closing_notes(outcomes, paths, store, kind, fmt) -> None:
+    """Once for the run: the scenes stored without a time, and a count."""
+    untimed = [o.path for o in outcomes if o.acquisition is not None and not o.acquisition.acquired_utc
+               and o.ok and not o.interrupted]
+    if untimed:
+        shown = ", ".join(untimed[:3]) + (f" and {len(untimed) - 3} more" if len(untimed) > 3 else "")
+        click.echo(f"imgmtf: note: no acquisition time for {len(untimed)} scene(s) ({shown}): neither an "
+                   "ACQUISITION_DATETIME metadata item nor a product name with a date says when it was "
+                   f"taken; stored in {store} without one, so a trend leaves it out: give --acquired TIME",
+                   err=True)
+    if len(paths) > 1:
+        usable = sum(o.ok for o in outcomes)
+        stored = f"; {sum(o.acquisition is not None and o.ok for o in outcomes)} stored in {store}" if store else ""
+        click.echo(f"{len(outcomes)} of {len(paths)} scenes scanned: {usable} with a usable {kind}, "
+                   f"{len(outcomes) - usable} without or failed{stored}", err=True)

@@ -1,4 +1,12 @@
-"""``imgmtf simulate``: render an edge or bar chip through the sensor."""
+"""``imgmtf simulate``: render an edge or bar chip through the sensor, or
+(``--campaign DIR``) a series of calibration-site scenes through a sensor
+that degrades at a known rate, with the truth beside them.
+
+The campaign is an option of ``simulate`` rather than a command of its own:
+it is what ``simulate`` does (render scenes of known MTF to files), and the
+command list's column keeps every short help on one line (a name as long as
+``simulate-campaign`` would wrap them).  Options that make one chip are
+refused beside ``--campaign``, and the campaign's without it."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -16,6 +24,14 @@ MAX_CHIP_PX = 4096                  # simulate --size: the renderer's 16 Mpx
 MAX_OVERSAMPLING = 100              # simulate --oversampling
 
 
+#: the options that describe one chip, and those that describe a campaign: each refused with the other
+CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std", "ground_noise", "oversampling",
+             "sensor_path", "out")
+CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
+                 "band_name")
+CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says otherwise
+
+
 @click.command(short_help="Render an edge or bar chip through the sensor (GeoTIFF, PNG).")
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
@@ -31,8 +47,8 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
                    "1.5m (metres on the ground)")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
-@click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default=True,
-              help="chip side, pixels")
+@click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default="50; 320 with --campaign",
+              help="chip (or campaign scene) side, pixels")
 @click.option("--gsd", type=FiniteFloat(0, min_open=True), help="output GSD in metres (default: the sensor's)")
 @click.option("--bits", type=click.Choice(["8", "16"]), default="16", show_default=True)
 @click.option("--noise-std", type=FiniteFloat(0), default=0.0, show_default=True, help="system noise std, DN")
@@ -41,13 +57,54 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
               help="sub-pixels per pixel")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False), help="sensor TOML file")
 @click.option("--seed", type=click.IntRange(min=0), help="random seed for the noise (an integer >= 0)")
-@click.option("--out", required=True, type=click.Path(dir_okay=False),
+@click.option("--out", type=click.Path(dir_okay=False),
               help="output file: .tif (a GeoTIFF that records the GSD and how the chip was made) "
                    "or .png (pixels only)")
-def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
-             ground_noise, oversampling, sensor_path, seed, out):
+@click.option("--campaign", "campaign_dir", type=click.Path(file_okay=False),
+              help="instead of a chip: a calibration campaign in this folder, one Baotou-like scene per "
+                   "acquisition through a sensor whose optics blur more each year, and its truth")
+@click.option("--acquisitions", type=click.IntRange(2, 1000), default=6, show_default=True,
+              help="campaign: how many scenes, one per acquisition date")
+@click.option("--start", default="2020-06-01T03:30:00Z", show_default=True,
+              help="campaign: the first acquisition's time, ISO 8601 UTC")
+@click.option("--interval", "interval_days", type=FiniteFloat(0, min_open=True), default=365.0, show_default=True,
+              help="campaign: days between acquisitions")
+@click.option("--degradation", type=FiniteFloat(0, 10), default=0.06, show_default=True,
+              help="campaign: the optics' blur grows by this fraction of its starting width each year")
+@click.option("--snr", type=FiniteFloat(0, min_open=True), default=180.0, show_default=True,
+              help="campaign: the smallest step between the target's quadrants over the noise")
+@click.option("--fill", is_flag=True,
+              help="campaign: every pixel outside the target 0, as in an L0R chip (its inner half-edges only)")
+@click.option("--platform", default="SYNTHSAT-1", show_default=True, help="campaign: PLATFORM tag of every scene")
+@click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
+@click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
+@click.pass_context
+def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
+             ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
+             degradation, snr, fill, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
-    (or a PNG)."""
+    (or a PNG); or, with --campaign DIR, a calibration campaign:
+    DIR/site_<time>.tif, one scene per acquisition (a four-quadrant target
+    tilted 16.8 deg on a uniform field; anisotropic Gaussian optics and a
+    square pixel, the optics blurring more each year), each tagged
+    ACQUISITION_DATETIME, PLATFORM, INSTRUMENT and BAND_NAME, and
+    DIR/truth.json and truth.csv: each acquisition's exact MTF at Nyquist
+    across and along track, and the true slope per year."""
+    given = {name for name in ctx.params if ctx.get_parameter_source(name) != click.core.ParameterSource.DEFAULT}
+    if campaign_dir is not None:
+        clash = [name for name in CHIP_ONLY if name in given]
+        if clash:
+            raise click.UsageError(f"{_flag(ctx, clash[0])} makes a single chip: not with --campaign")
+        with reported_errors():
+            _campaign(campaign_dir, acquisitions, start, interval_days, degradation,
+                      size if "size" in given else CAMPAIGN_SIZE_PX, snr, int(bits), seed or 0, gsd, fill,
+                      platform, instrument, band_name)
+        return
+    clash = [name for name in CAMPAIGN_ONLY if name in given]
+    if clash:
+        raise click.UsageError(f"{_flag(ctx, clash[0])} describes a campaign: give --campaign DIR")
+    if out is None:
+        raise click.UsageError("give --out FILE (a chip) or --campaign DIR (a series of scenes)")
     with reported_errors():
         default_low, default_high = DEFAULT_LEVELS_DN[int(bits)]     # a step that fits the bit depth
         low = default_low if low is None else low
@@ -98,3 +155,27 @@ def simulate(kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise
             click.echo(f"note: a PNG keeps the pixels only; the GSD and how the chip was made (which "
                        f"`measure` uses to draw the true MTF) are kept in a GeoTIFF: --out "
                        f"{Path(out).with_suffix('.tif')}")
+
+
+def _flag(ctx, name: str) -> str:
+    """The command-line flag of a parameter."""
+    return next(p.opts[0] for p in ctx.command.params if p.name == name)
+
+
+def _campaign(folder, acquisitions, start, interval_days, degradation, size_px, snr, bits, seed, gsd, fill,
+              platform, instrument, band_name) -> None:
+    from ..sensor.series import SyntheticCampaign
+    from ..synthetic import write_campaign
+    campaign = SyntheticCampaign(acquisitions, start, interval_days, degradation, snr=snr, size_px=size_px,
+                                 bits=bits, seed=seed, gsd_m=1.0 if gsd is None else gsd, fill=fill)
+    paths = write_campaign(folder, campaign, platform=platform, instrument=instrument, band_name=band_name)
+    click.echo(f"{'scene':<28} {'acquired (UTC)':<21} {'true MTF@Nyq across':>19} {'along':>7}")
+    for k, path in enumerate(paths):
+        truth = campaign.truth(k)
+        click.echo(f"{path.name:<28} {truth['acquired_utc']:<21} {truth['mtf_nyquist_across']:19.4f} "
+                   f"{truth['mtf_nyquist_along']:7.4f}")
+    slopes = campaign.true_slopes_per_year()
+    click.echo(f"true slope per year: across {slopes['across']:+.4f}, along {slopes['along']:+.4f} "
+               "(least squares over the acquisitions)")
+    click.echo(f"wrote {len(paths)} scenes ({size_px} x {size_px} px, {bits}-bit, SNR {snr:g}), "
+               f"truth.json and truth.csv to {folder}")

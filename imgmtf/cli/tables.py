@@ -133,12 +133,14 @@ def print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
                 click.echo(f"{'':>{len(head)}} warning: {warning}")
         else:       # the scene's name heads the table: the message need not repeat it
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
-    if summaries:
+    combined = [r for r in summaries if r.figures.get("summary") != "fit"]
+    fitted = [r for r in summaries if r.figures.get("summary") == "fit"]
+    if combined:
         click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
                    "the half-edges disagree beyond their intervals):")
         click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
                    f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'FWHM':>6} {'consist.':>8}")
-        for summary in summaries:
+        for summary in combined:
             r = summary.to_dict()
             click.echo(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
                        f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} "
@@ -146,8 +148,41 @@ def print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
                        f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
                        f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
                        f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('consistency'), 8, 2)}")
+    if fitted:
+        print_target_fits(fitted)
     for path in written:
         click.echo(f"wrote {path}")
+
+
+def print_target_fits(fitted) -> None:
+    """The sensor model fitted to each target's half-edges, across and along
+    track, and why a fit is not to be trusted (its misfit) or failed."""
+    stages: list[str] = next((r.figures["stages"] for r in fitted if r.figures.get("stages")), [])
+    click.echo(f"fitted per target, across and along track (sensor model: {', '.join(stages) or '-'}; "
+               "misfit p: the smallest p-value of structure in its half-edges' residuals):")
+    click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
+               f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
+    warned: set[str] = set()
+    hinted = False
+    for summary in fitted:
+        r = summary.to_dict()
+        head = f"{r['scope']:>6} {r.get('target_id') or '':>3}"
+        if not summary.ok:
+            click.echo(f"{head} {'fit failed':>7}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
+            continue
+        p = r.get("misfit_p")
+        click.echo(f"{head} {SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} {r['n_edges']:>5} "
+                   f"{num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
+                   f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
+                   f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('rer'), 6, 3)} "
+                   f"{'-' if p is None else f'{p:.2g}':>8}{'  MISFIT' if r.get('misfit') else ''}")
+        for warning in r.get("warnings") or []:
+            if warning not in warned:           # across and along share their fit's warnings
+                warned.add(warning)
+                click.echo(f"{'':>10} warning: {warning}")
+                if "does not fit" in warning and not hinted:
+                    hinted = True
+                    click.echo(f"{'':>10} (--fit-stages fits other stages; the combined rows assume no model)")
 
 
 SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}

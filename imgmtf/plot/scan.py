@@ -122,10 +122,11 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
             labels.add(r, (0.85, 1.0, 0.85, 0.95), "#004d00", zorder=7, weight="bold")
     targets = [s for s in summaries if s.get("scope") == "target"]
     for target_id in sorted({s["target_id"] for s in targets}):
-        rows = [s for s in targets if s["target_id"] == target_id]
-        lines = [f"T{target_id}"] + [
-            f"{_DIRECTION_SHORT.get(s['direction'], s['direction'])} {s['normal_angle_deg']:.0f}\u00b0: "
-            f"{_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}" for s in rows]
+        rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
+        lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"
+                                     for s in rows]
+        if len(lines) == 1:
+            continue
         x, y = rows[0]["x_px"], rows[0]["y_px"]
         right, low = x > 0.7 * extent_w, y < 0.15 * extent_h       # keep the label inside the image
         ax.annotate("\n".join(lines), (x, y), xytext=(-6 if right else 6, -6 if low else 6),
@@ -188,6 +189,16 @@ class _Labels:
         self.ax.text(x, y, str(record["id"]), fontsize=5.5, color=text_colour, ha="center", va="center",
                      weight=weight, zorder=zorder, clip_on=True,
                      bbox={"boxstyle": "round,pad=0.15", "fc": face, "ec": "black", "lw": 0.4})
+
+
+def _label(summary: dict) -> str:
+    """A summary's line in its target's label: a combined direction and its
+    normal, or the sensor model's fit across or along track (and whether it
+    fits)."""
+    direction = _DIRECTION_SHORT.get(summary["direction"], summary["direction"])
+    if summary.get("summary") == "fit":
+        return f"fit {direction}{' (misfit)' if summary.get('misfit') else ''}"
+    return f"{direction} {summary['normal_angle_deg']:.0f}\u00b0"
 
 
 def _num(value) -> str:

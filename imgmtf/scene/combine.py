@@ -248,7 +248,7 @@ def _summary(group: list[Record], site: dict) -> Record:
     normal = _mean_normal([r.figures["normal_angle_deg"] for r in group])
     track = first.params.get("track_azimuth_deg")
     figures = {
-        "direction": direction_label(normal, track), "normal_angle_deg": round(normal, 3),
+        "summary": "combined", "direction": direction_label(normal, track), "normal_angle_deg": round(normal, 3),
         "n_edges": len(group), "edge_ids": [r.site.get("id") for r in group],
         "mtf_nyquist": finite(nyquist.value), "mtf_nyquist_ci": [finite(nyquist.low), finite(nyquist.high)],
         "mtf50_cy_px": finite(mtf50.value) if mtf50 else None,

@@ -1,0 +1,283 @@
+"""Drift: how a figure (MTF at Nyquist, MTF50, FWHM, RER) of one platform,
+band, direction and method changes with time over a campaign.
+
+The drift is the slope of a weighted least-squares line through the
+figure against the acquisition time, in the figure's units per year
+(365.25 days).  Each point weighs by the inverse variance its interval
+implies (half-width over the normal quantile of its confidence); the
+slope's interval is Student-t with n - 2 degrees of freedom, its standard
+error scaled by the Birge ratio when the points scatter more than their
+intervals say (as :func:`imgmtf.scene.combine.combine` does).  Points
+without an interval (FWHM, RER, ``--intervals none``) weigh equally and
+the scatter alone gives the standard error.  A drift is flagged when the
+interval excludes 0.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import asdict, dataclass
+from datetime import UTC, datetime
+from statistics import NormalDist
+
+import numpy as np
+
+from ..atomic import atomic_output
+from ..errors import FileWriteError, ParameterError
+
+YEAR_S = 365.25 * 86400.0
+# figure -> its interval's columns in the targets layer (None: it has none)
+FIGURES = {
+    "mtf_nyquist": ("mtf_nyquist_ci_low", "mtf_nyquist_ci_high"),
+    "mtf50_cy_px": ("mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px"),
+    "fwhm_px": None,
+    "rer": None,
+}
+GROUP_KEYS = ("platform", "band_name", "direction", "method")
+ACROSS_ALONG = ("across-track", "along-track")
+TREND_COLUMNS = (*GROUP_KEYS, "figure", "n_acquisitions", "n_points", "first_utc", "last_utc",
+                 "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence", "weights",
+                 "consistency", "drift")
+
+
+@dataclass(frozen=True)
+class Line:
+    """A straight line fitted to (t, y): ``intercept`` at t = 0, ``slope``
+    with its interval (``low``, ``high``; NaN with fewer than 3 points),
+    ``consistency`` (the Birge ratio; NaN without intervals or with 2
+    points) and the ``weights`` used ("inverse-variance" or "equal")."""
+
+    intercept: float
+    slope: float
+    low: float
+    high: float
+    consistency: float
+    weights: str
+
+
+@dataclass(frozen=True)
+class Trend:
+    """The drift of one figure of one platform, band, direction and method
+    (the columns of ``trend.csv``); ``drift`` is True when the slope's
+    interval excludes 0."""
+
+    platform: str | None
+    band_name: str | None
+    direction: str | None
+    method: str | None
+    figure: str
+    n_acquisitions: int
+    n_points: int
+    first_utc: str
+    last_utc: str
+    value_at_first: float
+    slope_per_year: float
+    slope_ci_low: float
+    slope_ci_high: float
+    confidence: float
+    weights: str
+    consistency: float
+    drift: bool
+
+    def value_at(self, years: np.ndarray) -> np.ndarray:
+        """The line at ``years`` after the first acquisition."""
+        return self.value_at_first + self.slope_per_year * np.asarray(years, float)
+
+
+def fit_line(t, y, sd=None, confidence: float = 0.95) -> Line:
+    """Weighted least-squares line through (``t``, ``y``).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Abscissae and values (finite; two different t at least).
+    sd : array_like, optional
+        Each value's standard deviation (weights 1/sd^2); None or any
+        non-finite or zero entry: equal weights.
+    confidence : float
+        Of the slope's Student-t interval (n - 2 degrees of freedom).
+
+    Returns
+    -------
+    Line
+        With inverse-variance weights the slope's standard error is
+        sqrt(max(1, chi^2/(n-2)) / S), S = sum w (t - t_w)^2 (the intervals'
+        own, widened by the Birge ratio when the points scatter more);
+        with equal weights sqrt(s^2 / S), s^2 the residual variance.
+
+    Raises
+    ------
+    ParameterError
+        Fewer than two points, or all at one t.
+
+    Examples
+    --------
+    >>> line = fit_line([0, 1, 2, 3], [1.0, 0.9, 0.8, 0.7], sd=[0.01] * 4)
+    >>> round(line.slope, 6), round(line.high - line.slope, 6), line.weights
+    (-0.1, 0.019242, 'inverse-variance')
+    """
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    if t.size < 2 or np.ptp(t) == 0:
+        raise ParameterError("a trend needs two acquisitions at different times at least")
+    weighted = sd is not None and bool(np.all(np.isfinite(sd))) and bool(np.all(np.asarray(sd, float) > 0))
+    w = 1.0 / np.asarray(sd, float) ** 2 if weighted else np.ones_like(t)
+    t_mean = np.sum(w * t) / np.sum(w)
+    spread = np.sum(w * (t - t_mean) ** 2)
+    slope = float(np.sum(w * (t - t_mean) * y) / spread)
+    if abs(slope) * np.ptp(t) <= 1e-12 * np.max(np.abs(y)):
+        slope = 0.0             # a constant series: rounding, not a slope
+    intercept = float(np.sum(w * y) / np.sum(w) - slope * t_mean)
+    dof = t.size - 2
+    if dof < 1:
+        return Line(intercept, slope, math.nan, math.nan, math.nan, "inverse-variance" if weighted else "equal")
+    from .._stats import t_quantile
+    chi2 = float(np.sum(w * (y - intercept - slope * t) ** 2))
+    scale = max(1.0, chi2 / dof) if weighted else chi2 / dof
+    half = t_quantile(0.5 + confidence / 2, dof) * math.sqrt(scale / spread)
+    consistency = math.sqrt(chi2 / dof) if weighted else math.nan
+    return Line(intercept, slope, slope - half, slope + half, consistency,
+                "inverse-variance" if weighted else "equal")
+
+
+def years_since(times: Sequence[str], origin: str) -> np.ndarray:
+    """Times (ISO 8601 UTC; a date is its midnight) as years after ``origin``."""
+    start = parse_utc(origin)
+    return np.array([(parse_utc(t) - start).total_seconds() / YEAR_S for t in times])
+
+
+def parse_utc(text: str) -> datetime:
+    """An acquisition time of the store (``2021-11-21`` or ``2021-11-21T08:15:02Z``) as an aware datetime."""
+    moment = datetime.fromisoformat(text)
+    return moment if moment.tzinfo else moment.replace(tzinfo=UTC)
+
+
+def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
+    """The targets layer's rows that make each trend, by (platform, band
+    name, direction, method): per acquisition its scene-wide rows, or its
+    targets' rows when it has no scene-wide one; rows without an
+    acquisition time, and fits of a direction no edge constrained, are
+    left out.  Oblique (or unknown) directions are told apart by their
+    normals (:func:`imgmtf.scene.combine.normal_families`): their label
+    becomes ``oblique (normal 17 deg)``."""
+    usable = [r for r in rows if r.get("acquired_utc") and r.get("mtf_nyquist") is not None
+              and r.get("constrained") != 0]
+    groups: dict[tuple, dict[str, list[Mapping]]] = {}
+    for row in _by_normal(usable):
+        key = tuple(row.get(k) for k in GROUP_KEYS)
+        groups.setdefault(key, {}).setdefault(row["acquisition_id"], []).append(row)
+    out = {}
+    for key, by_acquisition in groups.items():
+        points: list[Mapping] = []
+        for members in by_acquisition.values():
+            scene = [r for r in members if r.get("scope") == "scene"]
+            points += scene or members
+        out[key] = sorted(points, key=lambda r: parse_utc(r["acquired_utc"]))
+    return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
+
+
+def _by_normal(rows: list[Mapping]) -> list[Mapping]:
+    """``rows`` with each oblique or unknown direction labelled by its
+    family of normals, so that a target's two oblique directions make two
+    trends, not one."""
+    from ..scene.combine import normal_families
+
+    plain = [r for r in rows if r.get("direction") in ACROSS_ALONG or r.get("normal_angle_deg") is None]
+    out = list(plain)
+    rest: dict[tuple, list[Mapping]] = {}
+    for row in rows:
+        if not any(row is r for r in plain):
+            rest.setdefault(tuple(row.get(k) for k in GROUP_KEYS), []).append(row)
+    for members in rest.values():
+        normals = np.array([r["normal_angle_deg"] for r in members], float)
+        families = normal_families(normals)
+        for family in np.unique(families):
+            chosen = np.mod(normals[families == family], 180.0)
+            mean = float(np.degrees(np.angle(np.mean(np.exp(2j * np.radians(chosen))))) / 2)
+            for row, f in zip(members, families):
+                if f == family:
+                    out.append({**row, "direction": f"{row['direction']} (normal {mean:.0f} deg)"})
+    return out
+
+
+def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> list[Mapping]:
+    """The rows a campaign's trends are made of: the targets layer's rows,
+    and for an acquisition that has none (``imgmtf measure --campaign``)
+    its measured edges (status ``ok``), each a point of method ``edge``."""
+    targets = list(targets)
+    summarised = {row.get("acquisition_id") for row in targets}
+    chips = [{**row, "method": "edge", "scope": "edge"} for row in edges
+             if row.get("acquisition_id") not in summarised and row.get("status") == "ok"]
+    return [*targets, *chips]
+
+
+def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
+    """The drift of every figure (:data:`FIGURES`) of every platform, band,
+    direction and method of a store's targets layer
+    (:func:`imgmtf.campaign.store.read_layer`); groups whose points span
+    less than two times are left out.
+
+    Examples
+    --------
+    >>> rows = [{"acquisition_id": str(k), "acquired_utc": f"{2020 + k}-01-01", "platform": "Sim",
+    ...          "band_name": "pan", "direction": "across-track", "method": "fit", "scope": "scene",
+    ...          "mtf_nyquist": 0.30 - 0.01 * k, "fwhm_px": 1.2} for k in range(4)]
+    >>> [(t.figure, round(t.slope_per_year, 4), t.n_acquisitions, t.drift) for t in trends(rows)]
+    [('mtf_nyquist', -0.01, 4, True), ('fwhm_px', 0.0, 4, False)]
+    """
+    z = NormalDist().inv_cdf(0.5 + confidence / 2)
+    out = []
+    for key, points in trend_points(rows).items():
+        first = points[0]["acquired_utc"]
+        for figure, bounds in FIGURES.items():
+            usable = [p for p in points if p.get(figure) is not None and math.isfinite(p[figure])]
+            times = [p["acquired_utc"] for p in usable]
+            if len({parse_utc(t) for t in times}) < 2:
+                continue
+            sd = None
+            if bounds:
+                sd = np.array([_half_width(p, bounds) / z for p in usable])
+            line = fit_line(years_since(times, first), [p[figure] for p in usable], sd, confidence)
+            group = dict(zip(GROUP_KEYS, key))
+            out.append(Trend(**group, figure=figure, n_acquisitions=len({p["acquisition_id"] for p in usable}),
+                             n_points=len(usable), first_utc=times[0], last_utc=times[-1],
+                             value_at_first=float(line.intercept + line.slope * years_since([times[0]], first)[0]),
+                             slope_per_year=line.slope, slope_ci_low=line.low, slope_ci_high=line.high,
+                             confidence=confidence, weights=line.weights, consistency=line.consistency,
+                             drift=bool(line.low > 0 or line.high < 0)))
+    return out
+
+
+def _half_width(row: Mapping, bounds: tuple[str, str]) -> float:
+    low, high = (row.get(b) for b in bounds)
+    if low is None or high is None:
+        return math.nan
+    return (high - low) / 2.0
+
+
+def write_trend_csv(found: Sequence[Trend], path: str) -> None:
+    """``found`` as ``trend.csv`` (columns :data:`TREND_COLUMNS`; slopes in
+    the figure's units per year; NaN as empty), written atomically.
+
+    Raises
+    ------
+    FileWriteError
+        The file cannot be written.
+    """
+    with atomic_output(path) as partial:
+        try:
+            with open(partial, "w", newline="", encoding="utf-8") as fh:
+                writer = csv.DictWriter(fh, fieldnames=list(TREND_COLUMNS))
+                writer.writeheader()
+                for trend in found:
+                    writer.writerow({k: _cell(v) for k, v in asdict(trend).items()})
+        except OSError as exc:
+            raise FileWriteError(f"{path}: cannot write: {exc.strerror or exc}") from None
+
+
+def _cell(value):
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return value

@@ -1,0 +1,37 @@
+"""``imgmtf report``: trends and the HTML report of a campaign store."""
+from __future__ import annotations
+
+import click
+
+from .errors import reported_errors
+from .options import FiniteFloat
+
+
+@click.command(short_help="Trend a campaign store's results and write its HTML report.")
+@click.argument("store", type=click.Path(dir_okay=False))
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="folder for trend.csv and report.html (created if missing)")
+@click.option("--requirement", type=FiniteFloat(0, 1), metavar="MTF",
+              help="the MTF at Nyquist required, drawn as a line on its figures")
+@click.option("--baseline", type=click.Path(dir_okay=False), metavar="SENSOR.toml",
+              help="sensor TOML whose across- and along-track MTF at Nyquist are the pre-launch values")
+@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+              show_default=True, help="confidence of the drift intervals")
+def report(store, out_dir, requirement, baseline, confidence):
+    """Fit the drift per year of every platform, band, direction and
+    method of the campaign STORE (a GeoPackage written by scan, measure
+    or fit with --campaign), and write OUT/trend.csv and OUT/report.html:
+    one self-contained page (figures embedded, nothing fetched) with the
+    MTF at Nyquist, MTF50, FWHM and RER against time, the drift, the
+    requirement and the pre-launch value, and every acquisition."""
+    with reported_errors():
+        from ..campaign.report import write_report
+        written = write_report(store, out_dir, requirement=requirement, baseline=baseline,
+                               confidence=confidence)
+    drifting = [t for t in written.trends if t.drift and t.figure == "mtf_nyquist"]
+    for t in drifting:
+        click.echo(f"drift: {t.platform or 'unknown platform'}, band {t.band_name or '?'}, {t.direction}, "
+                   f"{t.method}: MTF at Nyquist {t.slope_per_year:+.4f}/year "
+                   f"[{t.slope_ci_low:+.4f}, {t.slope_ci_high:+.4f}]")
+    click.echo(f"wrote {written.trend_csv}")
+    click.echo(f"wrote {written.report_html}")

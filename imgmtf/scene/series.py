@@ -1,0 +1,205 @@
+"""Many scenes scanned, each summarised and fitted, each written to a
+campaign store as it completes.
+
+One scene is scanned here with its candidates on the workers
+(:func:`imgmtf.scene.measure.scan_scene`); several are scanned one per
+worker (:func:`imgmtf.parallel.run_tasks`), which keeps every worker busy
+however few candidates a scene holds.  Each scene's outcome (its
+candidates, its combined and fitted summaries, its acquisition) is
+yielded as it completes, after its rows are in the store, and an
+interrupt waits until the caller has reported it: every acquisition
+stored is reported, every one reported is stored, and a scene cut short
+is never stored.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ImgmtfError, ParameterError
+from ..records import INTERNAL, Record
+from .settings import ScanSettings
+from .targetfit import DEFAULT_STAGES
+
+
+@dataclass(frozen=True, eq=False)
+class SceneOutcome:
+    """What one scene gave.
+
+    Attributes
+    ----------
+    path : str
+        The scene.
+    records : tuple of Record
+        Its candidates (:func:`imgmtf.scene.measure.scan_scene`).
+    summaries : tuple of Record
+        Its combined summaries (:func:`imgmtf.scene.combine.summarise_scan`),
+        then its fitted ones (:func:`imgmtf.scene.targetfit.fit_targets`).
+    acquisition : imgmtf.campaign.acquisitions.Acquisition or None
+        With a store: the acquisition its rows were stored as.
+    error, reason : str or None
+        Why the scene could not be scanned (the message names it).
+    interrupt : KeyboardInterrupt or None
+        What cut the scan short: ``records`` are then those measured so
+        far, and nothing was stored.
+    """
+
+    path: str
+    records: tuple[Record, ...] = ()
+    summaries: tuple[Record, ...] = ()
+    acquisition: Any = None
+    error: str | None = None
+    reason: str | None = None
+    interrupt: BaseException | None = field(default=None, repr=False)
+    figures_dir: str | None = field(default=None, repr=False)
+
+    @property
+    def interrupted(self) -> bool:
+        return self.interrupt is not None
+
+    @property
+    def ok(self) -> bool:
+        """A scan that found at least one usable target."""
+        return self.error is None and any(r.ok for r in self.records)
+
+
+def acquisition_settings(settings: ScanSettings, stages: str | None) -> dict:
+    """The settings that make an acquisition's identity in a store: the
+    estimate's, the scan's and the fitted stages."""
+    return {**settings.measure_settings().params(), "method": settings.method, "target": settings.target,
+            "scan": settings.as_dict(), "fit_stages": stages}
+
+
+def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, stages: str | None = DEFAULT_STAGES,
+                store: str | None = None, facts: Mapping[str, str | None] | None = None, workers: int = 1,
+                scheduler: str | None = None, progress: bool | None = None,
+                figures_dirs: Mapping[str, str] | None = None) -> Iterator[SceneOutcome]:
+    """Scan, summarise and fit each scene; with a ``store``, write each
+    acquisition's rows as it completes.
+
+    Parameters
+    ----------
+    paths : the scenes.
+    settings : how to scan (:class:`imgmtf.scene.settings.ScanSettings`).
+    stages : the stages fitted to each target's half-edges (None: no fit).
+    store : a campaign GeoPackage (created when missing): each scene's
+        accepted half-edges and its summaries, written in one transaction
+        as the scene completes (:func:`imgmtf.campaign.store.write_acquisition`).
+    facts : what the files may not say, for every scene: ``acquired``,
+        ``platform``, ``instrument``, ``band_name``
+        (:func:`imgmtf.campaign.acquisitions.read_acquisition`).
+    workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
+    figures_dirs : scene -> a folder for its accepted half-edges' figures.
+
+    Yields
+    ------
+    SceneOutcome
+        One per scene, in the order they complete (one scene: at once).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C (or SIGTERM under :func:`imgmtf.parallel.terminate_raises`):
+        after the outcome of a single scene cut short (``interrupted``),
+        or, with several, at once; every acquisition yielded before is in
+        the store.
+    ImgmtfError
+        The store cannot be written (:class:`imgmtf.campaign.store.StoreError`,
+        FileWriteError): the scenes stored so far stay.
+
+    Examples
+    --------
+    >>> for outcome in scan_scenes(["2020.tif", "2021.tif"], store="site.gpkg"):    # doctest: +SKIP
+    ...     print(outcome.path, outcome.acquisition.acquired_utc, len(outcome.summaries))
+    """
+    settings = ScanSettings() if settings is None else settings
+    if not isinstance(settings, ScanSettings):
+        raise ParameterError(f"settings must be a ScanSettings, got {settings!r}")
+    paths = [str(p) for p in paths]
+    figures_dirs = dict(figures_dirs or {})
+    facts = None if store is None else dict(facts or {})
+    if store is not None:
+        from ..campaign.store import ensure_store
+        ensure_store(store)             # a store that cannot be written fails before any scan
+    if len(paths) == 1:
+        outcome = scan_one(paths[0], settings, stages, facts, workers=workers, scheduler=scheduler,
+                           progress=progress, figures_dir=figures_dirs.get(paths[0]))
+        yield from _stored(outcome, store)
+        if outcome.interrupt is not None:
+            raise outcome.interrupt
+        return
+    from ..parallel import run_tasks
+
+    def lost(item, exc):
+        return SceneOutcome(item[0], error=f"{item[0]}: internal error: {type(exc).__name__}: {exc}",
+                            reason=INTERNAL)
+    tasks = [(path, settings, stages, facts, figures_dirs.get(path)) for path in paths]
+    for _, outcome in run_tasks(_scan_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                                description="scanning scenes", on_error=lost, ordered=False):
+        yield from _stored(outcome, store)
+
+
+def _scan_task(item) -> SceneOutcome:
+    path, settings, stages, facts, figures_dir = item
+    return scan_one(path, settings, stages, facts, progress=False, figures_dir=figures_dir)
+
+
+def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STAGES, facts=None, *, workers: int = 1,
+             scheduler: str | None = None, progress: bool | None = None,
+             figures_dir: str | None = None) -> SceneOutcome:
+    """One scene scanned, its targets combined and fitted, and (with
+    ``facts``, a mapping, even empty) its acquisition read; an outcome
+    with the error when the scene cannot be scanned, ``interrupted`` with
+    the records so far on Ctrl-C."""
+    from .combine import summarise_scan
+    from .measure import scan_scene
+    from .targetfit import fit_targets
+    try:
+        acquisition = None
+        if facts is not None:
+            from ..campaign.acquisitions import read_acquisition
+            acquisition = read_acquisition(path, band=settings.band, settings=acquisition_settings(settings, stages),
+                                           **facts)
+        try:
+            records = scan_scene(path, settings, workers=workers, scheduler=scheduler, progress=progress,
+                                 figures_dir=figures_dir)
+        except KeyboardInterrupt as exc:
+            partial = getattr(exc, "records", None)
+            if partial is None:
+                raise
+            return SceneOutcome(path, tuple(partial), tuple(summarise_scan(partial)), interrupt=exc)
+        summaries = summarise_scan(records)
+        if settings.target == "edge" and stages:
+            summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
+    except ImgmtfError as exc:
+        message = " ".join(str(exc).split())
+        return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
+                            reason=exc.reason)
+    return SceneOutcome(path, tuple(records), tuple(summaries), acquisition, figures_dir=figures_dir)
+
+
+def _stored(outcome: SceneOutcome, store: str | None) -> Iterator[SceneOutcome]:
+    """The scene's accepted half-edges and usable summaries written to the
+    store, then the outcome yielded, with Ctrl-C held back until the caller
+    has reported it: a scene is stored and reported, or neither."""
+    from ..parallel import signals_deferred
+    with signals_deferred():
+        if store is not None and outcome.acquisition is not None and outcome.ok and not outcome.interrupted:
+            from ..campaign.store import write_acquisition
+            write_acquisition(store, outcome.acquisition, [r for r in outcome.records if r.ok],
+                              [r for r in outcome.summaries if r.ok])
+        yield outcome
+
+
+def outputs_folder(out_dir: str, path: str, taken: set[str]) -> str:
+    """A scene's own sub-folder of ``out_dir`` (its file name without the
+    suffix; numbered when two scenes share one), recorded in ``taken``."""
+    stem = Path(path).stem or "scene"
+    name, k = stem, 1
+    while name in taken:
+        k += 1
+        name = f"{stem}-{k}"
+    taken.add(name)
+    return str(Path(out_dir) / name)

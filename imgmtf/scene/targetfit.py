@@ -1,0 +1,275 @@
+"""Across- and along-track MTF of a target: the sensor model fitted to all
+of its accepted half-edges.
+
+The combination of :mod:`.combine` gives one result per measured normal;
+a target tilted like Baotou's (16.8 deg) then has two "oblique" results,
+and neither is the across- or along-track MTF a specification quotes.
+Here the sensor model (:func:`imgmtf.fit_sensor`: the same stages, the
+same misfit test as ``imgmtf fit``; "optics,detector" by default) is
+fitted jointly to every accepted half-edge of a target, each measured
+again on its masked ROI exactly as the scan measured it (the window
+``roi`` of its site, the pixels whose centres lie inside its
+``roi_polygon_px``), and the model's MTF is read along the track and
+across it: MTF at Nyquist and MTF50 with the fit's delta-method
+intervals, FWHM and RER.
+
+The fit is in the sensor's frame: each edge's normal is turned by the
+track azimuth (``--track-azimuth``; 0, rows along track, for a scene in
+sensor geometry), so "across" and "along" are the track's.  A
+map-projected scene with no track azimuth has no across/along direction,
+and no fit rows.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import ImgmtfError, ParameterError
+from ..estimate.results import finite
+from ..records import Record
+
+#: the stages fitted to a target's half-edges by default: blur and pixel,
+#: what a target's few edges determine on both axes
+DEFAULT_STAGES = "optics,detector"
+_DIRECTIONS = {"across": "across-track", "along": "along-track"}
+
+
+def fit_targets(records, *, stages: str | list[str] = DEFAULT_STAGES, workers: int = 1,
+                scheduler: str | None = None, progress: bool | None = None) -> list[Record]:
+    """Fit the sensor model to each target's accepted half-edges (and to
+    the scene's, when it has several targets): two summary records per
+    fit, across- and along-track.
+
+    Parameters
+    ----------
+    records : list of Record
+        A scan's records (:func:`imgmtf.scene.measure.scan_scene`) of edge
+        targets; accepted half-edges with a ``target_id`` are fitted, each
+        read again from the scene (``path``) on its ROI.
+    stages : str or list of str
+        The stages fitted (:func:`imgmtf.fit_sensor`), default
+        "optics,detector".
+    workers, scheduler, progress
+        As for :func:`imgmtf.parallel.run_tasks`: one fit per task.
+
+    Returns
+    -------
+    list of Record
+        Per target (``scope`` "target", ``target_id``), then for the scene
+        (``scope`` "scene", only with two targets or more), an
+        "across-track" and an "along-track" record (each only when some
+        half-edge lies nearer that axis than the other: the model does not
+        extrapolate) with ``status`` "fitted" and ``summary`` "fit": ``mtf_nyquist`` and
+        ``mtf_nyquist_ci``, ``mtf50_cy_px`` and ``mtf50_ci_cy_px`` (cy/px),
+        ``fwhm_px``, ``rer``, the model's MTF curve, ``n_edges``,
+        ``edge_ids``, ``stages``, ``parameters`` (fitted values, m),
+        ``reduced_chi_square``, ``misfit`` (the model does not fit; a
+        warning says why) and ``misfit_p`` (the smallest p-value of the
+        half-edges' residual structure).  A fit that fails gives one
+        record per target with ``status`` "rejected" and the reason.
+        Empty for a pulse scan, a scene with no accepted half-edge, or an
+        unknown track direction.
+
+    Raises
+    ------
+    ParameterError
+        ``records`` is not a list of Records, or ``stages`` names no stage.
+
+    Examples
+    --------
+    >>> from imgmtf.scene.measure import scan_scene                       # doctest: +SKIP
+    >>> [(r.figures["direction"], r.figures["mtf_nyquist"]) for r in fit_targets(scan_scene("baotou.tif"))]
+    ...                                                                     # doctest: +SKIP
+    [('across-track', 0.1107), ('along-track', 0.0952)]
+    """
+    try:
+        records = list(records)
+    except TypeError:
+        raise ParameterError(f"records must be a list of a scan's Records, got {records!r}") from None
+    if any(not isinstance(r, Record) for r in records):
+        raise ParameterError("records must be a scan's Records (imgmtf.scan_scene)")
+    accepted = [r for r in records if r.ok and r.target == "edge" and r.site.get("scope") == "edge"
+                and r.site.get("target_id") is not None and r.site.get("roi_polygon_px")]
+    if not accepted or track_of(accepted[0]) is None:
+        return []
+    from ..parallel import run_tasks
+    targets = sorted({int(r.site["target_id"]) for r in accepted})
+    # each task measures its half-edges again itself (an EdgeResult does not travel between processes)
+    tasks = [([r for r in accepted if r.site["target_id"] == target], {"scope": "target", "target_id": target},
+              stages) for target in targets]
+    if len(targets) > 1:        # the scene's fit, the longest, first: the targets' fill the other workers
+        tasks.insert(0, (accepted, {"scope": "scene"}, stages))
+    fitted = list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                            description="fitting targets"))
+    return [row for rows in fitted[1:] + fitted[:1] for row in rows] if len(targets) > 1 else fitted[0]
+
+
+def track_of(record: Record) -> float | None:
+    """The track azimuth (deg clockwise from up) a scan record was measured with."""
+    track = record.params.get("track_azimuth_deg")
+    return None if track is None else float(track)
+
+
+def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon) -> np.ndarray:
+    """Pixels of a window (``shape``, its top-left pixel at ``origin`` x, y
+    in the scene) whose centres lie inside a convex ``polygon`` (corners x,
+    y in scene pixels, in either order round it).
+
+    Example
+    -------
+    >>> roi_mask((3, 4), (10, 20), [[10, 20], [12, 20], [12, 22], [10, 22]]).sum()
+    np.int64(9)
+    """
+    y, x = np.mgrid[0:shape[0], 0:shape[1]].astype(float)
+    x += origin[0]
+    y += origin[1]
+    p = np.asarray(polygon, float)
+    q = np.roll(p, -1, axis=0)
+    orientation = math.copysign(1.0, float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1])))
+    inside = np.ones(shape, bool)
+    for (x0, y0), (x1, y1) in zip(p, q):
+        inside &= orientation * ((x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)) >= -1e-6
+    return inside
+
+
+def _measured(records: list[Record]) -> list[Any]:
+    """Each accepted half-edge measured again on its masked ROI (no
+    intervals: the fit needs its samples and geometry), its normal turned
+    into the sensor's frame; why not (a message) where that fails."""
+    from ..estimate.edge import measure_edge
+    from ..inputs import saturation_levels
+    from ..io import read_raster
+    out: list[Any] = []
+    for record in records:
+        x, y, w, h = (int(v) for v in record.site["roi"])
+        try:
+            raster = read_raster(record.path, record.params.get("band"), window=(x, y, w, h))
+            mask = roi_mask(raster.data.shape, raster.origin, record.site["roi_polygon_px"])
+            given = record.params.get("saturation")
+            saturation = (float(given[0]), float(given[1])) if given else saturation_levels(raster.dtype)
+            result = measure_edge(raster.data, mask=mask, method=record.method, gsd_m=raster.gsd_m,
+                                  saturation=saturation, dtype=raster.dtype, intervals=False)
+        except ImgmtfError as exc:
+            out.append(" ".join(str(exc).split()))
+            continue
+        out.append(replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0)))
+    return out
+
+
+def _turned(normal_deg: float, track_deg: float) -> float:
+    """A normal (deg from the image's x axis) in the sensor's frame (from
+    the across-track axis), in (-90, 90]."""
+    angle = (normal_deg - track_deg) % 180.0
+    return angle - 180.0 if angle > 90.0 else angle
+
+
+def _fit_task(task) -> list[Record]:
+    records, site, stages = task
+    return _fit_rows(list(zip(records, _measured(records))), site, stages)
+
+
+def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
+    from ..estimate.fit import fit_sensor
+    records = [r for r, _ in members]
+    first = records[0]
+    edges = [e for _, e in members if not isinstance(e, str)]
+    where = _where(records, site)
+    try:
+        if not edges:
+            raise ImgmtfError(f"no half-edge could be measured again: {members[0][1]}", reason="unsuitable")
+        fit = fit_sensor(edges, stages=stages, confidence=_confidence(first))
+    except ImgmtfError as exc:
+        what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
+        return [Record(first.path, first.band, "edge", first.method, "rejected", exc.reason,
+                       f"{first.path}: the sensor model could not be fitted to {what}: {' '.join(str(exc).split())}",
+                       figures={"summary": "fit"}, site=where, params=_params(first, stages), run_utc=first.run_utc)]
+    used = [r for r, e in members if not isinstance(e, str)]
+    lost = [f"half-edge {r.site.get('id')} could not be measured again for the fit: {e}"
+            for r, e in members if isinstance(e, str)]
+    # an axis no edge lies nearer to is the model's extrapolation (tied or held parameters): no row
+    return [_direction_row(fit, direction, used, where, stages, lost) for direction in ("across", "along")
+            if fit.directions[direction]["constrained"]]
+
+
+def _direction_row(fit, direction: str, records: list[Record], site: dict, stages, lost: list[str]) -> Record:
+    from ..estimate.spectrum import relative_edge_response
+    from ..sensor.model import direction_angle
+    first = records[0]
+    sensor = fit.sensor
+    gsd = sensor.gsd_m
+    angle = direction_angle(direction)
+    figures_of = fit.directions[direction]
+    grid = np.arange(-8.0, 8.0, 1.0 / 64.0)
+    esf = sensor.line_response(angle, reach_px=8.0).esf(grid)
+    fwhm_px = sensor.fwhm_m(direction) / gsd
+    track = track_of(first) or 0.0
+    warnings = [*_warnings(fit, site, [r.site.get("id") for r in records]), *lost]
+    figures: dict[str, Any] = {
+        "summary": "fit", "direction": _DIRECTIONS[direction],
+        "normal_angle_deg": round(_turned(angle + track, 0.0), 3),
+        "n_edges": len(records), "edge_ids": [r.site.get("id") for r in records],
+        "mtf_nyquist": finite(figures_of["mtf_nyquist"]),
+        "mtf_nyquist_ci": [finite(v) for v in figures_of["mtf_nyquist_ci"]],
+        "mtf50_cy_px": finite(figures_of["mtf50_cy_px"]),
+        "mtf50_ci_cy_px": [finite(v) for v in figures_of["mtf50_cy_px_ci"]],
+        "fwhm_px": finite(fwhm_px), "rer": finite(relative_edge_response(grid, esf, _half_point(grid, esf))),
+        "stages": [s.name for s in sensor.stages],
+        "parameters": {p.key: finite(p.value) for p in fit.parameters if p.status == "fitted"},
+        "reduced_chi_square": finite(fit.reduced_chi_square), "misfit": bool(fit.misfit),
+        "misfit_p": finite(min(e.misfit_p for e in fit.edges)),
+        "rows_used": int(sum(r.figures.get("rows_used") or 0 for r in records)),
+        "snr_min": finite(min((r.figures.get("snr") or math.inf) for r in records)),
+        "gsd_m": first.figures.get("gsd_m"), "warnings": warnings,
+    }
+    if figures["gsd_m"]:
+        figures["mtf50_cy_m"] = finite((figures["mtf50_cy_px"] or math.nan) / figures["gsd_m"])
+        figures["fwhm_m"] = finite(fwhm_px * figures["gsd_m"])
+    frequencies = first.figures.get("frequencies_cy_px")
+    if frequencies:
+        curve, _, _ = fit.mtf_band(np.asarray(frequencies, float), angle)
+        figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
+    return Record(first.path, first.band, "edge", first.method, "fitted", figures=figures, site=site,
+                  params=_params(first, stages), run_utc=first.run_utc)
+
+
+def _warnings(fit, site: dict, ids: list):
+    """The fit's own warnings, the misfit said first and for the target;
+    an edge named by the scan's id (the fit numbers its inputs 1, 2...)."""
+    what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
+    if fit.misfit:
+        yield (f"the sensor model ({', '.join(s.name for s in fit.sensor.stages)}) does not fit {what}'s "
+               "half-edges: its across/along-track figures may be biased")
+    for warning in fit.warnings:
+        if warning.startswith("no GSD in the inputs") or "MTF is an extrapolation" in warning:
+            continue            # the scan's rows say so already (lengths here are px); no row extrapolates
+        for k, edge_id in enumerate(ids, 1):
+            if warning.startswith(f"edge {k}: "):
+                warning = f"half-edge {edge_id}: " + warning.removeprefix(f"edge {k}: ")
+        yield warning
+
+
+def _half_point(grid: np.ndarray, esf: np.ndarray) -> float:
+    """Where a rising normalised ESF crosses 0.5."""
+    return float(np.interp(0.5, esf, grid))
+
+
+def _confidence(record: Record) -> float:
+    return float((record.params.get("intervals") or {}).get("confidence") or 0.95)
+
+
+def _params(record: Record, stages) -> dict:
+    names = stages if isinstance(stages, str) else ",".join(stages)
+    return {"intervals": record.params.get("intervals"), "track_azimuth_deg": record.params.get("track_azimuth_deg"),
+            "scan": record.params.get("scan"), "fit": {"stages": names}}
+
+
+def _where(records: list[Record], site: dict) -> dict:
+    """A target's site: its centre, the mean of its half-edges' ends."""
+    where = dict(site)
+    if site["scope"] == "target":
+        ends = np.array([[r.site[k] for k in ("x0_px", "y0_px", "x1_px", "y1_px")] for r in records]).reshape(-1, 2)
+        where.update(x_px=round(float(ends[:, 0].mean()), 2), y_px=round(float(ends[:, 1].mean()), 2))
+    return where

@@ -1,0 +1,194 @@
+"""The campaign report and the commands that fill a store: report's files,
+a self-contained page, the figures; measure and fit with --campaign."""
+import csv
+import re
+
+import numpy as np
+import pytest
+import rasterio
+from click.testing import CliRunner
+
+import imgmtf
+from imgmtf.campaign.acquisitions import Acquisition
+from imgmtf.campaign.report import write_report
+from imgmtf.campaign.store import read_layer, write_acquisition
+from imgmtf.campaign.trend import TREND_COLUMNS
+from imgmtf.cli import main
+from imgmtf.errors import ParameterError
+from imgmtf.plot.campaign import plot_campaign, plot_trend
+from imgmtf.records import Record
+
+SLOPE = -0.02                   # MTF at Nyquist per year of the synthetic campaign
+
+
+def fit_row(direction, value, half=0.004, plot=None):
+    return Record("scene.tif", 1, "edge", "", "fitted",
+                  figures={"summary": "fit", "direction": direction, "mtf_nyquist": value,
+                           "mtf_nyquist_ci": [value - half, value + half], "mtf50_cy_px": 0.3 + value / 4,
+                           "mtf50_ci_cy_px": [0.29 + value / 4, 0.31 + value / 4], "fwhm_px": 1.6 - value,
+                           "rer": 0.4 + value, "constrained": True},
+                  site={"scope": "scene"}, plot=plot)
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    """Five yearly acquisitions whose MTF at Nyquist falls SLOPE a year
+    (dates one year of 365.25 days apart), and one without a time."""
+    tmp_path = tmp_path_factory.mktemp("campaign")
+    figure = tmp_path / "edge.png"
+    imgmtf.write_png(figure, np.tile(np.arange(64, dtype=np.uint8) * 4, (32, 1)))
+    path = tmp_path / "site.gpkg"
+    for k in range(5):
+        when = np.datetime64("2020-01-01T00:00:00") + np.timedelta64(int(k * 365.25 * 86400), "s")
+        acquisition = Acquisition(f"a{k}", f"scene{k}.tif", "0" * 64, f"{when}Z", "Simsat-1", "PAN", "pan",
+                                  overview=str(figure) if k == 0 else None)
+        write_acquisition(path, acquisition, [], [fit_row("across-track", 0.30 + SLOPE * k, plot=str(figure)),
+                                                  fit_row("along-track", 0.28 + SLOPE * k)])
+    write_acquisition(path, Acquisition("untimed", "old.tif", "1" * 64, None, "Simsat-1", None, "pan"), [],
+                      [fit_row("across-track", 0.5)])
+    return path
+
+
+@pytest.fixture(scope="module")
+def written(store, tmp_path_factory):
+    """The report of ``store``, with a requirement and the default sensor as the baseline."""
+    toml = tmp_path_factory.mktemp("sensor") / "sensor.toml"
+    imgmtf.Sensor().to_toml(toml)
+    return write_report(store, tmp_path_factory.mktemp("report"), requirement=0.2, baseline=toml)
+
+
+def test_the_report_writes_trends_and_a_self_contained_page(written):
+    with open(written.trend_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert tuple(rows[0]) == TREND_COLUMNS
+    nyquist = {r["direction"]: r for r in rows if r["figure"] == "mtf_nyquist"}
+    assert set(nyquist) == {"across-track", "along-track"}
+    for r in nyquist.values():
+        assert float(r["slope_per_year"]) == pytest.approx(SLOPE, rel=1e-4)
+        assert r["drift"] == "True" and r["n_acquisitions"] == "5" and r["method"] == "fit"
+    page = open(written.report_html, encoding="utf-8").read()
+    assert "<script" not in page and "<link" not in page and "@import" not in page
+    assert not re.search(r"(src|href)\s*=\s*[\"']?(https?:)?//", page) and "url(" not in page
+    sources = re.findall(r"<img [^>]*src=\"([^\"]*)\"", page)
+    assert all(s.startswith("data:image/png;base64,") for s in sources)
+    assert len(sources) == 2 + 1 + 5     # a figure per direction, the overview, each acquisition's edge figure
+    assert "1 without an acquisition time" in page and "no time" in page
+    assert "Simsat-1, band pan: across-track, fit" in page
+
+
+def test_a_baseline_sensor_gives_the_prelaunch_values(written):
+    page = open(written.report_html, encoding="utf-8").read()
+    sensor = imgmtf.Sensor()
+    assert f"across-track {sensor.mtf_nyquist('across'):.4f}" in page
+    assert f"along-track {sensor.mtf_nyquist('along'):.4f}" in page
+
+
+def test_an_empty_store_gives_a_report_that_says_so(tmp_path):
+    from imgmtf.campaign.store import ensure_store
+    ensure_store(tmp_path / "empty.gpkg")
+    written = write_report(tmp_path / "empty.gpkg", tmp_path / "out")
+    assert open(written.trend_csv).read().strip() == ",".join(TREND_COLUMNS)
+    assert "holds no acquisition" in open(written.report_html).read()
+
+
+def test_trend_figures_draw_points_line_requirement_and_baseline(store):
+    rows = [r for r in read_layer(store, "targets") if r["direction"] == "across-track" and r["acquired_utc"]]
+    from imgmtf.campaign.trend import trends
+    found = [t for t in trends(rows) if t.figure == "mtf_nyquist"]
+    fig = plot_trend(rows, trend=found[0], requirement=0.2, baseline=0.31)
+    ax = fig.axes[0]
+    flat = sorted(round(float(line.get_ydata()[0]), 6) for line in ax.lines if len(set(line.get_ydata())) == 1)
+    assert flat == [0.2, 0.31]                           # the requirement and the pre-launch value
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("/year" in label and "drift" in label for label in labels)
+    assert ax.get_ylabel() == "MTF at Nyquist"
+    grid = plot_campaign(rows, found, requirement=0.2, title="t")
+    assert [a.get_ylabel() for a in grid.axes] == ["MTF at Nyquist", "MTF50 (cycles/pixel)",
+                                                   "FWHM of the LSF (px)", "RER (relative edge response)"]
+    with pytest.raises(ParameterError, match="figure must be one of"):
+        plot_trend(rows, "mtf10")
+
+
+def test_the_report_command(tmp_path):
+    store = tmp_path / "small.gpkg"                       # one direction: one figure to draw
+    for k in range(3):
+        write_acquisition(store, Acquisition(f"a{k}", "s.tif", "0" * 64, f"{2020 + k}-01-01T00:00:00Z", "Simsat-1",
+                                             None, "pan"), [], [fit_row("across-track", 0.30 + SLOPE * k)])
+    result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "out"), "--requirement", "0.2"])
+    assert result.exit_code == 0, result.output
+    assert "drift: Simsat-1, band pan, across-track, fit: MTF at Nyquist -0.0200/year" in result.output
+    assert (tmp_path / "out" / "report.html").is_file() and (tmp_path / "out" / "trend.csv").is_file()
+    missing = CliRunner().invoke(main, ["report", str(tmp_path / "none.gpkg"), "--out", str(tmp_path / "o")])
+    assert missing.exit_code == 1 and "none.gpkg: no such campaign store" in missing.output
+    bad = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "o"), "--requirement", "nan"])
+    assert bad.exit_code == 2
+
+
+def chip(path, angle, when=None, sigma=0.4):
+    sensor = imgmtf.Sensor(optics_sigma_x_m=sigma, optics_sigma_y_m=sigma)
+    imgmtf.write_geotiff(path, imgmtf.render(sensor, imgmtf.Target("edge", angle), 64).image)
+    if when:
+        with rasterio.open(path, "r+") as dst:
+            dst.update_tags(ACQUISITION_DATETIME=when, PLATFORM="Simsat-1", BAND_NAME="pan")
+    return str(path)
+
+
+def test_measure_adds_each_chip_once_and_says_once_which_have_no_time(tmp_path):
+    store = str(tmp_path / "c.gpkg")
+    timed = chip(tmp_path / "timed.tif", 6.0, "2022-05-01T10:00:00Z")
+    plain = [chip(tmp_path / f"plain{k}.tif", 6.0 + k) for k in range(2)]
+    for _ in range(2):                                    # the second run replaces the first's rows
+        result = CliRunner().invoke(main, ["measure", timed, *plain, "--campaign", store])
+        assert result.exit_code == 0, result.output
+    assert result.output.count("no acquisition time") == 1 and "give --acquired" in result.output
+    assert len(read_layer(store, "acquisitions")) == 3 and len(read_layer(store, "edges")) == 3
+    [row] = [r for r in read_layer(store, "edges") if r["acquired_utc"]]
+    assert (row["platform"], row["band_name"], row["direction"], row["acquired_utc"]) == (
+        "Simsat-1", "pan", "across-track", "2022-05-01T10:00:00Z")
+    named = CliRunner().invoke(main, ["measure", plain[0], "--campaign", store, "--acquired", "2021-02-03",
+                                      "--platform", "Other", "--band-name", "B8", "--instrument", "X"])
+    assert named.exit_code == 0 and "no acquisition time" not in named.output
+    bad = CliRunner().invoke(main, ["measure", plain[0], "--campaign", store, "--acquired", "31/12/2021"])
+    assert bad.exit_code == 2 and "'31/12/2021' is not an ISO 8601 date or time" in bad.output
+
+
+def test_fit_adds_one_acquisition_with_its_across_and_along_rows(tmp_path):
+    store = str(tmp_path / "c.gpkg")
+    when = "2023-03-15T09:00:00Z"
+    files = [chip(tmp_path / "across.tif", 6.0, when), chip(tmp_path / "along.tif", -84.0, when)]
+    result = CliRunner().invoke(main, ["fit", *files, "--campaign", store])
+    assert result.exit_code == 0, result.output
+    rows = read_layer(store, "targets")
+    assert sorted((r["direction"], r["method"], r["acquired_utc"]) for r in rows) == [
+        ("across-track", "fit", when), ("along-track", "fit", when)]
+    truth = imgmtf.Sensor(optics_sigma_x_m=0.4, optics_sigma_y_m=0.4)
+    across = next(r for r in rows if r["direction"] == "across-track")
+    assert across["mtf_nyquist"] == pytest.approx(truth.mtf_nyquist("across"), abs=0.01)
+    assert across["mtf_nyquist_ci_low"] < across["mtf_nyquist"] < across["mtf_nyquist_ci_high"]
+    other = chip(tmp_path / "later.tif", -84.0, "2024-01-01")
+    mixed = CliRunner().invoke(main, ["fit", files[0], other, "--campaign", store])
+    assert mixed.exit_code == 1 and "different acquisitions" in mixed.output
+
+
+def test_a_fit_that_misfits_is_marked(store):
+    rows = [dict(r) for r in read_layer(store, "targets") if r["direction"] == "along-track"]
+    rows[1]["misfit"] = 1
+    ax = plot_trend(rows).axes[0]
+    crosses = [line for line in ax.lines if line.get_marker() == "x"]
+    assert len(crosses) == 1 and len(crosses[0].get_xdata()) == 1
+    assert "the model misfits: may be biased" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_the_page_embeds_the_latest_acquisitions_figures_only(tmp_path):
+    from imgmtf.campaign.report import MAX_ACQUISITIONS_WITH_FIGURES
+    figure = tmp_path / "overview.png"
+    imgmtf.write_png(figure, np.zeros((8, 8), np.uint8))
+    store = tmp_path / "many.gpkg"
+    count = MAX_ACQUISITIONS_WITH_FIGURES + 2
+    for k in range(count):
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2000 + k}-01-01", overview=str(figure)),
+                          [], [])
+    page = open(write_report(store, tmp_path / "out").report_html, encoding="utf-8").read()
+    assert page.count("<img ") == MAX_ACQUISITIONS_WITH_FIGURES
+    assert "2 earlier ones" in page and f"{2000 + count - 1}-01-01: s{count - 1}.tif" in page
+    assert "2000-01-01: s0.tif" not in page
