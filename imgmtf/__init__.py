@@ -40,7 +40,7 @@ _LAZY = {
     "run_selftest": "selftest",
     "QualityError": "estimate.gate", "TwoTargetsError": "estimate.gate",
     "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",
-    "write_acquisition": "campaign.store", "read_layer": "campaign.store",
+    "write_acquisition": "campaign.store", "read_layer": "campaign.store", "StoreError": "campaign.store",
     "design_filter": "restore.design", "RestorationFilter": "restore.design",
     "restore_file": "restore.apply", "RestoredFile": "restore.apply",
     "restore_image": "restore.restoration", "Restoration": "restore.restoration",

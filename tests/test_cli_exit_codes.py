@@ -14,7 +14,8 @@ from imgmtf.cli.main import COMMANDS
 #: read: the option fails first)
 REQUIRED = {"measure": ["x.tif"], "scan": ["x.tif"], "fit": ["x.tif"], "simulate": ["--out", "x.tif"],
             "reproduce": ["--out", "out"], "sensor": [], "selftest": [],
-            "restore": ["x.tif", "--sensor", "s.toml", "--target-nyquist", "0.4", "--out", "o.tif"]}
+            "restore": ["x.tif", "--sensor", "s.toml", "--target-nyquist", "0.4", "--out", "o.tif"],
+            "report": ["s.gpkg", "--out", "o"]}
 
 
 def out_of_range(kind: click.ParamType) -> list[str]:
@@ -105,6 +106,8 @@ CONTRADICTIONS = [
     ("scan", ["a.tif", "--intervals", "bootstrap", "--bootstrap", "0"], "give one"),
     ("simulate", ["--out", "a.tif", "--pulse-width", "2"], "--target pulse only"),
     ("simulate", ["--out", "a.tif", "--target", "pulse"], "needs --pulse-width"),
+    ("restore", ["a.tif", "b.tif", "--sensor", "s.toml", "--target-nyquist", "0.4", "--out", "o.tif",
+                 "--plot", "p.png"], "take a single image"),
     ("simulate", ["--out", "a.tif", "--target", "pulse", "--pulse-width", "60", "--size", "50"],
      "wider than the chip"),
     ("simulate", ["--out", "a.tif", "--offset", "100", "--size", "50"], "outside the 50 x 50 px chip"),
@@ -112,6 +115,9 @@ CONTRADICTIONS = [
      "render a smaller chip or lower the oversampling"),
     ("fit", ["a.tif", "--stages", "optics", "--hold", "detector"], "cannot hold 'detector'"),
     ("fit", ["a.tif", "--hold", "optics.width_m"], "cannot hold 'optics.width_m'"),
+    ("scan", ["a.tif", "--platform", "X"], "give --campaign STORE.gpkg"),
+    ("scan", ["a.tif", "--fit-stages", "optics,lens"], "unknown stage 'lens'"),
+    ("scan", ["a.tif", "--campaign", "s.gpkg", "--acquired", "last spring"], "is not an ISO 8601 date"),
 ]
 
 

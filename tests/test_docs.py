@@ -133,7 +133,8 @@ def assert_ignored(folder: Path) -> None:
         return
     ignored = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", *written],
                              capture_output=True, text=True).stdout.split()
-    assert sorted(set(written) - set(ignored)) == [], "examples write files .gitignore does not cover"
+    missing = sorted(set(written) - set(ignored))
+    assert not missing, f"examples write files .gitignore does not cover: {', '.join(missing)}"
 
 
 def test_python_m_doctest_passes_on_the_readme(sample_folder):
