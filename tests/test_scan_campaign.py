@@ -159,3 +159,18 @@ def test_a_landsat_product_scanned_without_options_is_dated_and_named_by_its_fil
     assert (row["platform"], row["instrument"], row["acquired_utc"], row["band_name"]) == \
         ("Landsat 9", "OLI-2", "2021-11-21", "B8")
     assert "no acquisition time" not in result.output
+
+
+def test_a_scene_scanned_with_outputs_names_its_overview_and_edge_figures_in_the_store(campaign, tmp_path):
+    # the campaign report shows each acquisition's overview and edge figures from what the store names
+    _, paths, _ = campaign
+    store, out = str(tmp_path / "site.gpkg"), tmp_path / "out"
+    result = CliRunner().invoke(main, ["scan", str(paths[0]), str(paths[1]), "--campaign", store, "--out", str(out),
+                                       "--edge-figures", "--fit-stages", "none", "--format", "json"])
+    assert result.exit_code == 0, result.output
+    for row in read_layer(store, "acquisitions"):
+        overview = row["overview"]
+        assert os.path.isabs(overview) and os.path.isfile(overview) and overview.endswith("overview.png")
+        assert os.path.basename(os.path.dirname(overview)) == os.path.splitext(os.path.basename(row["path"]))[0]
+    plots = [row["plot"] for row in read_layer(store, "edges")]
+    assert plots and all(os.path.isfile(p) for p in plots)

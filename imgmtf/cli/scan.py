@@ -124,7 +124,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                                 facts=facts if store else None, workers=workers, scheduler=scheduler,
                                 progress=progress,
                                 figures_dirs={p: str(Path(f) / "edges") for p, f in folders.items()}
-                                if edge_figures else None)
+                                if edge_figures else None,
+                                overviews={p: str(Path(f) / "overview.png") for p, f in folders.items()})
         try:
             with closing(completed):
                 for outcome in completed:

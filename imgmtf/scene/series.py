@@ -14,7 +14,7 @@ is never stored.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -75,7 +75,8 @@ def acquisition_settings(settings: ScanSettings, stages: str | None) -> dict:
 def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, stages: str | None = DEFAULT_STAGES,
                 store: str | None = None, facts: Mapping[str, str | None] | None = None, workers: int = 1,
                 scheduler: str | None = None, progress: bool | None = None,
-                figures_dirs: Mapping[str, str] | None = None) -> Iterator[SceneOutcome]:
+                figures_dirs: Mapping[str, str] | None = None,
+                overviews: Mapping[str, str] | None = None) -> Iterator[SceneOutcome]:
     """Scan, summarise and fit each scene; with a ``store``, write each
     acquisition's rows as it completes.
 
@@ -92,6 +93,9 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
         (:func:`imgmtf.campaign.acquisitions.read_acquisition`).
     workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
     figures_dirs : scene -> a folder for its accepted half-edges' figures.
+    overviews : scene -> where its overview figure is written (by
+        :func:`imgmtf.scene.export.write_outputs`), recorded with its
+        acquisition so that a campaign report shows it.
 
     Yields
     ------
@@ -119,13 +123,14 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
         raise ParameterError(f"settings must be a ScanSettings, got {settings!r}")
     paths = [str(p) for p in paths]
     figures_dirs = dict(figures_dirs or {})
+    overviews = dict(overviews or {})
     facts = None if store is None else dict(facts or {})
     if store is not None:
         from ..campaign.store import ensure_store
         ensure_store(store)             # a store that cannot be written fails before any scan
     if len(paths) == 1:
         outcome = scan_one(paths[0], settings, stages, facts, workers=workers, scheduler=scheduler,
-                           progress=progress, figures_dir=figures_dirs.get(paths[0]))
+                           progress=progress, figures_dir=figures_dirs.get(paths[0]), overview=overviews.get(paths[0]))
         yield from _stored(outcome, store)
         if outcome.interrupt is not None:
             raise outcome.interrupt
@@ -135,22 +140,23 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
     def lost(item, exc):
         return SceneOutcome(item[0], error=f"{item[0]}: internal error: {type(exc).__name__}: {exc}",
                             reason=INTERNAL)
-    tasks = [(path, settings, stages, facts, figures_dirs.get(path)) for path in paths]
+    tasks = [(path, settings, stages, facts, figures_dirs.get(path), overviews.get(path)) for path in paths]
     for _, outcome in run_tasks(_scan_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
                                 description="scanning scenes", on_error=lost, ordered=False):
         yield from _stored(outcome, store)
 
 
 def _scan_task(item) -> SceneOutcome:
-    path, settings, stages, facts, figures_dir = item
-    return scan_one(path, settings, stages, facts, progress=False, figures_dir=figures_dir)
+    path, settings, stages, facts, figures_dir, overview = item
+    return scan_one(path, settings, stages, facts, progress=False, figures_dir=figures_dir, overview=overview)
 
 
 def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STAGES, facts=None, *, workers: int = 1,
              scheduler: str | None = None, progress: bool | None = None,
-             figures_dir: str | None = None) -> SceneOutcome:
+             figures_dir: str | None = None, overview: str | None = None) -> SceneOutcome:
     """One scene scanned, its targets combined and fitted, and (with
-    ``facts``, a mapping, even empty) its acquisition read; an outcome
+    ``facts``, a mapping, even empty) its acquisition read, naming its
+    ``overview`` figure (an absolute path) when one is to be written; an outcome
     with the error when the scene cannot be scanned, ``interrupted`` with
     the records so far on Ctrl-C."""
     from .combine import summarise_scan
@@ -162,6 +168,8 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
             from ..campaign.acquisitions import read_acquisition
             acquisition = read_acquisition(path, band=settings.band, settings=acquisition_settings(settings, stages),
                                            **facts)
+            if overview:
+                acquisition = replace(acquisition, overview=str(Path(overview).resolve()))
         try:
             records = scan_scene(path, settings, workers=workers, scheduler=scheduler, progress=progress,
                                  figures_dir=figures_dir)
