@@ -27,10 +27,15 @@ from click.testing import CliRunner
 import imgmtf
 from imgmtf.cli import main
 
+from conftest import real_scene
+
 ROOT = Path(__file__).parent.parent
 # pages whose examples their own authors keep (the accuracy study, the
-# method, the scan), and the generated reproduction report
-OTHERS = {"accuracy.md", "method.md", "scan.md"}
+# method), and the generated reproduction report
+OTHERS = {"accuracy.md", "method.md"}
+# pages whose examples read the shared real scenes (never copied into the repository): linked into
+# the folder the examples run in, the page skipped where they are absent (conftest.real_scene)
+REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",)}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -102,6 +107,7 @@ def sample_folder(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("document", DOCUMENTS)
 def test_every_example_of_the_document_runs(document, sample_folder):
+    link_real_scenes(document, sample_folder)
     text = (ROOT / document).read_text()
     globs: dict = {"__name__": "__docs__"}
     ran = 0
@@ -122,13 +128,19 @@ def test_every_example_of_the_document_runs(document, sample_folder):
     assert_ignored(sample_folder)
 
 
+def link_real_scenes(document: str, folder: Path) -> None:
+    for name in REAL_SCENES_READ.get(document, ()):
+        (folder / name).symlink_to(real_scene(name))
+
+
 def assert_ignored(folder: Path) -> None:
     """Every file or folder the examples wrote, run from the repository's
     root as a newcomer runs them, is one .gitignore covers."""
     import shutil
     import subprocess
+    linked = {name for names in REAL_SCENES_READ.values() for name in names}
     written = [p.name + "/" * p.is_dir() for p in folder.iterdir()
-               if p.name != "data" and not p.name.startswith("block")]
+               if p.name != "data" and not p.name.startswith("block") and p.name not in linked]
     if not written or not shutil.which("git") or not (ROOT / ".git").exists():
         return
     ignored = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", *written],
@@ -183,6 +195,7 @@ def update_console_outputs(document: str) -> None:
         here = os.getcwd()
         os.chdir(folder)
         os.symlink(ROOT / "data", "data", target_is_directory=True)
+        link_real_scenes(document, Path(folder))
         try:
             for language, body, line in list(fenced_blocks(text)):
                 if language != "console":
