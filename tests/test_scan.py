@@ -110,7 +110,7 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
     assert result.exit_code == 0, result.output
     # the table names the scene once; an accepted edge's warnings stand beneath it
-    rejected = [line for line in result.stdout.splitlines() if " rejected " in line]
+    rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
     assert rejected and not any(f"{SCENE}:" in line for line in rejected)
     assert "warning: the image is not in sensor geometry" in result.stdout
     geo = json.loads((out / "targets.geojson").read_text())
@@ -227,3 +227,30 @@ def test_edge_figures_one_per_accepted_half_edge_named_by_its_id(tmp_path):
     assert not any(r.get("plot") for r in rows if r["status"] == "rejected")
     refused = CliRunner().invoke(main, ["scan", str(SCENE), "--edge-figures"])
     assert refused.exit_code == 2 and "give --out DIR" in refused.output
+
+
+def test_the_text_table_tallies_rejections_by_reason_and_verbose_lists_every_candidate():
+    rows = [json.loads(line) for line in CliRunner().invoke(
+        main, ["scan", str(SCENE), "--format", "json", "--fit-stages", "none"]).stdout.splitlines()]
+    candidates = [r for r in rows if r.get("scope") == "edge"]
+    counts = {}
+    for r in candidates:
+        if r["status"] == "rejected":
+            counts[r["reason"]] = counts.get(r["reason"], 0) + 1
+    brief = CliRunner().invoke(main, ["scan", str(SCENE), "--fit-stages", "none"]).stdout.splitlines()
+    tally = {line.split()[2]: int(line.split()[1]) for line in brief if line.startswith("rejected ")}
+    assert tally == counts and sum(tally.values()) == len(candidates) - 2
+    assert brief[0].endswith(f"{len(candidates)} candidate edges, 2 accepted")
+    # one line per reason, the most frequent first; the option that moves a limit is named
+    assert list(tally.values()) == sorted(tally.values(), reverse=True)
+    assert any("(--min-length sets the minimum)" in line for line in brief if " too-short " in line)
+    verbose = CliRunner().invoke(main, ["scan", str(SCENE), "--fit-stages", "none", "--verbose"]).stdout
+    lines = verbose.splitlines()
+    listed = [line for line in lines if " rejected  " in line]
+    assert len(listed) == sum(counts.values()) and not any(line.startswith("rejected ") for line in lines)
+
+
+def test_a_count_names_one_thing_in_the_singular():
+    from imgmtf.cli.tables import plural
+    assert (plural(1, "candidate edge"), plural(0, "candidate edge"), plural(17, "candidate bar")) == (
+        "1 candidate edge", "0 candidate edges", "17 candidate bars")

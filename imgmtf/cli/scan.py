@@ -64,12 +64,15 @@ DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without impo
 @click.option("--instrument", help="with --campaign: the instrument, where the file does not say")
 @click.option("--band-name", help="with --campaign: the band's name, where the file does not say")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
+@click.option("--verbose", is_flag=True,
+              help="list every rejected candidate, not one line per reason (--format json and --out's CSV "
+                   "always hold every row)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
          fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
-         progress, interval_method, replicates, confidence, workers, scheduler):
+         verbose, progress, interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
@@ -130,7 +133,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             with closing(completed):
                 for outcome in completed:
                     outcomes.append(outcome)
-                    _report(outcome, kind, band, folders.get(outcome.path), fmt)
+                    _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
         except KeyboardInterrupt as exc:
             interrupted = exc
     _closing_notes(outcomes, paths, store, kind, fmt)
@@ -163,7 +166,7 @@ def _stages(text: str) -> str | None:
     return ",".join(names)
 
 
-def _report(outcome, kind, band, folder, fmt) -> None:
+def _report(outcome, kind, band, folder, fmt, verbose) -> None:
     """One scene's tables (or JSON rows), and its outputs written."""
     if outcome.error:
         click.echo(f"imgmtf: error: {outcome.error}", err=True)
@@ -172,7 +175,7 @@ def _report(outcome, kind, band, folder, fmt) -> None:
     from ..scene.export import write_outputs
     info = raster_info(outcome.path)
     written = write_outputs(outcome.records, info, folder, band, outcome.summaries) if folder else []
-    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt)
+    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt, verbose)
     if not any(r.ok for r in outcome.records) and not outcome.interrupted:
         click.echo(f"imgmtf: error: {outcome.path}: no usable {kind} found "
                    f"({len(outcome.records)} candidates, all rejected)", err=True)
