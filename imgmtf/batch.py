@@ -15,10 +15,10 @@ import numpy as np
 
 from .atomic import ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
-from .estimate.intervals import Intervals
+from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
 from .figures import with_figure
-from .inputs import check_width, saturation_levels
+from .inputs import check_width, parse_length, saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
 from .records import Record, utc_now
@@ -36,8 +36,12 @@ class MeasureSettings:
     band : 1-based band, "all" for every band, None for the only band or
         RGB luminance.
     roi : (x, y, width, height) window read from every file (px).
-    pulse_width : (value, "px" or "m"), or None to estimate it.
-    intervals : confidence-interval settings (linearised by default).
+    pulse_width : (value, "px" or "m"), a number of px, a string as the
+        CLI takes it ("1.4", "1.4px", "18.3m"), or None to estimate it.
+    intervals : confidence-interval settings (linearised by default): an
+        :class:`~imgmtf.Intervals`, or what ``--intervals`` takes
+        ("influence", "bootstrap", "none"), or a number of bootstrap
+        replicates (0: none).
     force : measure even where a quality check fails (each a warning).
     saturation : (low, high) DN the sensor records; None for an integer
         file's type range (floats: none declared).
@@ -57,6 +61,9 @@ class MeasureSettings:
     track_azimuth_deg: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "intervals", as_intervals(self.intervals))
+        if self.pulse_width is not None:
+            object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
         if self.target not in ("edge", "pulse"):
             raise ParameterError(f"target must be 'edge' or 'pulse', got {self.target!r}")
         if self.pulse_width is not None and self.target != "pulse":
@@ -107,11 +114,62 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
     return out
 
 
-def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = None, *,
-                 run_utc: str | None = None) -> list[Record]:
-    """Every requested band of one file measured: one record each (an error
-    record when the file or a band cannot be measured, whatever the
-    failure).  ``run_utc`` stamps the records (default: now)."""
+def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
+                 *, run_utc: str | None = None, **options) -> list[Record]:
+    """Measure one image file as ``imgmtf measure FILE`` does: every
+    requested band, one record each, the same records (and numbers) that
+    ``imgmtf measure --format json FILE`` prints.
+
+    The file's GSD (figures on the ground), its data type (saturation
+    limits), its geometry (the track's direction) and, for an RGB(A) photo,
+    its luminance are taken from the file, as the CLI takes them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The image file (GeoTIFF, JP2, NITF, PNG, JPEG: anything GDAL reads).
+    settings : MeasureSettings, optional
+        How to measure; or give its fields as keywords (``target``,
+        ``method``, ``band``, ``roi``, ``pulse_width``, ``intervals``,
+        ``force``, ``saturation``, ``track_azimuth_deg``), which take what
+        the CLI's options take (``intervals="bootstrap"``,
+        ``pulse_width="1.5m"``, ``band="all"``).
+    plot_path : str, optional
+        Also save the measurement figure here (``measure --plot``).
+    run_utc : str, optional
+        The time stamp of the records (default: now).
+
+    Returns
+    -------
+    list of Record
+        One per band measured (one for a single-band file or a photo's
+        luminance); a file or band that cannot be measured gives an error
+        record (``status`` "error", its ``reason`` and message), never an
+        exception, as in a batch.
+
+    Raises
+    ------
+    ParameterError
+        Settings out of range, or both ``settings`` and keywords.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 64, gsd_m=0.5, seed=1)
+    >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=chip.gsd_m)
+    >>> [record] = imgmtf.measure_file("chip.tif", intervals="bootstrap")
+    >>> record.status, record.get("gsd_m"), record.get("params")["intervals"]["method"]
+    ('ok', 0.5, 'bootstrap')
+    >>> imgmtf.measure_file("missing.tif")
+    [Record('missing.tif', error, unreadable: missing.tif: no such file)]
+    """
+    if settings is None:
+        settings = MeasureSettings(**options)
+    elif options:
+        raise ParameterError(f"give settings or keyword options ({', '.join(options)}), not both")
+    elif not isinstance(settings, MeasureSettings):
+        raise ParameterError(f"settings must be a MeasureSettings, got {type(settings).__name__}")
+    path = os.fspath(path)
     run_utc = run_utc or utc_now()
     try:
         info = raster_info(path)
@@ -119,29 +177,31 @@ def measure_file(path: str, settings: MeasureSettings, plot_path: str | None = N
     except Exception as exc:               # the safety net: a record, never an abort
         return [settings.failed(path, settings.band, exc, run_utc)]
     skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
+    # what the file's reading adds to its first record's warnings (and to its figure's count of them)
+    skipped_note = ([f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured"]
+                    if skipped else [])
     records = []
-    for band in bands:
+    for index, band in enumerate(bands):
+        file_notes = skipped_note if index == 0 else []
         try:
             raster = read_raster(path, band, window=settings.roi)
             result = measure_raster(raster, settings)
             summary = result.to_dict(curves=True)
         except Exception as exc:
-            records.append(settings.failed(path, band, exc, run_utc))
+            failed = settings.failed(path, band, exc, run_utc)
+            records.append(failed.with_(figures={"warnings": file_notes}) if file_notes else failed)
             continue
+        if raster.band == "luminance":
+            # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
+            file_notes = [*file_notes, "measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded "
+                          "as stored (not linearised)" + (", alpha ignored" if info.alpha_bands else "")]
+        summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         if plot_path:
-            record = with_figure(record, functools.partial(_measurement_figure, result, raster),
+            record = with_figure(record, functools.partial(_measurement_figure, result, raster,
+                                                           summary["warnings"]),
                                  _band_plot_path(plot_path, band, len(bands)))
         records.append(record)
-    notes = []
-    if skipped:
-        notes.append(f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured")
-    if any(r.band == "luminance" for r in records):
-        # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
-        notes.append("measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded as stored "
-                     "(not linearised)" + (", alpha ignored" if info.alpha_bands else ""))
-    if notes and records:
-        records[0] = records[0].with_(figures={"warnings": [*records[0].get("warnings", []), *notes]})
     return records
 
 
@@ -224,12 +284,13 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result, raster):
-    """The measurement figure, titled with the file (and band), with the
+def _measurement_figure(result, raster, warnings):
+    """The measurement figure, titled with the file (and band), counting
+    every warning its record carries (the file's own among them), with the
     true MTF when the file is a chip imgmtf simulated."""
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
-    return plot_measurement(result, truth=true_mtf(raster), title=title)
+    return plot_measurement(result, truth=true_mtf(raster), title=title, warnings=warnings)
 
 
 def true_mtf(raster):
@@ -248,3 +309,12 @@ def true_mtf(raster):
     except (KeyError, TypeError, ValueError, ImgmtfError):
         return None
     return lambda f_cy_px: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
+
+
+def file_truth(path: str, band=None, window=None):
+    """:func:`true_mtf` of the chip in file ``path`` (None for a file
+    imgmtf did not simulate, or one it cannot read)."""
+    try:
+        return true_mtf(read_raster(path, band, window=window))
+    except ImgmtfError:
+        return None

@@ -2,7 +2,11 @@
 
 Every error imgmtf raises on purpose derives from :class:`ImgmtfError`, so a
 caller (and the CLI) can tell a problem with the input from a bug.  Messages
-are one line and name the offending value or file.
+are one line and name the offending value or file.  Each also derives from
+the builtin a caller would catch without knowing imgmtf: a bad parameter is a
+ValueError, a file that cannot be read or written an OSError (as rasterio's
+and open()'s are).  Every public exception is importable from ``imgmtf``
+(the quality gate's :class:`~imgmtf.estimate.gate.QualityError` too).
 """
 
 
@@ -30,14 +34,15 @@ class ConfigError(ImgmtfError):
     reason = "config"
 
 
-class FileWriteError(ImgmtfError):
-    """An output file cannot be written."""
+class FileWriteError(ImgmtfError, OSError):
+    """An output file cannot be written (an OSError, as open()'s is)."""
 
     reason = "write"
 
 
-class ImageReadError(ImgmtfError):
-    """An image file cannot be opened or decoded (``reason`` ``unreadable``;
+class ImageReadError(ImgmtfError, OSError):
+    """An image file cannot be opened or decoded, an OSError as rasterio's
+    read errors are (``reason`` ``unreadable``;
     ``too-large`` for an image above the read limit, ``unsupported-type``
     for complex pixels)."""
 

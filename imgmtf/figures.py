@@ -28,5 +28,7 @@ def save_figure(make_figure, path: str, dpi: int = 110) -> None:
     with atomic_output(path) as partial:
         try:
             make_figure().savefig(partial, dpi=dpi, format=Path(path).suffix.lstrip(".") or "png")
+        except ImgmtfError:
+            raise                 # says what is wrong already (a FileWriteError is an OSError too)
         except OSError as exc:
             raise FileWriteError(f"{path}: cannot write the figure: {exc.strerror or exc}") from None

@@ -258,3 +258,40 @@ def check_width(width_px: float) -> float:
             f"a {width_px:g} px wide bar puts the first zero of its sinc at {1 / width_px:.3f} cy/px, "
             f"below {MIN_FIRST_ZERO_CY_PX} cy/px: too little of the MTF can be recovered")
     return width_px
+
+
+LENGTH_UNITS = ("px", "m")
+
+
+def parse_length(value, default_unit: str = "px") -> tuple[float, str]:
+    """A length (a bar's width) as ``(value, unit)``, from what the CLI
+    takes ("1.4", "1.4px", "18.3m"), a number (in ``default_unit``) or a
+    ``(value, unit)`` pair; unit "px" (pixels) or "m" (metres on the ground).
+
+    Raises
+    ------
+    ParameterError
+        Not a number with an optional px or m suffix, or not finite.
+
+    Examples
+    --------
+    >>> parse_length("18.3m"), parse_length(" 1.4PX "), parse_length(2)
+    ((18.3, 'm'), (1.4, 'px'), (2.0, 'px'))
+    """
+    if isinstance(value, (tuple, list)) and len(value) == 2 and value[1] in LENGTH_UNITS:
+        number, unit = value
+    elif isinstance(value, str):
+        text = value.strip().lower()
+        unit = next((u for u in LENGTH_UNITS if text.endswith(u)), default_unit)
+        number = text[: -len(unit)] if text.endswith(unit) else text
+        try:
+            number = float(number)
+        except ValueError:
+            raise ParameterError(f"expected a number with an optional px or m suffix, got {value!r}") from None
+    else:
+        number, unit = value, default_unit
+    if isinstance(number, bool) or not isinstance(number, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"expected a length: a number, '1.4px' or '18.3m', got {value!r}")
+    if not math.isfinite(number):
+        raise ParameterError(f"expected a finite width, got {value!r}")
+    return float(number), unit

@@ -24,7 +24,7 @@ from rasterio.transform import Affine
 from rasterio.windows import Window
 
 from .atomic import atomic_output
-from .errors import FileWriteError, ImageContentError, ImageReadError, ParameterError
+from .errors import FileWriteError, ImageContentError, ImageReadError, ImgmtfError, ParameterError
 from .inputs import check_roi, luminance
 
 try:     # GDAL's own errors, which rasterio raises as they are from some calls
@@ -449,6 +449,8 @@ def _opened(path):
                                          "an MTF needs real DN: convert the band you want first "
                                          "(e.g. its magnitude)", reason="unsupported-type")
                 yield src
+    except ImgmtfError:
+        raise                     # already says what is wrong (an OSError too: not to be wrapped again)
     except GDAL_ERRORS as exc:
         kind = _image_kind(path)
         if kind:

@@ -202,9 +202,9 @@ class Record:
             else:
                 value = flat.get(source)
             if isinstance(value, (list, tuple, dict)):
-                value = json.dumps(value, sort_keys=True, default=_json_default)
-            elif isinstance(value, float) and not math.isfinite(value):
-                value = None
+                value = json.dumps(json_safe(value), sort_keys=True, default=_json_default)
+            elif isinstance(value, float):
+                value = json_safe(value)
             row[column] = "" if value is None else value
         return row
 
@@ -288,9 +288,16 @@ def to_json(record: Record) -> str:
 
 
 def json_safe(value):
-    """``value`` with NaN and infinities (at any depth) as None, for JSON."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
+    """``value`` with NaN and infinities (at any depth) as None, and -0.0 as
+    0.0 (a normal at -0.00 deg is at 0), for JSON and CSV.
+
+    Examples
+    --------
+    >>> json_safe({"normal_angle_deg": -0.0, "mtf": [0.5, float("nan")]})
+    {'normal_angle_deg': 0.0, 'mtf': [0.5, None]}
+    """
+    if isinstance(value, float):
+        return value + 0.0 if math.isfinite(value) else None
     if isinstance(value, dict):
         return {k: json_safe(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

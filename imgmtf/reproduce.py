@@ -219,7 +219,7 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
         "fig13_ground_noise_layers.png": plot.plot_ground_noise_layers(GroundNoise(), seed),
         "fig14_ground_noise.png": plot.plot_noise_sweep(ground, methods, true_nyq, "Ground noise"),
         "threshold.png": plot.plot_threshold(found, CRITERION_RELATIVE, CRITERION_FRACTION,
-                                             size.threshold_realisations),
+                                             size.threshold_realisations, thresholds=not quick),
     }
     for name, fig in figures.items():
         fig.savefig(out / name, dpi=100)

@@ -1,11 +1,32 @@
 """Shared helpers: exact edge responses computed independently of the
 renderer (inverse FFT of an analytic 1-D transfer function)."""
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import imgmtf as im
+
+#: the real scenes the project may read but not copy (../shared/data/real-scenes beside the
+#: repository, or wherever IMGMTF_SHARED_DATA points: the folder holding real-scenes/)
+SHARED_DATA_VARIABLE = "IMGMTF_SHARED_DATA"
+SHARED_DATA = Path(os.environ.get(SHARED_DATA_VARIABLE) or Path(__file__).resolve().parents[2] / "shared" / "data")
+REAL_SCENES = SHARED_DATA / "real-scenes"
+
+
+def real_scene(name: str, provenance: str = "") -> Path:
+    """The path of a real scene, the test skipped when the shared data are
+    absent; a folder IMGMTF_SHARED_DATA names must hold it (a failure, not
+    a skip: whoever sets the variable wants these tests run)."""
+    path = REAL_SCENES / name
+    if not path.is_file():
+        if os.environ.get(SHARED_DATA_VARIABLE):
+            pytest.fail(f"{SHARED_DATA_VARIABLE}={os.environ[SHARED_DATA_VARIABLE]}: no real-scenes/{name} there")
+        pytest.skip(f"{path} absent{f' (from {provenance})' if provenance else ''}: "
+                    f"set {SHARED_DATA_VARIABLE} to the folder holding real-scenes/")
+    return path
 
 
 def exact_esf(transfer, dx=1 / 512, n=1 << 16):

@@ -228,3 +228,35 @@ def test_a_simulated_chip_knows_its_true_mtf_and_its_figure_shows_it(tmp_path):
     assert true_mtf(read_raster(tmp_path / "c.png")) is None
     record, = measure_file(str(tmp_path / "c.tif"), MeasureSettings(), str(tmp_path / "c_mtf.png"))
     assert record.plot and (tmp_path / "c_mtf.png").stat().st_size > 10_000
+
+
+def test_measure_file_returns_what_measure_format_json_prints_on_the_sample_data():
+    """imgmtf.measure_file is the Python twin of `imgmtf measure FILE`: on
+    every sample file (simulated chips, RGBA photos, the scene it refuses)
+    the same records, number for number, the run's time stamp aside."""
+    import json
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    import imgmtf
+    from imgmtf.cli import main
+    from imgmtf.records import json_safe
+    data = Path(__file__).parent.parent / "data"
+    files = sorted(str(p) for p in data.iterdir() if p.suffix in (".tif", ".png"))
+    assert len(files) >= 6
+    result = CliRunner().invoke(main, ["measure", "--format", "json", *files])
+    printed = [json.loads(line) for line in result.stdout.splitlines()]
+    assert len(printed) == len(files) and result.exit_code == 1          # scene.tif: several edges
+    for path, row in zip(files, printed):
+        [record] = imgmtf.measure_file(path)
+        got = json.loads(json.dumps(json_safe(record.to_dict())))
+        assert got.pop("run_utc") and row.pop("run_utc")
+        assert got == row, path
+    assert {r["status"] for r in printed} == {"ok", "error"}
+    by_words = imgmtf.measure_file(files[0], intervals="none", method="spline")[0]
+    by_settings = imgmtf.measure_file(files[0], imgmtf.MeasureSettings(method="spline", intervals="none"))[0]
+    assert json_safe(by_words.figures) == json_safe(by_settings.figures)
+    assert by_words.method == "spline" and by_words.get("params")["intervals"]["method"] == "none"
+    with pytest.raises(im.ParameterError, match="not both"):
+        imgmtf.measure_file(files[0], imgmtf.MeasureSettings(), method="spline")

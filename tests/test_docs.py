@@ -1,7 +1,8 @@
 """Every example a user reads runs, so that none can drift from the code.
 
 * README.md and docs/*.md: each document's fenced blocks run in order in a
-  fresh folder holding the sample ``data/``: ``console`` blocks through the
+  fresh folder holding the sample ``data/`` (the README's Python examples as
+  ``python -m doctest README.md`` runs them): ``console`` blocks through the
   CLI (each ``$ imgmtf ...`` line, its exit status 0 unless the line ends
   with a ``# exit status N`` comment, and the output shown beneath it, where
   ``...`` stands for any text, as in a doctest; a command shown without
@@ -26,10 +27,15 @@ from click.testing import CliRunner
 import imgmtf
 from imgmtf.cli import main
 
+from conftest import real_scene
+
 ROOT = Path(__file__).parent.parent
 # pages whose examples their own authors keep (the accuracy study, the
-# method, the scan), and the generated reproduction report
-OTHERS = {"accuracy.md", "method.md", "scan.md"}
+# method), and the generated reproduction report
+OTHERS = {"accuracy.md", "method.md"}
+# pages whose examples read the shared real scenes (never copied into the repository): linked into
+# the folder the examples run in, the page skipped where they are absent (conftest.real_scene)
+REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",)}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -101,6 +107,7 @@ def sample_folder(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("document", DOCUMENTS)
 def test_every_example_of_the_document_runs(document, sample_folder):
+    link_real_scenes(document, sample_folder)
     text = (ROOT / document).read_text()
     globs: dict = {"__name__": "__docs__"}
     ran = 0
@@ -108,7 +115,7 @@ def test_every_example_of_the_document_runs(document, sample_folder):
         where = f"{document}:{line}"
         if language == "console":
             run_console(body, where)
-        elif language == "python":
+        elif language == "python" and document != "README.md":     # README: python -m doctest, below
             run_python(body, globs, where)
         elif language == "toml":
             path = sample_folder / f"block{line}.toml"
@@ -118,6 +125,38 @@ def test_every_example_of_the_document_runs(document, sample_folder):
             continue
         ran += 1
     assert ran or document != "README.md"
+    assert_ignored(sample_folder)
+
+
+def link_real_scenes(document: str, folder: Path) -> None:
+    for name in REAL_SCENES_READ.get(document, ()):
+        (folder / name).symlink_to(real_scene(name))
+
+
+def assert_ignored(folder: Path) -> None:
+    """Every file or folder the examples wrote, run from the repository's
+    root as a newcomer runs them, is one .gitignore covers."""
+    import shutil
+    import subprocess
+    linked = {name for names in REAL_SCENES_READ.values() for name in names}
+    written = [p.name + "/" * p.is_dir() for p in folder.iterdir()
+               if p.name != "data" and not p.name.startswith("block") and p.name not in linked]
+    if not written or not shutil.which("git") or not (ROOT / ".git").exists():
+        return
+    ignored = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", *written],
+                             capture_output=True, text=True).stdout.split()
+    missing = sorted(set(written) - set(ignored))
+    assert not missing, f"examples write files .gitignore does not cover: {', '.join(missing)}"
+
+
+def test_python_m_doctest_passes_on_the_readme(sample_folder):
+    """The README's Python examples as `python -m doctest README.md` runs
+    them: the whole file one docstring, no option flags (a fence right under
+    an output line becomes part of the expected output there)."""
+    failures, tried = doctest.testfile(str(ROOT / "README.md"), module_relative=False, verbose=False,
+                                       report=True, optionflags=0)
+    assert tried and not failures
+    assert_ignored(sample_folder)
 
 
 def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
@@ -156,6 +195,7 @@ def update_console_outputs(document: str) -> None:
         here = os.getcwd()
         os.chdir(folder)
         os.symlink(ROOT / "data", "data", target_is_directory=True)
+        link_real_scenes(document, Path(folder))
         try:
             for language, body, line in list(fenced_blocks(text)):
                 if language != "console":
@@ -181,3 +221,10 @@ if __name__ == "__main__":
     for name in DOCUMENTS:
         update_console_outputs(name)
         print(f"updated {name}")
+
+
+def test_the_readme_explains_every_reason_the_gate_gives():
+    from imgmtf.estimate.gate import FORCIBLE
+    table = [line for line in (ROOT / "README.md").read_text().splitlines() if line.startswith("| `")]
+    listed = {code for line in table for code in re.findall(r"`([a-z-]+)`", line.split("|")[1])}
+    assert sorted(FORCIBLE - listed) == []

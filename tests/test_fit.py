@@ -188,7 +188,6 @@ def test_cli_json_contract_toml_and_plot(pair, tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["fit", "{tmp}/flat.tif"], "flat.tif"),
     (["fit", "{tmp}/missing.tif"], "missing.tif"),
-    (["fit", "{tmp}/flat.tif", "--stages", "optics,focus"], "unknown stage 'focus'"),
     (["fit", "{tmp}"], "no image files"),
 ])
 def test_cli_bad_input_is_one_line_and_exit_1(tmp_path, args, message):

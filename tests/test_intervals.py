@@ -81,3 +81,34 @@ def test_pulse_interval_covers_the_truth():
     r = im.measure_pulse(chip.image, width_px=1.5)
     assert float(chip.true_mtf(0.5)) in r.mtf_nyquist_ci
     assert chip.true_mtf50_cy_px() in r.mtf50_ci_cy_px
+
+
+def test_the_words_the_cli_takes_name_intervals_in_python_too():
+    """intervals="bootstrap" wherever --intervals bootstrap is taken: the
+    estimators, a batch's and a scan's settings; an unknown word is refused."""
+    from imgmtf.batch import MeasureSettings
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.6, 6.0), 6.0, (60, 60), noise_std=2.0, seed=3)
+    by_word, by_settings = (im.measure_edge(chip, intervals=i) for i in ("bootstrap", im.Intervals("bootstrap")))
+    assert by_word.params["intervals"] == by_settings.params["intervals"]
+    assert by_word.mtf_nyquist_ci == by_settings.mtf_nyquist_ci
+    assert math.isnan(im.measure_edge(chip, intervals="none").mtf_nyquist_ci.low)
+    assert MeasureSettings(intervals="bootstrap").intervals == im.Intervals("bootstrap")
+    assert im.ScanSettings(intervals="none").intervals == im.Intervals("none")
+    with pytest.raises(ParameterError, match="'bootstrapp'"):
+        im.measure_edge(chip, intervals="bootstrapp")
+    with pytest.raises(ParameterError, match="'influense'"):
+        MeasureSettings(intervals="influense")
+
+
+def test_an_mtf_interval_never_runs_below_zero():
+    """The f/16 camera crop's MTF at Nyquist (0.0075) has a symmetric
+    interval reaching below 0: its low end is reported as 0, the estimate
+    and the high end as they were."""
+    from pathlib import Path
+    path = Path(__file__).parent.parent / "data" / "x0552_y1976_F16.png"
+    [record] = im.measure_file(path)
+    low, high = record.get("mtf_nyquist_ci")
+    assert low == 0.0 < record.get("mtf_nyquist") < high == pytest.approx(0.0273, abs=1e-4)
+    assert im.Interval(-0.5, 0.2).clipped_at_zero() == im.Interval(0.0, 0.2)
+    assert im.Interval(0.1, 0.2).clipped_at_zero() == im.Interval(0.1, 0.2)
+    assert math.isnan(im.Interval.none().clipped_at_zero().low)

@@ -98,6 +98,25 @@ def test_read_errors_name_the_file(tmp_path):
         write_geotiff(tmp_path / "no" / "dir.tif", np.zeros((4, 4), np.uint8))
 
 
+def test_read_and_write_errors_are_oserrors_as_rasterio_and_open_raise_them(tmp_path):
+    """A caller catching OSError around a read catches imgmtf's too; the
+    message is the one imgmtf wrote, not wrapped twice."""
+    with pytest.raises(OSError, match=r"missing.tif: no such file$"):
+        read_raster(tmp_path / "missing.tif")
+    with pytest.raises(OSError, match=r"cannot write"):
+        write_geotiff(tmp_path / "no" / "dir.tif", np.zeros((4, 4), np.uint8))
+    complex_path = tmp_path / "c.tif"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(complex_path, "w", driver="GTiff", width=20, height=20, count=1,
+                           dtype="complex64") as dst:
+            dst.write(np.ones((20, 20), np.complex64), 1)
+    with pytest.raises(ImageReadError, match="has complex pixels") as refused:    # raised inside the open file
+        read_raster(complex_path)
+    assert refused.value.reason == "unsupported-type" and "cannot read" not in str(refused.value)
+    assert issubclass(ImageReadError, OSError) and issubclass(FileWriteError, OSError)
+
+
 def test_truncated_tiff(tmp_path):
     chip = im.render(im.Sensor(), im.Target("edge", 6.0), 64).image
     path = tmp_path / "t.tif"

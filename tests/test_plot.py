@@ -56,4 +56,133 @@ def test_a_scan_overview_takes_scan_scenes_records_as_they_come():
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():
     from imgmtf.plot.measurement import _figure
     assert _figure(0.36431, "cy/px") == "0.3643 cy/px" and _figure(0.2667) == "0.2667"
-    assert _figure(float("nan"), "cy/px") == "masked by the bar's sinc"
+    assert _figure(float("nan"), "cy/px", "masked by the bar's sinc") == "masked by the bar's sinc"
+    assert _figure(float("nan"), "cy/px") == "undefined"
+
+
+def test_a_missing_figure_is_labelled_by_its_cause():
+    """A bar's sinc masks only a bar's figure; a forced edge whose MTF never
+    falls to 0.5 says so, not that a sinc masked it."""
+    from dataclasses import replace
+
+    from imgmtf.plot.measurement import missing_cause, plot_measurement
+    edge = _measured(6.0)
+    no_fifty = replace(edge, mtf50_cy_px=float("nan"), mtf=np.maximum(edge.mtf, 0.55),
+                       warnings=("mtf-undefined: MTF50 cannot be read off (measured anyway: forced)",))
+    assert missing_cause(no_fifty, "mtf50") == "undefined: the MTF stays above 0.5 up to 1 cy/px"
+    header = plot_measurement(no_fifty).get_suptitle()
+    assert "MTF50 undefined: the MTF stays above 0.5" in header and "sinc" not in header
+    bar = im.measure_pulse(im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, width_px=3.0), 80,
+                                     noise_std_dn=1.0, seed=2).image, width_px=3.0)
+    masked = replace(bar, mtf50_cy_px=float("nan"), mtf=np.where(bar.frequencies_cy_px < 0.3, 0.8, np.nan))
+    assert missing_cause(masked, "mtf50") == "masked by the bar's sinc"
+    assert missing_cause(masked, "mtf_nyquist") == "masked by the bar's sinc"
+    assert missing_cause(replace(edge, mtf=np.where(edge.frequencies_cy_px < 0.3, 0.8, np.nan)),
+                         "mtf_nyquist") == "undefined"
+
+
+def test_the_header_counts_every_warning_and_drops_none_unsaid():
+    from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    result = _measured(6.0)
+    warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
+    header = plot_measurement(result, warnings=warnings).get_suptitle()
+    assert f"warning 1 of {len(warnings)}: note 0" in header and "note 2" in header
+    assert "and 2 more warning(s)" in header and "note 3" not in header
+    assert "warning" not in plot_measurement(result).get_suptitle()
+
+
+def test_measures_figure_counts_the_files_own_warnings(tmp_path, monkeypatch):
+    """A photo measured on its luminance: the figure's header counts the
+    luminance warning the text table prints beside the SNR one."""
+    from pathlib import Path
+
+    import imgmtf.plot
+    from imgmtf.batch import measure_file
+    drawn = {}
+    real = imgmtf.plot.plot_measurement
+
+    def spy(result, **kwargs):
+        drawn.update(kwargs)
+        return real(result, **kwargs)
+    monkeypatch.setattr(imgmtf.plot, "plot_measurement", spy)
+    photo = Path(__file__).parent.parent / "data" / "x2084_y0616_F2.png"
+    [record] = measure_file(photo, plot_path=str(tmp_path / "f2.png"))
+    assert record.plot and len(record.get("warnings")) == 2
+    assert drawn["warnings"] == record.get("warnings") and "luminance" in drawn["warnings"][-1]
+
+
+def test_the_scan_legend_lists_ids_in_runs_and_counts_the_common_reasons():
+    from imgmtf.plot.scan import MAX_LISTED, _legend_label
+    group = [{"id": i} for i in (3, 4, 9, 10, 12, 13, 14, 15, 16)]
+    assert _legend_label("angle", group) == "angle (9)\n3-4, 9-10, 12-16"
+    assert _legend_label("too-short", [{"id": i} for i in range(MAX_LISTED + 1)]) == f"too-short ({MAX_LISTED + 1})"
+
+
+def test_locations_are_drawn_where_the_image_has_them():
+    """Measured through an ROI, the edge's locations are drawn in the
+    image's pixel coordinates, not the ROI's (a scan's edge figures: the
+    scene's)."""
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0, 200.0, 1200.0), 100, noise_std_dn=2.0, seed=1)
+    whole, part = im.measure_edge(chip.image), im.measure_edge(chip.image, roi=(20, 10, 60, 80))
+    lines = []
+    for result in (whole, part):
+        ax = Figure().subplots()
+        plot_locations(result, ax)
+        lines.append(next(ln for ln in ax.get_lines() if ln.get_label() == "least-squares line"))
+    (xw, yw), (xp, yp) = [(ln.get_xdata(), ln.get_ydata()) for ln in lines]
+    assert yp.min() == 10 and yp.max() == 89 and 20 < xp.min() < xp.max() < 80
+    assert np.interp(50.0, yp, xp) == __import__("pytest").approx(np.interp(50.0, yw, xw), abs=0.05)
+
+
+def test_the_fit_figure_draws_the_models_interval_and_the_truth_with_short_titles(tmp_path):
+    """fit.png: the model's interval drawn (and magnified about Nyquist),
+    the truth of a simulated chip beside it, titles short enough not to
+    run into each other, the frequency in cy/px as everywhere else."""
+    from click.testing import CliRunner
+
+    import imgmtf.plot
+    from imgmtf.batch import file_truth
+    from imgmtf.cli import main
+    from imgmtf.plot import plot_fit
+    folder = tmp_path / "a_long_folder_name_as_real_data_have"
+    folder.mkdir()
+    paths = [folder / "scene_2024_05_01_T10_across_track_edge.tif", folder / "along.tif"]
+    for path, angle in zip(paths, ("5", "84")):
+        assert CliRunner().invoke(main, ["simulate", "--angle", angle, "--size", "60", "--noise-std", "5",
+                                         "--seed", "1", "--out", str(path)]).exit_code == 0
+    fit = im.fit_sensor([str(p) for p in paths], stages="optics")
+    truths = [file_truth(str(p)) for p in paths]
+    assert all(truths) and file_truth(str(tmp_path / "missing.tif")) is None
+    fig = plot_fit(fit, truths=truths)
+    ax = fig.axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert any(label.startswith("true: 0.26") for label in labels)
+    assert any(label.startswith("model's 95 % interval") for label in labels)
+    assert ax.get_xlabel() == "frequency along the normal (cy/px)"
+    assert ax.get_title().splitlines()[0] == "scene_2024_...ack_edge.tif" and "folder" not in ax.get_title()
+    inset = ax.child_axes[0]
+    assert inset.get_xlim() == (0.47, 0.53) and inset.collections          # the band, magnified
+    fig.canvas.draw()
+    boxes = [a.title.get_window_extent() for a in fig.axes[:2]]
+    assert boxes[0].x1 < boxes[1].x0                                           # titles apart
+    assert imgmtf.plot.plot_fit is plot_fit
+
+
+def test_a_quick_runs_threshold_figure_says_na_as_its_report_does():
+    from imgmtf.plot import plot_threshold
+    found = {"msg": {"threshold": 200.0, "fractions": {100: 0.9, 200: 1.0}}}
+    quick = plot_threshold(found, 0.05, 0.95, 8, thresholds=False).axes[0].get_legend_handles_labels()[1]
+    full = plot_threshold(found, 0.05, 0.95, 100).axes[0].get_legend_handles_labels()[1]
+    assert quick[0] == "msg: threshold n/a (too few chips)" and full[0] == "msg: threshold SNR 200"
+
+
+def test_the_sensor_figures_legends_lie_off_the_curves():
+    """The LSF panel's legend is not where the FWHM is read (the half
+    maximum): it lies under the axes, as the MTF panels' do."""
+    from imgmtf.plot import plot_sensor
+    fig = plot_sensor(im.Sensor())
+    fig.canvas.draw()
+    for ax in fig.axes[1:4]:
+        assert ax.get_legend().get_window_extent().y1 < ax.get_window_extent().y0
+    assert fig.axes[2].get_xlabel() == "frequency (cy/px)"
+    assert min(ax.get_tightbbox().x0 for ax in fig.axes) >= 0          # nothing cut at the left edge

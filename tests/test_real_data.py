@@ -4,9 +4,10 @@ The camera crops in data/ come from the public-domain (CC0 1.0) repository
 carlasplund/SFR_calculation_code, folder edge_samples/ (data/README.md); the
 MTF50 bands are the three peers' (MTF Mapper, sfrmat5, sfrmat3) widened by
 1 % each side, as the accuracy issue quotes them.  The scenes are read from
-../shared/data/real-scenes/ (see its README for provenance and licences; the
-GPL-3.0 files are read there, never copied), and the tests are skipped when
-that folder is absent."""
+../shared/data/real-scenes/, or from real-scenes/ in the folder the
+environment variable IMGMTF_SHARED_DATA names (see its README for provenance
+and licences; the GPL-3.0 files are read there, never copied); the tests are
+skipped when that folder is absent and IMGMTF_SHARED_DATA is unset."""
 from pathlib import Path
 
 import pytest
@@ -14,9 +15,9 @@ import pytest
 import imgmtf as im
 from imgmtf.io import read_raster
 
+from conftest import real_scene
+
 DATA = Path(__file__).resolve().parents[1] / "data"
-SCENES = Path(__file__).resolve().parents[2] / "shared" / "data" / "real-scenes"
-needs_scenes = pytest.mark.skipif(not SCENES.is_dir(), reason="../shared/data/real-scenes is absent")
 
 
 @pytest.mark.parametrize("name, low, high", [("x2084_y0616_F2", 0.2909, 0.3037),
@@ -28,13 +29,12 @@ def test_real_camera_edges_read_within_the_peers_band(name, low, high):
     assert low <= r.mtf50_cy_px <= high
 
 
-@needs_scenes
 def test_the_mtf_estimator_synthetic_edge_reads_its_known_mtf():
     """MTF_Estimator's own synthetic edge (GPL-3.0, read in place): a
     Gaussian of FWHM 2.1013 px along each row, 16.7766 deg from vertical,
     so along the normal a Gaussian LSF of FWHM 2.0118 px: MTF at Nyquist
     0.0273, MTF50 0.2194 cy/px."""
-    raster = read_raster(SCENES / "mtf_estimator_synthetic_edge_angle16.7766_fwhm2.1013.tif")
+    raster = read_raster(real_scene("mtf_estimator_synthetic_edge_angle16.7766_fwhm2.1013.tif"))
     r = im.measure_edge(raster.data, dtype=raster.dtype)
     assert r.fwhm_px == pytest.approx(2.0118, rel=0.005)
     assert r.mtf50_cy_px == pytest.approx(0.2194, rel=0.005)
@@ -43,23 +43,21 @@ def test_the_mtf_estimator_synthetic_edge_reads_its_known_mtf():
         16.7766, abs=0.05)
 
 
-@needs_scenes
 def test_a_hand_roi_that_takes_in_the_baotou_chips_fill_is_refused_as_fill():
     """The Baotou L0R chip (GPL-3.0, read in place): every pixel outside the
     four-quadrant target is 0 and no nodata tag says so."""
-    path = SCENES / "baotou_l0r_checkerboard.tif"
+    path = real_scene("baotou_l0r_checkerboard.tif")
     raster = read_raster(path, window=(58, 40, 36, 30))
     with pytest.raises(im.ImgmtfError) as info:
         im.measure_edge(raster.data, dtype=raster.dtype)
     assert info.value.reason == "fill"
 
 
-@needs_scenes
 def test_a_map_projected_scene_has_no_track_direction():
     """Sentinel-2 B04 (Apache-2.0, qgis-image-quality-toolset): EPSG:32632,
     rows are not along track."""
     from imgmtf.batch import MeasureSettings, measure_file
-    (record,) = measure_file(str(SCENES / "sentinel2_b04_bagnolo.tif"),
+    (record,) = measure_file(str(real_scene("sentinel2_b04_bagnolo.tif")),
                              MeasureSettings(roi=(145, 470, 40, 45), force=True))
     assert record.ok and record.figures["direction"] == "unknown"
 
@@ -73,3 +71,26 @@ def test_a_photo_with_no_edge_is_refused():
     assert info.value.reason in ("not-straight", "no-target", "not-an-edge", "two-targets")
     if info.value.reason == "two-targets":
         assert "not-straight" in {c.reason for c in info.value.checks}
+
+
+def test_the_shared_data_variable_points_the_tests_at_a_copy(tmp_path, monkeypatch):
+    """IMGMTF_SHARED_DATA names the folder holding real-scenes/ wherever it
+    lies; unset, the tests look beside the repository (../shared/data)."""
+    import subprocess
+    import sys
+    copy = tmp_path / "elsewhere"
+    (copy / "real-scenes").mkdir(parents=True)
+    tests = Path(__file__).parent
+    code = ("import conftest, sys; print(conftest.REAL_SCENES)")
+    found = subprocess.run([sys.executable, "-c", code], cwd=tests, capture_output=True, text=True, check=True,
+                           env={**__import__("os").environ, "IMGMTF_SHARED_DATA": str(copy)}).stdout.strip()
+    assert found == str(copy / "real-scenes")
+    default = subprocess.run([sys.executable, "-c", code], cwd=tests, capture_output=True, text=True, check=True,
+                             env={k: v for k, v in __import__("os").environ.items() if k != "IMGMTF_SHARED_DATA"})
+    assert default.stdout.strip() == str(tests.resolve().parents[1] / "shared" / "data" / "real-scenes")
+    # set but missing a scene: the test fails rather than skips
+    import conftest
+    monkeypatch.setenv("IMGMTF_SHARED_DATA", str(copy))
+    monkeypatch.setattr(conftest, "REAL_SCENES", copy / "real-scenes")
+    with pytest.raises(pytest.fail.Exception, match="no real-scenes/missing.tif there"):
+        conftest.real_scene("missing.tif")

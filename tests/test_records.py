@@ -95,3 +95,16 @@ def test_csv_rows_carry_the_mtf_curve_on_a_fixed_grid():
     assert row["mtf_at_0.50_cy_px"] == 0.75 and row["mtf_at_0.25_cy_px"] == 0.875
     assert row["mtf_at_0.70_cy_px"] == ""                  # undefined there (a bar's sinc zero)
     assert all(v is None for v in curve_values(None, None).values())   # failures: empty cells
+
+
+def test_json_and_csv_hold_no_negative_zero():
+    """A normal at -0.0 deg is written 0.0 in JSON and CSV, as the text
+    table prints 0.00; NaN is null in JSON, empty in CSV."""
+    record = Record.measured("a.tif", 1, {"normal_angle_deg": -0.0, "mtf_nyquist": float("nan"),
+                                          "mtf_nyquist_ci": [-0.0, 0.1], "target": "edge", "method": "msg"},
+                             params={}, run_utc="2024-05-01T09:30:00Z")
+    line = to_json(record)
+    assert "-0.0" not in line and '"normal_angle_deg": 0.0' in line and '"mtf_nyquist": null' in line
+    row = record.csv_row()
+    assert str(row["normal_angle_deg"]) == "0.0" and row["mtf_nyquist_ci_low"] == 0.0
+    assert str(row["mtf_nyquist_ci_low"]) == "0.0" and row["mtf_nyquist"] == ""

@@ -112,14 +112,15 @@ def test_bad_sensor_and_outputs_exit_1(chip, tmp_path):
         (["--sensor", tmp_path / "bad.toml", "--out", tmp_path / "r.tif"], "malformed TOML"),
         (["--sensor", tmp_path / "none.toml", "--out", tmp_path / "r.tif"], "cannot read sensor file"),
         (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "no" / "r.tif"], "does not exist"),
-        (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", "--kernel", tmp_path / "k.csv"],
-         ".npy (NumPy) or .txt"),
         (["--sensor", chip.parent / "true.toml", "--out", chip], "overwrite its own input"),
-        (["--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", "--plot", tmp_path / "r.xyz"],
-         "a figure is written as"),
     ]
     for options, words in cases:
         result = run("restore", *common, *options)
         assert result.exit_code == 1 and words in result.output, (options, result.output)
+    # malformed options are usage errors (exit 2), as in every command
+    for options, words in ((["--kernel", tmp_path / "k.csv"], ".npy (NumPy) or .txt"),
+                           (["--plot", tmp_path / "r.xyz"], "a figure is written as")):
+        result = run("restore", *common, "--sensor", chip.parent / "true.toml", "--out", tmp_path / "r.tif", *options)
+        assert result.exit_code == 2 and words in result.output, (options, result.output)
     assert run("restore", chip, chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
-               "--out", tmp_path / "r.tif").exit_code == 1
+               "--out", tmp_path / "r.tif").exit_code == 2          # two images, one file: a contradiction

@@ -1,5 +1,4 @@
 """One image restored end to end (imgmtf.restore_image), on synthetic and real chips."""
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -7,7 +6,7 @@ import pytest
 import imgmtf as im
 from imgmtf.sensor.stages import Detector, GaussianOptics
 
-SCENES = Path(__file__).resolve().parents[2] / "shared" / "data" / "real-scenes"
+from conftest import real_scene
 
 
 @pytest.fixture(scope="module")
@@ -45,9 +44,7 @@ def test_baotou_a_model_that_does_not_fit_asks_an_absurd_filter(tmp_path):
     """The Baotou L0R chip (JorgeGIlG/MTF_Estimator, GPL-3.0, read in place) with the sensor
     `imgmtf.fit_sensor` gives for its four scan-accepted half-edges (Gaussian optics of
     sigma 1.063 and 1.035 px and the pixel; a misfit, reduced chi-square 4.1): docs/restore.md."""
-    path = SCENES / "baotou_l0r_checkerboard.tif"
-    if not path.exists():
-        pytest.skip("the shared real scenes are not here")
+    path = real_scene("baotou_l0r_checkerboard.tif", "JorgeGIlG/MTF_Estimator (GPL-3.0, read in place)")
     sensor = im.Sensor(1.0, [GaussianOptics(1.0633, 1.0346), Detector(1.0, 1.0)])
     done = im.restore_image(path, sensor, tmp_path / "r.tif", target_nyquist=0.25)
     assert done.filter.noise_std_dn == pytest.approx(29.4, rel=0.05)

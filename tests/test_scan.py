@@ -78,18 +78,29 @@ def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_rec
     summaries = [s.to_dict() for s in summarise_scan(scan_records)]
     rows = [r.to_dict() for r in scan_records]
     # records as scan_scene returns them draw as their dicts do
-    assert len(plot_scan(np.zeros((128, 256)), 2.0, scan_records, summarise_scan(scan_records)).axes[0].texts) == 4
+    as_records = plot_scan(np.zeros((128, 256)), 2.0, scan_records, summarise_scan(scan_records)).axes[0].texts
     fig = plot_scan(np.zeros((128, 256)), 2.0, rows, summaries)
     ax = fig.axes[0]
+    assert len(as_records) == len(ax.texts)
     reasons = {r["reason"] for r in rows if r["status"] == "rejected"}
     lines = [c for c in ax.collections if isinstance(c, LineCollection) and not isinstance(c, PolyCollection)]
     assert len(lines) == len(reasons) + 1 and not ax.patches          # one collection per reason, no boxes
     assert len([c for c in ax.collections if isinstance(c, PolyCollection)]) == 1
-    # the targets labelled, and each accepted half-edge by its id
-    assert sorted(t.get_text().split()[0] for t in ax.texts) == ["1", "2", "T1", "T2"]
+    # every candidate carries its id (few per reason here), as the table lists them; the targets their figures
+    labels = sorted(t.get_text().split()[0] for t in ax.texts)
+    assert labels == sorted([str(r["id"]) for r in rows] + [f"T{s['target_id']}" for s in summaries
+                                                            if s["scope"] == "target"], key=str)
+    # the accepted drawn above the rejected, both outlined so that they read on black and on white
+    accepted_line = lines[-1]
+    assert all(accepted_line.get_zorder() > c.get_zorder() for c in lines[:-1])
+    assert all(c.get_path_effects() for c in lines)
     assert ax.get_xlabel() == "column (px)" and ax.get_ylabel() == "row (px)"
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "accepted (2)" in legend and f"angle ({sum(r['reason'] == 'angle' for r in rows)})" in legend
+    n_angle = sum(r["reason"] == "angle" for r in rows)
+    assert legend[0].startswith("accepted (2)\n") and any(t.startswith(f"angle ({n_angle})") for t in legend)
+    # the legend lies outside the image, on its right
+    fig.canvas.draw()
+    assert ax.get_legend().get_window_extent().x0 > ax.get_window_extent().x1
     x0, y0, x1, y1 = ax.get_position().extents          # the image fills its axes: no blank band
     assert (x1 - x0) * fig.get_figwidth() / ((y1 - y0) * fig.get_figheight()) == pytest.approx(2.0)
 
@@ -99,7 +110,7 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
     assert result.exit_code == 0, result.output
     # the table names the scene once; an accepted edge's warnings stand beneath it
-    rejected = [line for line in result.stdout.splitlines() if " rejected " in line]
+    rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
     assert rejected and not any(f"{SCENE}:" in line for line in rejected)
     assert "warning: the image is not in sensor geometry" in result.stdout
     geo = json.loads((out / "targets.geojson").read_text())
@@ -216,3 +227,30 @@ def test_edge_figures_one_per_accepted_half_edge_named_by_its_id(tmp_path):
     assert not any(r.get("plot") for r in rows if r["status"] == "rejected")
     refused = CliRunner().invoke(main, ["scan", str(SCENE), "--edge-figures"])
     assert refused.exit_code == 2 and "give --out DIR" in refused.output
+
+
+def test_the_text_table_tallies_rejections_by_reason_and_verbose_lists_every_candidate():
+    rows = [json.loads(line) for line in CliRunner().invoke(
+        main, ["scan", str(SCENE), "--format", "json", "--fit-stages", "none"]).stdout.splitlines()]
+    candidates = [r for r in rows if r.get("scope") == "edge"]
+    counts = {}
+    for r in candidates:
+        if r["status"] == "rejected":
+            counts[r["reason"]] = counts.get(r["reason"], 0) + 1
+    brief = CliRunner().invoke(main, ["scan", str(SCENE), "--fit-stages", "none"]).stdout.splitlines()
+    tally = {line.split()[2]: int(line.split()[1]) for line in brief if line.startswith("rejected ")}
+    assert tally == counts and sum(tally.values()) == len(candidates) - 2
+    assert brief[0].endswith(f"{len(candidates)} candidate edges, 2 accepted")
+    # one line per reason, the most frequent first; the option that moves a limit is named
+    assert list(tally.values()) == sorted(tally.values(), reverse=True)
+    assert any("(--min-length sets the minimum)" in line for line in brief if " too-short " in line)
+    verbose = CliRunner().invoke(main, ["scan", str(SCENE), "--fit-stages", "none", "--verbose"]).stdout
+    lines = verbose.splitlines()
+    listed = [line for line in lines if " rejected  " in line]
+    assert len(listed) == sum(counts.values()) and not any(line.startswith("rejected ") for line in lines)
+
+
+def test_a_count_names_one_thing_in_the_singular():
+    from imgmtf.cli.tables import plural
+    assert (plural(1, "candidate edge"), plural(0, "candidate edge"), plural(17, "candidate bar")) == (
+        "1 candidate edge", "0 candidate edges", "17 candidate bars")

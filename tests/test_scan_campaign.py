@@ -80,12 +80,12 @@ def test_campaign_options_need_a_store_and_one_time_fits_one_scene(campaign, tmp
     assert result.exit_code == 2 and "--platform describes the acquisitions of a campaign store" in result.output
     result = CliRunner().invoke(main, ["scan", str(folder), "--campaign", str(tmp_path / "s.gpkg"),
                                        "--acquired", "2020-01-01"])
-    assert result.exit_code == 1 and "--acquired gives one time, for one scene; 4 scenes" in result.output
+    assert result.exit_code == 2 and "--acquired gives one time, for one scene; 4 scenes" in result.output
     result = CliRunner().invoke(main, ["scan", str(folder), "--campaign", str(tmp_path / "s.gpkg"),
                                        "--acquired", "last spring"])
-    assert result.exit_code == 1 and "Traceback" not in result.output
+    assert result.exit_code == 2 and "Traceback" not in result.output
     result = CliRunner().invoke(main, ["scan", str(folder), "--fit-stages", "optics,lens"])
-    assert result.exit_code == 1 and "unknown stage 'lens'" in result.output
+    assert result.exit_code == 2 and "unknown stage 'lens'" in result.output
 
 
 def test_fit_rows_are_printed_and_written_beside_the_combined_ones(tmp_path):

@@ -2,7 +2,6 @@
 measured on its own ROI clear of the junction and of fill, combined per
 direction; on synthetic scenes with a known MTF and on real L0R chips."""
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +12,8 @@ from imgmtf.scene.measure import scan_scene
 from imgmtf.scene.settings import ScanSettings
 from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants, texture
 
-REAL = Path(__file__).parent.parent.parent / "shared" / "data" / "real-scenes"
+from conftest import real_scene
+
 # A Baotou-like target: tilted 16.8 deg, two bright quadrants and two dark ones of different levels
 TARGET = QuadrantTarget((50.4, 50.3), 16.8, (9300.0, 2000.0, 9200.0, 3900.0), 40.0)
 
@@ -107,9 +107,7 @@ REAL_TARGETS = [
 
 @pytest.mark.parametrize("name, provenance, centre, ends", REAL_TARGETS, ids=[t[0] for t in REAL_TARGETS])
 def test_real_checkerboards_agree_with_measure_on_hand_chosen_rois(name, provenance, centre, ends):
-    path = REAL / name
-    if not path.exists():
-        pytest.skip(f"{path} absent (from {provenance})")
+    path = real_scene(name, provenance)
     records = scan_scene(str(path))
     accepted = [r for r in records if r.ok]
     assert len(accepted) >= 3
@@ -142,9 +140,7 @@ def test_real_checkerboards_agree_with_measure_on_hand_chosen_rois(name, provena
     ("landsat9_b5_radiance_desert.tif", "rdegoul/qgis-image-quality-toolset test/data/target4 (Apache-2.0)"),
 ])
 def test_map_projected_crops_scan_without_error_and_without_a_direction(name, provenance):
-    path = REAL / name
-    if not path.exists():
-        pytest.skip(f"{path} absent (from {provenance})")
+    path = real_scene(name, provenance)
     records = scan_scene(str(path), ScanSettings(intervals=im.Intervals("none")))
     assert records and not any(r.reason == "internal" for r in records)
     assert {r.site["direction"] for r in records} == {"unknown"}         # a CRS: rows are not along track

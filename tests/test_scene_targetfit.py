@@ -1,6 +1,5 @@
 """Across- and along-track MTF of a scanned target: the sensor model fitted
 to its half-edges, against the exact truth of the sensor that rendered it."""
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +11,8 @@ from imgmtf.scene.targetfit import fit_targets, roi_mask
 from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
 from imgmtf.sensor.stages import Detector, GaussianOptics
 
-REAL = Path(__file__).parent.parent.parent / "shared" / "data" / "real-scenes"
+from conftest import real_scene
+
 # anisotropic optics and a square pixel: across-track MTF at Nyquist 0.3841, along-track 0.2666
 SENSOR = im.Sensor(1.0, [GaussianOptics(0.32, 0.42), Detector(1.0, 1.0)])
 # a Baotou-like target tilted 16.8 deg, cut out of its scene with a 0-fill (as an L0R chip): its
@@ -77,11 +77,11 @@ def test_roi_mask_holds_the_pixel_centres_inside_a_tilted_rectangle():
     assert mask[3, 3] and not mask[0, 0] and np.array_equal(mask, roi_mask((7, 7), (0, 0), corners[::-1]))
 
 
-@pytest.mark.skipif(not (REAL / "baotou_l0r_checkerboard.tif").exists(), reason="no real scenes")
 def test_a_model_that_does_not_fit_the_real_baotou_target_says_so():
     """The real Baotou chip (JorgeGIlG/MTF_Estimator, GPL-3.0, read in place)
     has longer tails than a Gaussian: the fit flags it rather than giving a
     silent number."""
-    rows = fit_targets(scan_scene(str(REAL / "baotou_l0r_checkerboard.tif")))
+    rows = fit_targets(scan_scene(str(real_scene("baotou_l0r_checkerboard.tif",
+                                                 "JorgeGIlG/MTF_Estimator (GPL-3.0, read in place)"))))
     assert rows and all(r.figures["misfit"] and r.figures["misfit_p"] < 1e-3 for r in rows)
     assert all("does not fit target 1" in r.figures["warnings"][0] for r in rows)

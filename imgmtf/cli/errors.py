@@ -1,4 +1,5 @@
-"""How the CLI reports: a deliberate imgmtf error as one line and exit 1,
+"""How the CLI reports: a malformed option (out of range, or contradicting
+another) as exit 2, a deliberate imgmtf error as one line and exit 1,
 an interrupt as exit 130 or 143, an internal error as one line (its
 traceback with ``IMGMTF_DEBUG=1``); the hint it adds to a refusal."""
 from __future__ import annotations
@@ -34,6 +35,19 @@ def reported_errors():
         click.echo(f"imgmtf: internal error: {type(exc).__name__}: {one_line(exc)} "
                    "(please report it; IMGMTF_DEBUG=1 shows where)", err=True)
         sys.exit(1)
+
+
+@contextmanager
+def option_errors():
+    """A ParameterError raised while the options alone are turned into
+    settings (before any input is read) as click's usage error: exit status 2,
+    as for a value outside the range --help prints or options that
+    contradict each other; a problem found in an input stays exit 1."""
+    from ..errors import ParameterError
+    try:
+        yield
+    except ParameterError as exc:
+        raise click.UsageError(one_line(exc)) from None
 
 
 def force_hint(reason) -> str:

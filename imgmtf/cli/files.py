@@ -4,7 +4,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import FileWriteError, ImgmtfError, ParameterError
+import click
+
+from ..errors import FileWriteError, ImgmtfError
 from .errors import one_line
 
 
@@ -47,9 +49,10 @@ FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpe
 
 def check_figure_file(path: str) -> None:
     """As :func:`check_output_file`, and the suffix one of the figure
-    formats, so a wrong one is refused before any work, not after it."""
-    check_output_file(path)
+    formats, so a wrong one is refused (a usage error) before any work, not
+    after it."""
     suffix = Path(path).suffix.lower()
-    if suffix not in FIGURE_SUFFIXES:
-        raise ParameterError(f"{path}: a figure is written as {', '.join(s[1:] for s in FIGURE_SUFFIXES)} "
-                             f"(by its suffix); got {suffix or 'no suffix'}")
+    if suffix not in FIGURE_SUFFIXES:           # a malformed option: exit 2, as click's own checks
+        raise click.BadParameter(f"{path}: a figure is written as {', '.join(s[1:] for s in FIGURE_SUFFIXES)} "
+                                 f"(by its suffix); got {suffix or 'no suffix'}", param_hint="'--plot'")
+    check_output_file(path)

@@ -7,7 +7,7 @@ import click
 
 from ..errors import ParameterError
 from .campaign import CampaignWriter, campaign_options
-from .errors import reported_errors
+from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
 from .options import FiniteFloat, parse_roi
 from .tables import print_fit
@@ -29,7 +29,7 @@ from .tables import print_fit
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels read from every file (default: the whole image)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
-@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+@click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the intervals")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True,
@@ -46,9 +46,12 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
     the store with the model's across- and along-track rows (those some
     edge constrains)."""
     from ..batch import expand_inputs
-    from ..estimate.fit import fit_sensor
+    from ..estimate.fit import check_names, fit_sensor
     from ..sensor.model import Sensor
     with reported_errors():
+        start = Sensor.from_toml(sensor_path) if sensor_path else None
+        with option_errors():
+            check_names(stages, hold or (), start)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
@@ -60,7 +63,6 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
                                       band_name=band_name)
         if store:
             store.check_one_acquisition(files, band)
-        start = Sensor.from_toml(sensor_path) if sensor_path else None
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
                             roi=roi, confidence=confidence)
         written = []
@@ -70,8 +72,11 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
                                                      f"{', '.join(e.source for e in result.edges)}")
             written.append(out_path)
         if plot_path:
+            from ..batch import file_truth
             from ..plot import plot_fit
-            save_figure(plot_fit(result), plot_path)
+            # the truth of each chip imgmtf simulated (its GeoTIFF says how), drawn beside the model
+            truths = [file_truth(edge.source, band, roi) for edge in result.edges]
+            save_figure(plot_fit(result, truths=truths), plot_path)
             written.append(plot_path)
         if store:
             settings = {"command": "fit", "stages": stages, "sensor": sensor_path, "hold": hold, "gsd_m": gsd,
@@ -79,7 +84,9 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
             store.add_fit(files, result, settings, band=band, plot=plot_path)
             store.summary()
     if fmt == "json":
-        click.echo(json.dumps({**result.to_dict(), "written": written}))
+        from ..records import json_safe
+        # NaN as null, no -0.0: as measure's and scan's JSON
+        click.echo(json.dumps(json_safe({**result.to_dict(), "written": written})))
         return
     print_fit(result)
     for path in written:

@@ -9,7 +9,7 @@ import click
 
 from ..errors import ParameterError
 from .campaign import CampaignWriter, campaign_options
-from .errors import closing, interrupt_code, reported_errors, signal_name
+from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .files import check_figure_file, check_output_file
 from .options import (
     FiniteFloat,
@@ -37,7 +37,7 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
 @click.option("--pulse-width", callback=length_option("px"),
-              help="bar width: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
+              help="bar width, 0.2 to 10 px: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
                    "estimated from the profile when omitted")
 @click.option("--method", cls=MethodOption)
 @click.option("--roi", callback=parse_roi,
@@ -85,14 +85,16 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
             prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
         from ..batch import MeasureSettings, expand_inputs, measure_files
         from ..records import CsvWriter, JsonLinesWriter, utc_now
-        settings = MeasureSettings(kind, method, band, roi, pulse_width,
-                                   interval_settings(interval_method, replicates, confidence), force=force,
-                                   saturation=saturation, track_azimuth_deg=track_azimuth)
+        with option_errors():
+            settings = MeasureSettings(kind, method, band, roi, pulse_width,
+                                       interval_settings(interval_method, replicates, confidence), force=force,
+                                       saturation=saturation, track_azimuth_deg=track_azimuth)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
         if plot_path and len(files) > 1:
-            raise ParameterError("--plot takes a single input; use --plot-dir for several")
+            raise click.UsageError(f"--plot takes a single input, got {len(files)} files; "
+                                   "use --plot-dir for several")
         if plot_path:
             check_figure_file(plot_path)
         if csv_path:

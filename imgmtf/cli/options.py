@@ -7,6 +7,7 @@ import math
 import click
 
 MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
+MIN_REPLICATES, MAX_REPLICATES = 20, 5000     # as imgmtf.estimate.intervals checks them
 
 
 class FiniteFloat(click.FloatRange):
@@ -24,6 +25,25 @@ class FiniteFloat(click.FloatRange):
         number = super().convert(value, param, ctx)
         if not math.isfinite(number):
             self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number
+
+
+class Replicates(click.IntRange):
+    """--bootstrap N: 0 (no intervals) or MIN_REPLICATES to MAX_REPLICATES."""
+
+    name = "integer"
+
+    def __init__(self):
+        super().__init__(0, MAX_REPLICATES)
+
+    def _describe_range(self) -> str:
+        return f"0 or {MIN_REPLICATES}<=x<={MAX_REPLICATES}"
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if 0 < number < MIN_REPLICATES:
+            self.fail(f"{number} is not in the range {self._describe_range()} (fewer than {MIN_REPLICATES} "
+                      "replicates give no interval worth quoting)", param, ctx)
         return number
 
 
@@ -72,20 +92,16 @@ class MethodOption(click.Option):
 
 def length_option(default_unit: str):
     """Click callback: "1.4", "1.4px" or "18.3m" -> (value, unit), the value
-    finite and > 0."""
+    finite (:func:`imgmtf.inputs.parse_length`, which the API uses too)."""
     def parse(ctx, param, value):
         if value is None:
             return None
-        text = value.strip().lower()
-        unit = next((u for u in ("px", "m") if text.endswith(u)), None)
-        number = text[: -len(unit)] if unit else text
+        from ..errors import ParameterError
+        from ..inputs import parse_length
         try:
-            length = float(number)
-        except ValueError:
-            raise click.BadParameter(f"expected a number with an optional px or m suffix, got {value!r}") from None
-        if not math.isfinite(length):
-            raise click.BadParameter(f"expected a finite width, got {value!r}")
-        return length, unit or default_unit
+            return parse_length(value, default_unit)
+        except ParameterError as exc:
+            raise click.BadParameter(str(exc)) from None
     return parse
 
 
@@ -142,8 +158,8 @@ def interval_options(command):
     """--intervals, --bootstrap and --confidence, shared by measure and scan."""
     command = click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True),
                            default=0.95, show_default=True, help="confidence of the intervals")(command)
-    command = click.option("--bootstrap", "replicates", type=click.IntRange(min=0), metavar="N",
-                           help="intervals from a bootstrap of N row resamplings (20 to 5000; slower); "
+    command = click.option("--bootstrap", "replicates", type=Replicates(), metavar="N",
+                           help="intervals from a bootstrap of N row resamplings (slower); "
                                 "0: no intervals")(command)
     return click.option("--intervals", "interval_method", type=click.Choice(["influence", "bootstrap", "none"]),
                         show_default="influence",

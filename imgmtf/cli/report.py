@@ -15,7 +15,7 @@ from .options import FiniteFloat
               help="the MTF at Nyquist required, drawn as a line on its figures")
 @click.option("--baseline", type=click.Path(dir_okay=False), metavar="SENSOR.toml",
               help="sensor TOML whose across- and along-track MTF at Nyquist are the pre-launch values")
-@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+@click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the drift intervals")
 def report(store, out_dir, requirement, baseline, confidence):
     """Fit the drift per year of every platform, band, direction and

@@ -70,12 +70,13 @@ def restore(paths, sensor_path, target_nyquist, max_noise_gain, kernel_size, noi
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
-        if (kernel_path or plot_path) and len(files) > 1:
-            raise ParameterError("--kernel and --plot take a single image")
+        if (kernel_path or plot_path) and len(files) > 1:       # options that contradict: exit 2
+            raise click.UsageError(f"--kernel and --plot take a single image, got {len(files)}")
         if kernel_path:
+            if Path(kernel_path).suffix.lower() not in KERNEL_SUFFIXES:     # a malformed option: exit 2
+                raise click.BadParameter(f"{kernel_path}: a kernel is written as .npy (NumPy) or .txt (text)",
+                                         param_hint="'--kernel'")
             check_output_file(kernel_path)
-            if Path(kernel_path).suffix.lower() not in KERNEL_SUFFIXES:
-                raise ParameterError(f"{kernel_path}: a kernel is written as .npy (NumPy) or .txt (text)")
         if plot_path:
             check_figure_file(plot_path)
         outputs = _output_paths(files, out_path)
@@ -123,7 +124,7 @@ def _output_paths(files: list[str], out_path: str) -> list[str]:
     from ..atomic import ensure_folder
     if Path(out_path).suffix.lower() in RASTER_SUFFIXES and not Path(out_path).is_dir():
         if len(files) > 1:
-            raise ParameterError(f"{out_path}: {len(files)} images need a folder for --out, not one file")
+            raise click.UsageError(f"{out_path}: {len(files)} images need a folder for --out, not one file")
         outputs = [out_path]
         check_output_file(out_path)
     else:

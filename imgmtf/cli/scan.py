@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ..errors import ParameterError
-from .errors import closing, interrupt_code, reported_errors, signal_name
+from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
     FiniteFloat,
     MethodName,
@@ -34,7 +34,7 @@ DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without impo
 @click.option("--margin", type=click.IntRange(6, 1000), default=12, show_default=True,
               help="ROI extent either side of the target, px")
 @click.option("--pulse-width", callback=length_option("px"),
-              help="bar width (px or m) for every bar; estimated per bar when omitted")
+              help="bar width (0.2 to 10 px; px or m) for every bar; estimated per bar when omitted")
 @click.option("--method", type=MethodName(), default="msg", show_default=True)
 @click.option("--band", type=click.IntRange(min=1),
               help="1-based band (default: the only band, or the luminance of RGB)")
@@ -64,12 +64,15 @@ DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without impo
 @click.option("--instrument", help="with --campaign: the instrument, where the file does not say")
 @click.option("--band-name", help="with --campaign: the band's name, where the file does not say")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
+@click.option("--verbose", is_flag=True,
+              help="list every rejected candidate, not one line per reason (--format json and --out's CSV "
+                   "always hold every row)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
          fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
-         progress, interval_method, replicates, confidence, workers, scheduler):
+         verbose, progress, interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
@@ -97,21 +100,23 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         from ..parallel import prestart_workers
         from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
+        with option_errors():           # a malformed option: exit 2, before any work
+            stages = _stages(fit_stages)
+            settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
+                                    pulse_width=pulse_width, saturation=saturation,
+                                    track_azimuth_deg=track_azimuth,
+                                    intervals=interval_settings(interval_method, replicates, confidence))
+            if acquired is not None:
+                from ..campaign.acquisitions import parse_time
+                parse_time(acquired, "--acquired")
         paths = expand_inputs(scenes, recursive)
         if not paths:
             raise ParameterError(f"no image files in {', '.join(scenes)}")
         if acquired is not None and len(paths) > 1:
-            raise ParameterError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
-                                 "scan them one at a time, or let their metadata or product names say when")
-        if acquired is not None:
-            from ..campaign.acquisitions import parse_time
-            parse_time(acquired, "--acquired")          # refused before any work
-        stages = _stages(fit_stages)
+            raise click.UsageError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
+                                   "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
             prestart_workers(workers, ["imgmtf.scene.measure", "imgmtf.scene.targetfit"])
-        settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
-                                pulse_width=pulse_width, saturation=saturation, track_azimuth_deg=track_azimuth,
-                                intervals=interval_settings(interval_method, replicates, confidence))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
@@ -128,7 +133,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             with closing(completed):
                 for outcome in completed:
                     outcomes.append(outcome)
-                    _report(outcome, kind, band, folders.get(outcome.path), fmt)
+                    _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
         except KeyboardInterrupt as exc:
             interrupted = exc
     _closing_notes(outcomes, paths, store, kind, fmt)
@@ -161,7 +166,7 @@ def _stages(text: str) -> str | None:
     return ",".join(names)
 
 
-def _report(outcome, kind, band, folder, fmt) -> None:
+def _report(outcome, kind, band, folder, fmt, verbose) -> None:
     """One scene's tables (or JSON rows), and its outputs written."""
     if outcome.error:
         click.echo(f"imgmtf: error: {outcome.error}", err=True)
@@ -170,7 +175,7 @@ def _report(outcome, kind, band, folder, fmt) -> None:
     from ..scene.export import write_outputs
     info = raster_info(outcome.path)
     written = write_outputs(outcome.records, info, folder, band, outcome.summaries) if folder else []
-    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt)
+    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt, verbose)
     if not any(r.ok for r in outcome.records) and not outcome.interrupted:
         click.echo(f"imgmtf: error: {outcome.path}: no usable {kind} found "
                    f"({len(outcome.records)} candidates, all rejected)", err=True)

@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from ..errors import ParameterError
-from .errors import reported_errors
+from .errors import option_errors, reported_errors
 from .files import check_output_file, load_sensor
 from .options import FiniteFloat, length_option
 
@@ -43,7 +43,8 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--high", type=FiniteFloat(), show_default="1200 at 16 bits, 210 at 8",
               help="DN on the bright side (inside a pulse)")
 @click.option("--pulse-width", callback=length_option("px"),
-              help="bar width of a pulse target: 1.5 or 1.5px (pixels), 1.5m (metres on the ground)")
+              help="bar width of a pulse target, at least 0.2 px and at most --size: 1.5 or 1.5px (pixels), "
+                   "1.5m (metres on the ground)")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
 @click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default="50; 320 with --campaign",
@@ -114,31 +115,33 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
         from ..sensor.targets import Target
         suffix = Path(out).suffix.lower()
         if suffix not in (".tif", ".tiff", ".png"):
-            raise ParameterError(f"{out}: simulate writes a GeoTIFF (.tif, .tiff), which records the GSD "
-                                 "and how the chip was made, or a PNG (.png, pixels only); "
-                                 f"got {suffix or 'no suffix'}")
+            raise click.BadParameter(f"{out}: simulate writes a GeoTIFF (.tif, .tiff), which records the GSD and "
+                                     "how the chip was made, or a PNG (.png, pixels only); "
+                                     f"got {suffix or 'no suffix'}", param_hint="'--out'")
+        if kind == "pulse" and pulse_width is None:
+            raise click.UsageError("a pulse target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
+        if kind == "edge" and pulse_width is not None:
+            raise click.UsageError("--pulse-width applies to --target pulse only")
         check_output_file(out)
         sensor = load_sensor(sensor_path)
         gsd_m = sensor.gsd_m if gsd is None else gsd
-        if kind == "pulse" and pulse_width is None:
-            raise ParameterError("a pulse target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
-        if kind == "edge" and pulse_width is not None:
-            raise ParameterError("--pulse-width applies to --target pulse only")
-        width_px = 0.0
-        if kind == "pulse":
-            value, unit = pulse_width
-            width_px = value if unit == "px" else value / gsd_m
-            from ..inputs import MIN_BAR_WIDTH_PX
-            if not width_px >= MIN_BAR_WIDTH_PX:
-                raise ParameterError(f"a {width_px:g} px wide pulse is narrower than the {MIN_BAR_WIDTH_PX} px "
-                                     "imgmtf can measure (is the unit right?)")
-            if width_px > size:
-                raise ParameterError(f"the pulse width must be at most the chip ({size} px), "
-                                     f"got {width_px:g} px")
-        target = Target(kind, angle, low, high, offset, width_px)
-        chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
-                      noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
-                      seed=seed)
+        # simulate reads no input: a value the renderer refuses is a bad option (exit 2)
+        with option_errors():
+            width_px = 0.0
+            if kind == "pulse":
+                value, unit = pulse_width
+                width_px = value if unit == "px" else value / gsd_m
+                from ..inputs import MIN_BAR_WIDTH_PX
+                if not width_px >= MIN_BAR_WIDTH_PX:
+                    raise ParameterError(f"--pulse-width: a {width_px:g} px wide pulse is narrower than the "
+                                         f"{MIN_BAR_WIDTH_PX} px imgmtf can measure (is the unit right?)")
+                if width_px > size:
+                    raise ParameterError(f"--pulse-width ({width_px:g} px) is wider than the chip "
+                                         f"(--size {size} px)")
+            target = Target(kind, angle, low, high, offset, width_px)
+            chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
+                          noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
+                          seed=seed)
         if suffix == ".png":
             write_png(out, chip.image)
         else:

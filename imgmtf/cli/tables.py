@@ -71,7 +71,12 @@ def snr_cell(value) -> str:
 
 
 def num_cell(value, width: int, decimals: int) -> str:
-    return f"{value:{width}.{decimals}f}" if value is not None else f"{'-':>{width}}"
+    """A figure to ``decimals`` places right-aligned in ``width``; '-' where
+    undefined; never a signed zero ("-0.00" reads as 0.00)."""
+    if value is None:
+        return f"{'-':>{width}}"
+    text = f"{value:.{decimals}f}"
+    return f"{text.removeprefix('-') if float(text) == 0 else text:>{width}}"
 
 
 def print_fit(result) -> None:
@@ -103,31 +108,38 @@ def print_fit(result) -> None:
         click.echo(f"warning: {warning}")
 
 
-def print_scan(scene, info, kind, records, summaries, written, fmt) -> None:
+def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: bool = False) -> None:
+    """A scene's scan: the accepted candidates, then (unless ``verbose``,
+    which prints every candidate) one line per rejection reason with its
+    count and example ids, then the combined and fitted rows."""
     if fmt == "json":
         from ..records import to_json
         for r in (*records, *summaries):
             click.echo(to_json(r))
         return
     accepted = sum(r.ok for r in records)
-    click.echo(f"{scene}: {info.width} x {info.height} px, {len(records)} candidate "
-               f"{kind}s, {accepted} accepted")
-    click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
-               f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
-    click.echo(f"{'':>4} {'':>4} {'':>3} {'':>7} {'deg':>7} {'px':>5} {'':>5} {'':>7} {'':>15} {'cy/px':>7}")
-    for record in records:
+    click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
+               f"{accepted} accepted")
+    shown = records if verbose else [r for r in records if r.ok]
+    if shown:
+        click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
+                   f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
+        click.echo(f"{'':>4} {'':>4} {'':>3} {'':>7} {'deg':>7} {'px':>5} {'':>5} {'':>7} {'':>15} {'cy/px':>7}")
+    for record in shown:
         r = record.to_dict()
         head = (f"{r['id']:>4} {r.get('rank') or '':>4} {r.get('target_id') or '':>3} "
                 f"{SHORT_DIRECTIONS.get(r.get('direction'), r.get('direction') or '-'):>7} "
                 f"{num_cell(r.get('normal_angle_deg'), 7, 2)} {r['length_px']:5.0f}")
         if record.ok:
             roi = ",".join(str(v) for v in r["roi"])
-            click.echo(f"{head} {num_cell(r.get('snr'), 5, 0)} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
+            click.echo(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
                        f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
             for warning in r.get("warnings") or []:
                 click.echo(f"{'':>{len(head)}} warning: {warning}")
         else:       # the scene's name heads the table: the message need not repeat it
-            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
+            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
+    if not verbose:
+        print_rejections([r for r in records if not r.ok])
     combined = [r for r in summaries if r.figures.get("summary") != "fit"]
     fitted = [r for r in summaries if r.figures.get("summary") == "fit"]
     if combined:
@@ -181,6 +193,41 @@ def print_target_fits(fitted) -> None:
 
 
 SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
+
+#: what the CLI adds to a scan's rejection: the option that moves the limit (a
+#: too-short line, not too few rows clear of the junctions, which no option moves)
+SCAN_REASON_HINTS = {("too-short", "shorter than the minimum"): "--min-length sets the minimum",
+                     ("two-targets", ""): "--margin sets the ROI's reach"}
+MAX_EXAMPLE_IDS = 5
+
+
+def print_rejections(rejected) -> None:
+    """One line per rejection reason, most frequent first: how many, a few
+    ids (as the overview labels them) and the first one's message."""
+    by_reason: dict[str, list] = {}
+    for record in rejected:
+        by_reason.setdefault(record.reason, []).append(record)
+    for reason, group in sorted(by_reason.items(), key=lambda item: (-len(item[1]), item[0])):
+        ids = [str(r.get("id")) for r in group[:MAX_EXAMPLE_IDS]]
+        more = f" and {len(group) - MAX_EXAMPLE_IDS} more" if len(group) > MAX_EXAMPLE_IDS else ""
+        click.echo(f"rejected {len(group):>4} {reason} (id {', '.join(ids)}{more}): "
+                   f"e.g. {_rejection(group[0].to_dict())}")
+    if rejected:
+        click.echo("  (--verbose lists every candidate)")
+
+
+def _rejection(row: dict) -> str:
+    """A rejected candidate's message without the scene's name (the table's
+    heading names it), with the option that moves its limit."""
+    message = row["error"].removeprefix(row["path"] + ": ")
+    hint = next((h for (reason, words), h in SCAN_REASON_HINTS.items() if row["reason"] == reason and words in message),
+                None)
+    return message + (f" ({hint})" if hint else "")
+
+
+def plural(count: int, noun: str) -> str:
+    """"1 candidate edge", "17 candidate edges"."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def interval_cell(pair) -> str:

@@ -328,7 +328,7 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
     model = _Model(gsd, _initial_stages(names, start, gsd), data)
-    notes = model.screen_axes(_hold_keys(hold, model))
+    notes = model.screen_axes(_hold_keys(hold, model.keys))
     z = model.initial_vector()
     while True:
         z, jacobian = model.solve(z)
@@ -478,15 +478,45 @@ def _initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[
     return out
 
 
-def _hold_keys(hold, model: _Model) -> set[str]:
+def check_names(stages=None, hold=(), start: Sensor | None = None) -> list[str]:
+    """The stages a fit frees, and the parameters it holds, checked before
+    any data are read (the CLI's --stages and --hold: a usage error).
+
+    Parameters
+    ----------
+    stages, hold, start
+        As :func:`fit_sensor` takes them.
+
+    Returns
+    -------
+    list of str
+        The stages' names.
+
+    Raises
+    ------
+    ParameterError
+        An unknown stage, one named twice, or a held name that is no
+        fitted stage or parameter.
+
+    Examples
+    --------
+    >>> check_names("optics,detector", "detector.width_x_m")
+    ['optics', 'detector']
+    """
+    names = _stage_names(stages, start)
+    _hold_keys(hold, [f"{name}.{parameter}" for name in names for parameter in STAGES[name].fit_specs()])
+    return names
+
+
+def _hold_keys(hold, fitted: list[str]) -> set[str]:
     if isinstance(hold, str):
         hold = [h.strip() for h in hold.split(",") if h.strip()]
     keys = set()
     for item in _listed("hold", hold):
-        matches = [k for k in model.keys if k == item or k.split(".")[0] == item]
+        matches = [k for k in fitted if k == item or k.split(".")[0] == item]
         if not matches:
             raise ParameterError(f"cannot hold {item!r}: not a fitted stage or parameter; "
-                                 f"fitted: {', '.join(model.keys)}")
+                                 f"fitted: {', '.join(fitted)}")
         keys.update(matches)
     return keys
 

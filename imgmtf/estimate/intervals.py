@@ -141,18 +141,28 @@ def Bootstrap(replicates: int = 200, confidence: float = 0.95, seed: int = 0) ->
 
 def as_intervals(value) -> Intervals:
     """Interval settings from what a caller gives: None (the default
-    influence intervals), an :class:`Intervals`, an int N (a bootstrap of N
-    replicates; 0 for none), or False (none)."""
+    influence intervals), an :class:`Intervals`, a method's name as the
+    CLI's ``--intervals`` takes it ("influence", "bootstrap": 200
+    replicates, "none"), an int N (a bootstrap of N replicates; 0 for
+    none), or False (none).
+
+    Examples
+    --------
+    >>> as_intervals("bootstrap").replicates, as_intervals("none").enabled
+    (200, False)
+    """
     if value is None or value is True:
         return Intervals()
     if value is False:
         return NO_INTERVALS
     if isinstance(value, Intervals):
         return value
+    if isinstance(value, str):
+        return Intervals(value)
     if isinstance(value, (int, np.integer)):
         return Bootstrap(int(value))
-    raise ParameterError(f"intervals must be None, an Intervals, or a number of bootstrap replicates; "
-                         f"got {value!r}")
+    raise ParameterError(f"intervals must be None, an Intervals, one of {', '.join(map(repr, METHODS))}, or a "
+                         f"number of bootstrap replicates; got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -168,6 +178,19 @@ class Interval:
 
     def __contains__(self, value: float) -> bool:
         return self.low <= value <= self.high
+
+    def clipped_at_zero(self) -> Interval:
+        """The interval of a figure that cannot be negative (an MTF, a
+        modulus; a frequency): ends below 0 raised to 0.  It covers the
+        truth whenever the unclipped interval did, so its coverage is
+        unchanged; [0, h] says only that the figure is below h.
+
+        Examples
+        --------
+        >>> Interval(-0.0124, 0.0273).clipped_at_zero()
+        Interval(low=0.0, high=0.0273)
+        """
+        return Interval(max(self.low, 0.0), max(self.high, 0.0)) if self.low < 0 else self
 
     @property
     def width(self) -> float:

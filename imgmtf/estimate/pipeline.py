@@ -137,8 +137,10 @@ class Settings:
     lsf_window_factor : float or None
         That half-width in units of the 10-90 % rise (edges); None adapts
         it to the SNR.
-    intervals : Intervals
-        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`).
+    intervals : Intervals or str or int
+        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`),
+        or a method's name as ``--intervals`` takes it ("influence",
+        "bootstrap", "none"), or a number of bootstrap replicates (0: none).
     force : bool
         Measure even when a quality check fails (each failure becomes a
         warning) instead of refusing.
@@ -735,6 +737,8 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
                             "give the width if it is known, or use the default (influence) intervals")
         nyquist_ci, mtf50_ci = _bootstrap_intervals(
             settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
+    # an MTF (a modulus) and a frequency are never negative: ends below 0 are raised to 0 (docs/method.md)
+    nyquist_ci, mtf50_ci = nyquist_ci.clipped_at_zero(), mtf50_ci.clipped_at_zero()
 
     figures = dict(
         normal_angle_deg=_normal_angle(geometry), tilt_deg=geometry.tilt_deg,

@@ -1,18 +1,24 @@
 """Figures of a sensor fit: measured against model MTF per edge, residuals."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from ..estimate.spectrum import NYQUIST
-from ._common import expect, figure_axes
+from ._common import check_truth, expect, figure_axes
 from .sensor import plot_psf
 
 
-def plot_fit_edge(fit, index: int, ax=None):
+def plot_fit_edge(fit, index: int, ax=None, truth=None):
     """One edge of a sensor fit: its measured (non-parametric) MTF against
-    the fitted model's along its normal, with the model's interval."""
+    the fitted model's along its normal, the model's interval as a band
+    (drawn, and magnified about Nyquist in an inset, where it is too
+    narrow to see at full scale), and ``truth(f)`` (cy/px) when known (a
+    chip imgmtf simulated)."""
     expect(fit, "fit")
+    check_truth(truth)
     if not -len(fit.edges) <= index < len(fit.edges):
         from ..errors import ParameterError
         raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
@@ -22,16 +28,33 @@ def plot_fit_edge(fit, index: int, ax=None):
     f = np.linspace(0.0, 1.0, 201)
     value, low, high = fit.mtf_band(f, edge.normal_angle_deg, edge.gsd_m)
     lo, hi = edge.mtf_nyquist_ci
-    ax.fill_between(f, low, high, color="C0", alpha=0.3, lw=0)
-    ax.plot(f, value, color="C0", lw=2.0, label=f"model: {edge.mtf_nyquist:.4f} [{lo:.4f}, {hi:.4f}]")
-    ax.plot(m.frequencies_cy_px, m.mtf, "--", color="k", lw=1.0,
-            label=f"measured: {edge.measured_mtf_nyquist:.4f}")
-    ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
-    name = edge.source if len(edge.source) <= 32 else "..." + edge.source[-29:]
-    ax.set(title=f"{name}: normal {edge.normal_angle_deg:.1f} deg ({edge.direction})", xlim=(0, 1), ylim=(0, 1.05),
-           xlabel="frequency along the normal (cycles/pixel)", ylabel="MTF")
-    ax.legend(fontsize="small", title=f"at Nyquist ({100 * fit.confidence:g} % interval)",
-              title_fontsize="small")
+    percent = f"{100 * fit.confidence:g} %"
+    # above the curve's tail, right of Nyquist, where no data lie
+    inset = ax.inset_axes((0.56, 0.5, 0.41, 0.42))
+    half = 0.03
+    near = (f >= NYQUIST - half) & (f <= NYQUIST + half)
+    for axes, span in ((ax, slice(None)), (inset, near)):
+        axes.fill_between(f[span], low[span], high[span], color="C0", alpha=0.35, lw=0,
+                          label=f"model's {percent} interval")
+        axes.plot(f[span], value[span], color="C0", lw=1.6, label=f"model: {edge.mtf_nyquist:.4f} "
+                                                                  f"[{lo:.4f}, {hi:.4f}]")
+        measured = (np.abs(m.frequencies_cy_px - NYQUIST) <= half + 1e-9) if axes is inset else slice(None)
+        axes.plot(m.frequencies_cy_px[measured], m.mtf[measured], "--", color="k", lw=1.0,
+                  label=f"measured: {edge.measured_mtf_nyquist:.4f}")
+        if truth is not None:
+            axes.plot(f[span], truth(f[span]), ":", color="C3", lw=1.4,
+                      label=f"true: {float(truth(np.array([NYQUIST]))[0]):.4f}")
+        axes.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
+    window = np.concatenate([low[near], high[near], m.mtf[np.abs(m.frequencies_cy_px - NYQUIST) <= half + 1e-9]])
+    window = window[np.isfinite(window)]
+    pad = 0.15 * max(float(np.ptp(window)), 0.01)
+    inset.set(xlim=(NYQUIST - half, NYQUIST + half), ylim=(window.min() - pad, window.max() + pad))
+    inset.tick_params(labelsize=6)
+    inset.set_title("about Nyquist", fontsize=6, pad=2)
+    ax.set_title(f"{_short(edge.source)}\nnormal {edge.normal_angle_deg:.1f} deg ({edge.direction})", fontsize="medium")
+    ax.set(xlim=(0, 1), ylim=(0, 1.05), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
+    ax.legend(fontsize="x-small", title=f"at Nyquist ({percent} interval)", title_fontsize="x-small",
+              loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)   # below, off the data
     return fig
 
 
@@ -52,28 +75,38 @@ def plot_fit_residuals(fit, ax=None):
         centre = (np.nonzero(used)[0] + 0.5) * 0.25 + np.floor(x[keep].min() / 0.25) * 0.25
         scale = 100.0 / abs(edge.step_dn)
         line, = ax.plot(centre, mean * scale, ".-", lw=0.8, ms=3, color=f"C{i % 10}",
-                        label=f"{edge.source[-24:]}: {100 * edge.misfit_fraction:.2f} %")
+                        label=f"{_short(edge.source)}: {100 * edge.misfit_fraction:.2f} %")
         ax.fill_between(centre, -2 * edge.noise_dn / np.sqrt(count[used]) * scale,
                         2 * edge.noise_dn / np.sqrt(count[used]) * scale, color=line.get_color(), alpha=0.12, lw=0)
     ax.axhline(0, color="0.4", lw=0.8)
     ax.set(title="Residuals along the normal (0.25 px bins)", xlabel="distance from the edge (px)",
            ylabel="data - model (% of the step)")
-    ax.legend(fontsize="small", title="structure (RMS)", title_fontsize="small", loc="lower right")
+    ax.legend(fontsize="x-small", title="structure (RMS)", title_fontsize="x-small", loc="upper center",
+              bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)       # below the axes, off the data
     return fig
 
 
-def plot_fit(fit, max_edges: int = 6):
+def _short(source: str, width: int = 26) -> str:
+    """An edge's file name (its folder left out), shortened in the middle."""
+    name = Path(source).name or source
+    return name if len(name) <= width else name[: width // 2 - 2] + "..." + name[-(width // 2 - 1):]
+
+
+def plot_fit(fit, max_edges: int = 6, truths=None):
     """Measured against model MTF for each edge (the first ``max_edges``),
-    the residuals along the normals, and the fitted sensor's 2-D PSF."""
+    the residuals along the normals, and the fitted sensor's 2-D PSF;
+    ``truths`` the true MTF of each edge (a function of cy/px, or None)
+    when known."""
     expect(fit, "fit")
+    truths = list(truths) if truths is not None else [None] * len(fit.edges)
     shown = min(len(fit.edges), max_edges)
     panels = shown + 2
     cols = min(panels, 4)
     rows = -(-panels // cols)
-    fig = Figure(figsize=(4.4 * cols, 3.7 * rows), layout="constrained")
+    fig = Figure(figsize=(4.4 * cols, 4.4 * rows), layout="constrained")
     axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
     for i in range(shown):
-        plot_fit_edge(fit, i, axes[i])
+        plot_fit_edge(fit, i, axes[i], truth=truths[i])
     plot_fit_residuals(fit, axes[shown])
     plot_psf(fit.sensor, axes[shown + 1])
     axes[shown + 1].set_title("Fitted system PSF (peak = 1)")

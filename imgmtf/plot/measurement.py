@@ -18,18 +18,22 @@ def _view_px(result) -> float:
 
 def plot_locations(result, ax=None):
     """Per-row sub-pixel target locations and the fitted line (paper Fig.
-    5a), at equal scale in both axes so that the tilt looks as it is; the
-    rows' RMS scatter about the line is in the legend."""
+    5a), at equal scale in both axes so that the tilt looks as it is, in
+    the pixel coordinates of the image measured (its ROI's offset added:
+    a file's with ``imgmtf measure --roi``, a scene's for a scan's edge);
+    the rows' RMS scatter about the line is in the legend."""
     expect(result, "result")
     fig, ax = figure_axes(ax)
     g = result.geometry
     kept = g.kept
     fitted = g.slope * g.rows + g.intercept
     rms = float(np.sqrt(np.mean((g.locations[kept] - fitted[kept]) ** 2)))
+    x0, y0 = result.roi[:2]
 
     def image_xy(along, across):
-        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it
-        return (along, across) if g.transposed else (across, along)
+        # a near-horizontal target was measured on the transposed chip: draw it as the image shows it,
+        # where the image has it
+        return (along + x0, across + y0) if g.transposed else (across + x0, along + y0)
     line = "column" if g.transposed else "row"
     ax.plot(*image_xy(g.rows[kept], g.locations[kept]), "o", ms=3, mfc="none",
             label=f"{line} {result.target} location (scatter {rms:.3f} px RMS)")
@@ -42,7 +46,8 @@ def plot_locations(result, ax=None):
     ax.set(xlabel="column (px)", ylabel="row (px)")
     title_once(ax, f"{result.target.capitalize()}: normal at {result.normal_angle_deg:.2f} deg, "
                f"tilt {result.tilt_deg:.2f} deg")
-    ax.legend(fontsize="small")
+    # the line may run anywhere in these axes: its legend goes under them, off the data
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -91,7 +96,7 @@ def plot_lsf(result, ax=None):
     view = max(4.0, 2.5 * result.fwhm_px)
     ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
     title_once(ax, "Line spread function")
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="upper right")           # over a tail, clear of the peak
     return fig
 
 
@@ -116,12 +121,13 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     yerr = ([[result.mtf_nyquist - ci.low], [ci.high - result.mtf_nyquist]] if np.isfinite(ci.low) else None)
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""
     ax.errorbar([NYQUIST], [result.mtf_nyquist], yerr=yerr, fmt="o", color=c, capsize=3, ms=4,
-                label=f"MTF@Nyquist {_figure(result.mtf_nyquist)}{interval}")
+                label=f"MTF@Nyquist {_figure(result.mtf_nyquist, missing=missing_cause(result, 'mtf_nyquist'))}"
+                      f"{interval}")
     ci50 = result.mtf50_ci_cy_px
     xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
     interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
     ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
-                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}{interval50}")
+                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px', missing_cause(result, 'mtf50'))}{interval50}")
     top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
     ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
     if result.gsd_m:
@@ -140,18 +146,56 @@ def _once(ax, prefix: str, label: str) -> str:
     return "_nolegend_" if any(d.startswith(prefix) for d in drawn) else label
 
 
-def _figure(value: float, unit: str = "") -> str:
-    """A figure as the plots print it, with its unit; a bar's sinc can mask
-    it (NaN), and then it has none."""
+def _figure(value: float, unit: str = "", missing: str = "undefined") -> str:
+    """A figure as the plots print it, with its unit; where it is NaN, why
+    (``missing``, see :func:`missing_cause`)."""
     if not np.isfinite(value):
-        return "masked by the bar's sinc"
+        return missing
     return f"{value:.4f} {unit}" if unit else f"{value:.4f}"
 
 
-def plot_measurement(result, truth=None, title: str | None = None):
+def missing_cause(result, figure: str) -> str:
+    """Why ``figure`` ("mtf_nyquist" or "mtf50") of ``result`` is missing
+    (NaN), in the words a figure prints: the bar's sinc masks the
+    frequencies where it would be read, or the curve does not reach it (an
+    MTF that stays above 0.5, as a forced chip's may), or it is undefined.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60)
+    >>> result = imgmtf.measure_edge(chip.image)
+    >>> from dataclasses import replace
+    >>> sharp = replace(result, mtf50_cy_px=float("nan"), mtf=np.maximum(result.mtf, 0.6))
+    >>> missing_cause(sharp, "mtf50")
+    'undefined: the MTF stays above 0.5 up to 1 cy/px'
+    """
+    f, mtf = result.frequencies_cy_px, result.mtf
+    masked = ~np.isfinite(mtf)
+    by_sinc = "masked by the bar's sinc"
+    if figure == "mtf_nyquist":
+        return by_sinc if result.target == "pulse" and masked[np.argmin(np.abs(f - NYQUIST))] else "undefined"
+    first_masked = int(np.argmax(masked)) if masked.any() else mtf.size
+    if result.target == "pulse" and masked.any() and np.all(mtf[:first_masked] > 0.5):
+        return by_sinc
+    if first_masked and np.all(mtf[:first_masked] > 0.5):
+        return f"undefined: the MTF stays above 0.5 up to {f[first_masked - 1]:g} cy/px"
+    return "undefined"
+
+
+#: warnings the header prints in full; the rest it counts
+HEADER_WARNINGS = 3
+
+
+def plot_measurement(result, truth=None, title: str | None = None, warnings=None):
     """Target locations, profile (ESF or PRF), LSF and MTF of one
-    measurement, headed by ``title`` (the file) and the figures a report
-    quotes; ``truth(f)`` overlays a known MTF."""
+    measurement, headed by ``title`` (the file), the figures a report
+    quotes and its warnings; ``truth(f)`` overlays a known MTF.
+
+    ``warnings`` are those of the record the figure belongs to (default
+    the result's; ``imgmtf measure`` adds the file's own, such as a
+    photo's luminance): the header prints the first few and counts them
+    all, so that none is dropped unsaid."""
     expect(result, "result")
     check_truth(truth)
     fig = Figure(figsize=(12, 8.5), layout="constrained")
@@ -162,11 +206,16 @@ def plot_measurement(result, truth=None, title: str | None = None):
     plot_mtf(result, axes[1, 1], truth=truth)
     ci = result.mtf_nyquist_ci
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if np.isfinite(ci.low) else ""
-    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist)}{interval}, MTF50 {_figure(result.mtf50_cy_px, 'cy/px')}, "
+    summary = (f"MTF at Nyquist {_figure(result.mtf_nyquist, missing=missing_cause(result, 'mtf_nyquist'))}"
+               f"{interval}, MTF50 {_figure(result.mtf50_cy_px, 'cy/px', missing_cause(result, 'mtf50'))}, "
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
-    for i, warning in enumerate(result.warnings[:2]):
-        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(result.warnings)}: {warning}", 170,
+    warnings = list(result.warnings if warnings is None else warnings)
+    for i, warning in enumerate(warnings[:HEADER_WARNINGS]):
+        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(warnings)}: {warning}", 170,
                                            placeholder=" [...]")
+    if len(warnings) > HEADER_WARNINGS:
+        summary += (f"\nand {len(warnings) - HEADER_WARNINGS} more warning(s), listed in full by the text table "
+                    "and the record (JSON, CSV)")
     fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
     return fig

@@ -21,7 +21,8 @@ def plot_noise_sweep(rows, methods, true_nyquist, title):
         ax.axvline(100, color="0.6", ls=":", lw=0.8)
         ax.set(title=f"{title}: {method}", xlabel="estimated SNR", ylim=(0, 2 * true_nyquist))
     axes[0].set_ylabel("MTF at Nyquist")
-    axes[0].legend(fontsize="small")
+    # at high SNR the estimates hug the truth: the upper right is clear of them
+    axes[0].legend(fontsize="small", loc="upper right")
     return fig
 
 
@@ -31,7 +32,7 @@ def plot_estimates(kind: str, curves: dict, methods, width_px: float = 0.0):
     ``width_px`` wide), the MTF, and the MTF's error, as published (top) and
     with each method's own blur divided out (bottom, imgmtf's default).
     ``curves`` as :func:`imgmtf.reproduce.estimator_tables` returns it."""
-    fig = Figure(figsize=(15, 8.2), layout="constrained")
+    fig = Figure(figsize=(15, 10.5), layout="constrained")
     axes = fig.subplots(2, 3)
     x_true, profile_true, f_true, mtf_true = curves["truth"]
     name = "LSF (1/px)" if kind == "edge" else "pulse response (peak 1)"
@@ -65,9 +66,11 @@ def plot_estimates(kind: str, curves: dict, methods, width_px: float = 0.0):
                      title=f"MTF error, {variant}")
         for ax in (mtf_ax, error_ax):
             ax.axvline(NYQUIST, color="0.5", ls=":", lw=0.8)
-        profile_ax.legend(fontsize="small")
-        mtf_ax.legend(fontsize="small", title="MTF at Nyquist", title_fontsize="small")
-        error_ax.legend(fontsize="small")
+        # under each panel: inside, they sat on the peaks and on the zero line the errors are read against
+        below = dict(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.17), ncols=2, frameon=False)
+        profile_ax.legend(**below)
+        mtf_ax.legend(**below, title="MTF at Nyquist", title_fontsize="small")
+        error_ax.legend(**{**below, "ncols": 4})
     target = "edge" if kind == "edge" else f"{width_px:g} px bar"
     fig.suptitle(f"Estimates of a noise-free {target} (40 x 40 px, 6 deg, the paper's sensor) by each method "
                  f"against the truth (paper Fig. {9 if kind == 'edge' else 10})\ntop: as published, each "
@@ -93,11 +96,13 @@ def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20)
     return fig
 
 
-def plot_threshold(found, relative, fraction, chips_per_level: int):
+def plot_threshold(found, relative, fraction, chips_per_level: int, thresholds: bool = True):
     """Fraction of estimates within +-``relative`` of the truth against SNR,
     per method, with its 95 % binomial (Wilson) interval for
-    ``chips_per_level`` chips at each SNR, and the ``fraction`` criterion."""
-    fig, ax = figure_axes(None, (7, 4.4))
+    ``chips_per_level`` chips at each SNR, and the ``fraction`` criterion;
+    each method's threshold in the legend unless ``thresholds`` is false (a
+    quick run: too few chips per level for one, as its report says)."""
+    fig, ax = figure_axes(None, (7, 5.2))
     z = 1.96
     for i, (method, info) in enumerate(found.items()):
         snrs = np.array(sorted(info["fractions"]), float)
@@ -106,13 +111,14 @@ def plot_threshold(found, relative, fraction, chips_per_level: int):
         centre = (p + z * z / (2 * n)) / (1 + z * z / n)
         half = z / (1 + z * z / n) * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
         threshold = info["threshold"]
-        reached = f"threshold SNR {threshold:g}" if np.isfinite(threshold) else "never within the criterion"
+        reached = ("threshold n/a (too few chips)" if not thresholds else f"threshold SNR {threshold:g}"
+                   if np.isfinite(threshold) else "never within the criterion")
         ax.fill_between(snrs, centre - half, centre + half, color=f"C{i}", alpha=0.12, lw=0)
         ax.semilogx(snrs, p, "o-", ms=3, color=f"C{i}", label=f"{method}: {reached}")
     ax.axhline(fraction, color="0.5", ls="--", lw=0.8, label=f"criterion: {100 * fraction:g} %")
-    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist "
+    ax.set(title=f"Estimates within +-{100 * relative:.0f} % of the true MTF at Nyquist\n"
                  f"({chips_per_level} chips per SNR; bands: 95 % intervals)",
            xlabel="SNR (step / noise std)", ylabel="fraction of estimates", ylim=(0, 1.02))
     ax.title.set_fontsize("medium")
-    ax.legend(fontsize="small", loc="lower right")
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2, frameon=False)
     return fig

@@ -7,10 +7,20 @@ from matplotlib.figure import Figure
 _DIRECTION_SHORT = {"across-track": "across", "along-track": "along", "oblique": "oblique", "unknown": ""}
 
 
+#: a reason's candidates up to which the legend lists their ids and the image labels them;
+#: beyond, the legend counts them (their ids are in the table and the CSV)
+MAX_LISTED = 24
+#: one colour per reason, saturated enough to read on black and on white
+PALETTE = ("#ff7f0e", "#e0202a", "#b07cff", "#ffd92f", "#ff5ec4", "#17d4e8", "#c5d625", "#ff9f9f",
+           "#4f8bff", "#ffffff", "#b58b5b", "#9edae5")
+ACCEPTED = "#00ff00"
+
+
 def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=None, ax=None,
               width_in: float = 10.0):
-    """The overview of a scan: the scene with its accepted targets
-    prominent and labelled, its rejected candidates faint.
+    """The overview of a scan: the scene with every candidate drawn, coloured
+    by its verdict and labelled with its id, as the table and the CSV list
+    them.
 
     Parameters
     ----------
@@ -20,8 +30,10 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     records : the candidates' records (:class:`imgmtf.Record`, as
         :func:`imgmtf.scan_scene` returns them, or their ``to_dict()``):
         accepted ones are drawn as their tilted ROI (``roi_polygon_px``)
-        and segment in green; rejected ones as a thin faint line coloured
-        by reason, each reason counted in the legend.
+        and segment in green, above the rest; rejected ones as a line
+        coloured by reason, outlined in black so that it reads on any
+        background.  Each accepted candidate carries its id, and so do the
+        rejected ones of a reason with at most ``MAX_LISTED`` candidates.
     summaries : the per-target summaries (``scope`` "target", records or
         dicts, as :func:`imgmtf.summarise_scan` returns them): each
         target is labelled at its centre with, per direction, MTF at
@@ -30,7 +42,8 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
         percentiles.
     ax : an axes to draw on; a new figure, sized to the scene's aspect
         with no blank margins, when None.
-    width_in : the new figure's width (inches).
+    width_in : the new figure's width (inches), the legend's column to the
+        right of the image included.
 
     Returns
     -------
@@ -38,17 +51,19 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
 
     Notes
     -----
-    Drawn with one collection per reason and one for the accepted ROIs,
-    so that a scene with thousands of candidates draws in a fraction of a
-    second.
+    The legend, outside the image on its right, counts the candidates of
+    each verdict and reason and lists their ids.  Drawn with one
+    collection per reason and one for the accepted ROIs, so that a scene
+    with thousands of candidates draws in a fraction of a second.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> fig = plot_scan(np.zeros((50, 80)), 1.0, [])
     >>> float(fig.get_figwidth())
     10.0
     """
+    from matplotlib import patheffects
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.lines import Line2D
 
@@ -58,12 +73,13 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     height, width = overview.shape
     extent_w, extent_h = width * scale, height * scale
     if ax is None:
-        margins = (0.7, 0.1, 0.55, 0.45)            # left, right, bottom, top (in): axis labels, title
+        margins = (0.7, 2.6, 0.55, 0.45)            # left, right (the legend), bottom, top (in)
         image_w = width_in - margins[0] - margins[1]
         image_h = image_w * extent_h / max(extent_w, 1e-9)
-        fig = Figure(figsize=(width_in, image_h + margins[2] + margins[3]))
+        fig = Figure(figsize=(width_in, max(image_h, 2.2) + margins[2] + margins[3]))
         fig_h = fig.get_figheight()
-        ax = fig.add_axes((margins[0] / width_in, margins[2] / fig_h, image_w / width_in, image_h / fig_h))
+        ax = fig.add_axes((margins[0] / width_in, (fig_h - margins[3] - image_h) / fig_h, image_w / width_in,
+                           image_h / fig_h))
     fig = ax.figure
     finite = np.isfinite(overview)
     lo, hi = levels or (np.percentile(overview[finite], [0.5, 99.5]) if finite.any() else (0.0, 1.0))
@@ -75,34 +91,35 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     ax.set_ylabel("row (px)", fontsize=7)
     accepted = [r for r in records if r.get("status") == "accepted"]
     rejected = [r for r in records if r.get("status") != "accepted"]
+    outline = [patheffects.Stroke(linewidth=3.2, foreground="black"), patheffects.Normal()]
+    labels = _Labels(ax, extent_w)
     handles = []
     by_reason: dict[str, list] = {}
     for r in rejected:
-        by_reason.setdefault(r.get("reason") or "rejected", []).append(
-            [(r["x0_px"], r["y0_px"]), (r["x1_px"], r["y1_px"])])
-    palette = ["#ff7f0e", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f",
-               "#1f77b4", "#aec7e8", "#ffbb78", "#c5b0d5"]
-    for k, (reason, lines) in enumerate(sorted(by_reason.items(), key=lambda kv: -len(kv[1]))):
-        colour = palette[k % len(palette)]
-        ax.add_collection(LineCollection(lines, colors=colour, linewidths=0.6, alpha=0.45))
-        handles.append(Line2D([], [], color=colour, lw=1.5, alpha=0.7, label=f"{reason} ({len(lines)})"))
+        by_reason.setdefault(r.get("reason") or "rejected", []).append(r)
+    width = 1.4 if len(rejected) <= 300 else 0.9          # thousands of lines: thinner, the scene still shows
+    unlabelled = 0
+    for k, (reason, group) in enumerate(sorted(by_reason.items(), key=lambda kv: (-len(kv[1]), kv[0]))):
+        colour = PALETTE[k % len(PALETTE)]
+        ax.add_collection(LineCollection([_ends(r) for r in group], colors=colour, linewidths=width,
+                                         path_effects=outline, zorder=3))
+        handles.append(Line2D([], [], color=colour, lw=1.6, path_effects=outline,
+                              label=_legend_label(reason, group)))
+        if len(group) <= MAX_LISTED:
+            for r in group:
+                labels.add(r, colour, "black", zorder=5)
+        else:
+            unlabelled += len(group)
     if accepted:
         polygons = [r["roi_polygon_px"] for r in accepted if r.get("roi_polygon_px")]
-        ax.add_collection(PolyCollection(polygons, facecolors=(0.2, 1.0, 0.2, 0.08), edgecolors="#00e000",
-                                         linewidths=1.0))
-        ax.add_collection(LineCollection([[(r["x0_px"], r["y0_px"]), (r["x1_px"], r["y1_px"])] for r in accepted],
-                                         colors="#00ff00", linewidths=1.6))
-        handles.insert(0, Line2D([], [], color="#00e000", lw=2.5, label=f"accepted ({len(accepted)})"))
-        centres = {s["target_id"]: (s["x_px"], s["y_px"]) for s in summaries if s.get("scope") == "target"}
+        ax.add_collection(PolyCollection(polygons, facecolors=(0.2, 1.0, 0.2, 0.10), edgecolors=ACCEPTED,
+                                         linewidths=1.0, zorder=4))
+        ax.add_collection(LineCollection([_ends(r) for r in accepted], colors=ACCEPTED, linewidths=2.0,
+                                         path_effects=outline, zorder=4))
+        handles.insert(0, Line2D([], [], color=ACCEPTED, lw=2.2, path_effects=outline,
+                                 label=_legend_label("accepted", accepted)))
         for r in accepted:          # each accepted half-edge's id, as in the table and the CSV
-            if r.get("id") is None:
-                continue
-            ends = np.array([[r["x0_px"], r["y0_px"]], [r["x1_px"], r["y1_px"]]])
-            # near the end away from the target's label (at its centre), a fifth of the way in
-            far = int(np.argmax(np.hypot(*(ends - centres.get(r.get("target_id"), ends.mean(axis=0))).T)))
-            x, y = 0.8 * ends[far] + 0.2 * ends[1 - far]
-            ax.text(x, y, str(r["id"]), fontsize=6.5, color="#004d00", ha="center", va="center",
-                    bbox={"boxstyle": "circle,pad=0.15", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "none"})
+            labels.add(r, (0.85, 1.0, 0.85, 0.95), "#004d00", zorder=7, weight="bold")
     targets = [s for s in summaries if s.get("scope") == "target"]
     for target_id in sorted({s["target_id"] for s in targets}):
         rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
@@ -114,16 +131,64 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
         right, low = x > 0.7 * extent_w, y < 0.15 * extent_h       # keep the label inside the image
         ax.annotate("\n".join(lines), (x, y), xytext=(-6 if right else 6, -6 if low else 6),
                     textcoords="offset points", fontsize=6.5, color="black", va="top" if low else "bottom",
-                    ha="right" if right else "left", annotation_clip=True,
-                    bbox={"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.8), "ec": "#00a000", "lw": 0.8})
+                    ha="right" if right else "left", annotation_clip=True, zorder=8,
+                    bbox={"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "#00a000", "lw": 0.8})
     n_targets = len({s["target_id"] for s in targets})
+    ids = "ids as in the table and the CSV" + (f" ({unlabelled} in reasons too common to label)" if unlabelled
+                                                 else "")
     ax.set_title(f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
                  f"target{'s' * (n_targets != 1)} (labels: MTF at Nyquist | MTF50 cy/px per direction); "
-                 f"{len(rejected)} rejected", fontsize=8, loc="left")
+                 f"{len(rejected)} rejected; {ids}", fontsize=7.5, loc="left")
     if handles:
-        ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8, title="candidates",
-                  title_fontsize=7)
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7,
+                  title="candidates (ids)", title_fontsize=7, alignment="left", frameon=False)
     return fig
+
+
+def _ends(record) -> list[tuple[float, float]]:
+    return [(record["x0_px"], record["y0_px"]), (record["x1_px"], record["y1_px"])]
+
+
+def _legend_label(name: str, group) -> str:
+    """``name (count)`` and, when few enough, the ids (runs as 12-16),
+    wrapped to the legend's column."""
+    import textwrap
+    label = f"{name} ({len(group)})"
+    ids = sorted(r["id"] for r in group if r.get("id") is not None)
+    if not ids or len(ids) > MAX_LISTED:
+        return label
+    # consecutive ids as one run: the run starts where an id does not follow its predecessor
+    starts = [i for i in range(len(ids)) if i == 0 or ids[i] != ids[i - 1] + 1]
+    ends = [*(s - 1 for s in starts[1:]), len(ids) - 1]
+    runs = [f"{ids[s]}" if s == e else f"{ids[s]}-{ids[e]}" for s, e in zip(starts, ends)]
+    return label + "\n" + "\n".join(textwrap.wrap(", ".join(runs), 26))
+
+
+class _Labels:
+    """Each candidate's id at its segment's middle, or slid along it away
+    from the labels already placed (parallel or collinear candidates)."""
+
+    SPOTS = (0.5, 0.3, 0.7, 0.15, 0.85)
+
+    def __init__(self, ax, extent_w: float):
+        box = ax.get_position()
+        # scene px per typographic point, from the axes' width on the figure
+        self.px_per_pt = extent_w / max(box.width * ax.figure.get_figwidth() * 72.0, 1e-9)
+        self.ax = ax
+        self.placed: list[tuple[float, float]] = []
+
+    def add(self, record, face, text_colour, zorder: int, weight: str = "normal") -> None:
+        if record.get("id") is None:
+            return
+        (x0, y0), (x1, y1) = _ends(record)
+        clearance = 9.0 * self.px_per_pt
+        spots = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
+        free = [p for p in spots if all(np.hypot(p[0] - q[0], p[1] - q[1]) > clearance for q in self.placed)]
+        x, y = (free or spots)[0]
+        self.placed.append((x, y))
+        self.ax.text(x, y, str(record["id"]), fontsize=5.5, color=text_colour, ha="center", va="center",
+                     weight=weight, zorder=zorder, clip_on=True,
+                     bbox={"boxstyle": "round,pad=0.15", "fc": face, "ec": "black", "lw": 0.4})
 
 
 def _label(summary: dict) -> str:

@@ -39,7 +39,8 @@ def plot_sensor_lsf(sensor, ax=None):
     ax.axhline(0.5, color="0.6", lw=0.8, ls=":")
     r = 2 * _view_radius_m(sensor)
     ax.set(xlim=(-r, r), title="Line spread functions", xlabel="distance (m)", ylabel="normalised LSF")
-    ax.legend(fontsize="small")
+    # under the axes: inside, it would sit on the half maximum where the FWHM is read
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.16), frameon=False)
     return fig
 
 
@@ -61,8 +62,8 @@ def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
                 label=f"system: {sensor.mtf_nyquist(direction):.4f}")
         title = f"MTF {direction} track (at Nyquist)"
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
-    ax.set(title=title, xlabel="frequency (cycles/pixel)", ylabel="MTF", ylim=(0, 1.02), xlim=(0, 1))
-    ax.legend(fontsize="small")
+    ax.set(title=title, xlabel="frequency (cy/px)", ylabel="MTF", ylim=(0, 1.02), xlim=(0, 1))
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2, frameon=False)
     return fig
 
 
@@ -70,7 +71,7 @@ def plot_sensor(sensor):
     """PSF, LSFs, and each stage's MTF beside the system's across and along
     track (the paper's Figs. 2-3)."""
     expect(sensor, "sensor")
-    fig = Figure(figsize=(17, 4), layout="constrained")
+    fig = Figure(figsize=(17, 4.4), layout="constrained")
     axes = fig.subplots(1, 4)
     plot_psf(sensor, axes[0])
     plot_sensor_lsf(sensor, axes[1])

@@ -392,7 +392,8 @@ def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record
     measuring order, renamed to its id later), or a warning saying why not."""
     from ..plot import plot_measurement
     title = f"{context.path}: ROI {','.join(str(v) for v in record.figures['roi'])}"
-    return with_figure(record, lambda: plot_measurement(result, title=title),
+    in_scene = replace(result, roi=tuple(record.figures["roi"]))      # its locations drawn where the scene has them
+    return with_figure(record, lambda: plot_measurement(in_scene, title=title, warnings=record.get("warnings")),
                        str(Path(context.figures_dir or ".") / f"candidate{plan.index}.png"))
 
 

@@ -5,8 +5,8 @@ from dataclasses import dataclass, field
 
 from ..batch import MeasureSettings
 from ..errors import ParameterError
-from ..estimate.intervals import Intervals
-from ..inputs import check_number
+from ..estimate.intervals import Intervals, as_intervals
+from ..inputs import check_number, parse_length
 
 MIN_TILE_PX = 256
 MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
@@ -61,6 +61,9 @@ class ScanSettings:
     track_azimuth_deg: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
+        if self.pulse_width is not None:
+            object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))     # "1.5m", as --pulse-width
         for name in ("min_length_px", "max_length_px"):
             object.__setattr__(self, name, check_number(name, getattr(self, name)))
         for name in ("margin_px", "tile_px"):
