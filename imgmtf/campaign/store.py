@@ -92,7 +92,22 @@ _INTERVALS = {"mtf_nyquist_ci_low": ("mtf_nyquist_ci", 0), "mtf_nyquist_ci_high"
 
 
 class StoreError(ImgmtfError):
-    """A campaign store cannot be read or written (``reason`` ``store``)."""
+    """A campaign store cannot be read or written (``reason`` ``store``).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the store and the problem.
+    reason : str, optional
+        Machine-readable code (default ``"store"``).
+
+    Examples
+    --------
+    >>> from imgmtf import read_layer
+    >>> read_layer("missing.gpkg", "edges")
+    Traceback (most recent call last):
+    imgmtf.campaign.store.StoreError: missing.gpkg: no such campaign store
+    """
 
     reason = "store"
 
