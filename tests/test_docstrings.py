@@ -144,15 +144,20 @@ def problems(name: str, codes: set[str]) -> list[str]:
 def dataclass_fields(cls, errors):
     """A dataclass's fields are its parameters and its attributes at once;
     numpydoc looks for them under Parameters only (numpy/numpydoc#604), so
-    one documented under Attributes counts, with a type and a description."""
+    one documented under Attributes counts, with a type and a description,
+    as does one a dataclass it derives from documents.  A private field
+    (``_model``) is the class's own business, not documented."""
     doc = docscrape.ClassDoc(cls, config={"show_class_members": False})
-    documented = {name.strip() for entry in doc["Parameters"] + doc["Attributes"] for name in entry.name.split(",")}
+    inherited = [entry for base in cls.__mro__[1:] if dataclasses.is_dataclass(base)
+                 for entry in docscrape.ClassDoc(base, config={"show_class_members": False})["Attributes"]]
+    documented = {name.strip() for entry in doc["Parameters"] + doc["Attributes"] + inherited
+                  for name in entry.name.split(",")}
     stars = {inspect.Parameter.VAR_POSITIONAL: "*", inspect.Parameter.VAR_KEYWORD: "**"}
     out = []
     for code, message in errors:
         if code == "PR01":
             missing = sorted(stars.get(p.kind, "") + p.name for p in inspect.signature(cls).parameters.values()
-                             if stars.get(p.kind, "") + p.name not in documented)
+                             if stars.get(p.kind, "") + p.name not in documented and not p.name.startswith("_"))
             if not missing:
                 continue
             message = f"Parameters {missing} not documented"

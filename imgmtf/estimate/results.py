@@ -25,6 +25,10 @@ class MTFResult:
 
     Attributes
     ----------
+    method : str
+        The resampling method (:data:`imgmtf.METHODS`).
+    params : dict
+        The settings the estimate was made with (JSON-ready).
     normal_angle_deg : float
         Angle of the target's normal from the image's x (column) axis,
         towards +y (down), in (-90, 90]: the tilt of the target from the
@@ -36,6 +40,14 @@ class MTFResult:
         of the ground track's perpendicular or of the track (rows along
         track unless a track azimuth was given), "oblique" otherwise,
         "unknown" for a map-projected image without a track azimuth.
+    orientation : str
+        "vertical" when the target runs nearer the columns, "horizontal"
+        (its frame transposed) nearer the rows.
+    polarity : str
+        An edge's "rising" or "falling" (along +x of its frame), a bar's
+        "bright" or "dark".
+    rows_used, rows_total : int
+        The rows (of the target's frame) measured, and all it crosses.
     snr, noise_dn : float
         Contrast over the sides' noise (quantisation included), and that
         noise (DN).
@@ -45,6 +57,21 @@ class MTFResult:
         Their confidence intervals (NaN when switched off).
     fwhm_px : float
         Full width at half maximum of the recovered LSF.
+    mtfa : float
+        The area under the MTF from 0 to Nyquist, cy/px.
+    gsd_m : float or None
+        The pixel on the ground, m, when known.
+    frequencies_cy_px, mtf : numpy.ndarray
+        The MTF along the normal and its frequencies, cy/px.
+    lsf_x_px, lsf : numpy.ndarray
+        The recovered LSF (1/px) and its positions along the normal, px.
+    samples_x_px, samples_dn : numpy.ndarray
+        Every pixel used: its signed distance to the target's line, px, and
+        its value, DN (the over-sampled profile).
+    geometry : imgmtf.estimate.geometry.TargetGeometry
+        Where the target lies: the per-row locations and the fitted line.
+    roi : (int, int, int, int)
+        (x, y, width, height) of the window measured, px.
     noise_limit_cy_px : float
         Above it the MTF is within 3 standard deviations of its noise.
     lsf_half_width_px, tail_fraction : float
@@ -54,6 +81,8 @@ class MTFResult:
         Every quality check and its outcome.
     warnings : tuple of str
         What the user should know (low SNR, forced checks...).
+    mtf_function : callable or None
+        The corrected MTF at any frequency (:meth:`mtf_at`).
     """
 
     target: ClassVar[str] = ""

@@ -2,6 +2,8 @@
 when none are, a title that defers to the caller's."""
 from __future__ import annotations
 
+from typing import overload
+
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
@@ -27,6 +29,12 @@ def check_truth(truth: object) -> None:
         hint = (" (for a sensor: lambda f: sensor.normal_transfer(f, result.normal_angle_deg))"
                 if hasattr(truth, "normal_transfer") else "")
         raise ParameterError(f"truth must be a function of frequency in cy/px, got {type(truth).__name__}{hint}")
+
+
+@overload
+def figure_axes(ax: None, size: tuple[float, float] = ...) -> tuple[Figure, Axes]: ...
+@overload
+def figure_axes(ax: Axes | None, size: tuple[float, float] = ...) -> tuple[Figure | SubFigure, Axes]: ...
 
 
 def figure_axes(ax: Axes | None, size: tuple[float, float] = (5.0, 3.6)) -> tuple[Figure | SubFigure, Axes]:
