@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ImageContentError, ParameterError
-from ..filters import correlate1d
+from ._correlation import correlate1d
 
 
 @dataclass(frozen=True, eq=False)

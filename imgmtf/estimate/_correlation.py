@@ -11,7 +11,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 MODES = ("constant", "reflect")
 

@@ -4,7 +4,7 @@ import pytest
 from scipy import ndimage
 
 from imgmtf.errors import ParameterError
-from imgmtf.filters import correlate1d
+from imgmtf.estimate._correlation import correlate1d
 
 
 @pytest.mark.parametrize("mode", ["constant", "reflect"])
