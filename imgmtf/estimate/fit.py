@@ -46,6 +46,7 @@ normal, show structure the noise cannot explain.
 """
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,6 +55,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._blas import one_blas_thread
 from ..errors import ImgmtfError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing
@@ -327,7 +329,14 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
-    model = _Model(gsd, _initial_stages(names, start, gsd), data)
+    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
+    with one_blas_thread():
+        return _fit(_Model(gsd, _initial_stages(names, start, gsd), data), hold, confidence)
+
+
+def _fit(model: _Model, hold, confidence: float) -> SensorFit:
+    """Fit ``model``, holding what the data do not determine or need (see
+    the module's notes), and report."""
     notes = model.screen_axes(_hold_keys(hold, model.keys))
     z = model.initial_vector()
     while True:

@@ -11,10 +11,11 @@ over the knots in Python; the tests hold them to SciPy's.
 """
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
+
+from .._blas import one_blas_thread
 
 GCV_GRID = np.geomspace(1e-9, 1.0, 241)        # smoothing tried, as a fraction of the knots' span cubed
 
@@ -120,7 +121,7 @@ def smoothing_spline(x: np.ndarray, y: np.ndarray, weights: np.ndarray | None = 
     >>> bool(abs(smoothing_spline(x, y)(np.array([0.5]))[0] - 0.25) < 0.01)
     True
     """
-    with _one_blas_thread():
+    with one_blas_thread():
         return _smoothing_spline(x, y, weights)
 
 
@@ -163,17 +164,3 @@ def _smoothing_spline(x, y, weights):
     slope[:-1] = secant - h * (2 * curvature[:-1] + curvature[1:]) / 6.0
     slope[-1] = secant[-1] + h[-1] * (curvature[-2] + 2 * curvature[-1]) / 6.0
     return CubicCurve(x, values, slope)
-
-
-def _one_blas_thread():
-    """A context running BLAS on one thread: on matrices of a few hundred
-    rows its threads cost more than they save, and on a busy machine many
-    times more (an eigendecomposition of 150 rows: 4 ms on one thread, up
-    to 40 ms on two sharing their cores with other work)."""
-    return _blas_controller().limit(limits=1, user_api="blas")
-
-
-@functools.cache
-def _blas_controller():
-    from threadpoolctl import ThreadpoolController
-    return ThreadpoolController()
