@@ -643,7 +643,7 @@ class _Model:
             out.append((d.y - (lo + (hi - lo) * r.esf(d.x - x0))) / d.noise)
         return np.concatenate(out)
 
-    def jacobian(self, z: np.ndarray) -> np.ndarray:
+    def jacobian(self, z: np.ndarray):
         u = z[: self.n_free]
         base = self.responses(u)
         offsets = [z[self.n_free + 3 * e + 2] for e in range(len(self.data))]
@@ -660,25 +660,22 @@ class _Model:
                 -(z[self.n_free + 3 * e + 1] - z[self.n_free + 3 * e]) / d.noise
                 * (m.esf(d.x - x0) - esf) / h
                 for e, (d, m, x0, esf) in enumerate(zip(self.data, moved, offsets, base_esf))]))
+        # each edge's levels and offset act on its own samples only: a sparse
+        # Jacobian, whose size grows with the edges, not with their square
+        from scipy import sparse
         n = sum(d.x.size for d in self.data)
-        jac = np.zeros((n, z.size))
-        if columns:
-            jac[:, : self.n_free] = np.stack(columns, axis=1)
-        row = 0
+        stage = np.stack(columns, axis=1) if columns else np.zeros((n, 0))
+        blocks = []
         for e, (d, b, esf) in enumerate(zip(self.data, base, base_esf)):
             lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            rows = slice(row, row + d.x.size)
-            col = self.n_free + 3 * e
-            jac[rows, col] = -(1 - esf) / d.noise
-            jac[rows, col + 1] = -esf / d.noise
-            jac[rows, col + 2] = (hi - lo) * b.lsf(d.x - x0) / d.noise
-            row += d.x.size
-        return jac
+            blocks.append(np.stack([-(1 - esf), -esf, (hi - lo) * b.lsf(d.x - x0)], axis=1) / d.noise)
+        return sparse.hstack([sparse.csr_array(stage), sparse.block_diag(blocks)], format="csr")
 
     def solve(self, z: np.ndarray, max_iterations: int = 200):
         """Bounded least squares from ``z`` (SciPy's trust-region
-        reflective ``least_squares``, with :meth:`jacobian`, the columns
-        scaled by their norms).  Returns the solution and its Jacobian.
+        reflective ``least_squares``, with :meth:`jacobian`, sparse, the
+        columns scaled by their norms, the steps by LSMR).  Returns the
+        solution and its Jacobian.
 
         Raises
         ------
@@ -690,7 +687,8 @@ class _Model:
         z = np.clip(z, lower, upper)
         if max_iterations > 0:
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
-                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
+                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations,
+                                   tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12})
             if result.status > 0:
                 return result.x, result.jac
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
@@ -728,12 +726,12 @@ def _coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
 
 
-def _covariance(jacobian: np.ndarray, reduced_chi_square: float) -> np.ndarray:
-    """Parameter covariance from the weighted Jacobian, scaled up by the
-    reduced chi-square when the residuals exceed the noise (never down: on
-    noise-free integer chips the noise is the quantisation's, 1/sqrt(12) DN,
-    which flat plateaus do not show)."""
-    return np.linalg.pinv(jacobian.T @ jacobian) * max(reduced_chi_square, 1.0)
+def _covariance(jacobian, reduced_chi_square: float) -> np.ndarray:
+    """Parameter covariance from the weighted (sparse) Jacobian, scaled up by
+    the reduced chi-square when the residuals exceed the noise (never down:
+    on noise-free integer chips the noise is the quantisation's, 1/sqrt(12)
+    DN, which flat plateaus do not show)."""
+    return np.linalg.pinv((jacobian.T @ jacobian).toarray()) * max(reduced_chi_square, 1.0)
 
 
 # -- the report -------------------------------------------------------------------
