@@ -170,3 +170,31 @@ def test_direction_is_labelled_only_near_the_track():
     assert im.measure_edge(edge(angle=30.0), track_azimuth_deg=30.0).direction == "across-track"
     unknown = im.measure_edge(edge(), track_azimuth_deg=None)
     assert unknown.direction == "unknown" and any("map-projected" in w for w in unknown.warnings)
+
+
+def _normal_distance(shape=(100, 100), angle=6.0, offset=0.2):
+    rows, cols = shape
+    y, x = np.mgrid[0:rows, 0:cols].astype(float)
+    a = math.radians(angle)
+    return (x - (cols - 1) / 2) * math.cos(a) + (y - (rows - 1) / 2) * math.sin(a) - offset
+
+
+def test_a_side_that_curves_or_never_settles_is_non_uniform_and_a_lens_tail_is_not():
+    from conftest import diffraction_transfer, product
+    chip = edge(noise=3.0, dtype=np.float64)
+    d = _normal_distance()
+    bright = np.clip(d / 50.0, 0.0, None)
+    # an illumination fall-off growing as the square of the distance: 10 % of the contrast over the side
+    error = refused(chip + 1000 * 0.1 * bright ** 2, "non-uniform")
+    assert "departs from a settled level" in str(error)
+    # a level still rising towards its plateau 15 px out (20 % of the contrast to come): never settles
+    error = refused(chip + 1000 * 0.2 * (1 - np.exp(-d.clip(0) / 15)), "non-uniform")
+    assert "has not settled" in str(error)
+    # half as much curvature: measured, with the departure said
+    mild = im.measure_edge(chip + 1000 * 0.05 * bright ** 2)
+    assert any("departs from a settled level" in w for w in mild.warnings)
+    # diffraction's long tails (f/16) and a Gaussian's none are a settled level: no word
+    for h in (product(diffraction_transfer(8.6 / 16), gaussian_pixel_transfer(0.0, 6.0)), H):
+        r = im.measure_edge(exact_edge_chip(h, 6.0, shape=(100, 200), offset=0.2, noise_std=1.0))
+        assert not r.warnings and all(c.passed for c in r.checks)
+        assert abs(r.mtf_nyquist - float(h(0.5))) < 0.01

@@ -44,6 +44,7 @@ from ..inputs import as_array, check_number, prepare_image, quantum, saturation_
 from ..metrics import fwhm
 from . import gate
 from .detection import Line, robust_noise
+from .evidence import Evidence
 from .geometry import (
     EDGE_FIT_HALF_WINDOW_PX,
     TargetGeometry,
@@ -62,6 +63,7 @@ from .intervals import (
     influence_sds,
     linearised_interval,
 )
+from .profile_checks import run_profile_checks
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
 from .spectrum import (
@@ -713,7 +715,13 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks.append(gate.figures_check(
         mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
         mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
+    # the registered checks come last: a failure above (a sharpened halo) names the cause better
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    profile_checks, profile_warnings = run_profile_checks(Evidence(
+        d, raw, row, c, shape.scale_px, shape.plateau_px, shape.low, shape.high, noise, q, kind.tail_power,
+        kind.name, kind.profile, (side_names[0], side_names[1])))
+    checks += profile_checks
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings
     if cut:
         warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
