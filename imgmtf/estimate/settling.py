@@ -110,12 +110,12 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
 
     band = np.floor((reach - reach.min()) / BAND_PX).astype(int)
     counts = np.bincount(band)
-    means = np.bincount(band, weights=resid)
+    sums = np.bincount(band, weights=resid)
     full = counts >= MIN_BAND_SAMPLES
     if full.sum() <= SMOOTH_DEGREE + 1:
         return {"departure": (0.0, math.inf, 0.0), "unsettled": unsettled}
     centres = reach.min() + (np.nonzero(full)[0] + 0.5) * BAND_PX
-    means = means[full] / counts[full]
+    means = sums[full] / counts[full]
     error2 = sigma2 / counts[full] + ev.rounding_floor ** 2
     t = 2.0 * (centres - centres[0]) / max(centres[-1] - centres[0], 1e-9) - 1.0
     basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
