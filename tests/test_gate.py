@@ -198,3 +198,25 @@ def test_a_side_that_curves_or_never_settles_is_non_uniform_and_a_lens_tail_is_n
         r = im.measure_edge(exact_edge_chip(h, 6.0, shape=(100, 200), offset=0.2, noise_std=1.0))
         assert not r.warnings and all(c.passed for c in r.checks)
         assert abs(r.mtf_nyquist - float(h(0.5))) < 0.01
+
+
+def test_blur_that_changes_along_the_target_is_refused_or_said():
+    def halves(sigma_top, sigma_bottom, noise=3.0):
+        top = exact_edge_chip(gaussian_pixel_transfer(sigma_top, 6.0), 6.0, offset=0.2, noise_std=noise,
+                              dtype=np.float64)
+        bottom = exact_edge_chip(gaussian_pixel_transfer(sigma_bottom, 6.0), 6.0, offset=0.2, noise_std=noise,
+                                 seed=2, dtype=np.float64)
+        return np.vstack([top[:50], bottom[50:]])
+    error = refused(halves(0.5, 0.9), "varying-blur")
+    assert "rows 0-" in str(error) and "-99" in str(error)
+    slight = im.measure_edge(halves(0.5, 0.55, noise=1.0))
+    assert any("blur changes a little" in w for w in slight.warnings)
+    assert not any("blur" in w for w in im.measure_edge(halves(0.5, 0.5)).warnings)
+    # a bar whose lower half is blurred more
+    sharp, soft = (im.render(im.Sensor(optics_sigma_x_m=s, optics_sigma_y_m=s, motion_m=0.0,
+                                       electronics_cutoff_cy_m=0.0),
+                             im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, 3.0), (100, 80), noise_std_dn=2.0,
+                             seed=k).image for k, s in ((1, 0.4), (2, 0.8)))
+    refused(np.vstack([sharp[:50], soft[50:]]).astype(float), "varying-blur", measure=im.measure_pulse,
+            width_px=3.0)
+    assert im.measure_pulse(sharp, width_px=3.0).mtf_nyquist > 0

@@ -15,7 +15,11 @@ warnings.  Reasons:
 ``not-straight``          the per-row locations do not lie on one line (no
                           edge at all, a curved edge, texture)
 ``two-targets``           a second edge or bar beside the target
-``non-uniform``           a side with a level trend or texture
+``non-uniform``           a side with a level trend or texture, a level
+                          that curves or never settles
+                          (:mod:`.settling`)
+``varying-blur``          the blur changes along the target
+                          (:mod:`.blur_along`)
 ``too-short``             too few rows for a stable estimate
 ``mtf-above-one``         the MTF rises above 1 by more than its noise
 ``mtf-undefined``         MTF50, MTF at Nyquist or FWHM cannot be read off
@@ -84,7 +88,7 @@ class QualityError(UnsuitableTargetError):
 
 #: the reasons a user may overrule with ``force=True``
 FORCIBLE = frozenset({"fill", "saturated", "not-straight", "two-targets", "non-uniform", "too-short", "snr",
-                      "mtf-above-one", "mtf-undefined"})
+                      "mtf-above-one", "mtf-undefined", "varying-blur"})
 
 
 class TwoTargetsError(QualityError, MultipleTargetsError):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from .blur_along import uniform_blur
 from .evidence import Evidence
 from .gate import Check
 from .settling import settled_sides
@@ -12,7 +13,7 @@ from .settling import settled_sides
 ProfileCheck = Callable[[Evidence], tuple[list[Check], list[str]]]
 
 #: run in this order on every measured edge and bar
-PROFILE_CHECKS: tuple[ProfileCheck, ...] = (settled_sides,)
+PROFILE_CHECKS: tuple[ProfileCheck, ...] = (settled_sides, uniform_blur)
 
 
 def run_profile_checks(evidence: Evidence) -> tuple[list[Check], list[str]]:
