@@ -220,3 +220,35 @@ def test_blur_that_changes_along_the_target_is_refused_or_said():
     refused(np.vstack([sharp[:50], soft[50:]]).astype(float), "varying-blur", measure=im.measure_pulse,
             width_px=3.0)
     assert im.measure_pulse(sharp, width_px=3.0).mtf_nyquist > 0
+
+
+def test_a_flat_white_level_approached_smoothly_is_no_clip_and_a_clip_still_is():
+    """MTF Mapper's generator writes its white as one exact value (63897 DN,
+    22 % of the samples), with a wobble of its last digits below it (never
+    above, in steps of about 17 DN); its chips were refused as clipped.  A
+    Gaussian + pixel edge with that white stands in for them here."""
+    from conftest import true_mtf50
+    h = gaussian_pixel_transfer(0.45, 5.0)
+    white = 63897.0
+    exact = exact_edge_chip(h, 5.0, low=1638.0, high=white, offset=0.2, dtype=np.float64)
+    wobble = 17.0 * np.floor(np.abs(np.random.default_rng(5).normal(0.0, 1.9, exact.shape)))
+    wobbly = np.rint(exact) - wobble
+    assert (wobbly == white).mean() > 0.15
+    for chip in (wobbly, exact):
+        r = im.measure_edge(np.rint(chip).astype(np.uint16))
+        assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.01)
+    # the same white cut 5 % of the contrast lower is a clip, with the wobble and without
+    cut = white - 0.05 * (white - 1638.0)
+    refused(np.rint(np.minimum(wobbly, cut)).astype(np.uint16), "saturated")
+    refused(np.rint(np.minimum(exact, cut)).astype(np.uint16), "saturated")
+
+
+def test_noise_free_bars_up_to_10_px_wide_are_measured_and_clipped_ones_are_not():
+    for width in (8.0, 10.0):
+        chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, width), (100, 80))
+        result = im.measure_pulse(chip.image, width_px=width)
+        f = np.array([0.5, 1.5]) / width           # between the sinc's zeros at multiples of 1 / width
+        assert np.allclose(result.mtf_function(f), chip.true_mtf(f), atol=0.003)
+        for clip in (1100.0, 1190.0):
+            refused(np.minimum(chip.image.astype(float), clip), "saturated", measure=im.measure_pulse,
+                    width_px=width)
