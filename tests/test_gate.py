@@ -252,3 +252,33 @@ def test_noise_free_bars_up_to_10_px_wide_are_measured_and_clipped_ones_are_not(
         for clip in (1100.0, 1190.0):
             refused(np.minimum(chip.image.astype(float), clip), "saturated", measure=im.measure_pulse,
                     width_px=width)
+
+
+def test_nan_holes_and_hot_pixels_are_left_out_and_counted():
+    chip = edge(noise=3.0, dtype=np.float64)
+    y, x = np.mgrid[0:100, 0:100]
+    holes = chip.copy()
+    for cy, cx, radius in ((20, 30, 6), (60, 70, 8), (80, 45, 4)):       # cloud-like NaN blobs on both sides
+        holes[(y - cy) ** 2 + (x - cx) ** 2 < radius ** 2] = np.nan
+    clean = im.measure_edge(chip)
+    r = im.measure_edge(holes)
+    assert r.params["nodata_px"] == int(np.isnan(holes).sum())
+    assert any(f"{r.params['nodata_px']} NaN or nodata" in w for w in r.warnings)
+    assert abs(r.mtf_nyquist - clean.mtf_nyquist) < 0.01 and abs(r.mtf_nyquist - H(0.5)) < 0.015
+    # a mask leaves pixels out without a word; NaN among them is not counted again
+    masked = im.measure_edge(holes, mask=~np.isnan(holes))
+    assert "nodata_px" not in masked.params and masked.mtf_nyquist == r.mtf_nyquist
+    hot = chip.copy()
+    rng = np.random.default_rng(3)
+    # hot and dead pixels on the levels (within a few px of the edge a dead pixel hides in the step)
+    columns = rng.choice(np.r_[5:40, 62:95], 12, replace=False)
+    hot[rng.choice(100, 12, replace=False), columns] = np.where(np.arange(12) % 2, 4000.0, 0.0)
+    r = im.measure_edge(hot)
+    assert r.params["outlier_px"] == 12 and any("12 isolated" in w for w in r.warnings)
+    assert abs(r.mtf_nyquist - clean.mtf_nyquist) < 0.01
+    # no pixel of a clean edge or a thin noise-free bar, at any angle, is an outlier
+    from imgmtf.estimate.outliers import isolated_outliers
+    for angle in np.arange(2.0, 44.0, 3.7):
+        bar = im.render(im.Sensor(), im.Target("pulse", angle, 200, 1200, 0.3, 0.5), 100).image.astype(float)
+        assert not isolated_outliers(bar, 0.0).any()
+        assert not isolated_outliers(edge(noise=0.0, angle=angle, dtype=np.float64), 0.0).any()

@@ -63,6 +63,7 @@ from .intervals import (
     influence_sds,
     linearised_interval,
 )
+from .outliers import isolated_outliers
 from .profile_checks import run_profile_checks
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
@@ -549,6 +550,9 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     q = quantum(data, stored)
     checks = [gate.fill_check(data, stored)]
     pixel_noise = robust_noise(data)
+    rows, cols = data.shape
+    chosen = None if mask is None else np.asarray(mask)[y0:y0 + rows, x0:x0 + cols]
+    left_out = _left_out_pixels(data, chosen, pixel_noise)
 
     try:
         line, seed_checks = kind.seed(data, pixel_noise)
@@ -722,7 +726,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         d, raw, row, c, shape.scale_px, shape.plateau_px, shape.low, shape.high, noise, q, kind.tail_power,
         kind.name, kind.profile, (side_names[0], side_names[1])))
     checks += profile_checks
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + left_out[1]
     if cut:
         warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
@@ -766,8 +770,26 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
                         "track, so the direction is unknown; give the track's azimuth to label it")
     params = {**settings.as_dict(), **resampled.params, "lsf_half_width_px": core, "lsf_taper_px": taper,
-              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None}
+              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None,
+              **left_out[0]}
     return Measurement(figures, arrays, tuple(checks), tuple(warnings), params)
+
+
+def _left_out_pixels(data: np.ndarray, mask, noise: float) -> tuple[dict, list[str]]:
+    """Leave isolated hot and dead pixels out of ``data`` (set to NaN, in
+    place) and count them and the NaN or nodata pixels among those the
+    caller's ``mask`` (cropped to ``data``) keeps: (params, warnings)
+    saying so."""
+    nodata = int(np.count_nonzero(np.isnan(data) if mask is None else np.isnan(data) & mask))
+    hot = isolated_outliers(data, noise)
+    data[hot] = np.nan
+    counts = {"nodata_px": nodata, "outlier_px": int(hot.sum())}
+    said = []
+    if nodata:
+        said.append(f"{nodata} NaN or nodata pixel(s) inside the chip are left out of the estimate")
+    if hot.any():
+        said.append(f"{int(hot.sum())} isolated outlying pixel(s) (hot or dead) are left out of the estimate")
+    return {k: v for k, v in counts.items() if v}, said
 
 
 def _saturation(value) -> tuple[float, float]:
