@@ -19,10 +19,8 @@ significant changes are said.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
-from scipy.optimize import OptimizeWarning, curve_fit
 
 from .evidence import Evidence
 from .gate import Check
@@ -90,24 +88,65 @@ def _group_width(ev: Evidence, in_group: np.ndarray) -> tuple[float, float] | No
     if np.count_nonzero(near) < MIN_GROUP_SAMPLES:
         return None
     s, v = s[near], ev.values[in_group][near]
-    step = ev.high - ev.low
-    model = _bar if ev.profile == "bar" else _step
-    start = (step, 0.0, max(ev.scale_px, 0.2) * (0.5 if ev.profile == "bar" else 0.25), ev.low)
+    bar = ev.profile == "bar"
+    start = np.array([ev.high - ev.low, 0.0, max(ev.scale_px, 0.2) * (0.5 if bar else 0.25), ev.low])
+    fitted = _fit(_bar if bar else _step, s, v, start)
+    if fitted is None:
+        return None
+    params, variance = fitted
+    return abs(float(params[2])), variance
+
+
+def _step(s, p):
+    """A Fermi step and its Jacobian in (amplitude, centre, scale, base)."""
+    u = np.clip((s - p[1]) / p[2], -50.0, 50.0)
+    f = 1.0 / (1.0 + np.exp(-u))
+    slope = f * (1.0 - f)
+    return p[3] + p[0] * f, np.column_stack([f, -p[0] * slope / p[2], -p[0] * slope * u / p[2], np.ones_like(f)])
+
+
+def _bar(s, p):
+    """A Gaussian pulse and its Jacobian in (amplitude, centre, scale, base)."""
+    u = (s - p[1]) / p[2]
+    g = np.exp(-0.5 * u * u)
+    return p[3] + p[0] * g, np.column_stack([g, p[0] * g * u / p[2], p[0] * g * u * u / p[2], np.ones_like(g)])
+
+
+def _fit(model, s, v, start, iterations=60) -> tuple[np.ndarray, float] | None:
+    """Levenberg-Marquardt least squares of ``model`` to (s, v) from
+    ``start``: the parameters and the variance of the third (the scale),
+    scaled by the residual variance.  None where it does not converge to
+    finite numbers."""
+    p = start.astype(float)
+    fit, jac = model(s, p)
+    cost = float(np.sum((v - fit) ** 2))
+    damping = 1e-3
+    for _ in range(iterations):
+        normal = jac.T @ jac
+        gradient = jac.T @ (v - fit)
+        try:
+            step = np.linalg.solve(normal + damping * np.diag(np.maximum(np.diag(normal), 1e-12)), gradient)
+        except np.linalg.LinAlgError:
+            return None
+        trial = p + step
+        if trial[2] == 0:
+            damping *= 4.0
+            continue
+        trial_fit, trial_jac = model(s, trial)
+        trial_cost = float(np.sum((v - trial_fit) ** 2))
+        if np.isfinite(trial_cost) and trial_cost < cost:
+            converged = abs(step[2]) < 1e-7 * max(abs(trial[2]), 1e-9)
+            p, fit, jac, cost, damping = trial, trial_fit, trial_jac, trial_cost, damping / 3.0
+            if converged:
+                break
+        else:
+            damping *= 4.0
+            if damping > 1e10:
+                break
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", OptimizeWarning)
-            params, cov = curve_fit(model, s, v, p0=start, maxfev=2000)
-    except (RuntimeError, ValueError):
+        covariance = np.linalg.inv(jac.T @ jac) * cost / max(s.size - 4, 1)
+    except np.linalg.LinAlgError:
         return None
-    variance = float(cov[2, 2])
-    if not (np.isfinite(params).all() and math.isfinite(variance)) or params[2] == 0:
+    if not (np.isfinite(p).all() and math.isfinite(covariance[2, 2])):
         return None
-    return abs(float(params[2])), max(variance, 0.0)
-
-
-def _step(s, amplitude, centre, scale, base):
-    return base + amplitude / (1.0 + np.exp(np.clip(-(s - centre) / scale, -50.0, 50.0)))
-
-
-def _bar(s, amplitude, centre, scale, base):
-    return base + amplitude * np.exp(-0.5 * ((s - centre) / scale) ** 2)
+    return p, max(float(covariance[2, 2]), 0.0)

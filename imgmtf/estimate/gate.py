@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from statistics import NormalDist
 
 import numpy as np
-from scipy.stats import norm
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
 
@@ -431,8 +431,8 @@ def _pile_up(name, values, mask, quantum, contrast=None) -> Check:
     clipped = share > 0.05 and ratio > PILE_UP
     if clipped and contrast and share < 0.5:
         sigma = 1.4826 * float(np.median(np.abs(v - np.median(v))))
-        z = float(norm.isf(share))
-        clipped = sigma * (float(norm.pdf(z)) - z * share) > MIRROR_CLIP * contrast
+        z = NormalDist().inv_cdf(1.0 - share)
+        clipped = sigma * (NormalDist().pdf(z) - z * share) > MIRROR_CLIP * contrast
     return Check("saturated", not clipped,
                  f"{100 * share:.0f} % of the {name} side's samples sit at exactly "
                  f"{extreme:g} DN, {ratio:.1f} x as many as just inside it: clipped", ratio, PILE_UP)

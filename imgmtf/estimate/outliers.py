@@ -13,7 +13,6 @@ not straight.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter, minimum_filter
 
 OUTLIER_NOISE = 8.0           # beyond every neighbour by this many noise sd...
 OUTLIER_CONTRAST = 0.1        # ...and by this fraction of the chip's contrast
@@ -42,10 +41,8 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
     margin = max(OUTLIER_NOISE * noise, OUTLIER_CONTRAST * (high - low))
     if not margin > 0:
         return np.zeros(data.shape, bool)
-    around = np.ones((5, 5), bool)
-    around[2, 2] = False
-    above = maximum_filter(np.where(finite, data, -np.inf), footprint=around, mode="nearest")
-    below = minimum_filter(np.where(finite, data, np.inf), footprint=around, mode="nearest")
+    above = _around(np.where(finite, data, -np.inf), 2, np.maximum, -np.inf)
+    below = _around(np.where(finite, data, np.inf), 2, np.minimum, np.inf)
     # and beyond the block's own range: a thin bar's peak pixel rises above
     # its block by less than the bar's height (the block holds pixels along
     # the bar), a hot pixel on a level stands far out of its block's noise
@@ -54,7 +51,19 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
         beyond = np.maximum(margin, spread)
         outlier = finite & ((data > above + beyond) | (data < below - beyond))
     # isolated: no outlying neighbour (a cluster is a feature, the gate's to judge)
-    ring = np.ones((3, 3), bool)
-    ring[1, 1] = False
-    clustered = maximum_filter(outlier.astype(np.uint8), footprint=ring, mode="constant") > 0
+    clustered = _around(outlier, 1, np.logical_or, False)
     return outlier & ~clustered
+
+
+def _around(values: np.ndarray, reach: int, combine, fill) -> np.ndarray:
+    """``combine`` (np.maximum, np.minimum, np.logical_or) over each
+    pixel's block of half-size ``reach``, the pixel itself left out;
+    ``fill`` beyond the border."""
+    rows, cols = values.shape
+    padded = np.pad(values, reach, constant_values=fill)
+    out = np.full(values.shape, fill, dtype=values.dtype)
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            if dy or dx:
+                combine(out, padded[reach + dy: reach + dy + rows, reach + dx: reach + dx + cols], out=out)
+    return out
