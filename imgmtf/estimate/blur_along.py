@@ -27,6 +27,7 @@ from .gate import Check
 
 MIN_REACH_PX = 3.0              # the fit sees at least this far either side of the centre
 MIN_GROUP_SAMPLES = 40
+MIN_SCALE_PX = 0.02
 MIN_GROUP_ROWS = 8
 MAX_WIDTH_CHANGE = 0.08        # relative: the parts' MTFs at Nyquist then differ by about 0.03
 WARN_WIDTH_CHANGE = 0.03
@@ -94,6 +95,8 @@ def _group_width(ev: Evidence, in_group: np.ndarray) -> tuple[float, float] | No
     if fitted is None:
         return None
     params, variance = fitted
+    if abs(params[2]) < MIN_SCALE_PX:          # a step no blur: no fit to compare (fill, a clip)
+        return None
     return abs(float(params[2])), variance
 
 

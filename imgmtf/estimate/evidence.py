@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import TargetGeometry
+
 
 @dataclass(frozen=True, eq=False)
 class Evidence:
@@ -46,6 +48,8 @@ class Evidence:
     side_names : tuple of str
         What the left and the right side are called ("dark", "bright",
         "left background"...).
+    geometry : TargetGeometry or None
+        The target's line and its per-row locations.
     """
 
     distance_px: np.ndarray
@@ -62,6 +66,7 @@ class Evidence:
     name: str
     profile: str
     side_names: tuple[str, str]
+    geometry: TargetGeometry | None = None
 
     @property
     def contrast(self) -> float:

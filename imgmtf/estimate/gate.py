@@ -20,6 +20,8 @@ warnings.  Reasons:
                           (:mod:`.settling`)
 ``varying-blur``          the blur changes along the target
                           (:mod:`.blur_along`)
+``compression``           8 x 8 blocks of a lossy codec shape the target
+                          (:mod:`.blocks`)
 ``too-short``             too few rows for a stable estimate
 ``mtf-above-one``         the MTF rises above 1 by more than its noise
 ``mtf-undefined``         MTF50, MTF at Nyquist or FWHM cannot be read off
@@ -69,7 +71,8 @@ class Check:
 
     ``reason`` is the machine-readable code, ``message`` one line saying
     what was measured against what limit; ``value`` and ``limit`` are the
-    numbers (units in the message).
+    numbers (units in the message); ``share`` the fraction of the chip a
+    failure covers, where that is known (fill).
     """
 
     reason: str
@@ -77,6 +80,7 @@ class Check:
     message: str
     value: float | None = None
     limit: float | None = None
+    share: float | None = None
 
 
 class QualityError(UnsuitableTargetError):
@@ -94,11 +98,32 @@ class QualityError(UnsuitableTargetError):
 
 #: the reasons a user may overrule with ``force=True``
 FORCIBLE = frozenset({"fill", "saturated", "not-straight", "two-targets", "non-uniform", "too-short", "snr",
-                      "mtf-above-one", "mtf-undefined", "varying-blur"})
+                      "mtf-above-one", "mtf-undefined", "varying-blur", "compression"})
 
 
 class TwoTargetsError(QualityError, MultipleTargetsError):
     """A chip refused because it holds a second edge or bar."""
+
+
+MOSTLY_FILL = 0.5               # a forced chip more than this much fill measures the fill's boundary
+
+
+def untrusted_when_forced(checks) -> Check | None:
+    """The check that makes a forced number unusable, or None: an MTF above
+    1 beyond its noise (even within the gate's allowance), figures that
+    cannot be read off (not an MTF), or fill that is most of the chip or
+    comes with a second target (whose edge is then the fill's boundary).
+    A caller reports such a number as a failure, printed with its reason."""
+    failed = {c.reason: c for c in checks if not c.passed}
+    for check in checks:
+        if check.reason == "mtf-above-one" and check.value is not None and check.value > 0:
+            return Check("mtf-above-one", False, check.message, check.value, 0.0)
+    if "mtf-undefined" in failed:
+        return failed["mtf-undefined"]
+    fill = failed.get("fill")
+    if fill is not None and ((fill.share or 0.0) > MOSTLY_FILL or "two-targets" in failed):
+        return fill
+    return None
 
 
 def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
@@ -145,7 +170,7 @@ def fill_check(image: np.ndarray, dtype) -> Check:
         if jump > FILL_BOUNDARY:
             return Check("fill", False, f"{100 * count / values.size:.1f} % of the chip is fill at "
                          f"{value:g} DN with a hard boundary (no nodata tag declares it): crop the "
-                         "ROI away from it", jump, FILL_BOUNDARY)
+                         "ROI away from it", jump, FILL_BOUNDARY, count / values.size)
     return Check("fill", True, "no fill in the chip")
 
 

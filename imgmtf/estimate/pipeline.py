@@ -42,6 +42,7 @@ from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
+from ..transfer import Transfer, full_scale, parse_transfer
 from . import gate
 from .detection import Line, robust_noise
 from .evidence import Evidence
@@ -147,6 +148,10 @@ class Settings:
     force : bool
         Measure even when a quality check fails (each failure becomes a
         warning) instead of refusing.
+    transfer : str or Transfer
+        How the stored values relate to light (:mod:`imgmtf.transfer`):
+        "linear" (default: as stored), "srgb" or "gamma:G"; the values are
+        linearised before measuring.
 
     Raises
     ------
@@ -164,6 +169,7 @@ class Settings:
     lsf_window_factor: float | None = None
     intervals: Intervals = field(default_factory=Intervals)
     force: bool = False
+    transfer: Transfer = field(default_factory=Transfer)
 
     def __post_init__(self):
         check_method(self.method)
@@ -192,10 +198,11 @@ class Settings:
         set_(self, "intervals", as_intervals(self.intervals))
         if not isinstance(self.force, (bool, np.bool_)):
             raise ParameterError(f"force must be True or False, got {self.force!r}")
+        set_(self, "transfer", parse_transfer(self.transfer))
 
     def as_dict(self) -> dict:
         out = {"method": self.method, "step_px": self.step_px, "correct": self.correct,
-               "intervals": self.intervals.as_dict(), "force": self.force}
+               "intervals": self.intervals.as_dict(), "force": self.force, "transfer": str(self.transfer)}
         for key in ("snr_threshold", "lsf_half_width_px", "lsf_window_factor"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
@@ -547,6 +554,17 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     if track_azimuth_deg is not None:
         track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
     limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
+    decoded = []
+    if not settings.transfer.is_linear:
+        # linear light in the same DN scale; the type's limits stay put, its
+        # quantum does not (the decoded steps are uneven)
+        scale = full_scale(stored)
+        data = settings.transfer.linearise(data, scale)
+        limits = None if limits is None else (float(settings.transfer.linearise(np.array(limits[0]), scale)),
+                                              float(settings.transfer.linearise(np.array(limits[1]), scale)))
+        stored = np.dtype(np.float64)
+        decoded.append(f"the values were linearised ({settings.transfer}, full scale {scale:g} DN) before "
+                       "measuring")
     q = quantum(data, stored)
     checks = [gate.fill_check(data, stored)]
     pixel_noise = robust_noise(data)
@@ -724,9 +742,9 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     profile_checks, profile_warnings = run_profile_checks(Evidence(
         d, raw, row, c, shape.scale_px, shape.plateau_px, shape.low, shape.high, noise, q, kind.tail_power,
-        kind.name, kind.profile, (side_names[0], side_names[1])))
+        kind.name, kind.profile, (side_names[0], side_names[1]), geometry))
     checks += profile_checks
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + left_out[1]
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + left_out[1] + decoded
     if cut:
         warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from .blocks import block_boundaries
 from .blur_along import uniform_blur
 from .evidence import Evidence
 from .gate import Check
@@ -13,7 +14,7 @@ from .settling import settled_sides
 ProfileCheck = Callable[[Evidence], tuple[list[Check], list[str]]]
 
 #: run in this order on every measured edge and bar
-PROFILE_CHECKS: tuple[ProfileCheck, ...] = (settled_sides, uniform_blur)
+PROFILE_CHECKS: tuple[ProfileCheck, ...] = (block_boundaries, settled_sides, uniform_blur)
 
 
 def run_profile_checks(evidence: Evidence) -> tuple[list[Check], list[str]]:
