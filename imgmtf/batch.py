@@ -199,8 +199,11 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
             continue
         if raster.band == "luminance":
             # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
-            file_notes = [*file_notes, "measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded "
-                          "as stored (not linearised)" + (", alpha ignored" if info.alpha_bands else "")]
+            encoding = ("gamma-encoded as stored (not linearised: the sRGB or a gamma transfer curve linearises "
+                        "them)" if settings.transfer == "linear" else f"then linearised ({settings.transfer}: exact "
+                        "for a grey target, whose channels are equal)")
+            file_notes = [*file_notes, f"measured on the Rec. 709 luminance of the stored RGB values, {encoding}"
+                          + (", alpha ignored" if info.alpha_bands else "")]
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         record = _with_file_notes(record, raster, settings, result.checks)
@@ -220,7 +223,9 @@ def _with_file_notes(record: Record, raster, settings: MeasureSettings, checks) 
     if raster.compression:
         notes.append(f"the file is stored with {raster.compression} compression: the MTF includes the codec's loss "
                      "(measure an uncompressed copy for the system's own)")
-    if raster.dtype == "uint8" and settings.transfer == "linear" and raster.provenance is None:
+    # (an RGB file's luminance carries its own note of the encoding)
+    if (raster.dtype == "uint8" and settings.transfer == "linear" and raster.provenance is None
+            and raster.band != "luminance"):
         notes.append("8-bit values are measured as stored, taken as linear: if the image is gamma-encoded "
                      "(sRGB, as most 8-bit camera images are) the MTF reads wrong; linearise it with the sRGB "
                      "or a gamma transfer curve (MTF Mapper assumes sRGB for 8-bit input, Imatest its "

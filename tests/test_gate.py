@@ -282,3 +282,15 @@ def test_nan_holes_and_hot_pixels_are_left_out_and_counted():
         bar = im.render(im.Sensor(), im.Target("pulse", angle, 200, 1200, 0.3, 0.5), 100).image.astype(float)
         assert not isolated_outliers(bar, 0.0).any()
         assert not isolated_outliers(edge(noise=0.0, angle=angle, dtype=np.float64), 0.0).any()
+
+
+def test_a_road_beside_an_edge_and_a_shadow_beside_a_bar_are_second_targets():
+    d = _normal_distance()
+    road = edge(noise=3.0, dtype=np.float64) + 600.0 * ((d < -10) & (d > -16))     # a bright band on the dark side
+    refused(road, "two-targets")
+    bar = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, 2.0), (100, 80), noise_std_dn=3.0,
+                    seed=5).image.astype(float)
+    d = _normal_distance((100, 80), offset=0.3)
+    refused(bar - 300.0 * ((d > 7) & (d < 11)), "two-targets", measure=im.measure_pulse, width_px=2.0)
+    assert gate.mixed_profile(np.r_[np.full(10, 200.0), np.full(5, 800.0), np.full(10, 200.0), np.full(10, 1200.0)])
+    assert not gate.mixed_profile(np.r_[np.full(10, 200.0), np.linspace(200, 1200, 5), np.full(10, 1200.0)])

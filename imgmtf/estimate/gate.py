@@ -62,6 +62,7 @@ MIRROR_CLIP = 0.005             # the other side's distance from its level there
 FLAT_PEAK = 0.3                 # fraction of a noise-free bar's peak at exactly one value: clipped flat...
 FLAT_SHOULDER = 0.02            # ...unless it is reached gradually, through samples this far below (of the height)
 MAX_MTF_EXCESS = 0.05           # MTF above 1 + this (plus 3 noise sd) refuses the chip
+MIXED_SHARE = 0.25              # a profile with a step and a bar each this share of its range: two targets
 EDGE_STEP_RATIO = 0.5           # |right - left| / largest excursion: above it a step, below a bar
 
 
@@ -256,9 +257,32 @@ def classify_profile(values: np.ndarray) -> str:
     return "edge" if excursion > 0 and abs(right - left) >= EDGE_STEP_RATIO * excursion else "bar"
 
 
-def kind_check(kind: str, wanted: str) -> Check:
+def mixed_profile(values: np.ndarray) -> bool:
+    """Does the profile hold both a step and a bar (an edge with a road or a
+    shadow beside it)?  Its ends differ by at least ``MIXED_SHARE`` of its
+    range, and it also reaches that far beyond both ends, or turns back
+    that far between them."""
+    n_side = max(values.size // 8, 2)
+    left, right = values[:n_side].mean(), values[-n_side:].mean()
+    span = float(values.max() - values.min())
+    if span <= 0:
+        return False
+    beyond = max(values.max() - max(left, right), min(left, right) - values.min())
+    # or turns back between them (a bar between the edge's levels)
+    rising = values if right >= left else -values
+    turned = float(np.max(np.maximum.accumulate(rising) - rising))
+    return abs(right - left) >= MIXED_SHARE * span and max(beyond, turned) >= MIXED_SHARE * span
+
+
+def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Check:
+    """Is the profile the kind of target asked for?  Where it is not and it
+    holds a step and a bar at once (``values`` given), the reason is the
+    second feature beside the target, not the kind."""
     if kind == wanted:
         return Check(f"not-a-{'bar' if wanted == 'bar' else 'n-edge'}", True, f"the profile is a {kind}")
+    if values is not None and mixed_profile(values):
+        return Check("two-targets", False, f"the profile holds a step and a bar: a second feature (a road, a "
+                     f"shadow, another {'edge' if wanted == 'bar' else 'bar'}) lies beside the target")
     if wanted == "edge":
         return Check("not-an-edge", False, "the profile rises and falls back: a bar, not an edge "
                      "(measure it with --target pulse)")

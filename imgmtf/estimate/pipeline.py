@@ -417,7 +417,9 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
     """Where the target could not be followed row by row (a bar defeats an
     edge's step fits, and leaves its phases too sparse), the rows' mean
     profile about the seed says whether it is the other kind of target:
-    that is the reason to give (``not-an-edge``, ``not-a-bar``).
+    that is the reason to give (``not-an-edge``, ``not-a-bar``), or, where
+    the whole rows hold a step and a bar, the second target
+    (``two-targets``).
 
     Raises
     ------
@@ -426,8 +428,16 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
     _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
     counts = inside.sum(axis=0)
     if counts.min() > 0:
-        check = gate.kind_check(gate.classify_profile(values.sum(axis=0) / counts), kind.profile)
+        mean = values.sum(axis=0) / counts
+        check = gate.kind_check(gate.classify_profile(mean), kind.profile, mean)
         if not check.passed:
+            # the whole rows say whether the other kind stands beside a target of the wanted kind
+            _, wide, wide_inside = row_windows(work, seed_x, work.shape[1])
+            wide_counts = wide_inside.sum(axis=0)
+            covered = wide_counts >= 0.5 * work.shape[0]
+            if covered.sum() > 2 * EDGE_FIT_HALF_WINDOW_PX + 1:
+                whole = wide.sum(axis=0)[covered] / wide_counts[covered]
+                check = gate.kind_check(gate.classify_profile(mean), kind.profile, whole)
             raise UnsuitableTargetError(check.message, reason=check.reason) from None
 
 
@@ -607,7 +617,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         return (r, *_central_run(r.grid, r.values, kind.name))
     try:
         resampled, grid, values, span = resample(min(reach, INITIAL_SPAN_PX))
-        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile)
+        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile, values)
         if not kind_check.passed:
             raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
         try:
