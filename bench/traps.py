@@ -30,7 +30,7 @@ from imgmtf.errors import ImgmtfError
 from imgmtf.transfer import parse_transfer
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from conftest import (  # noqa: E402
+from conftest import (
     diffraction_transfer,
     exact_edge_chip,
     gaussian_pixel_transfer,
