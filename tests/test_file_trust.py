@@ -86,3 +86,12 @@ def test_a_clean_forced_number_is_a_success(tmp_path):
     im.write_geotiff(tmp_path / "edge.tif", chip.image)
     code, (row,) = measure("--force", tmp_path / "edge.tif")
     assert code == 0 and row["status"] == "ok"
+
+
+@pytest.mark.parametrize("width", ["8px", "10px"])
+def test_noise_free_wide_bars_from_simulate_are_measured(tmp_path, width):
+    path = tmp_path / "bar.tif"
+    made = CliRunner().invoke(main, ["simulate", "--target", "pulse", "--pulse-width", width, "--out", str(path)])
+    assert made.exit_code == 0, made.output
+    code, (row,) = measure("--target", "pulse", "--pulse-width", width, path)
+    assert code == 0 and row["status"] == "ok", row.get("error")

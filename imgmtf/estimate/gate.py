@@ -290,7 +290,7 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Chec
 
 
 def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum, noise_free,
-                      bright_core=None, monotone=True, contrast=None) -> list[Check]:
+                      bright_core=None, monotone=True, contrast=None, bar_edge_px=None) -> list[Check]:
     """Clipping on either side (``sides``: list of (name, mask, level)) or,
     for a bar, at its peak (``bright_core``: mask of the peak samples).
     ``limits`` = (low, high) DN the sensor records (integer type limits or
@@ -302,7 +302,8 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
     profile off while it still changes, a noise-free level is approached
     as smoothly as the other side's.  With noise and no such plateau, as
     a pile-up at one value.  ``contrast``: the step (DN), read off the
-    values where not given."""
+    values where not given; ``bar_edge_px``: a bar's half-width where it is
+    known (given, not read off the profile), the pivot of its top's mirror."""
     checks = []
     sides = list(sides)
     for name, mask, _ in sides:
@@ -336,7 +337,7 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
             checks.append(Check("saturated", False, f"the bar's peak reaches the saturation limit {extreme:g} DN: "
                                 "its true height is unknown", extreme, None))
         elif noise_free:
-            checks.append(_held_top(distance, values, centre, extreme, outward, quantum)
+            checks.append(_held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px)
                           or _flat_top(v, extreme, outward, abs(extreme - background)))
         else:
             checks.append(_pile_up("peak", values, bright_core, quantum))
@@ -401,10 +402,11 @@ def _flat_top(peak_values, extreme, outward, height) -> Check:
                  "flat", ratio, PILE_UP)
 
 
-def _held_top(distance, values, centre, extreme, outward, quantum) -> Check | None:
+def _held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px=None) -> Check | None:
     """A noise-free bar whose top holds one exact value out to r_top from
     its centre, checked as an edge's held side is: mirrored about the bar's
-    side where it is steepest, h, the background at 2 h - r_top has arrived at its
+    side h (``bar_edge_px`` where the width is known, else where the side is
+    steepest), the background at 2 h - r_top has arrived at its
     level too when the top is the bar's own (a bar wider than its blur; the
     top sums both sides' tails, the background at most as much), and is
     still on its way when a clip cut the top off.  None where the top holds
@@ -435,7 +437,7 @@ def _held_top(distance, values, centre, extreme, outward, quantum) -> Check | No
     steepest = int(np.argmin(slope))
     if slope[steepest] >= 0:
         return None
-    pivot = 0.5 * (centres[steepest] + centres[steepest + 1])
+    pivot = bar_edge_px or 0.5 * (centres[steepest] + centres[steepest + 1])
     r_top = float(s[(values == extreme) & (s < pivot)].max())      # where the top's exact value ends
     mirror = 2.0 * pivot - r_top
     width = 0.25
@@ -449,7 +451,7 @@ def _held_top(distance, values, centre, extreme, outward, quantum) -> Check | No
     limit = max(MIRROR_CLIP, MIRROR_QUANTA * quantum / height)
     return Check("saturated", gap <= limit,
                  f"the bar's top holds exactly {extreme:g} DN out to {r_top:.2f} px from its centre, where (mirrored "
-                 f"about its side's steepest point, {pivot:.2f} px out) the background is still "
+                 f"about its side, {pivot:.2f} px out) the background is still "
                  f"{100 * gap:.1f} % of the height from its level (at most {100 * limit:.1f} %): its top is "
                  "clipped flat", gap, limit)
 

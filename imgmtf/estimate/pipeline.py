@@ -734,7 +734,8 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks += gate.saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
                                      bright_core=kind.peak_mask(s, shape), monotone=kind.monotone,
-                                     contrast=contrast)
+                                     contrast=contrast, bar_edge_px=None if shape.extra.get("width_estimated", True)
+                                     else 0.5 * shape.extra["width_px"])
     checks += gate.side_checks(d, raw, row.astype(float), c, shape.plateau_px, contrast,
                                pixel_noise, kind.tail_power)
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
