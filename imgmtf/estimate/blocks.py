@@ -10,6 +10,8 @@ at quality 50 and below 0.12 against 0.04, and the MTF at Nyquist reads
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .evidence import Evidence
@@ -21,6 +23,7 @@ WARN_RATIO = 1.8               # boundary jumps this many times the inside ones.
 WARN_EXCESS_PX = 0.02          # ...and this much larger: said
 MAX_RATIO = 2.0                # and this much...
 MAX_EXCESS_PX = 0.045          # ...refused (reason compression)
+SIGNIFICANCE = 5.0             # standard errors
 
 
 def block_boundaries(ev: Evidence) -> tuple[list[Check], list[str]]:
@@ -41,15 +44,20 @@ def block_boundaries(ev: Evidence) -> tuple[list[Check], list[str]]:
         return [], []
     means = np.bincount(phase, weights=jumps, minlength=BLOCK_PX) / counts
     boundary = int(np.argmax(means))
-    inside = float(np.mean(np.delete(means, boundary)))
+    others = phase != boundary
+    inside = float(np.mean(jumps[others]))
     excess, ratio = float(means[boundary]) - inside, float(means[boundary]) / max(inside, 1e-9)
-    blocky = ratio > MAX_RATIO and excess > MAX_EXCESS_PX
+    # the largest of 8 phase means stands out by chance too: its excess must
+    # be many standard errors of the jumps' own scatter (noise)
+    error = float(np.std(jumps[others])) * math.sqrt(1.0 / counts[boundary] + 1.0 / others.sum())
+    significant = excess > SIGNIFICANCE * error
+    blocky = significant and ratio > MAX_RATIO and excess > MAX_EXCESS_PX
     check = Check("compression", not blocky,
                   f"the {ev.name}'s row locations jump by {means[boundary]:.3f} px every {BLOCK_PX} rows against "
                   f"{inside:.3f} px between (at most {MAX_EXCESS_PX} px more): {BLOCK_PX} x {BLOCK_PX} blocks of a "
                   "lossy codec (JPEG) shape the target, and its MTF is the codec's", excess, MAX_EXCESS_PX)
     said = []
-    if not blocky and ratio > WARN_RATIO and excess > WARN_EXCESS_PX:
+    if not blocky and significant and ratio > WARN_RATIO and excess > WARN_EXCESS_PX:
         said.append(f"the {ev.name}'s row locations jump every {BLOCK_PX} rows ({means[boundary]:.3f} px against "
                     f"{inside:.3f} px): block compression (JPEG), whose loss the MTF includes")
     return [check], said
