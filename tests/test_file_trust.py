@@ -108,3 +108,17 @@ def test_noise_is_no_block_grid():
         for result in (im.measure_edge(noisy, force=True), im.measure_pulse(bar, width_px=1.5, force=True)):
             assert all(c.passed for c in result.checks if c.reason == "compression")
             assert not any("block" in w for w in result.warnings)
+
+
+def test_refusals_a_scan_solves_point_to_it_and_others_do_not(tmp_path):
+    from imgmtf.cli.errors import refusal_hint
+    assert "imgmtf scan a.tif" in refusal_hint("fill", "", "a.tif") and "--force" in refusal_hint("fill", "", "a.tif")
+    assert "imgmtf scan" in refusal_hint("not-straight", "the edge bends: two straight pieces meet inside the chip")
+    assert "imgmtf scan" not in refusal_hint("not-straight", "the per-row edge locations scatter")
+    assert refusal_hint("unreadable") == ""
+    first = exact_edge_chip(H, 6.0, offset=-12.5, low=200, high=700)
+    second = exact_edge_chip(H, 6.0, offset=12.5, low=0, high=500)
+    path = tmp_path / "two.tif"
+    im.write_geotiff(path, (first.astype(float) + second).astype(np.uint16))
+    result = CliRunner().invoke(main, ["measure", str(path)])
+    assert result.exit_code == 1 and f"imgmtf scan {path}" in result.output
