@@ -370,19 +370,28 @@ def _held_plateau(distance, values, half, other, centre, name, contrast, quantum
     r0 = float(sv[band >= first].min())
     so, vo = s[other], values[other]
     level = float(np.median(vo[so >= 0.5 * (r0 + so.max())])) if (so >= r0).any() else float(np.median(vo))
-    width = 0.25
-    near = np.abs(so - r0) <= width
-    while near.sum() < 3 and width < 2.0:
-        width *= 2
-        near = np.abs(so - r0) <= width
-    if not near.any():
+    gap = _gap_at(so, vo, r0, level, contrast)
+    if gap is None:
         return None
-    gap = abs(float(np.median(vo[near])) - level) / contrast
     limit = max(MIRROR_CLIP, MIRROR_QUANTA * quantum / contrast)
     return Check("saturated", gap <= limit,
                  f"the {name} side holds exactly {extreme:g} DN from {r0:.2f} px out, where the other side is "
                  f"still {100 * gap:.1f} % of the contrast from its level (at most {100 * limit:.1f} %): clipped",
                  gap, limit)
+
+
+def _gap_at(distance, values, at_px, level, scale) -> float | None:
+    """How far (a fraction of ``scale``) the samples at ``at_px`` from the
+    centre (their median, within 0.25 px, widened to 2 px for at least 3
+    samples) stand from ``level``; None where none lie near."""
+    width = 0.25
+    near = np.abs(distance - at_px) <= width
+    while near.sum() < 3 and width < 2.0:
+        width *= 2
+        near = np.abs(distance - at_px) <= width
+    if not near.any():
+        return None
+    return abs(float(np.median(values[near])) - level) / scale
 
 
 def _flat_top(peak_values, extreme, outward, height) -> Check:
@@ -440,14 +449,9 @@ def _held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px=N
     pivot = bar_edge_px or 0.5 * (centres[steepest] + centres[steepest + 1])
     r_top = float(s[(values == extreme) & (s < pivot)].max())      # where the top's exact value ends
     mirror = 2.0 * pivot - r_top
-    width = 0.25
-    near = np.abs(s - mirror) <= width
-    while near.sum() < 3 and width < 2.0:
-        width *= 2
-        near = np.abs(s - mirror) <= width
-    if not near.any():
+    gap = _gap_at(s, values, mirror, background, height)
+    if gap is None:
         return None
-    gap = abs(float(np.median(values[near])) - background) / height
     limit = max(MIRROR_CLIP, MIRROR_QUANTA * quantum / height)
     return Check("saturated", gap <= limit,
                  f"the bar's top holds exactly {extreme:g} DN out to {r_top:.2f} px from its centre, where (mirrored "
