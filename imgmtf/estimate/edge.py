@@ -225,7 +225,7 @@ def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: floa
         The type the values were stored as, when ``image`` is a copy.
     **options
         Settings of :class:`imgmtf.estimate.pipeline.Settings`
-        (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``...).
+        (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``, ``transfer``...).
 
     Returns
     -------
