@@ -3,15 +3,23 @@
 1. render a 50 x 50 px edge chip of the paper's sensor at 20x (a 1000 x 1000
    sub-pixel scene plus the PSF's margin) to 16 bits;
 2. measure_edge on a 100 x 100 chip (SNR 100), each method;
-3. the CLI on 100 chips in one call (JSON Lines), with 1 and 2 workers, and
+3. a noise-free 8-bit 100 x 100 edge (its staircase rebuilt) against a noisy
+   16-bit one, in this process, chips interleaved (target <= 1.5 x);
+4. the CLI's marginal time per chip: ``imgmtf measure`` on 10 and on 50 chips
+   of a mixed set (8/16-bit, noise-free/noisy, 100 x 100), the difference
+   per extra chip (target <= 15 ms);
+5. fit_sensor of two 100 x 100 edges (across and along track), in this
+   process after a first call (target < 0.3 s), and the first call in a
+   fresh process, imports included;
+6. the CLI on 100 chips in one call (JSON Lines), with 1 and 2 workers, and
    the speed-up of 2 workers (target >= 1.6 x on 2 cores);
-4. start-up: ``imgmtf --help`` against ``python -c "import numpy"`` (target:
+7. start-up: ``imgmtf --help`` against ``python -c "import numpy"`` (target:
    within 3 x).
 
-The machine's load average is printed first: timings on a loaded machine
-are not the code's.
+The machine's load average is printed first, and again at the end: timings
+on a loaded machine are not the code's (the ratios suffer least).
 
-usage: python bench/speed.py [--runs N] [--only cli|startup]
+usage: python bench/speed.py [--runs N] [--only chips|cli|fit|startup]
 """
 from __future__ import annotations
 
@@ -29,15 +37,16 @@ import numpy as np
 import imgmtf as im
 from imgmtf.estimate.edge import EdgeEstimator
 from imgmtf.io import write_geotiff
+from imgmtf.sensor.stages import Detector, GaussianOptics
 
 
-def median_time(fn, runs):
+def median_time(fn, runs, clock=time.perf_counter):
     fn()
     times = []
     for _ in range(runs):
-        t = time.perf_counter()
+        t = clock()
         fn()
-        times.append(time.perf_counter() - t)
+        times.append(clock() - t)
     return float(np.median(times))
 
 
@@ -70,6 +79,89 @@ def cli_workers(paths, options=()) -> None:
     print(f"CLI: ({label}) --workers 2 speed-up {times[1] / times[2]:.2f} x (target >= 1.6 x)")
 
 
+def depth_ratio(runs: int) -> None:
+    """Median time per chip of noise-free 8-bit edges (30 -> 210 DN, the
+    staircase rebuilt) and of noisy 16-bit ones (SNR 100), same sensor,
+    angles and offsets, measured alternately."""
+    sensor = im.Sensor(1.0, [GaussianOptics(sigma_x_m=0.5, sigma_y_m=0.5), Detector(width_x_m=1.0, width_y_m=1.0)])
+    rng = np.random.default_rng(0)
+    eight, sixteen = [], []
+    for k in range(8):
+        target = dict(angle_deg=float(rng.uniform(3.0, 12.0)), offset_px=float(rng.uniform(-0.5, 0.5)))
+        eight.append(im.render(sensor, im.Target("edge", low_dn=30.0, high_dn=210.0, **target), 100, bits=8).image)
+        sixteen.append(im.render(sensor, im.Target("edge", low_dn=200.0, high_dn=1200.0, **target), 100,
+                                 noise_std_dn=10.0, seed=k).image)
+    rebuilt = sum(im.measure_edge(c).params["dequantised"] for c in eight)
+    times: dict[str, list[float]] = {"8": [], "16": []}
+    for _ in range(max(runs // 8, 3)):
+        for a, b in zip(eight, sixteen):
+            for key, chip in (("8", a), ("16", b)):
+                t = time.perf_counter()
+                im.measure_edge(chip)
+                times[key].append(time.perf_counter() - t)
+    t8, t16 = (float(np.median(times[k])) for k in ("8", "16"))
+    print(f"measure_edge 100 x 100: noise-free 8-bit {1000 * t8:6.1f} ms ({rebuilt}/8 staircases rebuilt), "
+          f"noisy 16-bit {1000 * t16:6.1f} ms: {t8 / t16:.2f} x (target <= 1.5 x)")
+
+
+def mixed_chips(folder, n: int) -> list[str]:
+    """``n`` 100 x 100 edge chips cycling through 8/16-bit and noise-free/
+    noisy (SNR 100), angles 3-12 deg."""
+    renderers = {bits: im.Renderer(im.Sensor(), 100, bits=bits) for bits in (8, 16)}
+    levels = {8: (30.0, 210.0), 16: (200.0, 1200.0)}
+    paths = []
+    for i in range(n):
+        bits, noisy = (8, 16)[i % 2], (i // 2) % 2 == 1
+        low, high = levels[bits]
+        c = renderers[bits](im.Target("edge", 3.0 + 9.0 * ((i * 0.618) % 1.0), low, high),
+                            noise_std_dn=(high - low) / 100 if noisy else 0.0, seed=i)
+        path = Path(folder) / f"mixed{i:03d}.tif"
+        write_geotiff(path, c.image, gsd_m=c.gsd_m)
+        paths.append(str(path))
+    return paths
+
+
+def cli_marginal(folder, runs: int) -> None:
+    """``imgmtf measure`` (one worker) on the first 10 and on all 50 mixed
+    chips: what each chip beyond the start-up costs."""
+    paths = mixed_chips(folder, 50)
+
+    def run(subset):
+        t = time.perf_counter()
+        out = subprocess.run([sys.executable, "-m", "imgmtf.cli", "measure", "--format", "json", *subset],
+                             capture_output=True, text=True)
+        return time.perf_counter() - t, sum(1 for line in out.stdout.splitlines() if '"status": "ok"' in line)
+    few, many = [], []
+    for _ in range(max(runs // 25, 2)):
+        few.append(run(paths[:10]))
+        many.append(run(paths))
+    t_few, t_many = float(np.median([t for t, _ in few])), float(np.median([t for t, _ in many]))
+    print(f"CLI: imgmtf measure, mixed 8/16-bit noise-free/noisy chips: 10 chips {t_few:5.2f} s "
+          f"({few[0][1]} measured), 50 chips {t_many:5.2f} s ({many[0][1]} measured): "
+          f"{1000 * (t_many - t_few) / 40:5.1f} ms per extra chip (target <= 15 ms)")
+
+
+def fit_time(runs: int) -> None:
+    """fit_sensor of an across- and an along-track 100 x 100 edge (SNR 250):
+    in this process after a first call, and a first call in a fresh
+    process (the imports it needs included)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = []
+        for k, angle in enumerate((6.0, 84.0)):
+            c = im.render(im.Sensor(), im.Target("edge", angle, 200.0, 1200.0), 100, noise_std_dn=4.0, seed=k)
+            paths.append(Path(tmp) / f"edge{k}.tif")
+            write_geotiff(paths[-1], c.image, gsd_m=c.gsd_m)
+        chips = [im.read_raster(p).data for p in paths]
+        t = median_time(lambda: im.fit_sensor(chips), max(runs // 10, 3))
+        cpu = median_time(lambda: im.fit_sensor(chips), max(runs // 10, 3), clock=time.process_time)
+        code = ("import time, imgmtf as im; t = time.perf_counter(); "
+                f"im.fit_sensor({[str(p) for p in paths]!r}); print(time.perf_counter() - t)")
+        first = float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                     check=True).stdout)
+    print(f"fit_sensor of two 100 x 100 edges: {t:6.3f} s in process ({cpu:.3f} s of CPU; target < 0.3 s); "
+          f"first call in a fresh process {first:5.2f} s")
+
+
 def chips(folder, n=100) -> list[str]:
     r = im.Renderer(im.Sensor(), 100)
     paths = []
@@ -84,14 +176,19 @@ def chips(folder, n=100) -> list[str]:
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--runs", type=int, default=50)
-    p.add_argument("--only", choices=["cli", "startup"])
+    p.add_argument("--only", choices=["chips", "cli", "fit", "startup"])
     a = p.parse_args()
     print(f"load average (1, 5, 15 min): {', '.join(f'{v:.2f}' for v in os.getloadavg())} "
           f"on {os.cpu_count()} cores")
     if a.only == "startup":
         return startup(max(a.runs // 5, 5))
+    if a.only == "chips":
+        return depth_ratio(a.runs)
+    if a.only == "fit":
+        return fit_time(a.runs)
     if a.only == "cli":
         with tempfile.TemporaryDirectory() as tmp:
+            cli_marginal(tmp, a.runs)
             paths = chips(tmp)
             cli_workers(paths)
             return cli_workers(paths, ("--bootstrap", "200"))
@@ -109,7 +206,10 @@ def main():
         t0 = median_time(lambda bare=bare: bare(chip), a.runs)
         print(f"measure_edge 100 x 100 chip, method {method:8s}:        {1000 * t:7.1f} ms "
               f"({1000 * t0:.1f} ms without intervals)")
+    depth_ratio(a.runs)
+    fit_time(a.runs)
     with tempfile.TemporaryDirectory() as tmp:
+        cli_marginal(tmp, a.runs)
         paths = chips(tmp)
         cli_workers(paths)
         cli_workers(paths, ("--bootstrap", "200"))
@@ -126,6 +226,7 @@ def main():
             ok = sum(1 for line in lines if '"status": "accepted"' in line)
             print(f"CLI: imgmtf scan, 4096 x 2048 px scene, {workers} worker(s): {elapsed:6.2f} s "
                   f"({len(lines)} candidates, {ok} accepted)")
+    print(f"load average (1, 5, 15 min) at the end: {', '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 if __name__ == "__main__":

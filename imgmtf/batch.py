@@ -22,6 +22,7 @@ from .inputs import check_width, parse_length, saturation_levels
 from .io import raster_info, read_raster
 from .parallel import run_tasks
 from .records import Record, utc_now
+from .transfer import parse_transfer
 
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
@@ -48,6 +49,9 @@ class MeasureSettings:
     track_azimuth_deg : the ground track's direction in the image, degrees
         clockwise from up; None: rows along track for images in sensor
         geometry, unknown for map-projected ones.
+    transfer : how the stored values relate to light, "linear" (as stored),
+        "srgb" or "gamma:G" (:mod:`imgmtf.transfer`): linearised before
+        measuring.
     """
 
     target: str = "edge"
@@ -59,6 +63,7 @@ class MeasureSettings:
     force: bool = False
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
+    transfer: str = "linear"
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
@@ -71,6 +76,7 @@ class MeasureSettings:
         if self.pulse_width is not None and self.pulse_width[1] == "px":
             check_width(self.pulse_width[0])
         check_method(self.method)   # an unknown method fails here, before any file is read
+        object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
     def estimator(self):
         # the estimators load SciPy and OpenCV: imported by the processes
@@ -78,14 +84,14 @@ class MeasureSettings:
         from .estimate.edge import EdgeEstimator
         from .estimate.pulse import PulseEstimator
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
-        return kind(self.method, intervals=self.intervals, force=self.force)
+        return kind(self.method, intervals=self.intervals, force=self.force, transfer=self.transfer)
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
         return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
                 "band": self.band, "force": self.force,
                 "saturation": list(self.saturation) if self.saturation else None,
-                "track_azimuth_deg": self.track_azimuth_deg,
+                "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None}
 
     def failed(self, path: str, band, exc: BaseException, run_utc: str) -> Record:
@@ -193,16 +199,46 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
             continue
         if raster.band == "luminance":
             # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
-            file_notes = [*file_notes, "measured on the Rec. 709 luminance of the stored RGB values, gamma-encoded "
-                          "as stored (not linearised)" + (", alpha ignored" if info.alpha_bands else "")]
+            encoding = ("gamma-encoded as stored (not linearised: the sRGB or a gamma transfer curve linearises "
+                        "them)" if settings.transfer == "linear" else f"then linearised ({settings.transfer}: exact "
+                        "for a grey target, whose channels are equal)")
+            file_notes = [*file_notes, f"measured on the Rec. 709 luminance of the stored RGB values, {encoding}"
+                          + (", alpha ignored" if info.alpha_bands else "")]
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
+        record = _with_file_notes(record, raster, settings, result.checks)
         if plot_path:
             record = with_figure(record, functools.partial(_measurement_figure, result, raster,
                                                            summary["warnings"]),
                                  _band_plot_path(plot_path, band, len(bands)))
         records.append(record)
     return records
+
+
+def _with_file_notes(record: Record, raster, settings: MeasureSettings, checks) -> Record:
+    """What the file itself says about the number: a lossy codec's loss in
+    it, values taken as linear that may not be, and a forced number that
+    no one should use (status ``untrusted``: printed, and a failure)."""
+    notes = []
+    if raster.compression:
+        notes.append(f"the file is stored with {raster.compression} compression: the MTF includes the codec's loss "
+                     "(measure an uncompressed copy for the system's own)")
+    # (an RGB file's luminance carries its own note of the encoding)
+    if (raster.dtype == "uint8" and settings.transfer == "linear" and raster.provenance is None
+            and raster.band != "luminance"):
+        notes.append("8-bit values are measured as stored, taken as linear: if the image is gamma-encoded "
+                     "(sRGB, as most 8-bit camera images are) the MTF reads wrong; linearise it with the sRGB "
+                     "or a gamma transfer curve (MTF Mapper assumes sRGB for 8-bit input, Imatest its "
+                     "gamma setting)")
+    if notes:
+        record = record.with_(figures={"warnings": [*record.get("warnings", []), *notes]})
+    if settings.force:
+        from .estimate.gate import untrusted_when_forced
+        failed = untrusted_when_forced(checks)
+        if failed is not None:
+            record = record.with_(status="untrusted", reason=failed.reason,
+                                  error=f"{record.path}: forced, but not to be trusted: {failed.message}")
+    return record
 
 
 def measure_raster(raster, settings: MeasureSettings):

@@ -129,7 +129,9 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
 
     ``mask`` (a boolean array of the image's shape, True where a pixel
     belongs to the chip) leaves the other pixels out: they come back as NaN,
-    which every stage skips.  Returns the float64 crop and the (x, y) of its
+    which every stage skips.  NaN pixels (a file's declared nodata, a
+    cloud mask) are left out alike; whether enough of the target remains
+    is the estimator's to judge (its rows, its sides).  Returns the float64 crop and the (x, y) of its
     top-left pixel in the image.
 
     Raises
@@ -137,8 +139,8 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
     ParameterError
         A bad ROI or mask.
     ImageContentError
-        An image that cannot be measured (NaN or nodata among the pixels
-        used, too small, flat, values no sensor records).
+        An image that cannot be measured (nothing but NaN or nodata,
+        infinite values, too small, flat, values no sensor records).
     """
     array = as_array(image)
     if array.ndim == 3 and array.shape[-1] in (3, 4):
@@ -161,11 +163,13 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         mask = None if mask is None else mask[y0:y0 + h, x0:x0 + w]
     data = array.astype(np.float64)
     used = np.ones(data.shape, bool) if mask is None else mask
-    bad = ~np.isfinite(data) & used
-    if bad.all() or not used.any():
+    infinite = np.isinf(data) & used
+    if infinite.any():
+        raise ImageContentError(f"{int(infinite.sum())} pixel(s) are infinite: not values a sensor records")
+    # NaN (a declared nodata, a cloud mask) is left out as a mask leaves pixels out
+    used = used & ~np.isnan(data)
+    if not used.any():
         raise ImageContentError("every pixel is NaN or nodata: nothing to measure")
-    if bad.any():
-        raise ImageContentError(f"{int(bad.sum())} pixel(s) are NaN, infinite or nodata")
     if min(data.shape) < MIN_SIZE_PX:
         raise ImageContentError(f"the image is {data.shape[1]} x {data.shape[0]} pixels; "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX} are needed")
@@ -177,8 +181,7 @@ def prepare_image(image, roi=None, mask=None) -> tuple[np.ndarray, tuple[int, in
         raise ImageContentError(f"the pixel values span only {values.max() - values.min():.3g}: below "
                                 f"{MIN_RANGE_DN:g} the fits lose their precision; rescale the image "
                                 "(multiply it by a power of ten)")
-    if mask is not None:
-        data[~mask] = np.nan
+    data[~used] = np.nan
     return data, (x0, y0)
 
 

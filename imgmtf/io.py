@@ -67,6 +67,10 @@ class Raster:
         True when the file has a coordinate reference system: a
         map-projected (or geographic) product, whose rows are not along
         the sensor's track.
+    compression : str or None
+        The lossy codec the file was written with ("JPEG", "lossy JPEG
+        2000", "lossy WebP", "LERC"...), None for lossless or none: its
+        loss is part of any MTF measured from the file.
 
     Example
     -------
@@ -85,6 +89,7 @@ class Raster:
     dtype: str = "float64"
     origin: tuple[int, int] = (0, 0)
     map_projected: bool = False
+    compression: str | None = None
 
     @property
     def provenance(self) -> dict | None:
@@ -375,9 +380,27 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
             raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
                                  "choose one with --band N, or --band all")
         tags = src.tags()
+        codec = lossy_codec(src)
     if data.size == 0:
         raise ImageContentError(f"{path}: the image is empty")
-    return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y), map_projected)
+    return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y), map_projected, codec)
+
+
+def lossy_codec(src) -> str | None:
+    """The lossy codec an open dataset was written with, from its driver,
+    its TIFF compression tag and GDAL's reversibility note; None for
+    lossless storage."""
+    structure = src.tags(ns="IMAGE_STRUCTURE")
+    reversible = structure.get("COMPRESSION_REVERSIBILITY", "").upper()
+    compression = (structure.get("COMPRESSION") or (src.compression.name if src.compression else "")).upper()
+    if src.driver == "JPEG" or compression in ("JPEG", "OJPEG", "YCBCR JPEG"):
+        return "JPEG"
+    if reversible.startswith("LOSSY"):
+        return {"JP2OpenJPEG": "lossy JPEG 2000", "JP2KAK": "lossy JPEG 2000", "JP2ECW": "lossy JPEG 2000",
+                "WEBP": "lossy WebP"}.get(src.driver, f"lossy {compression or src.driver}")
+    if compression == "LERC" and float(structure.get("MAX_Z_ERROR", "0") or 0) > 0:
+        return "LERC (lossy)"
+    return None
 
 
 def _check_shape(path: str, shape) -> tuple[int, int]:

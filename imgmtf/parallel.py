@@ -17,6 +17,7 @@ once before it propagates; the caller keeps what had completed.
 """
 from __future__ import annotations
 
+import importlib
 import itertools
 import multiprocessing
 import os
@@ -162,9 +163,11 @@ def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
         return
     if "forkserver" in multiprocessing.get_all_start_methods() and not _fork_server_running():
         return _start_fork_server(modules)
-    pool = _new_pool(workers)
-    for _ in range(workers):
-        pool.submit(_import_modules, tuple(modules))
+    # every worker imports the modules as it starts (not as a task: one
+    # worker could take every such task while another was still starting)
+    pool = _new_pool(workers, tuple(modules))
+    for _ in range(workers):        # a process is started per task submitted while none is idle
+        pool.submit(int)
     _prestarted.append((workers, pool))
 
 
@@ -192,12 +195,6 @@ def _start_fork_server(modules: Iterable[str]) -> None:
                 os.environ[name] = value
 
 
-def _import_modules(modules: tuple[str, ...]) -> None:
-    import importlib
-    for name in modules:
-        importlib.import_module(name)
-
-
 def _take_prestarted(workers: int):
     """The prestarted pool if it has ``workers`` processes, else None; any
     other prestarted pool is shut down."""
@@ -210,9 +207,9 @@ def _take_prestarted(workers: int):
     return None
 
 
-def _new_pool(workers: int) -> ProcessPoolExecutor:
+def _new_pool(workers: int, modules: tuple[str, ...] = ()) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(workers, mp_context=_fresh_processes(), initializer=_init_worker,
-                               initargs=(os.getpid(),))
+                               initargs=(os.getpid(), modules))
 
 
 class InputOrder:
@@ -358,15 +355,17 @@ def _fresh_processes():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _init_worker(parent_pid: int) -> None:
+def _init_worker(parent_pid: int, modules: tuple[str, ...] = ()) -> None:
     """Set up a local worker process: a watchdog that ends the worker when
     the parent is gone, Ctrl-C left to the parent, one numerical-library
-    thread."""
+    thread; then import ``modules``."""
     threading.Thread(target=_watch_parent, args=(parent_pid, os.getppid()), daemon=True,
                      name="imgmtf-parent-watchdog").start()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     limit_threads()
+    for name in modules:
+        importlib.import_module(name)
 
 
 def limit_threads() -> None:

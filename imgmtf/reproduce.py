@@ -14,12 +14,10 @@ import csv
 import functools
 import math
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from .errors import FileWriteError, ImgmtfError
 from .estimate.edge import EdgeEstimator
@@ -28,6 +26,7 @@ from .estimate.pulse import PulseEstimator
 from .estimate.resampling import METHODS
 from .estimate.results import MTFResult
 from .metrics import fwhm
+from .parallel import run_tasks
 from .sensor.model import Sensor
 from .sensor.noise import GroundNoise
 from .sensor.rendering import Renderer
@@ -92,14 +91,11 @@ def _edge_task(task) -> dict:
             "results": _measure_all(chip.image, methods)}
 
 
-def run_tasks(tasks, workers: int, label: str, progress: bool | None = None) -> list[dict]:
-    """Run tasks in ``workers`` processes (1: in this one), in order, with a
-    progress bar on stderr (``progress`` None: only on a terminal)."""
-    bar = dict(desc=label, leave=False, disable=None if progress is None else not progress)
-    if workers <= 1:
-        return [_edge_task(t) for t in tqdm(tasks, **bar)]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(tqdm(pool.map(_edge_task, tasks, chunksize=4), total=len(tasks), **bar))
+def measure_chips(tasks, workers: int, progress: bool | None = None) -> list[dict]:
+    """Render and measure every task's chip in ``workers`` processes (1: in
+    this one; :func:`imgmtf.parallel.run_tasks`), results in task order,
+    with a progress bar on stderr (``progress`` None: only on a terminal)."""
+    return list(run_tasks(_edge_task, tasks, workers=workers, progress=progress, description="simulating chips"))
 
 
 def estimator_tables(methods) -> tuple[list[dict], dict]:
@@ -188,20 +184,21 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
     tables, curves = estimator_tables(methods)
     _write_csv(out / "tables_1_2.csv", tables)
 
+    # all the chips in one run of one pool of workers:
     # Fig. 12: one chip per noise std, 1200 -> 200 DN (falling edge)
-    system = run_tasks([("system", i, float(std), 1200.0, False, _seed(seed, 1, i), methods)
-                        for i, std in enumerate(size.system_stds)], workers, "system noise", progress)
+    tasks = [("system", i, float(std), 1200.0, False, _seed(seed, 1, i), methods)
+             for i, std in enumerate(size.system_stds)]
     # ground noise: 11 transition heights x N realisations
     ground_sd = _ground_noise_output_std(seed)
     heights = [round(snr * ground_sd) for snr in GROUND_SNRS]
-    ground = run_tasks([("ground", i * 1000 + k, 0.0, 200.0 + h, True, _seed(seed, 2, i, k), methods)
-                        for i, h in enumerate(heights) for k in range(size.ground_realisations)],
-                       workers, "ground noise", progress)
+    tasks += [("ground", i * 1000 + k, 0.0, 200.0 + h, True, _seed(seed, 2, i, k), methods)
+              for i, h in enumerate(heights) for k in range(size.ground_realisations)]
     # threshold: N chips per nominal SNR, 1000 DN step
-    threshold_rows = run_tasks([("threshold", i * 1000 + k, 1000.0 / snr, 1200.0, False,
-                                 _seed(seed, 3, i, k), methods)
-                                for i, snr in enumerate(THRESHOLD_SNRS)
-                                for k in range(size.threshold_realisations)], workers, "threshold", progress)
+    tasks += [("threshold", i * 1000 + k, 1000.0 / snr, 1200.0, False, _seed(seed, 3, i, k), methods)
+              for i, snr in enumerate(THRESHOLD_SNRS) for k in range(size.threshold_realisations)]
+    rows = measure_chips(tasks, workers, progress)
+    system, ground, threshold_rows = ([row for row in rows if row["kind"] == kind]
+                                      for kind in ("system", "ground", "threshold"))
     for row in threshold_rows:
         row["snr_nominal"] = THRESHOLD_SNRS[row["index"] // 1000]
     found = thresholds(threshold_rows, true_nyq, methods)

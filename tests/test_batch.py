@@ -45,8 +45,8 @@ def bad_inputs(tmp_path):
     full = write(tmp_path / "full.tif", edge.astype(np.uint16))
     (tmp_path / "truncated.tif").write_bytes(full.read_bytes()[:600])
     (tmp_path / "empty.tif").write_bytes(b"")
-    nan = edge.copy()
-    nan[10:12, 20:30] = np.nan
+    infinite = edge.copy()
+    infinite[10:12, 20:30] = np.inf
     two = edge + np.where(np.arange(64)[None, :] > 50, 800.0, 0.0)
     saturated = np.clip(edge * 60, 0, 65535)
     cases = {
@@ -56,7 +56,7 @@ def bad_inputs(tmp_path):
         "flat": (write(tmp_path / "flat.tif", np.full((64, 64), 500, np.uint16)), "flat"),
         "all nodata": (write(tmp_path / "nodata.tif", np.zeros((64, 64), np.uint16), nodata=0),
                        "every pixel is nan or nodata"),
-        "NaNs": (write(tmp_path / "nans.tif", nan.astype(np.float32)), "20 pixel(s) are nan"),
+        "infinities": (write(tmp_path / "infinite.tif", infinite.astype(np.float32)), "20 pixel(s) are infinite"),
         "saturated": (write(tmp_path / "saturated.tif", saturated.astype(np.uint16)), "saturated"),
         "two edges": (write(tmp_path / "two.tif", two.astype(np.uint16)), "two edges"),
         "too small": (write(tmp_path / "small.tif", edge[:12, 26:38].astype(np.uint16)), "at least 16 x 16"),

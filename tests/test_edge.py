@@ -126,10 +126,12 @@ def test_bad_images():
         measure_edge(np.full((50, 50), 3.0))
     with pytest.raises(ImageContentError, match="at least 16 x 16"):
         measure_edge(chip[:10, :40])
-    nan = chip.copy()
-    nan[5, 5] = np.nan
-    with pytest.raises(ImageContentError, match="NaN"):
-        measure_edge(nan)
+    infinite = chip.copy()
+    infinite[5, 5] = np.inf
+    with pytest.raises(ImageContentError, match="infinite"):
+        measure_edge(infinite)
+    with pytest.raises(ImageContentError, match="every pixel is NaN"):
+        measure_edge(np.full((40, 40), np.nan))
     with pytest.raises(ImageContentError, match="2-D"):
         measure_edge(np.zeros((3, 20, 20)))
     with pytest.raises(TargetNotFoundError):

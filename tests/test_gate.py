@@ -170,3 +170,127 @@ def test_direction_is_labelled_only_near_the_track():
     assert im.measure_edge(edge(angle=30.0), track_azimuth_deg=30.0).direction == "across-track"
     unknown = im.measure_edge(edge(), track_azimuth_deg=None)
     assert unknown.direction == "unknown" and any("map-projected" in w for w in unknown.warnings)
+
+
+def _normal_distance(shape=(100, 100), angle=6.0, offset=0.2):
+    rows, cols = shape
+    y, x = np.mgrid[0:rows, 0:cols].astype(float)
+    a = math.radians(angle)
+    return (x - (cols - 1) / 2) * math.cos(a) + (y - (rows - 1) / 2) * math.sin(a) - offset
+
+
+def test_a_side_that_curves_or_never_settles_is_non_uniform_and_a_lens_tail_is_not():
+    from conftest import diffraction_transfer, product
+    chip = edge(noise=3.0, dtype=np.float64)
+    d = _normal_distance()
+    bright = np.clip(d / 50.0, 0.0, None)
+    # an illumination fall-off growing as the square of the distance: 10 % of the contrast over the side
+    error = refused(chip + 1000 * 0.1 * bright ** 2, "non-uniform")
+    assert "departs from a settled level" in str(error)
+    # a level still rising towards its plateau 15 px out (20 % of the contrast to come): never settles
+    error = refused(chip + 1000 * 0.2 * (1 - np.exp(-d.clip(0) / 15)), "non-uniform")
+    assert "has not settled" in str(error)
+    # half as much curvature: measured, with the departure said
+    mild = im.measure_edge(chip + 1000 * 0.05 * bright ** 2)
+    assert any("departs from a settled level" in w for w in mild.warnings)
+    # diffraction's long tails (f/16) and a Gaussian's none are a settled level: no word
+    for h in (product(diffraction_transfer(8.6 / 16), gaussian_pixel_transfer(0.0, 6.0)), H):
+        r = im.measure_edge(exact_edge_chip(h, 6.0, shape=(100, 200), offset=0.2, noise_std=1.0))
+        assert not r.warnings and all(c.passed for c in r.checks)
+        assert abs(r.mtf_nyquist - float(h(0.5))) < 0.01
+
+
+def test_blur_that_changes_along_the_target_is_refused_or_said():
+    def halves(sigma_top, sigma_bottom, noise=3.0):
+        top = exact_edge_chip(gaussian_pixel_transfer(sigma_top, 6.0), 6.0, offset=0.2, noise_std=noise,
+                              dtype=np.float64)
+        bottom = exact_edge_chip(gaussian_pixel_transfer(sigma_bottom, 6.0), 6.0, offset=0.2, noise_std=noise,
+                                 seed=2, dtype=np.float64)
+        return np.vstack([top[:50], bottom[50:]])
+    error = refused(halves(0.5, 0.9), "varying-blur")
+    assert "rows 0-" in str(error) and "-99" in str(error)
+    slight = im.measure_edge(halves(0.5, 0.55, noise=1.0))
+    assert any("blur changes a little" in w for w in slight.warnings)
+    assert not any("blur" in w for w in im.measure_edge(halves(0.5, 0.5)).warnings)
+    # a bar whose lower half is blurred more
+    sharp, soft = (im.render(im.Sensor(optics_sigma_x_m=s, optics_sigma_y_m=s, motion_m=0.0,
+                                       electronics_cutoff_cy_m=0.0),
+                             im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, 3.0), (100, 80), noise_std_dn=2.0,
+                             seed=k).image for k, s in ((1, 0.4), (2, 0.8)))
+    refused(np.vstack([sharp[:50], soft[50:]]).astype(float), "varying-blur", measure=im.measure_pulse,
+            width_px=3.0)
+    assert im.measure_pulse(sharp, width_px=3.0).mtf_nyquist > 0
+
+
+def test_a_flat_white_level_approached_smoothly_is_no_clip_and_a_clip_still_is():
+    """MTF Mapper's generator writes its white as one exact value (63897 DN,
+    22 % of the samples), with a wobble of its last digits below it (never
+    above, in steps of about 17 DN); its chips were refused as clipped.  A
+    Gaussian + pixel edge with that white stands in for them here."""
+    from conftest import true_mtf50
+    h = gaussian_pixel_transfer(0.45, 5.0)
+    white = 63897.0
+    exact = exact_edge_chip(h, 5.0, low=1638.0, high=white, offset=0.2, dtype=np.float64)
+    wobble = 17.0 * np.floor(np.abs(np.random.default_rng(5).normal(0.0, 1.9, exact.shape)))
+    wobbly = np.rint(exact) - wobble
+    assert (wobbly == white).mean() > 0.15
+    for chip in (wobbly, exact):
+        r = im.measure_edge(np.rint(chip).astype(np.uint16))
+        assert r.mtf50_cy_px == pytest.approx(true_mtf50(h), rel=0.01)
+    # the same white cut 5 % of the contrast lower is a clip, with the wobble and without
+    cut = white - 0.05 * (white - 1638.0)
+    refused(np.rint(np.minimum(wobbly, cut)).astype(np.uint16), "saturated")
+    refused(np.rint(np.minimum(exact, cut)).astype(np.uint16), "saturated")
+
+
+def test_noise_free_bars_up_to_10_px_wide_are_measured_and_clipped_ones_are_not():
+    for width in (8.0, 10.0):
+        chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, width), (100, 80))
+        result = im.measure_pulse(chip.image, width_px=width)
+        f = np.array([0.5, 1.5]) / width           # between the sinc's zeros at multiples of 1 / width
+        assert np.allclose(result.mtf_function(f), chip.true_mtf(f), atol=0.003)
+        for clip in (1100.0, 1190.0):
+            refused(np.minimum(chip.image.astype(float), clip), "saturated", measure=im.measure_pulse,
+                    width_px=width)
+
+
+def test_nan_holes_and_hot_pixels_are_left_out_and_counted():
+    chip = edge(noise=3.0, dtype=np.float64)
+    y, x = np.mgrid[0:100, 0:100]
+    holes = chip.copy()
+    for cy, cx, radius in ((20, 30, 6), (60, 70, 8), (80, 45, 4)):       # cloud-like NaN blobs on both sides
+        holes[(y - cy) ** 2 + (x - cx) ** 2 < radius ** 2] = np.nan
+    clean = im.measure_edge(chip)
+    r = im.measure_edge(holes)
+    assert r.params["nodata_px"] == int(np.isnan(holes).sum())
+    assert any(f"{r.params['nodata_px']} NaN or nodata" in w for w in r.warnings)
+    assert abs(r.mtf_nyquist - clean.mtf_nyquist) < 0.01 and abs(r.mtf_nyquist - H(0.5)) < 0.015
+    # a mask leaves pixels out without a word; NaN among them is not counted again
+    masked = im.measure_edge(holes, mask=~np.isnan(holes))
+    assert "nodata_px" not in masked.params and masked.mtf_nyquist == r.mtf_nyquist
+    hot = chip.copy()
+    rng = np.random.default_rng(3)
+    # hot and dead pixels on the levels (within a few px of the edge a dead pixel hides in the step)
+    columns = rng.choice(np.r_[5:40, 62:95], 12, replace=False)
+    hot[rng.choice(100, 12, replace=False), columns] = np.where(np.arange(12) % 2, 4000.0, 0.0)
+    r = im.measure_edge(hot)
+    assert r.params["outlier_px"] == 12 and any("12 isolated" in w for w in r.warnings)
+    assert abs(r.mtf_nyquist - clean.mtf_nyquist) < 0.01
+    # no pixel of a clean edge or a thin noise-free bar, at any angle, is an outlier
+    from imgmtf.estimate.outliers import isolated_outliers
+    for angle in np.arange(2.0, 44.0, 3.7):
+        bar = im.render(im.Sensor(), im.Target("pulse", angle, 200, 1200, 0.3, 0.5), 100).image.astype(float)
+        assert not isolated_outliers(bar, 0.0).any()
+        assert not isolated_outliers(edge(noise=0.0, angle=angle, dtype=np.float64), 0.0).any()
+
+
+def test_a_road_beside_an_edge_and_a_shadow_beside_a_bar_are_second_targets():
+    d = _normal_distance()
+    road = edge(noise=3.0, dtype=np.float64) + 600.0 * ((d < -10) & (d > -16))     # a bright band on the dark side
+    refused(road, "two-targets")
+    bar = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.3, 2.0), (100, 80), noise_std_dn=3.0,
+                    seed=5).image.astype(float)
+    d = _normal_distance((100, 80), offset=0.3)
+    refused(bar - 300.0 * ((d > 7) & (d < 11)), "two-targets", measure=im.measure_pulse, width_px=2.0)
+    assert gate.mixed_profile(np.r_[np.full(10, 200.0), np.full(5, 800.0), np.full(10, 200.0), np.full(10, 1200.0)])
+    assert not gate.mixed_profile(np.r_[np.full(10, 200.0), np.linspace(200, 1200, 5), np.full(10, 1200.0)])

@@ -42,3 +42,30 @@ def test_a_rebuilt_staircase_still_has_an_honest_interval():
     r = im.measure_edge(exact_edge_chip(h, 7.0, offset=0.1, low=100, high=118, dtype=np.uint8))
     assert r.params["dequantised"] and h(0.5) in r.mtf_nyquist_ci
     assert r.mtf_nyquist_ci.width > 0.015            # the rebuild's own error, not noise, sets it
+
+
+def test_each_crossing_is_the_split_with_fewest_samples_on_the_wrong_side():
+    from imgmtf.estimate.quantisation import _crossings
+    rng = np.random.default_rng(4)
+    for _ in range(100):
+        n = int(rng.integers(5, 300))
+        d = np.sort(rng.uniform(-5, 5, n))
+        u = np.round(10 * (1 + np.tanh(d / rng.uniform(0.3, 2))) + rng.normal(0, rng.choice([0.0, 0.3, 2.0]), n))
+        thresholds = np.arange(u.min(), u.max()) + 0.5
+        # every split tried: above it on its left, at or below it on its right; the first of equals
+        above = u[None, :] > thresholds[:, None]
+        above_left = np.cumsum(above, axis=1)
+        below_right = (n - np.arange(1, n + 1))[None, :] - (above_left[:, -1:] - above_left)
+        np.testing.assert_array_equal(_crossings(u, thresholds), np.argmin(above_left + below_right, axis=1))
+
+
+def test_a_noise_free_8_bit_edge_is_rebuilt_without_scipy(tmp_path):
+    import subprocess
+    import sys
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    np.save(tmp_path / "chip.npy", exact_edge_chip(h, 6.0, offset=0.2, low=30, high=210, dtype=np.uint8))
+    code = ("import sys, numpy as np, imgmtf as im; "
+            f"r = im.measure_edge(np.load({str(tmp_path / 'chip.npy')!r})); "
+            "print(r.params['dequantised'], [m for m in ('scipy', 'skimage') if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["True", "[]"]

@@ -4,7 +4,7 @@ import pytest
 from click.testing import CliRunner
 
 from imgmtf.cli import main
-from imgmtf.reproduce import QUICK, StudySize, _seed, run_tasks, thresholds
+from imgmtf.reproduce import QUICK, StudySize, _seed, measure_chips, thresholds
 
 
 def read(path):
@@ -27,7 +27,7 @@ def quick_run(tmp_path_factory):
 def test_results_do_not_depend_on_the_number_of_workers():
     tasks = [("system", i, float(std), 1200.0, False, _seed(3, 1, i), ("msg",)) for i, std in enumerate((2, 9))]
     tasks.append(("ground", 0, 0.0, 1500.0, True, _seed(3, 2, 0, 0), ("msg",)))
-    assert run_tasks(tasks, 1, "one") == run_tasks(tasks, 2, "two")
+    assert measure_chips(tasks, 1) == measure_chips(tasks, 2)
 
 
 def test_cli_quick_run_reports_and_says_it_is_quick(quick_run):

@@ -254,3 +254,15 @@ def test_a_count_names_one_thing_in_the_singular():
     from imgmtf.cli.tables import plural
     assert (plural(1, "candidate edge"), plural(0, "candidate edge"), plural(17, "candidate bar")) == (
         "1 candidate edge", "0 candidate edges", "17 candidate bars")
+
+
+def test_a_strip_one_pixel_high_is_refused_before_any_tile_is_read(tmp_path):
+    strip = np.where(np.arange(50000) > 25000, 1200, 200)[None, :].astype(np.uint16)
+    path = tmp_path / "strip.tif"
+    with rasterio.open(path, "w", driver="GTiff", width=50000, height=1, count=1, dtype="uint16") as dst:
+        dst.write(strip, 1)
+    with pytest.raises(im.ImgmtfError) as info:
+        scan_scene(str(path))
+    assert info.value.reason == "image" and "50000 x 1 px" in str(info.value)
+    result = CliRunner().invoke(main, ["scan", str(path)])
+    assert result.exit_code == 1 and "at least 16 x 16" in result.output and "Traceback" not in result.output

@@ -22,7 +22,7 @@ def reported_errors():
     try:
         yield
     except ImgmtfError as exc:
-        click.echo(f"imgmtf: error: {one_line(exc)}{force_hint(exc.reason)}", err=True)
+        click.echo(f"imgmtf: error: {one_line(exc)}{refusal_hint(exc.reason, str(exc))}", err=True)
         sys.exit(1)
     except KeyboardInterrupt as exc:
         click.echo("imgmtf: interrupted", err=True)
@@ -50,10 +50,22 @@ def option_errors():
         raise click.UsageError(one_line(exc)) from None
 
 
-def force_hint(reason) -> str:
-    """What the CLI adds to a quality-gate refusal: the flag that overrules it."""
+# refusals a scan of the whole file resolves: it finds each edge and bar
+# and measures them one by one, away from fill and from each other
+SCAN_SOLVES = frozenset({"fill", "two-targets"})
+
+
+def refusal_hint(reason, message: str = "", path: str | None = None) -> str:
+    """What the CLI adds to a quality-gate refusal: ``imgmtf scan`` where
+    the chip holds fill, several edges or a checkerboard's corner, and the
+    flag that overrules the gate."""
     from ..estimate.gate import FORCIBLE
-    return " (--force measures it anyway)" if reason in FORCIBLE else ""
+    hints = []
+    if reason in SCAN_SOLVES or (reason == "not-straight" and "meet inside the chip" in message):
+        hints.append(f"imgmtf scan {path or 'FILE'} finds and measures each edge in it")
+    if reason in FORCIBLE:
+        hints.append("--force measures it anyway")
+    return f" ({'; '.join(hints)})" if hints else ""
 
 
 def one_line(exc: BaseException) -> str:

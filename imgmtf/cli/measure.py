@@ -60,13 +60,16 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
                    "rows along track, as in L0/L1 products; unknown for map-projected files)")
+@click.option("--transfer", default="linear", show_default=True, metavar="linear|srgb|gamma:G",
+              help="how the stored values relate to light: linearised before measuring (srgb: the sRGB "
+                   "curve, gamma:2.2 a power law; 8-bit camera images are usually sRGB)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
 @campaign_options
 def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
-            force, saturation, track_azimuth, progress, interval_method, replicates, confidence, workers,
-            scheduler, campaign, acquired, platform, instrument, band_name):
+            force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
+            workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
@@ -88,7 +91,7 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         with option_errors():
             settings = MeasureSettings(kind, method, band, roi, pulse_width,
                                        interval_settings(interval_method, replicates, confidence), force=force,
-                                       saturation=saturation, track_azimuth_deg=track_azimuth)
+                                       saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from .errors import force_hint
+from .errors import refusal_hint
 
 
 class TextRows:
@@ -38,7 +38,8 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
         first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
     indent = " " * len(first)
     if record["status"] == "error":
-        return f"{first} error: {record['error']}{force_hint(record.get('reason'))}"
+        hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
+        return f"{first} error: {record['error']}{hint}"
     last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
@@ -52,6 +53,8 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
+    if record["status"] == "untrusted":
+        cells.append(f"{indent} error: {record['error']}")
     cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
 

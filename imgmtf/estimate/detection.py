@@ -1,8 +1,11 @@
 """Find straight edges in an image chip: the seed for the sub-pixel fits.
 
-Canny edge pixels (scikit-image's algorithm, :mod:`.edgemap`) vote in a
-Hough transform for lines; the strongest line is the edge.  A second line with comparable support, away
-from the first, means the chip holds two edges (or a bar).
+OpenCV finds them: Canny edge pixels (``cv2.Canny`` on Sobel gradients of
+the Gaussian-smoothed chip) vote in a Hough transform for lines
+(``cv2.HoughLinesPointSet``); the strongest line is the edge.  A second line
+with comparable support, away from the first, means the chip holds two
+edges (or a bar).  The tests hold the seed to within 1 deg of
+scikit-image's ``feature.canny`` and ``transform.hough_line``.
 
 Angles follow :mod:`imgmtf.targets`: a line is x cos(theta) + y sin(theta)
 = rho, with theta the angle of its normal from the x (column) axis, which
@@ -13,13 +16,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from ..errors import ImageContentError, TargetNotFoundError
-from .edgemap import canny, hough_line
 
 _THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
-_THETAS = np.deg2rad(np.arange(-90.0, 90.0, _THETA_STEP_DEG))
+GAUSSIAN_TRUNCATE = 4.0        # the smoothing kernel reaches this many sigma (as scikit-image's)
+# cv2.Canny takes 16-bit gradients: the strongest is scaled to this, or the
+# low threshold to GRADIENT_LOW_UNITS where outliers would squeeze it below
+GRADIENT_FULL_SCALE = 16383
+GRADIENT_LOW_UNITS = 64
 
 
 @dataclass(frozen=True)
@@ -38,10 +45,36 @@ SEED_MAX_SIDE_PX = 512         # larger chips are seeded on a block-averaged cop
 def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> list[Line]:
     """Straight lines of strong gradient, strongest first.
 
-    Canny thresholds are set relative to the image's strongest gradients,
-    so the result does not depend on the DN scale.  A chip larger than
-    ``SEED_MAX_SIDE_PX`` is searched on a block-averaged copy (the per-row
-    fits refine the seed anyway), the lines mapped back to full resolution.
+    Canny thresholds are set relative to the image's own range (its 1st to
+    99th percentile), so the result does not depend on the DN scale or the
+    bit depth.  A chip larger than ``SEED_MAX_SIDE_PX`` is searched on a
+    block-averaged copy (the per-row fits refine the seed anyway), the lines
+    mapped back to full resolution.  Left-out pixels (NaN) are ignored.
+
+    Parameters
+    ----------
+    image : (M, N) ndarray
+        The chip, DN; NaN where left out.
+    max_lines : int
+        At most this many lines.
+    sigma : float
+        Standard deviation of the Gaussian smoothing before the gradients, px.
+
+    Returns
+    -------
+    list of Line
+        Strongest first; empty when the chip has fewer than 5 edge pixels.
+
+    Raises
+    ------
+    ImageContentError
+        The image is flat.
+
+    Examples
+    --------
+    >>> step = np.zeros((30, 40)); step[:, 20:] = 1.0      # a vertical edge between columns 19 and 20
+    >>> [(abs(line.theta_deg) <= 1.0, abs(line.rho_px - 19.5) <= 1.0) for line in find_lines(step)]
+    [(True, True)]
     """
     factor = int(math.ceil(max(image.shape) / SEED_MAX_SIDE_PX))
     if factor > 1:
@@ -57,49 +90,118 @@ def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> lis
     lo, hi = np.percentile(image[valid], [1, 99])
     if not hi > lo:
         raise ImageContentError("the image is flat: no contrast to measure")
-    norm = (fill_nearest(image, valid) - lo) / (hi - lo)
-    mask = None if valid.all() else valid
-    edges = canny(norm, sigma=sigma, low_threshold=0.1, high_threshold=0.2, mask=mask)
-    if edges.sum() < 5:
-        edges = canny(norm, sigma=sigma, low_threshold=0.5, high_threshold=0.8,
-                      use_quantiles=True, mask=mask)
-    if edges.sum() < 5:
+    dx, dy = _gradients(np.where(valid, (image - lo) / (hi - lo), 0.0), valid, sigma)
+    inside = _interior(valid)
+    edges = _canny(dx, dy, 0.1, 0.2, inside)
+    if np.count_nonzero(edges) < 5:
+        low, high = np.percentile(np.hypot(dx, dy), [50.0, 80.0])      # weak edges: quantiles instead
+        edges = _canny(dx, dy, float(low), float(high), inside)
+    if np.count_nonzero(edges) < 5:
         return []
-    acc, thetas, rhos = hough_line(edges, _THETAS)
-    return _peaks(acc, thetas, rhos, edges, max_lines)
+    return _strongest_lines(edges, max_lines)
 
 
-def _peaks(acc, thetas, rhos, edges, max_lines, min_distance_px=5, min_angle_deg=8.0,
-           on_line_px=1.0) -> list[Line]:
-    """Strongest accumulator cells, strongest first: each line's own edge
-    pixels (within ``on_line_px`` of it) then stop voting, and its
-    neighbourhood (``min_distance_px`` in rho, ``min_angle_deg`` in theta)
-    is suppressed, before the next is taken; cells below a quarter of the
-    strongest are ignored.  Taking back the votes keeps a short segment
-    far from the origin, whose pixels also elect lines a few degrees and
-    more than ``min_distance_px`` away, from passing for two lines."""
-    threshold = 0.25 * acc.max()
-    dr = min_distance_px
-    dt = int(round(min_angle_deg / _THETA_STEP_DEG))
-    offset = int(round(-rhos[0]))
-    cos, sin = np.cos(thetas), np.sin(thetas)
+def _gradients(image: np.ndarray, valid: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """Sobel gradients along x (columns) and y (rows) of ``image`` smoothed
+    by a Gaussian that ignores the pixels outside ``valid`` and beyond the
+    edges (the smoothed image divided by the smoothed mask: they neither
+    pull it down nor cut a false edge into it)."""
+    radius = int(GAUSSIAN_TRUNCATE * sigma + 0.5)
+    size = (2 * radius + 1, 2 * radius + 1)
+
+    def blur(values):
+        return cv2.GaussianBlur(values, size, sigma, borderType=cv2.BORDER_CONSTANT)
+    smoothed = blur(image.astype(np.float32)) / (blur(valid.astype(np.float32)) + np.float32(1e-12))
+    dx = cv2.Sobel(smoothed, cv2.CV_32F, 1, 0, ksize=3, borderType=cv2.BORDER_REFLECT)
+    dy = cv2.Sobel(smoothed, cv2.CV_32F, 0, 1, ksize=3, borderType=cv2.BORDER_REFLECT)
+    return dx, dy
+
+
+def _interior(valid: np.ndarray) -> np.ndarray:
+    """The pixels whose 3 x 3 neighbourhood lies wholly in ``valid`` and in
+    the image: only they may be edges (their gradients see no left-out
+    pixel)."""
+    return cv2.erode(valid.astype(np.uint8), np.ones((3, 3), np.uint8),
+                     borderType=cv2.BORDER_CONSTANT, borderValue=0).astype(bool)
+
+
+def _canny(dx: np.ndarray, dy: np.ndarray, low: float, high: float, inside: np.ndarray) -> np.ndarray:
+    """Canny edge map (``cv2.Canny``, L2 gradient magnitude) from float
+    gradients and hysteresis thresholds in their unit, restricted to
+    ``inside``.  OpenCV takes 16-bit gradients: they are scaled so that the
+    strongest fills the range, unless outliers would then leave the low
+    threshold fewer than ``GRADIENT_LOW_UNITS`` steps (those saturate)."""
+    strongest = max(float(np.abs(dx).max()), float(np.abs(dy).max()), 1e-30)
+    scale = GRADIENT_FULL_SCALE / strongest
+    if low > 0:
+        scale = max(scale, GRADIENT_LOW_UNITS / low)
+
+    def fixed(values):
+        return np.clip(np.rint(values * scale), -32767, 32767).astype(np.int16)
+    edges = cv2.Canny(fixed(dx), fixed(dy), min(low * scale, 32767.0), min(high * scale, 32767.0),
+                      L2gradient=True)
+    return (edges > 0) & inside
+
+
+def _strongest_lines(edges, max_lines, min_distance_px=5, min_angle_deg=8.0, on_line_px=1.0) -> list[Line]:
+    """Lines of the Hough transform of the edge pixels, strongest first:
+    each line's own edge pixels (within ``on_line_px`` of it) then stop
+    voting and the transform is run again on the others; a line within
+    ``min_distance_px`` in rho and ``min_angle_deg`` in theta of one taken
+    is passed over, and lines with under a quarter of the first's votes are
+    ignored.  Taking back the votes keeps a short segment far from the
+    origin, whose pixels also elect lines a few degrees and more than
+    ``min_distance_px`` away, from passing for two lines."""
     ys, xs = np.nonzero(edges)
-    voting = np.ones(xs.size, bool)
-    lines = []
-    for _ in range(max_lines):
-        i, j = np.unravel_index(int(np.argmax(acc)), acc.shape)
-        if acc[i, j] < threshold or acc[i, j] == 0:
+    points = np.column_stack([xs, ys]).astype(np.float32)
+    reach = math.ceil(math.hypot(*edges.shape)) + 1
+    lines: list[Line] = []
+    threshold = 0
+    while len(lines) < max_lines and len(points):
+        found = cv2.HoughLinesPointSet(points.reshape(-1, 1, 2), 4 * max_lines + 4, threshold,
+                                       -reach, reach, 1.0, -math.pi / 2, math.pi / 2,
+                                       math.radians(_THETA_STEP_DEG))
+        if found is None:
             break
-        lines.append(Line(float(np.rad2deg(thetas[j])), float(rhos[i]), int(acc[i, j])))
-        on = voting & (np.abs(xs * cos[j] + ys * sin[j] - rhos[i]) <= on_line_px)
-        if on.any():        # their votes in every direction, binned as hough_line bins them
-            bins = np.rint(np.outer(xs[on], cos) + np.outer(ys[on], sin)).astype(np.int64) + offset
-            cells = (bins * thetas.size + np.arange(thetas.size)).ravel()
-            acc -= np.bincount(cells, minlength=acc.size).reshape(acc.shape)
-            np.maximum(acc, 0, out=acc)
-            voting &= ~on
-        acc[max(i - dr, 0): i + dr + 1, max(j - dt, 0): j + dt + 1] = 0
+        # (OpenCV returns single-precision angles: put them back on the grid)
+        candidates = [Line(_THETA_STEP_DEG * round(math.degrees(theta) / _THETA_STEP_DEG), float(rho), int(votes))
+                      for votes, rho, theta in found.reshape(-1, 3)]
+        line = next((c for c in candidates if not any(_near(c, taken, min_distance_px, min_angle_deg)
+                                                      for taken in lines)), None)
+        if line is None:
+            break
+        if not lines:
+            threshold = max(math.ceil(0.25 * line.votes) - 1, 0)     # OpenCV keeps votes > threshold
+        t = math.radians(line.theta_deg)
+        on = np.abs(points[:, 0] * math.cos(t) + points[:, 1] * math.sin(t) - line.rho_px) <= on_line_px
+        lines.append(_fitted(line, points[on]))
+        points = points[~on]
     return lines
+
+
+def _fitted(line: Line, points: np.ndarray) -> Line:
+    """``line`` moved onto the straight line through its own edge pixels
+    (their principal axis): a cell of the Hough transform is one of a
+    plateau of cells several degrees wide for a short segment."""
+    if len(points) < 3:
+        return line
+    centre = points.mean(axis=0, dtype=float)
+    _, _, axes = np.linalg.svd(points - centre, full_matrices=False)
+    normal = axes[1]
+    t = math.radians(line.theta_deg)
+    if normal[0] * math.cos(t) + normal[1] * math.sin(t) < 0:
+        normal = -normal
+    theta = math.atan2(normal[1], normal[0])
+    rho = float(centre @ normal)
+    if theta >= math.pi / 2 or theta < -math.pi / 2:       # the convention's range: [-90, 90) deg
+        theta, rho = theta - math.copysign(math.pi, theta), -rho
+    return Line(math.degrees(theta), rho, line.votes)
+
+
+def _near(a: Line, b: Line, distance_px: float, angle_deg: float) -> bool:
+    """Is ``a`` within ``distance_px`` in rho and ``angle_deg`` in theta of
+    ``b`` (in the Hough transform's cells)?"""
+    return abs(a.rho_px - b.rho_px) <= distance_px and abs(a.theta_deg - b.theta_deg) <= angle_deg
 
 
 def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0,
@@ -164,17 +266,6 @@ def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
     t = math.radians(line.theta_deg)
     y, x = np.indices(shape)
     return x * math.cos(t) + y * math.sin(t) - line.rho_px
-
-
-def fill_nearest(image: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """``image`` with every pixel outside ``valid`` set to its nearest valid
-    pixel's value: left-out pixels continue the chip instead of cutting a
-    false edge into it."""
-    if valid.all():
-        return image
-    from scipy.ndimage import distance_transform_edt
-    index = distance_transform_edt(~valid, return_distances=False, return_indices=True)
-    return image[tuple(index)]
 
 
 def robust_noise(image: np.ndarray) -> float:

@@ -16,6 +16,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._blas import one_blas_thread
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import TargetGeometry, locate_edge
@@ -180,8 +181,9 @@ class EdgeEstimator:
                  saturation: tuple[float, float] | None = None, dtype=None,
                  track_azimuth_deg: float | None = 0.0) -> EdgeResult:
         """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
-        m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
-                dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        with one_blas_thread():         # small matrices: threads cost more than they save
+            m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
+                    dtype=dtype, track_azimuth_deg=track_azimuth_deg)
         f, a = m.figures, m.arrays
         left, right = f["side_levels"]
         return EdgeResult(
@@ -223,7 +225,7 @@ def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: floa
         The type the values were stored as, when ``image`` is a copy.
     **options
         Settings of :class:`imgmtf.estimate.pipeline.Settings`
-        (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``...).
+        (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``, ``transfer``...).
 
     Returns
     -------

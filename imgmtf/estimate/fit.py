@@ -12,7 +12,7 @@ where ESF is the sensor's exact edge response along that edge's normal
 offset) are the edge's own nuisance parameters.  All edges share the
 stages' parameters, so an across-track and an along-track edge together
 constrain both axes.  The parameters are fitted by bounded least squares
-(an active-set Levenberg-Marquardt, :meth:`_Model.solve`), each edge
+(``scipy.optimize.least_squares``, :meth:`_Model.solve`), each edge
 weighted by the inverse of its noise, measured without the model (each
 sample against the line through its two neighbours, :func:`profile_noise`).
 
@@ -46,6 +46,7 @@ normal, show structure the noise cannot explain.
 """
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,6 +55,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._blas import one_blas_thread
 from ..errors import ImgmtfError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing
@@ -327,7 +329,14 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
-    model = _Model(gsd, _initial_stages(names, start, gsd), data)
+    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
+    with one_blas_thread():
+        return _fit(_Model(gsd, _initial_stages(names, start, gsd), data), hold, confidence)
+
+
+def _fit(model: _Model, hold, confidence: float) -> SensorFit:
+    """Fit ``model``, holding what the data do not determine or need (see
+    the module's notes), and report."""
     notes = model.screen_axes(_hold_keys(hold, model.keys))
     z = model.initial_vector()
     while True:
@@ -538,6 +547,7 @@ class _Model:
         self.values = dict(self.start)           # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
+        self._last_responses: tuple = (None, [])
 
     # -- which parameters are free ------------------------------------------------
     def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
@@ -612,9 +622,16 @@ class _Model:
         return Sensor(self.gsd, stages)
 
     def responses(self, u: np.ndarray):
-        sensor = self.sensor(u)
-        return [sensor.line_response(d.normal_angle_deg, d.gsd_m, reach_px=float(np.abs(d.x).max()) + 2.0)
-                for d in self.data]
+        """Each edge's line response for stage coordinates ``u``; the last
+        ones kept, since the solver asks for the residuals and then the
+        Jacobian at the same point."""
+        key = (tuple(self.free), u.tobytes())
+        if self._last_responses[0] != key:
+            sensor = self.sensor(u)
+            self._last_responses = (key, [sensor.line_response(d.normal_angle_deg, d.gsd_m,
+                                                               reach_px=float(np.abs(d.x).max()) + 2.0)
+                                          for d in self.data])
+        return self._last_responses[1]
 
     # -- least squares ------------------------------------------------------------
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
@@ -626,7 +643,7 @@ class _Model:
             out.append((d.y - (lo + (hi - lo) * r.esf(d.x - x0))) / d.noise)
         return np.concatenate(out)
 
-    def jacobian(self, z: np.ndarray) -> np.ndarray:
+    def jacobian(self, z: np.ndarray):
         u = z[: self.n_free]
         base = self.responses(u)
         offsets = [z[self.n_free + 3 * e + 2] for e in range(len(self.data))]
@@ -643,55 +660,37 @@ class _Model:
                 -(z[self.n_free + 3 * e + 1] - z[self.n_free + 3 * e]) / d.noise
                 * (m.esf(d.x - x0) - esf) / h
                 for e, (d, m, x0, esf) in enumerate(zip(self.data, moved, offsets, base_esf))]))
+        # each edge's levels and offset act on its own samples only: a sparse
+        # Jacobian, whose size grows with the edges, not with their square
+        from scipy import sparse
         n = sum(d.x.size for d in self.data)
-        jac = np.zeros((n, z.size))
-        if columns:
-            jac[:, : self.n_free] = np.stack(columns, axis=1)
-        row = 0
+        stage = np.stack(columns, axis=1) if columns else np.zeros((n, 0))
+        blocks = []
         for e, (d, b, esf) in enumerate(zip(self.data, base, base_esf)):
             lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            rows = slice(row, row + d.x.size)
-            col = self.n_free + 3 * e
-            jac[rows, col] = -(1 - esf) / d.noise
-            jac[rows, col + 1] = -esf / d.noise
-            jac[rows, col + 2] = (hi - lo) * b.lsf(d.x - x0) / d.noise
-            row += d.x.size
-        return jac
+            blocks.append(np.stack([-(1 - esf), -esf, (hi - lo) * b.lsf(d.x - x0)], axis=1) / d.noise)
+        return sparse.hstack([sparse.csr_array(stage), sparse.block_diag(blocks)], format="csr")
 
     def solve(self, z: np.ndarray, max_iterations: int = 200):
-        """Bounded Levenberg-Marquardt from ``z``: steps solve the small
-        normal equations (a few parameters, many samples) for the
-        parameters not held at a bound by the gradient (an active set), and
-        are clipped to the bounds.  Returns the solution and its Jacobian."""
+        """Bounded least squares from ``z`` (SciPy's trust-region
+        reflective ``least_squares``, with :meth:`jacobian`, sparse, the
+        columns scaled by their norms, the steps by LSMR).  Returns the
+        solution and its Jacobian.
+
+        Raises
+        ------
+        ImgmtfError
+            No convergence within ``max_iterations`` Jacobians.
+        """
+        from scipy.optimize import least_squares
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        r = self.residuals(z)
-        cost, damping = float(r @ r), 1e-3
-        for _ in range(max_iterations):
-            jac = self.jacobian(z)
-            a, g = jac.T @ jac, jac.T @ r
-            pinned = ((z <= lower) & (g > 0)) | ((z >= upper) & (g < 0))
-            free = ~pinned
-            scale = np.where(np.diag(a) > 0, np.diag(a), 1.0)
-            while True:
-                step = np.zeros(z.size)
-                try:
-                    step[free] = np.linalg.solve(a[np.ix_(free, free)] + damping * np.diag(scale[free]), -g[free])
-                except np.linalg.LinAlgError:
-                    step[:] = np.nan
-                trial = np.clip(z + step, lower, upper)
-                r_trial = self.residuals(trial) if np.all(np.isfinite(trial)) else None
-                cost_trial = float(r_trial @ r_trial) if r_trial is not None else math.inf
-                if cost_trial <= cost or damping > 1e12:
-                    break
-                damping *= 5.0
-            if cost_trial > cost:           # no step lowers the cost: a minimum
-                return z, jac
-            assert r_trial is not None       # a finite cost came from residuals
-            gain, moved = cost - cost_trial, np.abs(trial - z).max()
-            z, r, cost, damping = trial, r_trial, cost_trial, max(damping / 3.0, 1e-9)
-            if gain <= 1e-9 * cost or moved <= 1e-12:
-                return z, self.jacobian(z)
+        if max_iterations > 0:
+            result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
+                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations,
+                                   tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12})
+            if result.status > 0:
+                return result.x, result.jac
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
                           f"{max_iterations} iterations; try fewer stages (--stages) or hold some (--hold)",
                           reason="fit")
@@ -727,12 +726,12 @@ def _coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
 
 
-def _covariance(jacobian: np.ndarray, reduced_chi_square: float) -> np.ndarray:
-    """Parameter covariance from the weighted Jacobian, scaled up by the
-    reduced chi-square when the residuals exceed the noise (never down: on
-    noise-free integer chips the noise is the quantisation's, 1/sqrt(12) DN,
-    which flat plateaus do not show)."""
-    return np.linalg.pinv(jacobian.T @ jacobian) * max(reduced_chi_square, 1.0)
+def _covariance(jacobian, reduced_chi_square: float) -> np.ndarray:
+    """Parameter covariance from the weighted (sparse) Jacobian, scaled up by
+    the reduced chi-square when the residuals exceed the noise (never down:
+    on noise-free integer chips the noise is the quantisation's, 1/sqrt(12)
+    DN, which flat plateaus do not show)."""
+    return np.linalg.pinv((jacobian.T @ jacobian).toarray()) * max(reduced_chi_square, 1.0)
 
 
 # -- the report -------------------------------------------------------------------
@@ -764,7 +763,6 @@ def _mtf50_band(model, u, covariance, angle_deg, gsd, confidence):
 
 
 def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, confidence: float) -> SensorFit:
-    from scipy.stats import chi2
     n = model.n_free
     u = z[:n]
     sensor = model.sensor(u)
@@ -810,7 +808,7 @@ def _report(model: _Model, z: np.ndarray, covariance: np.ndarray, notes: dict, c
         res = residuals[start_row: start_row + d.x.size] * d.noise
         start_row += d.x.size
         chi = float(np.sum((res / d.noise) ** 2) / max(d.x.size - 3 - n / len(model.data), 1))
-        p, fraction = _misfit(d.x - x0, res, d.noise, abs(hi - lo), r, chi2)
+        p, fraction = _misfit(d.x - x0, res, d.noise, abs(hi - lo), r)
         value, low, high = _mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
@@ -858,7 +856,7 @@ def _value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> 
     return abs(value(u + se_u) - value(u))
 
 
-def _misfit(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response, chi2):
+def _misfit(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response):
     """P-value and size (RMS fraction of the step, noise removed) of the
     residuals' structure: their means in bins along the normal, over the
     transition (where the model's edge response is between 0.1 % and 99.9 %,
@@ -877,7 +875,8 @@ def _misfit(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, res
         return 1.0, 0.0
     means, count = total[used] / count[used], count[used]
     statistic = float(np.sum(count * means**2) / noise**2)
-    p = float(chi2.sf(statistic, used.sum()))
+    from scipy.special import chdtrc  # (scipy.stats, for this one tail, costs most of a second to import)
+    p = float(chdtrc(used.sum(), statistic))
     systematic = max(float(np.mean(means**2 - noise**2 / count)), 0.0)
     return p, math.sqrt(systematic) / step
 

@@ -42,8 +42,10 @@ from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
+from ..transfer import Transfer, full_scale, parse_transfer
 from . import gate
 from .detection import Line, robust_noise
+from .evidence import Evidence
 from .geometry import (
     EDGE_FIT_HALF_WINDOW_PX,
     TargetGeometry,
@@ -62,6 +64,8 @@ from .intervals import (
     influence_sds,
     linearised_interval,
 )
+from .outliers import isolated_outliers
+from .profile_checks import run_profile_checks
 from .quantisation import dequantise
 from .resampling import METHODS, check_method, resample_profile
 from .spectrum import (
@@ -144,6 +148,10 @@ class Settings:
     force : bool
         Measure even when a quality check fails (each failure becomes a
         warning) instead of refusing.
+    transfer : str or Transfer
+        How the stored values relate to light (:mod:`imgmtf.transfer`):
+        "linear" (default: as stored), "srgb" or "gamma:G"; the values are
+        linearised before measuring.
 
     Raises
     ------
@@ -161,6 +169,7 @@ class Settings:
     lsf_window_factor: float | None = None
     intervals: Intervals = field(default_factory=Intervals)
     force: bool = False
+    transfer: Transfer = field(default_factory=Transfer)
 
     def __post_init__(self):
         check_method(self.method)
@@ -189,10 +198,11 @@ class Settings:
         set_(self, "intervals", as_intervals(self.intervals))
         if not isinstance(self.force, (bool, np.bool_)):
             raise ParameterError(f"force must be True or False, got {self.force!r}")
+        set_(self, "transfer", parse_transfer(self.transfer))
 
     def as_dict(self) -> dict:
         out = {"method": self.method, "step_px": self.step_px, "correct": self.correct,
-               "intervals": self.intervals.as_dict(), "force": self.force}
+               "intervals": self.intervals.as_dict(), "force": self.force, "transfer": str(self.transfer)}
         for key in ("snr_threshold", "lsf_half_width_px", "lsf_window_factor"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
@@ -407,7 +417,9 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
     """Where the target could not be followed row by row (a bar defeats an
     edge's step fits, and leaves its phases too sparse), the rows' mean
     profile about the seed says whether it is the other kind of target:
-    that is the reason to give (``not-an-edge``, ``not-a-bar``).
+    that is the reason to give (``not-an-edge``, ``not-a-bar``), or, where
+    the whole rows hold a step and a bar, the second target
+    (``two-targets``).
 
     Raises
     ------
@@ -416,8 +428,16 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
     _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
     counts = inside.sum(axis=0)
     if counts.min() > 0:
-        check = gate.kind_check(gate.classify_profile(values.sum(axis=0) / counts), kind.profile)
+        mean = values.sum(axis=0) / counts
+        check = gate.kind_check(gate.classify_profile(mean), kind.profile, mean)
         if not check.passed:
+            # the whole rows say whether the other kind stands beside a target of the wanted kind
+            _, wide, wide_inside = row_windows(work, seed_x, work.shape[1])
+            wide_counts = wide_inside.sum(axis=0)
+            covered = wide_counts >= 0.5 * work.shape[0]
+            if covered.sum() > 2 * EDGE_FIT_HALF_WINDOW_PX + 1:
+                whole = wide.sum(axis=0)[covered] / wide_counts[covered]
+                check = gate.kind_check(gate.classify_profile(mean), kind.profile, whole)
             raise UnsuitableTargetError(check.message, reason=check.reason) from None
 
 
@@ -544,9 +564,23 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     if track_azimuth_deg is not None:
         track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
     limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
+    decoded = []
+    if not settings.transfer.is_linear:
+        # linear light in the same DN scale; the type's limits stay put, its
+        # quantum does not (the decoded steps are uneven)
+        scale = full_scale(stored)
+        data = settings.transfer.linearise(data, scale)
+        limits = None if limits is None else (float(settings.transfer.linearise(np.array(limits[0]), scale)),
+                                              float(settings.transfer.linearise(np.array(limits[1]), scale)))
+        stored = np.dtype(np.float64)
+        decoded.append(f"the values were linearised ({settings.transfer}, full scale {scale:g} DN) before "
+                       "measuring")
     q = quantum(data, stored)
     checks = [gate.fill_check(data, stored)]
     pixel_noise = robust_noise(data)
+    rows, cols = data.shape
+    chosen = None if mask is None else np.asarray(mask)[y0:y0 + rows, x0:x0 + cols]
+    left_out = _left_out_pixels(data, chosen, pixel_noise)
 
     try:
         line, seed_checks = kind.seed(data, pixel_noise)
@@ -583,7 +617,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         return (r, *_central_run(r.grid, r.values, kind.name))
     try:
         resampled, grid, values, span = resample(min(reach, INITIAL_SPAN_PX))
-        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile)
+        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile, values)
         if not kind_check.passed:
             raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
         try:
@@ -699,7 +733,9 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
                   for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
     checks += gate.saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
-                                     bright_core=kind.peak_mask(s, shape), monotone=kind.monotone)
+                                     bright_core=kind.peak_mask(s, shape), monotone=kind.monotone,
+                                     contrast=contrast, bar_edge_px=None if shape.extra.get("width_estimated", True)
+                                     else 0.5 * shape.extra["width_px"])
     checks += gate.side_checks(d, raw, row.astype(float), c, shape.plateau_px, contrast,
                                pixel_noise, kind.tail_power)
     snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
@@ -713,7 +749,13 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     checks.append(gate.figures_check(
         mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
         mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings
+    # the registered checks come last: a failure above (a sharpened halo) names the cause better
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    profile_checks, profile_warnings = run_profile_checks(Evidence(
+        d, raw, row, c, shape.scale_px, shape.plateau_px, shape.low, shape.high, noise, q, kind.tail_power,
+        kind.name, kind.profile, (side_names[0], side_names[1]), geometry))
+    checks += profile_checks
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + left_out[1] + decoded
     if cut:
         warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
@@ -757,8 +799,26 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
                         "track, so the direction is unknown; give the track's azimuth to label it")
     params = {**settings.as_dict(), **resampled.params, "lsf_half_width_px": core, "lsf_taper_px": taper,
-              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None}
+              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None,
+              **left_out[0]}
     return Measurement(figures, arrays, tuple(checks), tuple(warnings), params)
+
+
+def _left_out_pixels(data: np.ndarray, mask, noise: float) -> tuple[dict, list[str]]:
+    """Leave isolated hot and dead pixels out of ``data`` (set to NaN, in
+    place) and count them and the NaN or nodata pixels among those the
+    caller's ``mask`` (cropped to ``data``) keeps: (params, warnings)
+    saying so."""
+    nodata = int(np.count_nonzero(np.isnan(data) if mask is None else np.isnan(data) & mask))
+    hot = isolated_outliers(data, noise)
+    data[hot] = np.nan
+    counts = {"nodata_px": nodata, "outlier_px": int(hot.sum())}
+    said = []
+    if nodata:
+        said.append(f"{nodata} NaN or nodata pixel(s) inside the chip are left out of the estimate")
+    if hot.any():
+        said.append(f"{int(hot.sum())} isolated outlying pixel(s) (hot or dead) are left out of the estimate")
+    return {k: v for k, v in counts.items() if v}, said
 
 
 def _saturation(value) -> tuple[float, float]:

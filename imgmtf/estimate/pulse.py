@@ -18,6 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from .._blas import one_blas_thread
 from ..errors import TargetNotFoundError, UnsuitableTargetError
 from ..inputs import check_width
 from ..metrics import fwhm
@@ -213,8 +214,9 @@ class PulseEstimator:
                  saturation=None, dtype=None, track_azimuth_deg: float | None = 0.0) -> PulseResult:
         """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
         (estimated from the profile when None); see :func:`measure_pulse`."""
-        m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
-                dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        with one_blas_thread():         # small matrices: threads cost more than they save
+            m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
+                    dtype=dtype, track_azimuth_deg=track_azimuth_deg)
         f, a = m.figures, m.arrays
         width = f["width_px"]
         band = usable_band(width)

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ImageContentError, ParameterError
-from ..filters import correlate1d
+from ._correlation import correlate1d
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,7 +152,7 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         # sum over the windows holding a sample's bin of a_k^(j) (u0 + offset)^j,
         # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
         # power p of the offset only meets the coefficients j >= p
-        conv = [correlate1d(a[..., p:, :], (-1.0) ** p * offsets ** p, axis=-1, mode="constant")
+        conv = [correlate1d(a[..., p:, :], (-1.0) ** p * offsets ** p, axis=-1)
                 for p in range(order + 1)]
         g = np.stack([sum(math.comb(j, m_) * conv[j - m_][..., m_, :] for j in range(m_, order + 1))
                       for m_ in range(order + 1)], axis=-2)      # (..., order + 1, n_grid)

@@ -27,12 +27,12 @@ import numpy as np
 
 from ..atomic import ensure_folder
 from ..batch import pulse_width_px
-from ..errors import ImgmtfError, ParameterError
+from ..errors import ImageContentError, ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
 from ..estimate.geometry import direction_label
 from ..figures import with_figure
-from ..inputs import saturation_levels
+from ..inputs import MIN_SIZE_PX, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from ..parallel import run_tasks
 from ..records import Record, utc_now
@@ -202,6 +202,10 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         raise ParameterError(f"settings must be a ScanSettings, got {settings!r}")
     run_utc = utc_now()
     info = raster_info(path)
+    if min(info.width, info.height) < MIN_SIZE_PX:
+        # a strip or a one-pixel scene holds no chip: refused before any tile is read
+        raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; an edge or bar chip needs "
+                                f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
     segments, fill_fraction = detect_segments(path, settings)
     junctions, events = find_junctions(segments)
     halves = split_at_junctions(segments, junctions, events, fill_fraction)

@@ -4,21 +4,20 @@ import pytest
 from scipy import ndimage
 
 from imgmtf.errors import ParameterError
-from imgmtf.filters import correlate1d
+from imgmtf.estimate._correlation import correlate1d
 
 
-@pytest.mark.parametrize("mode", ["constant", "reflect"])
 @pytest.mark.parametrize("shape, axis, taps", [((50,), -1, 3), ((7, 40), -1, 21), ((40, 30), 0, 17),
                                                ((3, 5, 60), 1, 5), ((6, 4), 1, 9)])
-def test_matches_scipy(shape, axis, taps, mode):
+def test_matches_scipy(shape, axis, taps):
     rng = np.random.default_rng(taps)
     values, weights = rng.normal(size=shape), rng.normal(size=taps)
-    expected = ndimage.correlate1d(values, weights, axis=axis, mode=mode)
-    np.testing.assert_allclose(correlate1d(values, weights, axis, mode), expected, rtol=0, atol=1e-12)
+    expected = ndimage.correlate1d(values, weights, axis=axis, mode="constant")
+    np.testing.assert_allclose(correlate1d(values, weights, axis), expected, rtol=0, atol=1e-12)
 
 
 def test_an_empty_axis_gives_an_empty_result():
-    assert correlate1d(np.zeros((3, 0)), [1.0, 2.0, 1.0], mode="reflect").shape == (3, 0)
+    assert correlate1d(np.zeros((3, 0)), [1.0, 2.0, 1.0]).shape == (3, 0)
 
 
 def test_a_centred_impulse_gives_the_kernel_reversed_about_its_centre():
@@ -26,7 +25,7 @@ def test_a_centred_impulse_gives_the_kernel_reversed_about_its_centre():
     np.testing.assert_array_equal(out, [0, 0, 5, 4, 3, 2, 1, 0, 0])
 
 
-@pytest.mark.parametrize("weights, mode", [([1.0, 1.0], "constant"), ([], "constant"), ([1.0], "wrap")])
-def test_bad_kernel_or_mode(weights, mode):
+@pytest.mark.parametrize("weights", [[1.0, 1.0], [], [[1.0]]])
+def test_bad_kernel(weights):
     with pytest.raises(ParameterError):
-        correlate1d(np.ones(5), weights, mode=mode)
+        correlate1d(np.ones(5), weights)

@@ -1,9 +1,9 @@
 """One-dimensional correlation along an axis of an array, in NumPy.
 
-The estimators' hot path (the seed search's smoothing and gradients, the
-local-polynomial resampling) needs only short correlations along one axis;
-doing them here keeps SciPy's ndimage, about a fifth of a second to import,
-out of a measurement's start-up.
+The local-polynomial resampling (:mod:`.resampling`) needs only short
+correlations along one axis, with zeros beyond the ends; doing them here
+keeps SciPy's ndimage, about a fifth of a second to import, out of a
+measurement's start-up.
 """
 from __future__ import annotations
 
@@ -11,12 +11,10 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
 
-from .errors import ParameterError
-
-MODES = ("constant", "reflect")
+from ..errors import ParameterError
 
 
-def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1, mode: str = "constant") -> np.ndarray:
+def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1) -> np.ndarray:
     """Correlate ``values`` with ``weights`` along ``axis``:
     ``out[i] = sum_k weights[k] * values[i + k - len(weights) // 2]``.
 
@@ -27,11 +25,8 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1, mode: str
     weights : 1-D array of odd length
         The correlation kernel, centred on its middle element.
     axis : int
-        The axis to correlate along.
-    mode : {"constant", "reflect"}
-        Beyond the ends: zeros, or the values mirrored about the edge
-        (``d c b a | a b c d``), as ``scipy.ndimage.correlate1d`` with the
-        same mode.
+        The axis to correlate along; zeros beyond its ends (as
+        ``scipy.ndimage.correlate1d`` with ``mode="constant"``).
 
     Returns
     -------
@@ -41,7 +36,7 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1, mode: str
     Raises
     ------
     ParameterError
-        An even-length or empty kernel, or an unknown mode.
+        An even-length or empty kernel.
 
     Example
     -------
@@ -51,17 +46,12 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1, mode: str
     weights = np.asarray(weights, float)
     if weights.ndim != 1 or weights.size % 2 == 0:
         raise ParameterError(f"correlate1d takes a kernel of odd length, got shape {weights.shape}")
-    if mode not in MODES:
-        raise ParameterError(f"correlate1d mode must be one of {', '.join(MODES)}, got {mode!r}")
     moved = np.moveaxis(np.asarray(values, float), axis, -1)
     half, n = weights.size // 2, moved.shape[-1]
     if moved.size == 0:
         return np.zeros(np.shape(values))
-    if mode == "constant":      # (np.pad's general machinery costs more than the correlation)
-        padded = np.zeros((*moved.shape[:-1], n + 2 * half))
-        padded[..., half: half + n] = moved
-    else:
-        padded = np.pad(moved, [(0, 0)] * (moved.ndim - 1) + [(half, half)], mode="symmetric")
+    padded = np.zeros((*moved.shape[:-1], n + 2 * half))    # (np.pad's general machinery costs more)
+    padded[..., half: half + n] = moved
     # every output's window as a strided view (no copy), weighted in one pass
     out = np.einsum("...nk,k->...n", sliding_window_view(padded, weights.size, axis=-1), weights)
     return np.moveaxis(out, -1, axis)

@@ -1,0 +1,37 @@
+"""Run NumPy's linear algebra on one BLAS thread for a while.
+
+The estimators' matrices are small (a few hundred rows, or tall and a few
+columns wide): OpenBLAS's threads cost more than they save there, and on a
+machine whose cores are busy with other work, many times more (a sensor fit
+of two edges took 4.9 s with two threads against 1.0 s with one, at a load of
+4 on 2 cores).  Worker processes run on one thread anyway
+(:func:`imgmtf.parallel.limit_threads`); this serves a computation in the
+caller's own process, and gives the threads back after it.
+"""
+from __future__ import annotations
+
+import functools
+import sys
+
+
+def one_blas_thread():
+    """A context manager: BLAS on one thread inside it, as before after it
+    (NumPy's BLAS, and SciPy's where SciPy's linear algebra is loaded: load
+    it before entering).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> with one_blas_thread():
+    ...     float(np.linalg.det(np.eye(3)))
+    1.0
+    """
+    return _controller("scipy.linalg" in sys.modules).limit(limits=1, user_api="blas")
+
+
+@functools.cache
+def _controller(scipy_loaded: bool):
+    """The libraries' thread pools, found once (a few ms) for each of the two
+    states that matter: before and after SciPy brings its own BLAS."""
+    from threadpoolctl import ThreadpoolController
+    return ThreadpoolController()

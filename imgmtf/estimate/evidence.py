@@ -1,0 +1,80 @@
+"""What the gate's profile checks read: the samples of a measured chip and
+the shape the pipeline read off them, in one frozen record.
+
+The checks registered in :mod:`.profile_checks` each take an
+:class:`Evidence` and return their :class:`.gate.Check` objects and any
+warnings, so that a new check is one module and one registration.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import TargetGeometry
+
+
+@dataclass(frozen=True, eq=False)
+class Evidence:
+    """A chip's profile samples and what the pipeline read off them.
+
+    Attributes
+    ----------
+    distance_px : numpy.ndarray
+        Each sample's signed distance from the target's line (px).
+    values : numpy.ndarray
+        Each sample's value as recorded (DN).
+    rows : numpy.ndarray
+        Each sample's row along the target (vertical frame).
+    centre_px : float
+        The target's middle along the normal (px, on ``distance_px``'s scale).
+    scale_px : float
+        The target's width: an edge's 10-90 % rise, a bar's half-width at 10 %.
+    plateau_px : float
+        How far from the centre the sides begin (px).
+    low, high : float
+        The reference levels (DN): an edge's left and right level, a bar's
+        background and peak.
+    pixel_noise : float
+        The chip's pixel noise (DN).
+    quantum : float
+        The DN step of the recorded values (0: not quantised).
+    tail_power : int
+        p of the sides' tail model, level + A / |s|^p.
+    name : str
+        The target as a user names it ("edge", "bar").
+    profile : str
+        "edge" (a step) or "bar" (a pulse).
+    side_names : tuple of str
+        What the left and the right side are called ("dark", "bright",
+        "left background"...).
+    geometry : TargetGeometry or None
+        The target's line and its per-row locations.
+    """
+
+    distance_px: np.ndarray
+    values: np.ndarray
+    rows: np.ndarray
+    centre_px: float
+    scale_px: float
+    plateau_px: float
+    low: float
+    high: float
+    pixel_noise: float
+    quantum: float
+    tail_power: int
+    name: str
+    profile: str
+    side_names: tuple[str, str]
+    geometry: TargetGeometry | None = None
+
+    @property
+    def contrast(self) -> float:
+        """The step (edge) or the height (bar), DN, > 0."""
+        return abs(self.high - self.low)
+
+    @property
+    def rounding_floor(self) -> float:
+        """A part of a bin mean's error that does not average down (DN): a
+        noise-free quantised profile rounds neighbouring samples alike."""
+        return self.quantum / np.sqrt(12.0) if self.pixel_noise < 0.5 * self.quantum else 0.0

@@ -1,0 +1,69 @@
+"""Isolated outliers: hot and dead pixels.
+
+A hot or dead pixel stands alone above (or below) every other pixel of
+the 5 x 5 block about it by far more than the noise and than the block's
+own range; a pixel on an edge or a bar never does (an edge's pixel lies
+between its neighbours across the edge; a bar's peak pixel has pixels
+along the bar within the block, and rises above them by less than the
+bar's height, the block's range).  Such pixels
+are left out of the estimate (as NaN, which every stage skips) and
+counted, instead of throwing the row's edge fit off and the chip out as
+not straight.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+OUTLIER_NOISE = 8.0           # beyond every neighbour by this many noise sd...
+OUTLIER_CONTRAST = 0.1        # ...and by this fraction of the chip's contrast
+
+
+def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
+    """Mask of the pixels of ``data`` (2-D, DN, NaN left out) that stand
+    above all the other pixels of the 5 x 5 block about them, or below all
+    of them, by more than
+    ``OUTLIER_NOISE`` times ``noise`` (DN), ``OUTLIER_CONTRAST`` of the
+    chip's contrast (its 1st to 99th percentile) and the block's own range,
+    with no such pixel among
+    their eight neighbours (a pixel, not a feature).
+
+    Examples
+    --------
+    >>> chip = np.tile(np.where(np.arange(40) < 20, 100.0, 900.0), (40, 1))
+    >>> chip[10, 5] = 4000.0
+    >>> np.argwhere(isolated_outliers(chip, noise=2.0)).tolist()
+    [[10, 5]]
+    """
+    finite = np.isfinite(data)
+    if finite.sum() < 9:
+        return np.zeros(data.shape, bool)
+    low, high = np.percentile(data[finite], [1.0, 99.0])
+    margin = max(OUTLIER_NOISE * noise, OUTLIER_CONTRAST * (high - low))
+    if not margin > 0:
+        return np.zeros(data.shape, bool)
+    above = _around(np.where(finite, data, -np.inf), 2, np.maximum, -np.inf)
+    below = _around(np.where(finite, data, np.inf), 2, np.minimum, np.inf)
+    # and beyond the block's own range: a thin bar's peak pixel rises above
+    # its block by less than the bar's height (the block holds pixels along
+    # the bar), a hot pixel on a level stands far out of its block's noise
+    spread = np.where(np.isfinite(above - below), above - below, 0.0)
+    with np.errstate(invalid="ignore"):
+        beyond = np.maximum(margin, spread)
+        outlier = finite & ((data > above + beyond) | (data < below - beyond))
+    # isolated: no outlying neighbour (a cluster is a feature, the gate's to judge)
+    clustered = _around(outlier, 1, np.logical_or, False)
+    return outlier & ~clustered
+
+
+def _around(values: np.ndarray, reach: int, combine, fill) -> np.ndarray:
+    """``combine`` (np.maximum, np.minimum, np.logical_or) over each
+    pixel's block of half-size ``reach``, the pixel itself left out;
+    ``fill`` beyond the border."""
+    rows, cols = values.shape
+    padded = np.pad(values, reach, constant_values=fill)
+    out = np.full(values.shape, fill, dtype=values.dtype)
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            if dy or dx:
+                combine(out, padded[reach + dy: reach + dy + rows, reach + dx: reach + dx + cols], out=out)
+    return out

@@ -1,0 +1,139 @@
+"""Do the sides settle?  A side of a clean target is a flat field beside a
+blur's tail, level + A / |s|^p: what an imaging system's LSF leaves beyond
+a few widths of it (diffraction, stray light and every hard-edged aperture
+fall off so).  Beyond three rises a Gaussian, a pixel, a defocus disk,
+diffraction from f/4 to f/22 and an OLPF all stay within 0.1 % of the
+contrast of that model, and their tails are alike on both sides.
+
+Two things real imagery does break it, and the pipeline's tail model would
+absorb either as blur (the MTF reads low, in the issue's case 0.04 for
+0.27 at Nyquist):
+
+- a level that curves across a side (an illumination fall-off, a slope
+  beside a tarp): the side departs from level + A / |s|^p by a smooth
+  shape that no tail takes;
+- a plateau that never settles (one side still rising far from the target,
+  a shading towards it): one side's tail is much larger than the other's,
+  where a lens's own tails come in pairs.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .evidence import Evidence
+from .gate import Check
+
+MIN_SIDE_SAMPLES = 40
+MIN_SIDE_EXTENT_PX = 4.0
+BAND_PX = 1.0                  # the side's residuals are averaged in bands this wide
+MIN_BAND_SAMPLES = 5
+SMOOTH_DEGREE = 3              # a smooth departure: a cubic across the side's extent
+MAX_DEPARTURE = 0.02           # of the contrast: refused beyond this...
+WARN_DEPARTURE = 0.005         # ...and said beyond this
+MAX_TAIL_ASYMMETRY = 0.05      # one side's unsettled share at its start beyond the other's...
+MAX_UNSETTLED = 0.08            # ...with this much of the contrast still to come on it: refused
+WARN_TAIL_ASYMMETRY = 0.03      # said, with...
+WARN_UNSETTLED = 0.04           # ...this much still to come (a gamma-encoded camera edge shows up to 6.5 %)
+SIGNIFICANCE = 5.0             # in standard deviations of the noise
+
+
+def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
+    """The departure of each side from level + A / |s|^p (a smooth shape
+    fitted to its band means) and the asymmetry of the two sides' tails.
+
+    Returns the checks (reason ``non-uniform``) and the warnings for
+    departures too small to refuse but larger than the estimate ignores.
+    """
+    s = ev.distance_px - ev.centre_px
+    fits = [_side_fit(ev, s, mask) for mask in (s <= -ev.plateau_px, s >= ev.plateau_px)]
+    checks: list[Check] = []
+    warnings: list[str] = []
+    for name, fit in zip(ev.side_names, fits):
+        if fit is None:
+            continue
+        departure, sd, where = fit["departure"]
+        share = departure / ev.contrast
+        significant = departure > SIGNIFICANCE * sd
+        checks.append(Check(
+            "non-uniform", not (significant and share > MAX_DEPARTURE),
+            f"the {name} side's level departs from a settled level by {100 * share:.1f} % of the contrast "
+            f"({where:.0f} px from the {ev.name}; at most {100 * MAX_DEPARTURE:g} %): it curves or keeps "
+            "changing (illumination, a slope), not a uniform field", share, MAX_DEPARTURE))
+        if significant and WARN_DEPARTURE < share <= MAX_DEPARTURE:
+            warnings.append(f"the {name} side's level departs from a settled level by {100 * share:.1f} % of "
+                            f"the contrast ({where:.0f} px from the {ev.name}): a shading, a halo or a "
+                            "texture there changes the MTF")
+    if all(fit is not None for fit in fits):
+        (left, left_sd), (right, right_sd) = (fit["unsettled"] for fit in fits)  # type: ignore[index]
+        asymmetry, slow = abs(left - right), max(left, right)
+        significant = asymmetry > SIGNIFICANCE * math.hypot(left_sd, right_sd)
+        slower = ev.side_names[0] if left > right else ev.side_names[1]
+        unsettled = significant and asymmetry > MAX_TAIL_ASYMMETRY and slow > MAX_UNSETTLED
+        checks.append(Check(
+            "non-uniform", not unsettled,
+            f"the {slower} side has not settled {ev.plateau_px:.1f} px from the {ev.name}: "
+            f"{100 * slow:.1f} % of the contrast is still to come there (at most {100 * MAX_UNSETTLED:g} %), "
+            f"against {100 * min(left, right):.1f} % on the other side: a shading beside the target, not a "
+            "lens's tails", slow, MAX_UNSETTLED))
+        if significant and not unsettled and asymmetry > WARN_TAIL_ASYMMETRY and slow > WARN_UNSETTLED:
+            warnings.append(f"the {slower} side settles more slowly than the other ({100 * slow:.1f} % of the "
+                            f"contrast still to come {ev.plateau_px:.1f} px from the {ev.name}, against "
+                            f"{100 * min(left, right):.1f} %): a shading beside the target, or a gamma-encoded "
+                            "image, reads as blur")
+    return checks, warnings
+
+
+def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
+    """One side's level + A / |s|^p fit: its smooth departure (DN, its
+    standard deviation, where, px) and its unsettled share at the side's
+    start (fraction of the contrast towards the other level, and its sd)."""
+    if np.count_nonzero(mask) < MIN_SIDE_SAMPLES:
+        return None
+    reach, v = np.abs(s[mask]), ev.values[mask]
+    if np.ptp(reach) < MIN_SIDE_EXTENT_PX:
+        return None
+    u = reach ** -float(ev.tail_power)
+    design = np.column_stack([np.ones_like(u), u])
+    normal = design.T @ design
+    if np.linalg.cond(normal) > 1e12:
+        return None
+    coef = np.linalg.solve(normal, design.T @ v)
+    resid = v - design @ coef
+    sigma2 = max(float(resid @ resid) / max(resid.size - 2, 1), ev.quantum ** 2 / 12.0)
+    # the model's own noise: its tail at the side's start, towards the target's other level
+    start_u = ev.plateau_px ** -float(ev.tail_power)
+    towards = _towards_target(ev, left=bool(s[mask][0] < 0))
+    tail_cov = np.linalg.inv(normal)[1, 1] * sigma2
+    unsettled = (towards * coef[1] * start_u / ev.contrast, math.sqrt(tail_cov) * start_u / ev.contrast)
+
+    band = np.floor((reach - reach.min()) / BAND_PX).astype(int)
+    counts = np.bincount(band)
+    sums = np.bincount(band, weights=resid)
+    full = counts >= MIN_BAND_SAMPLES
+    if full.sum() <= SMOOTH_DEGREE + 1:
+        return {"departure": (0.0, math.inf, 0.0), "unsettled": unsettled}
+    centres = reach.min() + (np.nonzero(full)[0] + 0.5) * BAND_PX
+    means = sums[full] / counts[full]
+    error2 = sigma2 / counts[full] + ev.rounding_floor ** 2
+    t = 2.0 * (centres - centres[0]) / max(centres[-1] - centres[0], 1e-9) - 1.0
+    basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
+    weights = 1.0 / np.maximum(error2, 1e-300)
+    normal_b = (basis * weights[:, None]).T @ basis
+    cov = np.linalg.pinv(normal_b)
+    smooth_coef = cov @ (basis * weights[:, None]).T @ means
+    curve = basis @ smooth_coef
+    worst = int(np.argmax(np.abs(curve)))
+    sd = math.sqrt(max(float(basis[worst] @ cov @ basis[worst]), 0.0))
+    return {"departure": (float(abs(curve[worst])), sd, float(centres[worst])), "unsettled": unsettled}
+
+
+def _towards_target(ev: Evidence, left: bool) -> float:
+    """+1 or -1: the sign that turns a side's tail amplitude A into the
+    share of the contrast still to come towards the target (positive for a
+    blur's tail, whose LSF is positive)."""
+    if ev.profile == "bar":
+        return 1.0 if ev.high >= ev.low else -1.0
+    rising = ev.high >= ev.low           # the right level above the left
+    return (1.0 if rising else -1.0) * (1.0 if left else -1.0)
