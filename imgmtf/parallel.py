@@ -108,20 +108,37 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
 
     Parameters
     ----------
-    workers : local worker processes (1: run here, no processes), at most
-        :data:`MAX_WORKERS`.
-    scheduler : a Dask distributed scheduler address (``tcp://host:8786``)
-        to run on that cluster, or ``"local"`` for a local Dask cluster of
-        ``workers`` processes; None for local processes.  The workers must
-        see the same files at the same paths (a shared file system).
-    progress : show a progress bar (on stderr); None shows it when stderr
-        is a terminal and there is more than one item.
-    on_error : ``on_error(item, exception)`` gives the result of a task
-        that raised or whose worker died; None lets the exception through.
-    ordered : False yields ``(index, result)`` pairs as tasks complete.
+    function : callable
+        What to run on each item (picklable: a module's function).
+    items : iterable
+        The tasks' arguments, one each.
+    workers : int, optional
+        Local worker processes (1, the default: run here, no processes), at
+        most :data:`MAX_WORKERS`.
+    scheduler : str, optional
+        A Dask distributed scheduler address (``tcp://host:8786``) to run on
+        that cluster, or ``"local"`` for a local Dask cluster of ``workers``
+        processes; None for local processes.  The workers must see the same
+        files at the same paths (a shared file system).
+    progress : bool, optional
+        Show a progress bar (on stderr); None shows it when stderr is a
+        terminal and there is more than one item.
+    description : str, optional
+        The progress bar's label (default "measuring").
+    on_error : callable, optional
+        ``on_error(item, exception)`` gives the result of a task that raised
+        or whose worker died; None lets the exception through.
+    ordered : bool, optional
+        False yields ``(index, result)`` pairs as tasks complete (default
+        True: results in input order).
 
-    Example
-    -------
+    Yields
+    ------
+    object
+        Each task's result (or ``(index, result)`` pairs, unordered).
+
+    Examples
+    --------
     >>> list(run_tasks(abs, [-2, 1, -3], workers=2))
     [2, 1, 3]
     """

@@ -38,8 +38,8 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1) -> np.nda
     ParameterError
         An even-length or empty kernel.
 
-    Example
-    -------
+    Examples
+    --------
     >>> correlate1d(np.array([0.0, 1.0, 0.0, 0.0]), np.array([1.0, 2.0, 3.0]))
     array([3., 2., 1., 0.])
     """

@@ -7,7 +7,7 @@ with comparable support, away from the first, means the chip holds two
 edges (or a bar).  The tests hold the seed to within 1 deg of
 scikit-image's ``feature.canny`` and ``transform.hough_line``.
 
-Angles follow :mod:`imgmtf.targets`: a line is x cos(theta) + y sin(theta)
+Angles follow :mod:`imgmtf.sensor.targets`: a line is x cos(theta) + y sin(theta)
 = rho, with theta the angle of its normal from the x (column) axis, which
 is also the tilt of the line from the column axis.
 """

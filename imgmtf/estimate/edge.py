@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
 from .._blas import one_blas_thread
 from . import gate
@@ -40,11 +41,31 @@ BAR_MAX_SEPARATION_PX = 8.0    # two parallel lines closer than this are one bar
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
 class EdgeResult(MTFResult):
     """MTF of one edge and everything it was computed from (see
-    :class:`imgmtf.estimate.results.MTFResult`).  ``esf`` is normalised to
-    rise from 0 to 1 whatever the edge's polarity; ``levels_dn`` are the
-    left and right levels (the vertical frame's: left is -x, or up for a
-    near-horizontal edge); ``bright_side`` names where the bright side
-    lies in the image as stored; ``rer`` is the relative edge response."""
+    :class:`imgmtf.estimate.results.MTFResult` for the fields every
+    measurement has).
+
+    Attributes
+    ----------
+    rer : float
+        The relative edge response: the normalised ESF's rise over the
+        pixel centred on the edge.
+    esf_x_px, esf : numpy.ndarray
+        The resampled ESF, normalised to rise from 0 to 1 whatever the
+        edge's polarity, and its positions along the normal, px.
+    levels_dn : (float, float)
+        The left and right levels, DN (the vertical frame's: left is -x, or
+        up for a near-horizontal edge).
+    bright_side : str
+        Where the bright side lies in the image as stored.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60)
+    >>> result = imgmtf.measure_edge(chip.image)
+    >>> round(result.rer, 2), result.polarity, round(float(result.esf[-1]), 2)
+    (0.67, 'rising', 1.0)
+    """
 
     target: ClassVar[str] = "edge"
     rer: float
@@ -170,15 +191,16 @@ class EdgeEstimator:
     True
     """
 
-    def __init__(self, method: str = "msg", **settings):
+    def __init__(self, method: str = "msg", **settings: Any):
         self.settings: Settings = make_settings(method, **settings)
 
     @property
     def method(self) -> str:
         return self.settings.method
 
-    def __call__(self, image, *, roi=None, mask=None, gsd_m: float | None = None,
-                 saturation: tuple[float, float] | None = None, dtype=None,
+    def __call__(self, image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None,
+                 mask: np.ndarray | None = None, gsd_m: float | None = None,
+                 saturation: tuple[float, float] | None = None, dtype: DTypeLike | None = None,
                  track_azimuth_deg: float | None = 0.0) -> EdgeResult:
         """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
         with one_blas_thread():         # small matrices: threads cost more than they save
@@ -193,9 +215,10 @@ class EdgeEstimator:
             esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
 
 
-def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: float | None = None,
-                 saturation: tuple[float, float] | None = None, force: bool = False,
-                 track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> EdgeResult:
+def measure_edge(image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None, mask: np.ndarray | None = None,
+                 method: str = "msg", gsd_m: float | None = None, saturation: tuple[float, float] | None = None,
+                 force: bool = False, track_azimuth_deg: float | None = 0.0, dtype: DTypeLike | None = None,
+                 **options: Any) -> EdgeResult:
     """Measure the MTF of the straight edge in ``image``.
 
     Parameters
@@ -208,7 +231,7 @@ def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: floa
     mask : ndarray of bool, optional
         Of the image's shape: True for the pixels that belong to the chip
         (a tilted ROI, a target cut out of its fill), the others left out.
-    method : str
+    method : str, optional
         "msg" (default), "sliding", "spline" or "iso".
     gsd_m : float, optional
         Ground sample distance (m), to report cycles/m and metres.
@@ -216,11 +239,11 @@ def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: floa
         (low, high) DN the sensor records; default an integer image's
         type range, none declared for floats (clipping is still detected
         from the values).
-    force : bool
+    force : bool, optional
         Measure even when a quality check fails, each failure a warning.
-    track_azimuth_deg : float or None
+    track_azimuth_deg : float or None, optional
         The ground track's direction, degrees clockwise from the image's
-        up (0: rows along track); None when unknown.
+        up (0, the default: rows along track); None when unknown.
     dtype : numpy dtype, optional
         The type the values were stored as, when ``image`` is a copy.
     **options
@@ -230,6 +253,8 @@ def measure_edge(image, *, roi=None, mask=None, method: str = "msg", gsd_m: floa
     Returns
     -------
     EdgeResult
+        The MTF along the edge's normal (cy/px; 1 at zero frequency), its
+        figures with their intervals, and what they were computed from.
 
     Raises
     ------

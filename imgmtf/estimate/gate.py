@@ -88,7 +88,23 @@ class QualityError(UnsuitableTargetError):
     """A chip refused by the quality gate; ``checks`` lists the failed
     checks, the first one's reason is the error's.  ``force=True`` (the
     CLI's ``--force``) measures such a chip anyway, each failed check a
-    warning."""
+    warning.
+
+    Parameters
+    ----------
+    failed : list of Check
+        The failed checks, the first the one the message and reason give.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, bits=8)    # 1200 DN clips at 255
+    >>> try:
+    ...     imgmtf.measure_edge(chip.image)
+    ... except imgmtf.QualityError as error:
+    ...     print(error.reason, [check.reason for check in error.checks])
+    saturated ['saturated', 'saturated']
+    """
 
     def __init__(self, failed: list[Check]):
         others = [r for r in dict.fromkeys(c.reason for c in failed[1:]) if r != failed[0].reason]
@@ -103,7 +119,25 @@ FORCIBLE = frozenset({"fill", "saturated", "not-straight", "two-targets", "non-u
 
 
 class TwoTargetsError(QualityError, MultipleTargetsError):
-    """A chip refused because it holds a second edge or bar."""
+    """A chip refused because it holds a second edge or bar.
+
+    Parameters
+    ----------
+    failed : list of Check
+        The failed checks, the first the one that found the second target.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> band = np.full((60, 60), 200.0)
+    >>> band[:, 20:40] = 1200.0                      # a wide bar: two edges
+    >>> try:
+    ...     imgmtf.measure_edge(band)
+    ... except imgmtf.TwoTargetsError as error:
+    ...     print(error.reason, isinstance(error, imgmtf.MultipleTargetsError))
+    two-targets True
+    """
 
 
 MOSTLY_FILL = 0.5               # a forced chip more than this much fill measures the fill's boundary
@@ -181,8 +215,8 @@ def fill_values(values: np.ndarray, dtype) -> list[float]:
     type's limits, and a negative minimum where the rest is not negative
     (-9999).
 
-    Example
-    -------
+    Examples
+    --------
     >>> fill_values(np.array([-9999.0, 5.0, 7.0]), "float32")
     [-9999.0, 0.0]
     """

@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
 from .._blas import one_blas_thread
 from ..errors import TargetNotFoundError, UnsuitableTargetError
@@ -52,14 +53,34 @@ WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-wid
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
 class PulseResult(MTFResult):
-    """MTF from one bar (see :class:`imgmtf.estimate.results.MTFResult`).
+    """MTF from one bar (see :class:`imgmtf.estimate.results.MTFResult` for
+    the fields every measurement has; ``fwhm_px`` is the recovered LSF's).
 
-    ``prf`` is the pulse response normalised to a unit peak above the
-    background (positive for dark bars too); ``pulse_width_px`` the bar
-    width used (``width_estimated`` when it came from the profile);
-    ``usable_band_cy_px`` the frequency below which the bar's sinc stays
-    above 0.1, so that dividing by it is meaningful; ``fwhm_px`` is the
-    recovered LSF's, ``prf_fwhm_px`` the PRF's."""
+    Attributes
+    ----------
+    pulse_width_px : float
+        The bar's width used, px.
+    width_estimated : bool
+        True when the width came from the profile rather than the caller.
+    usable_band_cy_px : float
+        The frequency below which the bar's sinc stays above 0.1, so that
+        dividing by it is meaningful, cy/px.
+    prf_x_px, prf : numpy.ndarray
+        The pulse response, normalised to a unit peak above the background
+        (positive for dark bars too), and its positions along the normal, px.
+    prf_fwhm_px : float
+        The pulse response's FWHM, px.
+    background_dn, peak_dn : float
+        The background's level and the bar's peak, DN.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("pulse", 6.0, width_px=1.5), 60)
+    >>> result = imgmtf.measure_pulse(chip.image, width_px=1.5)
+    >>> result.pulse_width_px, result.width_estimated, result.polarity
+    (1.5, False, 'bright')
+    """
 
     target: ClassVar[str] = "pulse"
     pulse_width_px: float
@@ -203,15 +224,17 @@ class PulseEstimator:
     0.27
     """
 
-    def __init__(self, method: str = "msg", **settings):
+    def __init__(self, method: str = "msg", **settings: Any):
         self.settings = make_settings(method, **settings)
 
     @property
     def method(self) -> str:
         return self.settings.method
 
-    def __call__(self, image, *, width_px: float | None = None, roi=None, mask=None, gsd_m: float | None = None,
-                 saturation=None, dtype=None, track_azimuth_deg: float | None = 0.0) -> PulseResult:
+    def __call__(self, image: ArrayLike, *, width_px: float | None = None, roi: tuple[int, int, int, int] | None = None,
+                 mask: np.ndarray | None = None, gsd_m: float | None = None,
+                 saturation: tuple[float, float] | None = None, dtype: DTypeLike | None = None,
+                 track_azimuth_deg: float | None = 0.0) -> PulseResult:
         """Measure the bar in ``image`` (2-D array, DN), ``width_px`` wide
         (estimated from the profile when None); see :func:`measure_pulse`."""
         with one_blas_thread():         # small matrices: threads cost more than they save
@@ -233,9 +256,11 @@ class PulseEstimator:
             peak_dn=float(peak))
 
 
-def measure_pulse(image, *, width_px: float | None = None, roi=None, mask=None, method: str = "msg",
-                  gsd_m: float | None = None, saturation=None, force: bool = False,
-                  track_azimuth_deg: float | None = 0.0, dtype=None, **options) -> PulseResult:
+def measure_pulse(image: ArrayLike, *, width_px: float | None = None, roi: tuple[int, int, int, int] | None = None,
+                  mask: np.ndarray | None = None, method: str = "msg", gsd_m: float | None = None,
+                  saturation: tuple[float, float] | None = None, force: bool = False,
+                  track_azimuth_deg: float | None = 0.0, dtype: DTypeLike | None = None,
+                  **options: Any) -> PulseResult:
     """Measure the MTF from the bar (pulse) in ``image``.
 
     Parameters
@@ -245,12 +270,33 @@ def measure_pulse(image, *, width_px: float | None = None, roi=None, mask=None, 
     width_px : float, optional
         The bar's width along its normal (px); estimated from the first
         zero of the PRF's spectrum when None.
-    roi, mask, method, gsd_m, saturation, force, track_azimuth_deg, dtype, **options
+    roi : (int, int, int, int), optional
+        (x, y, width, height) crop, px.
+    mask : ndarray of bool, optional
+        Of the image's shape: True for the pixels that belong to the chip.
+    method : str, optional
+        "msg" (default), "sliding", "spline" or "iso".
+    gsd_m : float, optional
+        Ground sample distance (m), to report cycles/m and metres.
+    saturation : (float, float), optional
+        (low, high) DN the sensor records (default an integer image's type
+        range).
+    force : bool, optional
+        Measure even when a quality check fails, each failure a warning.
+    track_azimuth_deg : float or None, optional
+        The ground track's direction, degrees clockwise from the image's
+        up (0, the default: rows along track); None when unknown.
+    dtype : numpy dtype, optional
+        The type the values were stored as, when ``image`` is a copy.
+    **options
         As for :func:`imgmtf.measure_edge`.
 
     Returns
     -------
     PulseResult
+        The MTF along the bar's normal (cy/px; 1 at zero frequency, the
+        bar's own sinc divided out), its figures with their intervals, and
+        what they were computed from.
 
     Raises
     ------
@@ -291,8 +337,8 @@ def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast
     values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
     about it, for the intervals (:class:`imgmtf.estimate.pipeline.WidthReading`).
 
-    Example
-    -------
+    Examples
+    --------
     A 1.5 px bar through a Gaussian PSF (sigma 0.5 px), made 0.02 px wider:
 
     >>> from scipy.special import erf

@@ -23,8 +23,10 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
 from ._correlation import correlate1d
@@ -442,8 +444,8 @@ def check_method(method: str) -> ResamplingMethod:
     ParameterError
         ``method`` is not a key of :data:`METHODS`.
 
-    Example
-    -------
+    Examples
+    --------
     >>> check_method("iso").defaults
     {'bin_px': 0.25}
     """
@@ -453,7 +455,8 @@ def check_method(method: str) -> ResamplingMethod:
 
 
 def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = "msg",
-                     step: float = 0.05, half_range: float, weights=None, **options) -> Resampled:
+                     step: float = 0.05, half_range: float, weights: ArrayLike | None = None,
+                     **options: Any) -> Resampled:
     """Resample an over-sampled, unevenly spaced profile onto a uniform grid.
 
     Parameters
