@@ -103,7 +103,7 @@ class QualityError(UnsuitableTargetError):
     ...     imgmtf.measure_edge(chip.image)
     ... except imgmtf.QualityError as error:
     ...     print(error.reason, [check.reason for check in error.checks])
-    saturated ['saturated', 'saturated']
+    saturated ['saturated']
     """
 
     def __init__(self, failed: list[Check]):
