@@ -57,6 +57,7 @@ def monotone_cubic(x: np.ndarray, y: np.ndarray) -> CubicCurve:
     Returns
     -------
     CubicCurve
+        The interpolant, callable at any x (clipped into the knots' range).
 
     Examples
     --------
@@ -113,6 +114,7 @@ def smoothing_spline(x: np.ndarray, y: np.ndarray, weights: np.ndarray | None = 
     Returns
     -------
     CubicCurve
+        The smoothing spline, callable at any x (clipped into the knots' range).
 
     Examples
     --------
