@@ -211,7 +211,8 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0,
 
     A line counts when at least ``min_votes`` Canny pixels lie on it and the
     mean levels 1-5 px either side of it differ by ``min_contrast`` times
-    the image noise.  The competitor is a second such line with at least
+    the image noise; the strongest has the most votes times that
+    difference.  The competitor is a second such line with at least
     half the support of the first lying more than 3 px away from it inside
     the chip: another edge, or the far side of a bar (the quality gate
     tells them apart, :mod:`.gate`).  ``noise`` is the image's pixel noise
@@ -222,11 +223,15 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0,
     TargetNotFoundError : no such line.
     """
     noise = robust_noise(image) if noise is None else noise
-    lines = [ln for ln in find_lines(image)
-             if ln.votes >= min_votes and step_contrast(image, ln) >= min_contrast * noise]
+    scored = [(ln, step_contrast(image, ln)) for ln in find_lines(image) if ln.votes >= min_votes]
+    lines = [ln for ln, contrast in sorted(((ln, c) for ln, c in scored if c >= min_contrast * noise),
+                                           key=lambda lc: -lc[0].votes * lc[1])]
     if not lines:
         raise TargetNotFoundError("no straight edge found: no line of strong contrast "
                                   "stands out of the noise")
+    # lines crossing the whole chip get nearly the same votes: the one with the
+    # largest step across it is the target (a road's sides beside an edge have
+    # as much support as the edge, and less contrast)
     best = lines[0]
     rival = next((other for other in lines[1:]
                   if other.votes >= 0.5 * best.votes and _separation(best, other, image.shape) > 3.0), None)
