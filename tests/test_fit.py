@@ -55,7 +55,7 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     assert wrong.misfit and any("does not fit" in w for w in wrong.warnings)
     assert wrong.edges[0].misfit_p < 1e-3
     # the advice names stages the model lacks, never one it has
-    from imgmtf.estimate.fit import _other_stages
+    from imgmtf.estimate.fit.model import other_stages as _other_stages
     assert _other_stages(wrong.sensor.stages) == "try other stages (e.g. diffraction, defocus, olpf)"
     assert _other_stages(right.sensor.stages) == "try other stages (e.g. defocus, olpf)"
     everything = im.Sensor(1.0, [st.Diffraction(8.0), st.Defocus(1.0), st.OLPF(0.7), st.Detector()])
@@ -70,8 +70,10 @@ def test_profile_noise_needs_no_model():
 
 
 def test_a_fit_that_does_not_converge_is_an_imgmtf_error(pair):
-    data = [fit_module._edge_data(pair[0].image, 0, None, None, None)]
-    model = fit_module._Model(1.0, fit_module._initial_stages(["optics"], None, 1.0), data)
+    from imgmtf.estimate.fit.data import edge_data
+    from imgmtf.estimate.fit.model import Model, initial_stages
+    data = [edge_data(pair[0].image, 0, None, None, None)]
+    model = Model(1.0, initial_stages(["optics"], None, 1.0), data)
     with pytest.raises(ImgmtfError, match="did not converge"):
         model.solve(model.initial_vector(), max_iterations=0)
 

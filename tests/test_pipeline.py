@@ -8,7 +8,7 @@ import pytest
 import imgmtf as im
 from imgmtf.errors import ParameterError
 from imgmtf.estimate.geometry import direction_label
-from imgmtf.estimate.pipeline import make_settings
+from imgmtf.estimate.settings import make_settings
 
 from conftest import (
     defocus_transfer,

@@ -21,9 +21,12 @@ from .._blas import one_blas_thread
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import TargetGeometry, locate_edge
-from .pipeline import Settings, Shape, TargetKind, make_settings, outer_samples, run
+from .kind import Shape, TargetKind
+from .pipeline import run
 from .results import MTFResult, finite
+from .settings import Settings, make_settings
 from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
+from .tails import outer_samples
 
 # Measured by `imgmtf reproduce` (docs/reproduction.md): on the paper's 40-row
 # edge chips, 95 % of msg estimates fall within +-5 % of the true MTF at
@@ -170,7 +173,7 @@ class EdgeEstimator:
         Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
         (default "msg").
     **settings
-        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        The settings of :class:`imgmtf.estimate.settings.Settings` as
         keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
         intervals); ``snr_threshold=None`` uses the measured threshold for
         the edge's length (:func:`confident_snr`); ``lsf_window_factor=None``
@@ -247,7 +250,7 @@ def measure_edge(image: ArrayLike, *, roi: tuple[int, int, int, int] | None = No
     dtype : numpy dtype, optional
         The type the values were stored as, when ``image`` is a copy.
     **options
-        Settings of :class:`imgmtf.estimate.pipeline.Settings`
+        Settings of :class:`imgmtf.estimate.settings.Settings`
         (``intervals``, ``bootstrap``, ``step_px``, ``lsf_half_width_px``, ``transfer``...).
 
     Returns

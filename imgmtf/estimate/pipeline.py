@@ -1,6 +1,6 @@
 """One profile pipeline for edges and bars.
 
-Every estimate runs the same stages; a target kind (:class:`TargetKind`:
+Every estimate runs the same stages; a target kind (:class:`.kind.TargetKind`:
 :class:`imgmtf.estimate.edge.EdgeKind`, :class:`imgmtf.estimate.pulse.PulseKind`)
 supplies only what differs:
 
@@ -32,9 +32,7 @@ supplies only what differs:
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import ClassVar
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -42,32 +40,30 @@ from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
-from ..transfer import Transfer, full_scale, parse_transfer
+from ..transfer import full_scale
 from . import gate
-from .detection import Line, robust_noise
+from .detection import robust_noise
 from .evidence import Evidence
 from .geometry import (
-    EDGE_FIT_HALF_WINDOW_PX,
     TargetGeometry,
     check_angle,
     direction_label,
     profile_samples,
-    row_windows,
     vertical_frame,
 )
 from .intervals import (
     Interval,
-    Intervals,
-    as_intervals,
     bootstrap_figures,
     influence_sd,
     influence_sds,
     linearised_interval,
 )
+from .kind import TargetKind, refuse_other_kind
 from .outliers import isolated_outliers
 from .profile_checks import run_profile_checks
 from .quantisation import dequantise
-from .resampling import METHODS, check_method, resample_profile
+from .resampling import resample_profile
+from .settings import Settings
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
@@ -79,18 +75,13 @@ from .spectrum import (
     restore_lsf,
     white_noise_mtf_sd,
 )
+from .tails import fit_side, model_reach, outer_samples, tail_integral
 
-DEFAULT_FREQUENCIES = np.round(np.arange(0.0, 1.0 + 1e-9, 0.01), 10)
-STEP_RANGE_PX = (0.005, 0.25)     # finer costs time for nothing; coarser misses the LSF's shape
-MAX_FREQUENCY_CY_PX = 4.0
 TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
 TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
-MIN_TAIL_SAMPLES = 12
 LONG_TAIL_SHARE = 0.03            # tails beyond the core holding more of the signal keep the clean window
 INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
 CORE_STEP_PX = 0.5                # the core grows in these steps while the tail model misfits
-MODEL_CHECK_PX = 3.0              # the model must explain this much of the profile past the core
-MODEL_BIN_PX = 0.5
 # The estimator's own error where noise is not the whole error, added in
 # quadrature to the interval: on exact chips the worst error at Nyquist is
 # about 0.0005 for Gaussian-type blurs; the tail model's share of the
@@ -111,399 +102,6 @@ BACKGROUND_FRACTION = 2.0 / 3.0   # a bar's background is read from the samples 
 WIDTH_SHARE_WARNING = 0.5         # an estimated width making more of the variance at Nyquist is worth a warning
 MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
 
-
-@dataclass(frozen=True, eq=False)
-class Settings:
-    """How an over-sampled-profile estimator measures (shared by edges and
-    bars).
-
-    Parameters
-    ----------
-    method : str
-        Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
-        ("msg", "sliding", "spline", "iso").
-    step_px : float
-        Resampled profile grid step (px), 0.005 to 0.25; "iso" always uses
-        its 1/4-px bins.
-    correct : bool
-        Divide out the blur of the estimator's own steps.  False
-        reproduces the uncorrected classic algorithms.
-    frequencies_cy_px : array_like
-        Where the reported MTF curve is sampled (cy/px, 0 to 4).
-    snr_threshold : float or None
-        Below this SNR the result carries a warning; None uses the
-        measured threshold for the target's length.
-    method_options : dict
-        Overrides of the method's defaults (e.g. ``window_px``).
-    lsf_half_width_px : float or None
-        Half-width of the flat core of the LSF window (px); None chooses
-        it from the target's width and the SNR.
-    lsf_window_factor : float or None
-        That half-width in units of the 10-90 % rise (edges); None adapts
-        it to the SNR.
-    intervals : Intervals or str or int
-        Confidence-interval settings (:class:`imgmtf.estimate.intervals.Intervals`),
-        or a method's name as ``--intervals`` takes it ("influence",
-        "bootstrap", "none"), or a number of bootstrap replicates (0: none).
-    force : bool
-        Measure even when a quality check fails (each failure becomes a
-        warning) instead of refusing.
-    transfer : str or Transfer
-        How the stored values relate to light (:mod:`imgmtf.transfer`):
-        "linear" (default: as stored), "srgb" or "gamma:G"; the values are
-        linearised before measuring.
-
-    Raises
-    ------
-    ParameterError
-        For any value out of its range or of the wrong kind.
-    """
-
-    method: str = "msg"
-    step_px: float = 0.05
-    correct: bool = True
-    frequencies_cy_px: np.ndarray = field(default_factory=lambda: DEFAULT_FREQUENCIES)
-    snr_threshold: float | None = None
-    method_options: dict = field(default_factory=dict)
-    lsf_half_width_px: float | None = None
-    lsf_window_factor: float | None = None
-    intervals: Intervals = field(default_factory=Intervals)
-    force: bool = False
-    transfer: Transfer = field(default_factory=Transfer)
-
-    def __post_init__(self):
-        check_method(self.method)
-        set_ = object.__setattr__
-        set_(self, "step_px", check_number("step_px", self.step_px, low=STEP_RANGE_PX[0], high=STEP_RANGE_PX[1]))
-        if not isinstance(self.correct, (bool, np.bool_)):
-            raise ParameterError(f"correct must be True or False, got {self.correct!r}")
-        try:
-            f = np.asarray(self.frequencies_cy_px, float).ravel()
-        except (TypeError, ValueError):
-            raise ParameterError(f"frequencies_cy_px must be numbers, got {self.frequencies_cy_px!r}") from None
-        if f.size == 0 or not np.all(np.isfinite(f)) or f.min() < 0 or f.max() > MAX_FREQUENCY_CY_PX:
-            raise ParameterError(f"frequencies_cy_px must be finite, in [0, {MAX_FREQUENCY_CY_PX:g}] cy/px")
-        set_(self, "frequencies_cy_px", f)
-        if self.snr_threshold is not None:
-            set_(self, "snr_threshold", check_number("snr_threshold", self.snr_threshold, positive=True))
-        if not isinstance(self.method_options, dict):
-            raise ParameterError(f"method_options must be a dict, got {self.method_options!r}")
-        _check_method_options(self.method, self.method_options)
-        if self.lsf_half_width_px is not None:
-            set_(self, "lsf_half_width_px", check_number("lsf_half_width_px", self.lsf_half_width_px,
-                                                         low=0.5, high=64.0))
-        if self.lsf_window_factor is not None:
-            set_(self, "lsf_window_factor", check_number("lsf_window_factor", self.lsf_window_factor,
-                                                         low=0.5, high=10.0))
-        set_(self, "intervals", as_intervals(self.intervals))
-        if not isinstance(self.force, (bool, np.bool_)):
-            raise ParameterError(f"force must be True or False, got {self.force!r}")
-        set_(self, "transfer", parse_transfer(self.transfer))
-
-    def as_dict(self) -> dict:
-        out = {"method": self.method, "step_px": self.step_px, "correct": self.correct,
-               "intervals": self.intervals.as_dict(), "force": self.force, "transfer": str(self.transfer)}
-        for key in ("snr_threshold", "lsf_half_width_px", "lsf_window_factor"):
-            if getattr(self, key) is not None:
-                out[key] = getattr(self, key)
-        if self.method_options:
-            out["method_options"] = dict(self.method_options)
-        return out
-
-
-def _check_method_options(method: str, options: dict) -> None:
-    """Bounds of the resampling methods' options (unknown names are the
-    dispatcher's to refuse)."""
-    bounds = {"window_px": (0.05, 8.0), "order": (0, 8), "cutoff_cy_px": (0.1, 20.0), "bin_px": (0.02, 1.0)}
-    for name, value in options.items():
-        if name in bounds:
-            low, high = bounds[name]
-            check_number(name, value, low=low, high=high, integer=name == "order")
-    unknown = set(options) - set(METHODS[method].defaults)
-    if unknown:
-        raise ParameterError(f"method {method!r} takes no option(s) {', '.join(sorted(unknown))}; "
-                             f"it takes {', '.join(METHODS[method].defaults)}")
-
-
-def make_settings(method: str = "msg", *, bootstrap=None, **options) -> Settings:
-    """:class:`Settings` from keywords, with ``bootstrap=N`` meaning N
-    bootstrap replicates (0: no intervals) and unknown keywords refused by
-    name."""
-    known = set(Settings.__dataclass_fields__)
-    unknown = sorted(set(options) - known)
-    if unknown:
-        raise ParameterError(f"unknown option(s) {', '.join(unknown)}; valid: bootstrap, "
-                             f"{', '.join(sorted(known - {'method'}))}")
-    if bootstrap is not None:
-        if "intervals" in options:
-            raise ParameterError("give intervals= or bootstrap=, not both")
-        options["intervals"] = as_intervals(bootstrap)
-    return Settings(method, **options)
-
-
-class TargetKind:
-    """What differs between targets; see :class:`imgmtf.estimate.edge.EdgeKind`
-    and :class:`imgmtf.estimate.pulse.PulseKind`, the two implementations.
-
-    Attributes: ``name`` is the target as a user names it ("edge", "bar");
-    ``profile`` what its profile must look like
-    (:func:`.gate.classify_profile`); ``tail_power`` p of its profile's
-    tails, level + A / |s|^p; ``monotone`` whether the profile only rises
-    (a staircase can then be rebuilt, :mod:`.quantisation`);
-    ``subtracts_background`` whether its LSF-like profile is the profile
-    above a fitted background (a bar) rather than a derivative (an edge);
-    ``restore_min_divisor`` the divisor below which the recovered LSF's
-    spectrum is bridged rather than divided.
-    """
-
-    name: ClassVar[str]
-    profile: ClassVar[str]
-    tail_power: ClassVar[int]
-    monotone: ClassVar[bool]
-    subtracts_background: ClassVar[bool]
-    restore_min_divisor: ClassVar[float]
-
-    def seed(self, data: np.ndarray, noise: float) -> tuple[Line, list[gate.Check]]:
-        """The target's line in the chip and the gate's checks of what else
-        was found, the chip's pixel noise being ``noise`` (DN)."""
-        raise NotImplementedError
-
-    def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
-        """The target's line fitted through its per-row locations."""
-        raise NotImplementedError
-
-    def shape(self, grid: np.ndarray, values: np.ndarray, d: np.ndarray, v: np.ndarray,
-              half_range: float) -> Shape:
-        """What the resampled profile (and its samples) say of the target."""
-        raise NotImplementedError
-
-    def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:
-        """The LSF window's flat half-width at this SNR (``factor``: a
-        user's multiple of the target's width)."""
-        raise NotImplementedError
-
-    def taper_factor(self, snr: float) -> float:
-        """The window's taper as a multiple of its core."""
-        raise NotImplementedError
-
-    def confident_snr(self, rows: int) -> float:
-        """The SNR below which the estimate carries a warning."""
-        raise NotImplementedError
-
-    def lsf(self, grid: np.ndarray, values: np.ndarray,
-            background) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
-        """(x, lsf, adjoint): the LSF-like profile on ``x`` and the map of
-        weights on ``x`` back to weights on ``grid``."""
-        raise NotImplementedError
-
-    def lsf_tail_amplitudes(self) -> list[np.ndarray]:
-        """Per side (left, right), the linear map from that side's fitted
-        (level, A) to the LSF-like tail's amplitude a (a / s^2)."""
-        raise NotImplementedError
-
-    def divisor(self, step: float, transfer, shape: Shape) -> Callable[[np.ndarray], np.ndarray]:
-        """The transfer between the system's LSF and the LSF-like profile."""
-        raise NotImplementedError
-
-    def noise_gain(self, shape: Shape, contrast: float) -> Callable[[np.ndarray], np.ndarray]:
-        """How white sample noise grows with frequency in the MTF."""
-        raise NotImplementedError
-
-    def saturation_sides(self, sides: list) -> list:
-        """The sides the saturation checks examine, named for the user."""
-        raise NotImplementedError
-
-    def peak_mask(self, s: np.ndarray, shape: Shape) -> np.ndarray | None:
-        """The samples of a bar's peak (None for an edge)."""
-        raise NotImplementedError
-
-    def read_width(self, grid: np.ndarray, shape: Shape) -> WidthReading | None:
-        """Where the divisor rests on a width read off the profile (a bar's
-        estimated width), how it was read (:class:`WidthReading`), so that
-        its own noise joins the intervals; None where the divisor is known."""
-        return None
-
-
-@dataclass(frozen=True, eq=False)
-class WidthReading:
-    """A width W (px) read off the profile as the first zero f0 = 1 / W of
-    R(f), a linear functional of the profile's values (a bar's spectrum
-    about its centre).  ``freqs`` (cy/px): f0, then a grid about it;
-    ``on_grid``: dR(f) / d value, one row per frequency over the profile's
-    grid; ``per_background``: dR(f) / d background level; ``values``: R at
-    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW."""
-
-    width_px: float
-    freqs: np.ndarray
-    on_grid: np.ndarray
-    per_background: np.ndarray
-    values: np.ndarray
-    slope: float
-    log_slope: Callable[[np.ndarray], np.ndarray]
-
-    def width_change(self, spectrum_change_at_zero):
-        """The change of W (px) a change dR of R at f0 makes: the zero moves
-        by -dR / R'(f0), and W = 1 / f0 by dR / (R'(f0) f0^2)."""
-        f_zero = float(self.freqs[0])
-        return spectrum_change_at_zero / (self.slope * f_zero * f_zero)
-
-    def spread_px(self, spectrum_sd: np.ndarray, t: float) -> float:
-        """Half the width (px) of the set of W whose zero 1 / W the data
-        cannot tell from f0: the run of the grid about f0 where
-        |R(f)| <= t sd(R(f)) (Fieller's interval for a zero, which stays
-        honest where R is shallow and the linearised one is not); inf when
-        the run reaches the grid's low end (no zero is read at all)."""
-        f, margin = self.freqs[1:], t * spectrum_sd - np.abs(self.values[1:])
-        inside = margin >= 0
-        k = int(np.clip(np.searchsorted(f, self.freqs[0]), 1, f.size - 1))
-        k = k if inside[k] else k - 1
-        if not inside[k]:
-            return 0.0
-        outside = np.flatnonzero(~inside)
-        below, above = outside[outside < k], outside[outside > k]
-        if below.size == 0:
-            return math.inf
-
-        def edge(i, j):      # where the margin crosses 0 between grid points i (inside) and j (outside)
-            return f[i] + (f[j] - f[i]) * margin[i] / (margin[i] - margin[j])
-        f_low = edge(below[-1] + 1, below[-1])
-        f_high = edge(above[0] - 1, above[0]) if above.size else f[-1]
-        return 0.5 * (1.0 / f_low - 1.0 / f_high)
-
-
-@dataclass(frozen=True)
-class Shape:
-    """What a kind reads off its resampled profile: ``centre`` (px, the
-    target's middle along the normal), ``scale_px`` (its width: an edge's
-    10-90 % rise, a bar's half-width at 10 %), the reference levels
-    ``low``/``high`` (DN: an edge's left and right, a bar's background and
-    peak), the ``core_px`` the LSF window keeps flat at the given SNR
-    factor, where the ``plateau_px`` sides begin, and ``extra`` figures."""
-
-    centre: float
-    scale_px: float
-    low: float
-    high: float
-    plateau_px: float
-    extra: dict = field(default_factory=dict)
-
-
-@dataclass(frozen=True, eq=False)
-class SideFit:
-    """Level + A / |s|^p fitted to one side's samples: ``coef`` (level, A),
-    ``operator`` the least-squares map from the selected samples' values to
-    ``coef`` (2 x n), ``mask`` which samples, ``sd`` the residual standard
-    deviation (DN)."""
-
-    coef: np.ndarray
-    operator: np.ndarray
-    mask: np.ndarray
-    sd: float
-
-
-def _tail_integral(s, v, side: int, start: float, half_range: float, kind) -> tuple[float, float]:
-    """Area (DN px) of one side's fitted LSF-like tail a / s^2 from ``start``
-    to the data's reach, a (1 / start - 1 / reach), and its standard error."""
-    fit = fit_side(s, v, (np.sign(s) == side) & (np.abs(s) >= start), kind.tail_power)
-    if not np.isfinite(fit.coef).all() or not math.isfinite(fit.sd):
-        return 0.0, math.inf
-    to_amplitude = kind.lsf_tail_amplitudes()[0 if side < 0 else 1]
-    span = 1.0 / start - 1.0 / max(half_range, start)
-    amplitude_sd = fit.sd * math.sqrt(float(np.sum((to_amplitude @ fit.operator) ** 2)))
-    return float(to_amplitude @ fit.coef) * span, amplitude_sd * span
-
-
-def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) -> None:
-    """Where the target could not be followed row by row (a bar defeats an
-    edge's step fits, and leaves its phases too sparse), the rows' mean
-    profile about the seed says whether it is the other kind of target:
-    that is the reason to give (``not-an-edge``, ``not-a-bar``), or, where
-    the whole rows hold a step and a bar, the second target
-    (``two-targets``).
-
-    Raises
-    ------
-    UnsuitableTargetError
-        The mean profile is of the other kind."""
-    _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
-    counts = inside.sum(axis=0)
-    if counts.min() > 0:
-        mean = values.sum(axis=0) / counts
-        check = gate.kind_check(gate.classify_profile(mean), kind.profile, mean)
-        if not check.passed:
-            # the whole rows say whether the other kind stands beside a target of the wanted kind
-            _, wide, wide_inside = row_windows(work, seed_x, work.shape[1])
-            wide_counts = wide_inside.sum(axis=0)
-            covered = wide_counts >= 0.5 * work.shape[0]
-            if covered.sum() > 2 * EDGE_FIT_HALF_WINDOW_PX + 1:
-                whole = wide.sum(axis=0)[covered] / wide_counts[covered]
-                check = gate.kind_check(gate.classify_profile(mean), kind.profile, whole)
-            raise UnsuitableTargetError(check.message, reason=check.reason) from None
-
-
-def outer_samples(d: np.ndarray, half_range: float, fraction: float) -> tuple[np.ndarray, np.ndarray]:
-    """Masks of the samples beyond ``fraction`` of the range on the left
-    and on the right (at least the three outermost pixels' worth each)."""
-    order = np.sort(d)
-    left = min(-fraction * half_range, order[min(order.size - 1, 3 * MIN_TAIL_SAMPLES)])
-    right = max(fraction * half_range, order[max(0, order.size - 1 - 3 * MIN_TAIL_SAMPLES)])
-    return d <= left, d >= right
-
-
-def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> SideFit:
-    """Least-squares level and tail of the samples selected by ``mask``
-    (``s``: distance from the target's centre).  Too few samples, or too
-    little spread in |s|^-p to tell a tail from a level: a flat level."""
-    x = np.abs(s[mask])
-    values = v[mask]
-    if x.size < 3:
-        return SideFit(np.array([np.nan, 0.0]), np.zeros((2, x.size)), mask, math.nan)
-    u = x ** -float(power)
-    if x.size >= MIN_TAIL_SAMPLES and np.std(u) > 1e-3 * np.mean(u):
-        design = np.column_stack([np.ones_like(u), u])
-        operator = np.linalg.solve(design.T @ design, design.T)
-    else:
-        design = np.ones((x.size, 1))
-        operator = np.vstack([np.full(x.size, 1.0 / x.size), np.zeros(x.size)])
-    coef = operator @ values
-    resid = values - np.column_stack([np.ones_like(u), u]) @ coef
-    dof = max(x.size - design.shape[1], 1)
-    return SideFit(coef, operator, mask, float(math.sqrt(resid @ resid / dof)))
-
-
-def model_reach(s: np.ndarray, v: np.ndarray, side: int, start: float, power: int, step: float,
-                floor: float = 0.0) -> float:
-    """Where a side's tail model takes over: the smallest distance from
-    ``start`` on (in ``step`` px steps, at most half the side's range) from
-    which level + A / |s|^p, fitted out to the end of the data, explains the
-    next few pixels to within their noise.  Before it the LSF still carries
-    structure of its own (a shoulder, a halo) that the window must keep as
-    measured; at low SNR the test has little power and the core stays at
-    ``start``.  ``floor`` (DN) is a part of each bin's error that does not
-    average down (rounding shared by neighbouring samples)."""
-    reach = np.abs(s[np.sign(s) == side])
-    values = v[np.sign(s) == side]
-    if reach.size < 4 * MIN_TAIL_SAMPLES:
-        return start
-    far = float(reach.max())
-    x0 = start
-    while x0 <= 0.5 * far:
-        fit = fit_side(reach, values, reach >= x0, power)
-        near = (reach >= x0) & (reach < x0 + MODEL_CHECK_PX)
-        if not math.isfinite(fit.sd) or fit.sd == 0 or near.sum() < MIN_TAIL_SAMPLES:
-            return x0
-        u = reach[near] ** -float(power)
-        resid = values[near] - (fit.coef[0] + fit.coef[1] * u)
-        bins = np.floor((reach[near] - x0) / MODEL_BIN_PX).astype(int)
-        counts = np.bincount(bins)
-        full = counts >= 3
-        means = np.bincount(bins, weights=resid)[full] / counts[full]
-        chi2 = float(np.sum(means ** 2 / (fit.sd ** 2 / counts[full] + floor ** 2)))
-        dof = int(full.sum())
-        if dof == 0 or chi2 <= dof + 3.0 * math.sqrt(2.0 * dof):
-            return x0
-        x0 += step
-    return x0
 
 
 @dataclass(frozen=True)
@@ -674,7 +272,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
         # near the core: there the narrow low-SNR window costs more bias than
         # it saves noise, so such a profile (one whose tails stand out of
         # their own noise) keeps the clean window
-        tails = [_tail_integral(s, v, side, core, half_range, kind) for side in (-1, 1)]
+        tails = [tail_integral(s, v, side, core, half_range, kind) for side in (-1, 1)]
         share = sum(abs(area) for area, _ in tails) / contrast
         share_sd = math.hypot(*(sd for _, sd in tails)) / contrast
         if share > LONG_TAIL_SHARE and share > 3.0 * share_sd:

@@ -26,18 +26,12 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
-from .pipeline import (
-    BACKGROUND_FRACTION,
-    TAPER_FACTOR,
-    Shape,
-    TargetKind,
-    WidthReading,
-    make_settings,
-    outer_samples,
-    run,
-)
+from .kind import Shape, TargetKind, WidthReading
+from .pipeline import BACKGROUND_FRACTION, TAPER_FACTOR, run
 from .results import MTFResult, finite
+from .settings import make_settings
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
+from .tails import outer_samples
 
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
 ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
@@ -204,7 +198,7 @@ class PulseEstimator:
         Resampling method, a key of :data:`imgmtf.estimate.resampling.METHODS`
         (default "msg").
     **settings
-        The settings of :class:`imgmtf.estimate.pipeline.Settings` as
+        The settings of :class:`imgmtf.estimate.settings.Settings` as
         keywords (``bootstrap=N`` for N bootstrap replicates, 0 for no
         intervals); ``snr_threshold=None`` uses the paper's 100 (the
         reproduction study measured edges only).
@@ -335,7 +329,7 @@ def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast
     profile normalised by ``contrast_dn`` (its values minus the background,
     over the peak's height in DN): R(f) and its pull on the profile's
     values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
-    about it, for the intervals (:class:`imgmtf.estimate.pipeline.WidthReading`).
+    about it, for the intervals (:class:`imgmtf.estimate.kind.WidthReading`).
 
     Examples
     --------

@@ -1,0 +1,133 @@
+"""The driver: the edges read, the model set up, fitted, and its stages freed
+or held by the likelihood ratio."""
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+import numpy as np
+
+from ..._blas import one_blas_thread
+from ...errors import ImgmtfError, ParameterError
+from ...inputs import check_number
+from ...sensor.model import Sensor
+from .data import edge_data
+from .model import Model, hold_keys, initial_stages, listed, parameter_covariance, stage_names
+from .report import fit_report
+from .results import SensorFit
+
+#: a parameter stays free only if holding it costs this much chi-square
+#: (in units of the reduced chi-square): p = 0.001 for one degree of freedom
+LIKELIHOOD_RATIO = 10.8
+
+
+def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_m: float | None = None,
+               band: int | None = None, roi: tuple[int, int, int, int] | None = None,
+               confidence: float = 0.95) -> SensorFit:
+    """Fit a sensor's stages to the profiles of one or more edges.
+
+    Parameters
+    ----------
+    edges : sequence
+        Each an image file path, a 2-D array (DN) or an
+        :class:`imgmtf.EdgeResult` already measured; one edge per image.
+    stages : str or sequence of str, optional
+        Stage names to fit (comma-separated or a list; see
+        :data:`imgmtf.sensor.stages.STAGES`); default the stages of
+        ``start``, or the paper's four.
+    start : Sensor, optional
+        Starting (and held) values of the stages it has; other stages
+        start from their defaults scaled to the GSD.
+    hold : sequence of str
+        Parameters held at their starting values: "stage" or "stage.name".
+    gsd_m : float, optional
+        Ground sample distance (m); default the first file's, else 1
+        (parameters then in pixels).
+    band : int, optional
+        1-based band of multi-band files (default: the only band or the
+        luminance).
+    roi : (int, int, int, int), optional
+        (x, y, width, height) window, px, taken from every file or array
+        (only it is read from a file); not for EdgeResults.
+    confidence : float
+        Of the intervals, in (0, 1).
+
+    Returns
+    -------
+    SensorFit
+
+    Raises
+    ------
+    ParameterError
+        Unknown stage or parameter names, no edges, bad ``confidence``, a
+        ``roi`` outside an input.
+    ImgmtfError
+        An input that cannot be read or has no measurable edge (the
+        message names it), or a fit that does not converge.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 60).image for a in (6.0, 84.0)]
+    >>> fit = imgmtf.fit_sensor(chips)
+    >>> abs(fit.edges[0].mtf_nyquist - 0.2667) < 0.002
+    True
+    """
+    if not (isinstance(confidence, (int, float, np.floating)) and 0 < confidence < 1):
+        raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
+    if gsd_m is not None:
+        gsd_m = check_number("gsd_m", gsd_m, positive=True)
+    if start is not None and not isinstance(start, Sensor):
+        raise ParameterError(f"start must be a Sensor, got {start!r}")
+    names = stage_names(stages, start)
+    from ..edge import EdgeResult
+    if isinstance(edges, (str, Path, np.ndarray, EdgeResult)):
+        edges = [edges]
+    items = listed("edges", edges, "files, arrays or EdgeResults")
+    data = [edge_data(item, k, gsd_m, band, roi) for k, item in enumerate(items)]
+    if not data:
+        raise ParameterError("no edges to fit")
+    gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
+    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
+    with one_blas_thread():
+        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
+
+
+def run_fit(model: Model, hold, confidence: float) -> SensorFit:
+    """Fit ``model``, holding what the data do not determine or need (see
+    the module's notes), and report."""
+    notes = model.screen_axes(hold_keys(hold, model.keys))
+    z = model.initial_vector()
+    while True:
+        z, jacobian = model.solve(z)
+        scale = max(model.chi_square(z) / max(model.dof, 1), 1.0)
+        covariance = parameter_covariance(jacobian, scale)
+        undetermined = model.undetermined(z, covariance)
+        if not undetermined:
+            break
+        worst = max(undetermined, key=lambda i: (model.specs[model.free[i]].rank, undetermined[i]))
+        notes[model.free[worst]] = ("held", f"not determined by the data (within one standard error its blur "
+                                            f"length spans {undetermined[worst]:.2g} px); "
+                                            "held at its starting value")
+        z = model.hold(z, worst)
+    # hold, best-known first, each parameter the data do not need (holding it
+    # at its starting value costs less than the likelihood-ratio threshold),
+    # but keep one free parameter on each axis an edge sees
+    for key in sorted(model.free, key=lambda k: -model.specs[k].rank):
+        if not model.covers_axes([k for k in model.free if k != key]):
+            continue            # the last free parameter of an axis: its uncertainty belongs in the intervals
+        index = model.free.index(key)
+        trial = model.copy()
+        z_held = trial.hold(z, index)
+        try:
+            z_held, jacobian_held = trial.solve(z_held)
+        except ImgmtfError:
+            continue
+        cost = (trial.chi_square(z_held) - model.chi_square(z)) / scale
+        if cost < LIKELIHOOD_RATIO:
+            notes[key] = ("held", f"the data do not need it (freeing it gains chi-square {max(cost, 0):.1f} "
+                                  f"< {LIKELIHOOD_RATIO:g}); held at its starting value")
+            model, z = trial, z_held
+            scale = max(model.chi_square(z) / max(model.dof, 1), 1.0)
+            covariance = parameter_covariance(jacobian_held, scale)
+    return fit_report(model, z, covariance, notes, confidence)

@@ -1,0 +1,332 @@
+"""The model fitted: the sensor's stages in fit coordinates, each edge's
+nuisance levels and offset, residuals, Jacobian, covariance and the
+model's MTF with its delta-method band."""
+from __future__ import annotations
+
+import math
+from statistics import NormalDist
+
+import numpy as np
+
+from ...errors import ImgmtfError, ParameterError
+from ...metrics import first_crossing
+from ...sensor.model import PAPER_STAGES, Sensor
+from ...sensor.stages import STAGES, Stage
+from .data import EdgeData
+
+#: a free parameter is undetermined when its 1-SE range of blur length is
+#: wider than this fraction of the length ...
+DETERMINED_RELATIVE = 0.5
+#: ... and than this many pixels
+DETERMINED_PX = 0.2
+
+
+def stage_names(names, start: Sensor | None) -> list[str]:
+    if names is None:
+        names = [s.name for s in start.stages] if start is not None else list(PAPER_STAGES)
+    elif isinstance(names, str):
+        names = [n.strip() for n in names.split(",") if n.strip()]
+    names = listed("stages", names)
+    if not names:
+        raise ParameterError("no stages to fit")
+    for name in names:
+        if name not in STAGES:
+            raise ParameterError(f"unknown stage {name!r}; known: {', '.join(STAGES)}")
+    if len(set(names)) != len(names):
+        raise ParameterError(f"a stage is named twice in {', '.join(names)}")
+    return names
+
+
+def listed(name: str, values, kinds: str = "names, or one comma-separated string") -> list:
+    """``values`` as a list; a ParameterError naming ``name`` when it is no collection (None, 3)."""
+    try:
+        return list(values)
+    except TypeError:
+        raise ParameterError(f"{name} must be a list of {kinds}, got {values!r}") from None
+
+
+def initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[Stage]:
+    given = {s.name: s for s in (start.stages if start is not None else ())}
+    out = []
+    for name in names:
+        if name in given:
+            out.append(given[name])
+        else:  # the defaults are for a 1 m GSD: the same blur in pixels
+            default = STAGES[name]()
+            out.append(default.with_fit_coordinates(default.fit_coordinates(1.0), gsd))
+    return out
+
+
+def check_names(stages=None, hold=(), start: Sensor | None = None) -> list[str]:
+    """The stages a fit frees, and the parameters it holds, checked before
+    any data are read (the CLI's --stages and --hold: a usage error).
+
+    Parameters
+    ----------
+    stages, hold, start
+        As :func:`fit_sensor` takes them.
+
+    Returns
+    -------
+    list of str
+        The stages' names.
+
+    Raises
+    ------
+    ParameterError
+        An unknown stage, one named twice, or a held name that is no
+        fitted stage or parameter.
+
+    Examples
+    --------
+    >>> check_names("optics,detector", "detector.width_x_m")
+    ['optics', 'detector']
+    """
+    names = stage_names(stages, start)
+    hold_keys(hold, [f"{name}.{parameter}" for name in names for parameter in STAGES[name].fit_specs()])
+    return names
+
+
+def hold_keys(hold, fitted: list[str]) -> set[str]:
+    if isinstance(hold, str):
+        hold = [h.strip() for h in hold.split(",") if h.strip()]
+    keys = set()
+    for item in listed("hold", hold):
+        matches = [k for k in fitted if k == item or k.split(".")[0] == item]
+        if not matches:
+            raise ParameterError(f"cannot hold {item!r}: not a fitted stage or parameter; "
+                                 f"fitted: {', '.join(fitted)}")
+        keys.update(matches)
+    return keys
+
+
+class Model:
+    """The shared stage parameters and each edge's nuisance parameters as
+    one vector z = [free stage coordinates, then L, R, x0 per edge]."""
+
+    def __init__(self, gsd: float, stages: list[Stage], data: list[EdgeData]):
+        self.gsd, self.stages, self.data = gsd, stages, data
+        self.specs, self.keys, self.units = {}, [], {}
+        for stage in stages:
+            for name, spec in stage.fit_specs().items():
+                key = f"{stage.name}.{name}"
+                self.specs[key] = spec
+                self.keys.append(key)
+                self.units[key] = stage.units()[name]
+        self.start = {k: v for s in stages for k, v in stage_coordinates(s, gsd).items()}
+        self.values = dict(self.start)           # coordinates of held parameters live here
+        self.ties: dict[str, str] = {}
+        self.free = list(self.keys)
+        self._last_responses: tuple = (None, [])
+
+    # -- which parameters are free ------------------------------------------------
+    def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
+        """Tie or hold what no edge's axis constrains; hold ``held``."""
+        notes = {k: ("held", "held by request at its starting value") for k in held}
+        seen = {"across" if axis == "x" else "along" for axis in self.seen_axes()}
+        axis_of = {"x": "across", "y": "along"}
+        for key, spec in self.specs.items():
+            if key in held or spec.axis == "xy" or axis_of[spec.axis] in seen:
+                continue
+            twin = f"{key.split('.')[0]}.{spec.pair}" if spec.pair else next(
+                (k for k, s in self.specs.items() if s.pair and f"{k.split('.')[0]}.{s.pair}" == key), None)
+            if twin and twin not in held:
+                self.ties[key] = twin
+                notes[key] = ("tied", f"no {axis_of[spec.axis]}-track edge: taken equal to {twin}")
+            else:
+                notes[key] = ("held", f"no {axis_of[spec.axis]}-track edge: held at its starting value")
+        self.free = [k for k in self.keys if k not in notes]
+        return notes
+
+    def copy(self) -> Model:
+        other = object.__new__(Model)
+        other.__dict__.update(self.__dict__)
+        other.values, other.ties, other.free = dict(self.values), dict(self.ties), list(self.free)
+        return other
+
+    def seen_axes(self) -> set[str]:
+        """Image axes some edge mostly constrains: "x" (across), "y" (along)."""
+        return {"x" if abs(d.normal_angle_deg) < 45 else "y" for d in self.data}
+
+    def covers_axes(self, free: list[str]) -> bool:
+        """Whether parameters ``free`` (with those tied to them) act on every
+        axis an edge sees."""
+        axes: set[str] = set()
+        for key in free:
+            for k in [key] + [t for t, source in self.ties.items() if source == key]:
+                axes.update(("x", "y") if self.specs[k].axis == "xy" else (self.specs[k].axis,))
+        return self.seen_axes() <= axes
+
+    def hold(self, z: np.ndarray, index: int) -> np.ndarray:
+        key = self.free.pop(index)
+        self.values[key] = self.start[key]
+        return np.delete(z, index)
+
+    @property
+    def n_free(self) -> int:
+        return len(self.free)
+
+    @property
+    def dof(self) -> int:
+        return sum(d.x.size for d in self.data) - self.n_free - 3 * len(self.data)
+
+    def initial_vector(self) -> np.ndarray:
+        nuisance = [v for d in self.data for v in (*d.levels, 0.0)]
+        return np.array([self.start[k] for k in self.free] + nuisance, float)
+
+    def bounds(self):
+        upper = [self.specs[k].upper_px ** self.specs[k].power for k in self.free]
+        big = np.inf
+        lower = [0.0] * self.n_free + [-big] * (3 * len(self.data))
+        return np.array(lower), np.array(upper + [big] * (3 * len(self.data)))
+
+    def sensor(self, u: np.ndarray) -> Sensor:
+        coords = dict(self.values)
+        coords.update(zip(self.free, u))
+        for key, twin in self.ties.items():
+            coords[key] = coords[twin]
+        stages = []
+        for stage in self.stages:
+            own = {k.split(".", 1)[1]: v for k, v in coords.items() if k.split(".")[0] == stage.name}
+            stages.append(stage.with_fit_coordinates(own, self.gsd) if own else stage)
+        return Sensor(self.gsd, stages)
+
+    def responses(self, u: np.ndarray):
+        """Each edge's line response for stage coordinates ``u``; the last
+        ones kept, since the solver asks for the residuals and then the
+        Jacobian at the same point."""
+        key = (tuple(self.free), u.tobytes())
+        if self._last_responses[0] != key:
+            sensor = self.sensor(u)
+            self._last_responses = (key, [sensor.line_response(d.normal_angle_deg, d.gsd_m,
+                                                               reach_px=float(np.abs(d.x).max()) + 2.0)
+                                          for d in self.data])
+        return self._last_responses[1]
+
+    # -- least squares ------------------------------------------------------------
+    def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
+        u = z[: self.n_free]
+        responses = responses or self.responses(u)
+        out = []
+        for e, (d, r) in enumerate(zip(self.data, responses)):
+            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
+            out.append((d.y - (lo + (hi - lo) * r.esf(d.x - x0))) / d.noise)
+        return np.concatenate(out)
+
+    def jacobian(self, z: np.ndarray):
+        u = z[: self.n_free]
+        base = self.responses(u)
+        offsets = [z[self.n_free + 3 * e + 2] for e in range(len(self.data))]
+        base_esf = [r.esf(d.x - x0) for d, r, x0 in zip(self.data, base, offsets)]
+        _, upper = self.bounds()
+        columns = []
+        for k in range(self.n_free):
+            h = 1e-3 * max(u[k], 0.05 * upper[k] ** 0.5)
+            h = -h if u[k] + h > upper[k] else h
+            shifted = u.copy()
+            shifted[k] += h
+            moved = self.responses(shifted)
+            columns.append(np.concatenate([
+                -(z[self.n_free + 3 * e + 1] - z[self.n_free + 3 * e]) / d.noise
+                * (m.esf(d.x - x0) - esf) / h
+                for e, (d, m, x0, esf) in enumerate(zip(self.data, moved, offsets, base_esf))]))
+        # each edge's levels and offset act on its own samples only: a sparse
+        # Jacobian, whose size grows with the edges, not with their square
+        from scipy import sparse
+        n = sum(d.x.size for d in self.data)
+        stage = np.stack(columns, axis=1) if columns else np.zeros((n, 0))
+        blocks = []
+        for e, (d, b, esf) in enumerate(zip(self.data, base, base_esf)):
+            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
+            blocks.append(np.stack([-(1 - esf), -esf, (hi - lo) * b.lsf(d.x - x0)], axis=1) / d.noise)
+        return sparse.hstack([sparse.csr_array(stage), sparse.block_diag(blocks)], format="csr")
+
+    def solve(self, z: np.ndarray, max_iterations: int = 200):
+        """Bounded least squares from ``z`` (SciPy's trust-region
+        reflective ``least_squares``, with :meth:`jacobian`, sparse, the
+        columns scaled by their norms, the steps by LSMR).  Returns the
+        solution and its Jacobian.
+
+        Raises
+        ------
+        ImgmtfError
+            No convergence within ``max_iterations`` Jacobians.
+        """
+        from scipy.optimize import least_squares
+        lower, upper = self.bounds()
+        z = np.clip(z, lower, upper)
+        if max_iterations > 0:
+            result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
+                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations,
+                                   tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12})
+            if result.status > 0:
+                return result.x, result.jac
+        raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
+                          f"{max_iterations} iterations; try fewer stages (--stages) or hold some (--hold)",
+                          reason="fit")
+
+    def chi_square(self, z: np.ndarray) -> float:
+        return float(np.sum(self.residuals(z) ** 2))
+
+    def undetermined(self, z: np.ndarray, covariance: np.ndarray) -> dict[int, float]:
+        """Index -> 1-SE range (px of blur length) of each free parameter
+        the data do not determine."""
+        out = {}
+        for i, key in enumerate(self.free):
+            power = self.specs[key].power
+            u, se = z[i], math.sqrt(max(covariance[i, i], 0.0))
+            length = u ** (1 / power)
+            width = ((u + se) ** (1 / power) - max(u - se, 0.0) ** (1 / power)) / 2
+            if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
+                out[i] = width if np.isfinite(width) else math.inf
+        return out
+
+
+def other_stages(stages) -> str:
+    """What to try when the model misfits: the long-tailed stages it lacks,
+    or, with all of them in, the non-parametric estimate."""
+    have = {s.name for s in stages}
+    missing = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
+    if missing:
+        return f"try other stages (e.g. {', '.join(missing)})"
+    return "compare with the non-parametric estimate (imgmtf measure), which assumes no form of blur"
+
+
+def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
+    return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
+
+
+def parameter_covariance(jacobian, reduced_chi_square: float) -> np.ndarray:
+    """Parameter covariance from the weighted (sparse) Jacobian, scaled up by
+    the reduced chi-square when the residuals exceed the noise (never down:
+    on noise-free integer chips the noise is the quantisation's, 1/sqrt(12)
+    DN, which flat plateaus do not show)."""
+    return np.linalg.pinv((jacobian.T @ jacobian).toarray()) * max(reduced_chi_square, 1.0)
+
+
+
+def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
+              gsd: float, confidence: float):
+    sensor = model.sensor(u)
+    value = np.abs(sensor.normal_transfer(f, angle_deg, gsd))
+    n = model.n_free
+    if n == 0:
+        return value, value, value
+    _, upper = model.bounds()
+    grads = []
+    for k in range(n):
+        h = 1e-4 * max(u[k], 0.05 * upper[k] ** 0.5)
+        h = -h if u[k] + h > upper[k] else h
+        shifted = u.copy()
+        shifted[k] += h
+        grads.append((np.abs(model.sensor(shifted).normal_transfer(f, angle_deg, gsd)) - value) / h)
+    g = np.stack(grads, axis=-1)
+    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g), 0.0))
+    z = NormalDist().inv_cdf(0.5 + confidence / 2)
+    return value, np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
+
+
+def model_mtf50_band(model, u, covariance, angle_deg, gsd, confidence):
+    f = np.linspace(0.0, 2.0, 4001)
+    value, low, high = model_mtf_band(model, u, covariance, f, angle_deg, gsd, confidence)
+    return first_crossing(f, value, 0.5), (first_crossing(f, low, 0.5), first_crossing(f, high, 0.5))

@@ -1,0 +1,138 @@
+"""The fit reported: parameters with their standard errors, correlations,
+each edge's misfit test, the MTF across and along track."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...metrics import first_crossing
+from ...sensor.model import DIRECTIONS, direction_angle
+from ...sensor.stages import Stage
+from ..geometry import direction_label
+from .model import Model, model_mtf50_band, model_mtf_band, other_stages
+from .results import MISFIT_FRACTION, MISFIT_P, EdgeFit, FittedParameter, SensorFit
+
+#: residual bins along the normal (px) for the misfit test
+MISFIT_BIN_PX = 0.25
+#: parameter pairs reported when their correlation exceeds this
+HIGH_CORRELATION = 0.9
+
+
+def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict, confidence: float) -> SensorFit:
+    n = model.n_free
+    u = z[:n]
+    sensor = model.sensor(u)
+    start = model.sensor(np.array([model.start[k] for k in model.free]))
+    responses = model.responses(u)
+    residuals = model.residuals(z, responses)
+    reduced = float(np.sum(residuals**2) / max(model.dof, 1))
+    warnings = []
+
+    parameters = []
+    _, upper = model.bounds()
+    for stage in sensor.stages:
+        units = stage.units()
+        for name, value in stage.to_dict(include_name=False).items():
+            key = f"{stage.name}.{name}"
+            if key in model.free:
+                i = model.free.index(key)
+                se = value_error(stage, name, u[i], math.sqrt(max(covariance[i, i], 0.0)), model.gsd)
+                status, note = "fitted", ""
+                if u[i] >= upper[i] * (1 - 1e-6):
+                    note = "at the bound of its range"
+                    warnings.append(f"{key} is at the bound of its range ({value:.4g} {units[name]}): the model "
+                                    "strains to fit the edges, whose blur may have another form; its MTF may be "
+                                    f"biased: {other_stages(model.stages)}")
+            elif key in notes:
+                se, (status, note) = math.nan, notes[key]
+            else:  # a parameter the fit does not touch (wavelength, pitch)
+                se, status, note = math.nan, "held", "not fitted"
+            parameters.append(FittedParameter(stage.name, name, float(value), float(se), units[name], status, note))
+
+    correlations = []
+    if n > 1:
+        sd = np.sqrt(np.maximum(np.diag(covariance)[:n], 1e-300))
+        corr = covariance[:n, :n] / np.outer(sd, sd)
+        for i in range(n):
+            for j in range(i + 1, n):
+                if abs(corr[i, j]) > HIGH_CORRELATION:
+                    correlations.append((model.free[i], model.free[j], float(corr[i, j])))
+
+    edges, start_row = [], 0
+    for e, (d, r) in enumerate(zip(model.data, responses)):
+        lo, hi, x0 = z[n + 3 * e: n + 3 * e + 3]
+        res = residuals[start_row: start_row + d.x.size] * d.noise
+        start_row += d.x.size
+        chi = float(np.sum((res / d.noise) ** 2) / max(d.x.size - 3 - n / len(model.data), 1))
+        p, fraction = misfit_test(d.x - x0, res, d.noise, abs(hi - lo), r)
+        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
+        f = np.linspace(0.0, 2.0, 4001)
+        measured = d.measurement
+        edge = EdgeFit(d.source, d.normal_angle_deg, direction_label(d.normal_angle_deg, 0.0),
+                       "across" if abs(d.normal_angle_deg) < 45 else "along", d.gsd_m,
+                       int(measured.rows_used), float(measured.snr), float(value), (float(low), float(high)),
+                       first_crossing(f, np.abs(sensor.normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5),
+                       float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
+                       (float(lo), float(hi)), float(x0), chi, p, fraction, d.x, res, measured)
+        edges.append(edge)
+        if p < MISFIT_P and fraction > MISFIT_FRACTION:
+            warnings.append(f"{d.source}: the model does not fit this edge: its residuals are structured "
+                            f"along the normal ({100 * fraction:.2f} % of the step, p = {p:.1g}); its MTF may be "
+                            f"biased: {other_stages(model.stages)}")
+
+    if not model.covers_axes(model.free):
+        warnings.append("no parameter acting on every axis an edge sees could be determined: the MTF there is "
+                        "the starting sensor's; give more or sharper edges, or other stages")
+    seen = {e.constrains for e in edges}
+    directions = {}
+    for direction in DIRECTIONS:
+        angle = direction_angle(direction)
+        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), angle, model.gsd, confidence)
+        mtf50, mtf50_ci = model_mtf50_band(model, u, covariance, angle, model.gsd, confidence)
+        directions[direction] = {"mtf_nyquist": float(value), "mtf_nyquist_ci": [float(low), float(high)],
+                                 "mtf50_cy_px": mtf50, "mtf50_cy_px_ci": list(mtf50_ci),
+                                 "constrained": direction in seen}
+        if direction not in seen:
+            warnings.append(f"no {direction}-track edge: the {direction}-track MTF is an extrapolation "
+                            "of the model (tied and held parameters)")
+    if not any(d.gsd_known for d in model.data):
+        warnings.append(f"no GSD in the inputs: lengths are in units of {model.gsd:g} m per pixel "
+                        "(at 1 m, metres are pixels); give the GSD (--gsd, gsd_m=) for lengths on the ground")
+    return SensorFit(sensor, start, tuple(parameters), tuple(correlations), reduced, tuple(edges), directions,
+                     confidence, tuple(warnings), model, u, covariance)
+
+
+def value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> float:
+    """Standard error of a parameter in its own unit, from that of its fit
+    coordinate (linearised; one-sided at the coordinate's zero)."""
+    def value(coordinate):
+        return getattr(stage.with_fit_coordinates({name: max(coordinate, 0.0)}, gsd), name)
+    if u > se_u:
+        return abs(value(u + se_u) - value(u - se_u)) / 2
+    return abs(value(u + se_u) - value(u))
+
+
+def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response):
+    """P-value and size (RMS fraction of the step, noise removed) of the
+    residuals' structure: their means in bins along the normal, over the
+    transition (where the model's edge response is between 0.1 % and 99.9 %,
+    and at least +-3 px)."""
+    grid = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
+    esf = response.esf(grid)
+    inside = grid[(esf > 1e-3) & (esf < 1 - 1e-3)]
+    reach = max(3.0, float(np.abs(inside).max()) if inside.size else 3.0)
+    keep = np.abs(x) <= reach
+    bins = np.floor(x[keep] / MISFIT_BIN_PX).astype(int)
+    bins -= bins.min() if bins.size else 0
+    count = np.bincount(bins)
+    total = np.bincount(bins, weights=residuals[keep])
+    used = count >= 3
+    if not used.any():
+        return 1.0, 0.0
+    means, count = total[used] / count[used], count[used]
+    statistic = float(np.sum(count * means**2) / noise**2)
+    from scipy.special import chdtrc  # (scipy.stats, for this one tail, costs most of a second to import)
+    p = float(chdtrc(used.sum(), statistic))
+    systematic = max(float(np.mean(means**2 - noise**2 / count)), 0.0)
+    return p, math.sqrt(systematic) / step

@@ -1,0 +1,207 @@
+"""What a sensor fit returns: each parameter, each edge and the whole fit."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...sensor.model import Sensor
+from .model import Model, model_mtf_band
+
+if TYPE_CHECKING:
+    from ..edge import EdgeResult
+
+#: misfit warning: binned residuals significant at this level ...
+MISFIT_P = 1e-3
+#: ... and their systematic part larger than this fraction of the step
+MISFIT_FRACTION = 5e-4
+
+
+@dataclass(frozen=True)
+class FittedParameter:
+    """One stage parameter after the fit.
+
+    ``status`` is "fitted", "held" (at its starting value: ``note`` says
+    why) or "tied" (equal to its other-axis twin: ``note`` names it).
+    ``standard_error`` is in the parameter's unit (NaN unless fitted).
+    """
+
+    stage: str
+    name: str
+    value: float
+    standard_error: float
+    unit: str
+    status: str
+    note: str = ""
+
+    @property
+    def key(self) -> str:
+        return f"{self.stage}.{self.name}"
+
+    def to_dict(self) -> dict:
+        return {"stage": self.stage, "name": self.name, "value": json_value(self.value),
+                "standard_error": json_value(self.standard_error), "unit": self.unit,
+                "status": self.status, "note": self.note}
+
+
+@dataclass(frozen=True, eq=False)
+class EdgeFit:
+    """One input edge: the model's MTF along its normal and how well the
+    model fits its profile.
+
+    Attributes
+    ----------
+    source : str
+        The file (or "array 1", ... for arrays).
+    normal_angle_deg : float
+        Angle of the edge normal from the x axis (the edge's tilt from the column axis).
+    direction : str
+        "across-track" or "along-track" when the normal lies within 10 deg
+        of that axis, else "oblique": the label :func:`imgmtf.measure_edge`
+        gives with rows along track (``track_azimuth_deg=0``), the geometry
+        the fit assumes.
+    constrains : str
+        "across" (|angle| < 45 deg) or "along": the image axis whose
+        parameters the edge mostly constrains.
+    mtf_nyquist, mtf_nyquist_ci : float, (float, float)
+        The fitted model's MTF at 0.5 cy/px along the normal, and its interval.
+    mtf50_cy_px : float
+        The model's MTF50 along the normal, cycles per pixel.
+    measured_mtf_nyquist : float
+        The non-parametric estimate of the same edge, for comparison.
+    noise_dn, step_dn, levels_dn, offset_px :
+        Noise (measured without the model), fitted step R - L, levels (L, R)
+        and sub-pixel offset of the edge.
+    reduced_chi_square : float
+        Of this edge's residuals against its noise.
+    misfit_p, misfit_fraction : float
+        P-value of the residuals binned along the normal (small: structure),
+        and the size of that structure, RMS as a fraction of the step.
+    """
+
+    source: str
+    normal_angle_deg: float
+    direction: str
+    constrains: str
+    gsd_m: float
+    rows_used: int
+    snr: float
+    mtf_nyquist: float
+    mtf_nyquist_ci: tuple[float, float]
+    mtf50_cy_px: float
+    measured_mtf_nyquist: float
+    noise_dn: float
+    step_dn: float
+    levels_dn: tuple[float, float]
+    offset_px: float
+    reduced_chi_square: float
+    misfit_p: float
+    misfit_fraction: float
+    samples_x_px: np.ndarray = field(repr=False)
+    residuals_dn: np.ndarray = field(repr=False)
+    measurement: EdgeResult = field(repr=False)
+
+    def to_dict(self) -> dict:
+        return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
+                "constrains": self.constrains, "gsd_m": self.gsd_m, "rows_used": self.rows_used,
+                "snr": json_value(self.snr),
+                "mtf_nyquist": self.mtf_nyquist, "mtf_nyquist_ci": [json_value(v) for v in self.mtf_nyquist_ci],
+                "mtf50_cy_px": json_value(self.mtf50_cy_px),
+                "measured_mtf_nyquist": json_value(self.measured_mtf_nyquist), "noise_dn": self.noise_dn,
+                "step_dn": self.step_dn, "levels_dn": list(self.levels_dn), "offset_px": self.offset_px,
+                "reduced_chi_square": self.reduced_chi_square, "misfit_p": self.misfit_p,
+                "misfit_fraction": self.misfit_fraction}
+
+
+@dataclass(frozen=True, eq=False)
+class SensorFit:
+    """The fitted sensor and everything said about it (see the module
+    docstring for the method).
+
+    Attributes
+    ----------
+    sensor, start : Sensor
+        The fitted sensor (its TOML is what ``imgmtf fit --out`` writes) and
+        the one the fit started from.
+    parameters : tuple of FittedParameter
+        Every parameter with its value, standard error and unit; held and
+        tied ones say why in their ``note``.
+    correlations : tuple of (str, str, float)
+        Fitted parameter pairs correlated beyond 0.9: the data constrain a
+        combination of them better than each.
+    reduced_chi_square : float
+        Of the residuals, each edge weighted by its noise (1 for a model
+        that fits to the noise).
+    edges : tuple of EdgeFit
+        Per input edge: the model's MTF at Nyquist along its normal (cy/px)
+        with an interval, the measured one, and the misfit statistics.
+    directions : dict
+        "across" and "along": the model's MTF at Nyquist and MTF50 (cy/px)
+        with intervals, and whether an edge constrains that axis.
+    confidence : float
+        Of the intervals.
+    warnings : tuple of str
+        Where the model does not fit an edge, and which direction no edge
+        constrains.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> fit.directions["across"]["constrained"], fit.misfit
+    (True, False)
+    """
+
+    sensor: Sensor
+    start: Sensor
+    parameters: tuple[FittedParameter, ...]
+    correlations: tuple[tuple[str, str, float], ...]
+    reduced_chi_square: float
+    edges: tuple[EdgeFit, ...]
+    directions: dict
+    confidence: float
+    warnings: tuple[str, ...]
+    _model: Model = field(repr=False)
+    _u: np.ndarray = field(repr=False)
+    _covariance: np.ndarray = field(repr=False)
+
+    @property
+    def misfit(self) -> bool:
+        """True when the model does not fit: an edge's residuals are
+        structured, or a fitted parameter sits at the bound of its range."""
+        return any(e.misfit_p < MISFIT_P and e.misfit_fraction > MISFIT_FRACTION for e in self.edges) or any(
+            p.note == "at the bound of its range" for p in self.parameters)
+
+    def mtf_band(self, f_cy_px, angle_deg: float, gsd_m: float | None = None):
+        """The model's MTF along the normal of an edge tilted ``angle_deg``,
+        at ``f_cy_px`` cycles per pixel of ``gsd_m`` (default the sensor's),
+        with its lower and upper confidence bounds: ``(mtf, low, high)``."""
+        gsd = self.sensor.gsd_m if gsd_m is None else gsd_m
+        return model_mtf_band(self._model, self._u, self._covariance, np.asarray(f_cy_px, float),
+                         angle_deg, gsd, self.confidence)
+
+    def to_dict(self) -> dict:
+        """JSON-ready: one object holding the sensor, parameters, fit
+        quality, directions and a record per input edge (``edges``)."""
+        from ...version import __version__
+        return {"imgmtf_version": __version__, "method": "fit",
+                "stages": [s.name for s in self.sensor.stages], "gsd_m": self.sensor.gsd_m,
+                "confidence": self.confidence, "reduced_chi_square": self.reduced_chi_square,
+                "misfit": self.misfit,
+                "parameters": [p.to_dict() for p in self.parameters],
+                "correlations": [{"a": a, "b": b, "r": r} for a, b, r in self.correlations],
+                "directions": {k: {kk: json_value(vv) if not isinstance(vv, (list, tuple))
+                                   else [json_value(x) for x in vv] for kk, vv in v.items()}
+                               for k, v in self.directions.items()},
+                "warnings": list(self.warnings), "sensor": self.sensor.to_dict(),
+                "edges": [e.to_dict() for e in self.edges]}
+
+
+
+def json_value(value):
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None

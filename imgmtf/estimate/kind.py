@@ -1,0 +1,192 @@
+"""What differs between target kinds (:class:`TargetKind`: an edge, a bar),
+the levels and scale a kind reads off its profile (:class:`Shape`), a bar's
+width as read (:class:`WidthReading`), and the refusal of a profile of the
+other kind."""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from ..errors import UnsuitableTargetError
+from . import gate
+from .detection import Line
+from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
+
+
+class TargetKind:
+    """What differs between targets; see :class:`imgmtf.estimate.edge.EdgeKind`
+    and :class:`imgmtf.estimate.pulse.PulseKind`, the two implementations.
+
+    Attributes: ``name`` is the target as a user names it ("edge", "bar");
+    ``profile`` what its profile must look like
+    (:func:`.gate.classify_profile`); ``tail_power`` p of its profile's
+    tails, level + A / |s|^p; ``monotone`` whether the profile only rises
+    (a staircase can then be rebuilt, :mod:`.quantisation`);
+    ``subtracts_background`` whether its LSF-like profile is the profile
+    above a fitted background (a bar) rather than a derivative (an edge);
+    ``restore_min_divisor`` the divisor below which the recovered LSF's
+    spectrum is bridged rather than divided.
+    """
+
+    name: ClassVar[str]
+    profile: ClassVar[str]
+    tail_power: ClassVar[int]
+    monotone: ClassVar[bool]
+    subtracts_background: ClassVar[bool]
+    restore_min_divisor: ClassVar[float]
+
+    def seed(self, data: np.ndarray, noise: float) -> tuple[Line, list[gate.Check]]:
+        """The target's line in the chip and the gate's checks of what else
+        was found, the chip's pixel noise being ``noise`` (DN)."""
+        raise NotImplementedError
+
+    def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
+        """The target's line fitted through its per-row locations."""
+        raise NotImplementedError
+
+    def shape(self, grid: np.ndarray, values: np.ndarray, d: np.ndarray, v: np.ndarray,
+              half_range: float) -> Shape:
+        """What the resampled profile (and its samples) say of the target."""
+        raise NotImplementedError
+
+    def core_px(self, shape: Shape, snr: float, factor: float | None) -> float:
+        """The LSF window's flat half-width at this SNR (``factor``: a
+        user's multiple of the target's width)."""
+        raise NotImplementedError
+
+    def taper_factor(self, snr: float) -> float:
+        """The window's taper as a multiple of its core."""
+        raise NotImplementedError
+
+    def confident_snr(self, rows: int) -> float:
+        """The SNR below which the estimate carries a warning."""
+        raise NotImplementedError
+
+    def lsf(self, grid: np.ndarray, values: np.ndarray,
+            background) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+        """(x, lsf, adjoint): the LSF-like profile on ``x`` and the map of
+        weights on ``x`` back to weights on ``grid``."""
+        raise NotImplementedError
+
+    def lsf_tail_amplitudes(self) -> list[np.ndarray]:
+        """Per side (left, right), the linear map from that side's fitted
+        (level, A) to the LSF-like tail's amplitude a (a / s^2)."""
+        raise NotImplementedError
+
+    def divisor(self, step: float, transfer, shape: Shape) -> Callable[[np.ndarray], np.ndarray]:
+        """The transfer between the system's LSF and the LSF-like profile."""
+        raise NotImplementedError
+
+    def noise_gain(self, shape: Shape, contrast: float) -> Callable[[np.ndarray], np.ndarray]:
+        """How white sample noise grows with frequency in the MTF."""
+        raise NotImplementedError
+
+    def saturation_sides(self, sides: list) -> list:
+        """The sides the saturation checks examine, named for the user."""
+        raise NotImplementedError
+
+    def peak_mask(self, s: np.ndarray, shape: Shape) -> np.ndarray | None:
+        """The samples of a bar's peak (None for an edge)."""
+        raise NotImplementedError
+
+    def read_width(self, grid: np.ndarray, shape: Shape) -> WidthReading | None:
+        """Where the divisor rests on a width read off the profile (a bar's
+        estimated width), how it was read (:class:`WidthReading`), so that
+        its own noise joins the intervals; None where the divisor is known."""
+        return None
+
+
+@dataclass(frozen=True, eq=False)
+class WidthReading:
+    """A width W (px) read off the profile as the first zero f0 = 1 / W of
+    R(f), a linear functional of the profile's values (a bar's spectrum
+    about its centre).  ``freqs`` (cy/px): f0, then a grid about it;
+    ``on_grid``: dR(f) / d value, one row per frequency over the profile's
+    grid; ``per_background``: dR(f) / d background level; ``values``: R at
+    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW."""
+
+    width_px: float
+    freqs: np.ndarray
+    on_grid: np.ndarray
+    per_background: np.ndarray
+    values: np.ndarray
+    slope: float
+    log_slope: Callable[[np.ndarray], np.ndarray]
+
+    def width_change(self, spectrum_change_at_zero):
+        """The change of W (px) a change dR of R at f0 makes: the zero moves
+        by -dR / R'(f0), and W = 1 / f0 by dR / (R'(f0) f0^2)."""
+        f_zero = float(self.freqs[0])
+        return spectrum_change_at_zero / (self.slope * f_zero * f_zero)
+
+    def spread_px(self, spectrum_sd: np.ndarray, t: float) -> float:
+        """Half the width (px) of the set of W whose zero 1 / W the data
+        cannot tell from f0: the run of the grid about f0 where
+        |R(f)| <= t sd(R(f)) (Fieller's interval for a zero, which stays
+        honest where R is shallow and the linearised one is not); inf when
+        the run reaches the grid's low end (no zero is read at all)."""
+        f, margin = self.freqs[1:], t * spectrum_sd - np.abs(self.values[1:])
+        inside = margin >= 0
+        k = int(np.clip(np.searchsorted(f, self.freqs[0]), 1, f.size - 1))
+        k = k if inside[k] else k - 1
+        if not inside[k]:
+            return 0.0
+        outside = np.flatnonzero(~inside)
+        below, above = outside[outside < k], outside[outside > k]
+        if below.size == 0:
+            return math.inf
+
+        def edge(i, j):      # where the margin crosses 0 between grid points i (inside) and j (outside)
+            return f[i] + (f[j] - f[i]) * margin[i] / (margin[i] - margin[j])
+        f_low = edge(below[-1] + 1, below[-1])
+        f_high = edge(above[0] - 1, above[0]) if above.size else f[-1]
+        return 0.5 * (1.0 / f_low - 1.0 / f_high)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """What a kind reads off its resampled profile: ``centre`` (px, the
+    target's middle along the normal), ``scale_px`` (its width: an edge's
+    10-90 % rise, a bar's half-width at 10 %), the reference levels
+    ``low``/``high`` (DN: an edge's left and right, a bar's background and
+    peak), the ``core_px`` the LSF window keeps flat at the given SNR
+    factor, where the ``plateau_px`` sides begin, and ``extra`` figures."""
+
+    centre: float
+    scale_px: float
+    low: float
+    high: float
+    plateau_px: float
+    extra: dict = field(default_factory=dict)
+
+
+def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) -> None:
+    """Where the target could not be followed row by row (a bar defeats an
+    edge's step fits, and leaves its phases too sparse), the rows' mean
+    profile about the seed says whether it is the other kind of target:
+    that is the reason to give (``not-an-edge``, ``not-a-bar``), or, where
+    the whole rows hold a step and a bar, the second target
+    (``two-targets``).
+
+    Raises
+    ------
+    UnsuitableTargetError
+        The mean profile is of the other kind."""
+    _, values, inside = row_windows(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
+    counts = inside.sum(axis=0)
+    if counts.min() > 0:
+        mean = values.sum(axis=0) / counts
+        check = gate.kind_check(gate.classify_profile(mean), kind.profile, mean)
+        if not check.passed:
+            # the whole rows say whether the other kind stands beside a target of the wanted kind
+            _, wide, wide_inside = row_windows(work, seed_x, work.shape[1])
+            wide_counts = wide_inside.sum(axis=0)
+            covered = wide_counts >= 0.5 * work.shape[0]
+            if covered.sum() > 2 * EDGE_FIT_HALF_WINDOW_PX + 1:
+                whole = wide.sum(axis=0)[covered] / wide_counts[covered]
+                check = gate.kind_check(gate.classify_profile(mean), kind.profile, whole)
+            raise UnsuitableTargetError(check.message, reason=check.reason) from None
