@@ -378,7 +378,7 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
             data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
         else:
             raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
-                                 "choose one with --band N, or --band all")
+                                 "choose one band, or all", reason="bands")
         tags = src.tags()
         codec = lossy_codec(src)
     if data.size == 0:
@@ -425,8 +425,7 @@ def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) ->
         what = "the window" if windowed else "the image"
         raise ImageReadError(
             f"{path}: {what} is {width} x {height} px ({width * height / 2**20:.2f} Mpx), more than "
-            f"the {MAX_READ_PIXELS // 2**20} Mpx read at once; measure a part of it "
-            f"(--roi X,Y,W,H)", reason="too-large")
+            f"the {MAX_READ_PIXELS // 2**20} Mpx read at once; measure a window of it", reason="too-large")
 
 
 def check_regular_file(path: str) -> None:

@@ -425,7 +425,7 @@ def _dask_completed(function, items, workers, scheduler, on_error):
         from distributed import Client, LocalCluster
         from distributed import as_completed as dask_as_completed
     except ImportError:
-        raise ParameterError("--scheduler needs Dask: pip install 'imgmtf[dask]'") from None
+        raise ParameterError("a Dask scheduler needs Dask: pip install 'imgmtf[dask]'") from None
     cluster = None
     try:
         if scheduler == LOCAL_CLUSTER:

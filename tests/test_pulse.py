@@ -103,8 +103,9 @@ def test_no_bar_and_an_edge_are_refused():
 
 def test_narrow_bar_width_cannot_be_estimated():
     h = gaussian_pixel_transfer(0.7, 6.0)
-    with pytest.raises(UnsuitableTargetError, match="--pulse-width"):
+    with pytest.raises(UnsuitableTargetError, match="give its width") as info:
         measure_pulse(exact_pulse_chip(h, 6.0, 0.5))
+    assert info.value.reason == "bar-width"          # the CLI answers it with --pulse-width
 
 
 def test_estimate_width_closed_form():
@@ -144,7 +145,7 @@ def test_a_read_width_carries_its_uncertainty_into_the_interval_and_says_so():
     # at Nyquist a 1.5 px bar's MTF moves 2.2 % per 0.01 px of width: that uncertainty dominates
     assert read.mtf_nyquist_ci.width > 2.0 * given.mtf_nyquist_ci.width
     assert float(chip.true_mtf(0.5)) in read.mtf_nyquist_ci
-    assert any("read off its profile" in w and "--pulse-width" in w for w in read.warnings)
+    assert any("read off its profile" in w and "give the width" in w for w in read.warnings)
     assert not any("read off its profile" in w for w in given.warnings)
     boot = measure_pulse(chip.image, bootstrap=50)
     assert any("bootstrap holds the bar's width" in w for w in boot.warnings)

@@ -298,7 +298,7 @@ def read_acquisition(path: str | Path, *, band: int | str | None = None, setting
 
     path = str(path)
     settings = dict(json_safe(settings or {}))
-    options = {"acquired_utc": parse_time(acquired, "--acquired") if acquired is not None else None,
+    options = {"acquired_utc": parse_time(acquired, "acquired") if acquired is not None else None,
                "platform": platform, "instrument": instrument, "band_name": band_name, "level": level}
     info = raster_info(path)
     metadata = raster_metadata(path, band if isinstance(band, int) else None)

@@ -53,14 +53,20 @@ def option_errors():
 # refusals a scan of the whole file resolves: it finds each edge and bar
 # and measures them one by one, away from fill and from each other
 SCAN_SOLVES = frozenset({"fill", "two-targets"})
+# the option that answers a refusal, by its reason code: the library's message
+# says what is wrong with the data, the command line what to do about it
+OPTION_HINTS = {"two-targets": "--roi X,Y,W,H crops it to one target", "not-an-edge": "--target pulse measures a bar",
+                "not-a-bar": "--target edge measures an edge", "too-large": "--roi X,Y,W,H measures a window",
+                "bands": "--band N chooses one, --band all measures each", "bar-width": "--pulse-width gives it",
+                "fit": "--stages fits fewer, --hold holds some", "no-signal": "--signal-std gives it"}
 
 
 def refusal_hint(reason, message: str = "", path: str | None = None) -> str:
-    """What the CLI adds to a quality-gate refusal: ``imgmtf scan`` where
-    the chip holds fill, several edges or a checkerboard's corner, and the
-    flag that overrules the gate."""
+    """What the CLI adds to a refusal: the option that answers its reason,
+    ``imgmtf scan`` where the chip holds fill, several edges or a
+    checkerboard's corner, and the flag that overrules the gate."""
     from ..estimate.gate import FORCIBLE
-    hints = []
+    hints = [OPTION_HINTS[reason]] if reason in OPTION_HINTS else []
     if reason in SCAN_SOLVES or (reason == "not-straight" and "meet inside the chip" in message):
         hints.append(f"imgmtf scan {path or 'FILE'} finds and measures each edge in it")
     if reason in FORCIBLE:

@@ -200,7 +200,9 @@ SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
 #: what the CLI adds to a scan's rejection: the option that moves the limit (a
 #: too-short line, not too few rows clear of the junctions, which no option moves)
 SCAN_REASON_HINTS = {("too-short", "shorter than the minimum"): "--min-length sets the minimum",
-                     ("two-targets", ""): "--margin sets the ROI's reach"}
+                     ("two-targets", ""): "--margin sets the ROI's reach",
+                     ("not-an-edge", ""): "--target pulse measures bars",
+                     ("not-a-bar", ""): "--target edge measures edges"}
 MAX_EXAMPLE_IDS = 5
 
 

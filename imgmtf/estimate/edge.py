@@ -102,7 +102,7 @@ class EdgeKind(TargetKind):
                                      f"{describe(line)} and {describe(rival)}) meet inside the chip"))
         else:
             checks.append(gate.Check("two-targets", False, f"two edges found (at {describe(line)} and "
-                                     f"{describe(rival)}): crop the image to one edge with --roi"))
+                                     f"{describe(rival)})"))
         return line, checks
 
     def locate(self, work, seed_x, transposed) -> TargetGeometry:

@@ -318,9 +318,8 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Chec
         return Check("two-targets", False, f"the profile holds a step and a bar: a second feature (a road, a "
                      f"shadow, another {'edge' if wanted == 'bar' else 'bar'}) lies beside the target")
     if wanted == "edge":
-        return Check("not-an-edge", False, "the profile rises and falls back: a bar, not an edge "
-                     "(measure it with --target pulse)")
-    return Check("not-a-bar", False, "the profile is a step, not a bar (measure it as an edge)")
+        return Check("not-an-edge", False, "the profile rises and falls back: a bar, not an edge")
+    return Check("not-a-bar", False, "the profile is a step, not a bar")
 
 
 def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum, noise_free,
@@ -563,7 +562,7 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
                   texture, MAX_SIDE_TEXTURE),
             Check("two-targets", second <= MAX_SECOND_FEATURE,
                   f"another feature lies on the {name} side, {np.nonzero(full)[0][worst] if full.any() else 0}"
-                  f" px from the target ({100 * second:.0f} % of the contrast): crop it out with --roi",
+                  f" px from the target ({100 * second:.0f} % of the contrast)",
                   second, MAX_SECOND_FEATURE),
         ]
     return checks

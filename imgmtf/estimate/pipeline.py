@@ -369,7 +369,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
             warnings.append(
                 f"the bar's width, read off its profile ({shape.extra['width_px']:.3f} px), is uncertain "
                 f"enough to make {100 * width_share:.0f} % of the variance at Nyquist: give the width "
-                "if it is known (--pulse-width, width_px=)")
+                "if it is known")
     elif settings.intervals.method == "bootstrap":
         if width_influence is not None:
             warnings.append(f"the bootstrap holds the bar's width ({shape.extra['width_px']:.3f} px, read "

@@ -121,7 +121,7 @@ class PulseKind(TargetKind):
         others = [ln for ln in lines[1:] if not parallel_within(best, ln, data.shape, reach, angle_deg=8.0)
                   and not meet_inside(best, ln, data.shape) and ln.votes >= 0.5 * best.votes]
         checks = [gate.Check("two-targets", False, f"another line of strong contrast at {describe(others[0])} "
-                             f"besides the bar at {describe(best)}: crop the image to one bar with --roi")
+                             f"besides the bar at {describe(best)}")
                   ] if others else []
         return best, checks
 
@@ -380,7 +380,7 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
         raise UnsuitableTargetError(
             f"the bar width cannot be estimated from this profile (no zero in its spectrum below "
             f"{MAX_ZERO_SEARCH_CY_PX} cy/px, so the bar is narrower than "
-            f"{1 / MAX_ZERO_SEARCH_CY_PX:.2f} px); give it with --pulse-width")
+            f"{1 / MAX_ZERO_SEARCH_CY_PX:.2f} px); give its width", reason="bar-width")
     i = change[0]
     zero = f[i] - real[i] * (f[i + 1] - f[i]) / (real[i + 1] - real[i])
     return float(1.0 / zero)

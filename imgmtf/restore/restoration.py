@@ -140,7 +140,7 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
         noise, signal = measure_noise(path, band=_first_band(info))
         if signal_std_dn is None and signal == 0.0:
             raise ImageContentError(f"{path}: the image's centre holds no signal above its noise ({noise:.3g} DN) "
-                                    "to weigh the noise against: give the scene's contrast (--signal-std)")
+                                    "to weigh the noise against: give the scene's contrast", reason="no-signal")
         noise_std_dn = noise if noise_std_dn is None else noise_std_dn
         signal_std_dn = signal if signal_std_dn is None else signal_std_dn
     restoration = design_filter(sensor, target_nyquist, noise_std_dn=noise_std_dn, signal_std_dn=signal_std_dn,

@@ -403,7 +403,7 @@ def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record
 
 def _confident_snr(target: str, rows: int) -> float:
     """The SNR from which the estimator trusts a target of this kind and
-    length (:meth:`imgmtf.estimate.pipeline.TargetKind.confident_snr`)."""
+    length (:meth:`imgmtf.estimate.kind.TargetKind.confident_snr`)."""
     from ..estimate.edge import EdgeKind
     from ..estimate.pulse import PulseKind
     return (EdgeKind if target == "edge" else PulseKind).confident_snr(rows)

@@ -69,13 +69,13 @@ class ScanSettings:
         for name in ("margin_px", "tile_px"):
             object.__setattr__(self, name, check_number(name, getattr(self, name), integer=True))
         if self.band == "all":
-            raise ParameterError("scan one band at a time (--band N)")
+            raise ParameterError("scan one band at a time (band=N)")
         if self.band is not None:
             object.__setattr__(self, "band", check_number("band", self.band, low=1, integer=True))
         if not self.min_length_px >= 16:
-            raise ParameterError(f"--min-length must be at least 16 px, got {self.min_length_px}")
+            raise ParameterError(f"min_length_px must be at least 16 px, got {self.min_length_px}")
         if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
-            raise ParameterError(f"--max-length ({self.max_length_px:g} px) must lie between --min-length "
+            raise ParameterError(f"max_length_px ({self.max_length_px:g} px) must lie between min_length_px "
                                  f"({self.min_length_px:g} px) and {MAX_LENGTH_PX} px")
         if self.margin_px < 6:
             raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")

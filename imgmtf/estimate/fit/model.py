@@ -262,7 +262,7 @@ class Model:
             if result.status > 0:
                 return result.x, result.jac
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
-                          f"{max_iterations} iterations; try fewer stages (--stages) or hold some (--hold)",
+                          f"{max_iterations} iterations; try fewer stages or hold some",
                           reason="fit")
 
     def chi_square(self, z: np.ndarray) -> float:

@@ -98,7 +98,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                             "of the model (tied and held parameters)")
     if not any(d.gsd_known for d in model.data):
         warnings.append(f"no GSD in the inputs: lengths are in units of {model.gsd:g} m per pixel "
-                        "(at 1 m, metres are pixels); give the GSD (--gsd, gsd_m=) for lengths on the ground")
+                        "(at 1 m, metres are pixels); give the GSD for lengths on the ground")
     return SensorFit(sensor, start, tuple(parameters), tuple(correlations), reduced, tuple(edges), directions,
                      confidence, tuple(warnings), model, u, covariance)
 
