@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import functools
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,6 +26,9 @@ from .parallel import run_tasks
 from .records import Record, utc_now
 from .transfer import parse_transfer
 
+if TYPE_CHECKING:
+    from .estimate.results import MTFResult
+
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
 
@@ -32,26 +37,50 @@ IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".
 class MeasureSettings:
     """How to measure every file of a batch.
 
-    target : "edge" or "pulse".
-    method : resampling method (see :data:`imgmtf.resampling.METHODS`).
-    band : 1-based band, "all" for every band, None for the only band or
-        RGB luminance.
-    roi : (x, y, width, height) window read from every file (px).
-    pulse_width : (value, "px" or "m"), a number of px, a string as the
-        CLI takes it ("1.4", "1.4px", "18.3m"), or None to estimate it.
-    intervals : confidence-interval settings (linearised by default): an
+    Parameters
+    ----------
+    target : {"edge", "pulse"}, optional
+        The target (default "edge").
+    method : str, optional
+        Resampling method (see :data:`imgmtf.estimate.resampling.METHODS`;
+        default "msg").
+    band : int or str, optional
+        1-based band, "all" for every band, None (default) for the only
+        band or RGB luminance.
+    roi : (int, int, int, int), optional
+        (x, y, width, height) window read from every file, px.
+    pulse_width : (float, str), float or str, optional
+        (value, "px" or "m"), a number of px, a string as the CLI takes it
+        ("1.4", "1.4px", "18.3m"), or None (default) to estimate it.
+    intervals : Intervals, str or int, optional
+        Confidence-interval settings (linearised by default): an
         :class:`~imgmtf.Intervals`, or what ``--intervals`` takes
         ("influence", "bootstrap", "none"), or a number of bootstrap
         replicates (0: none).
-    force : measure even where a quality check fails (each a warning).
-    saturation : (low, high) DN the sensor records; None for an integer
-        file's type range (floats: none declared).
-    track_azimuth_deg : the ground track's direction in the image, degrees
-        clockwise from up; None: rows along track for images in sensor
-        geometry, unknown for map-projected ones.
-    transfer : how the stored values relate to light, "linear" (as stored),
-        "srgb" or "gamma:G" (:mod:`imgmtf.transfer`): linearised before
-        measuring.
+    force : bool, optional
+        Measure even where a quality check fails (each a warning).
+    saturation : (float, float), optional
+        (low, high) DN the sensor records; None for an integer file's type
+        range (floats: none declared).
+    track_azimuth_deg : float, optional
+        The ground track's direction in the image, degrees clockwise from
+        up; None: rows along track for images in sensor geometry, unknown
+        for map-projected ones.
+    transfer : str, optional
+        How the stored values relate to light, "linear" (as stored), "srgb"
+        or "gamma:G" (:mod:`imgmtf.transfer`): linearised before measuring.
+
+    Raises
+    ------
+    ParameterError
+        A setting out of range, or a pulse width for an edge.
+
+    Examples
+    --------
+    >>> from imgmtf import MeasureSettings
+    >>> settings = MeasureSettings(target="pulse", pulse_width="18.3m", intervals="none")
+    >>> settings.pulse_width, settings.intervals.method
+    ((18.3, 'm'), 'none')
     """
 
     target: str = "edge"
@@ -78,9 +107,9 @@ class MeasureSettings:
         check_method(self.method)   # an unknown method fails here, before any file is read
         object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
-    def estimator(self):
+    def estimator(self) -> Callable[..., MTFResult]:
         # the estimators load SciPy and OpenCV: imported by the processes
-        # that measure (WORKER_MODULES), not by a batch's parent
+        # that measure (imgmtf.cli.measure.MEASURING_MODULES), not by a batch's parent
         from .estimate.edge import EdgeEstimator
         from .estimate.pulse import PulseEstimator
         kind = EdgeEstimator if self.target == "edge" else PulseEstimator
@@ -94,8 +123,25 @@ class MeasureSettings:
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None}
 
-    def failed(self, path: str, band, exc: BaseException, run_utc: str) -> Record:
-        """The error record of a file (or band) that could not be measured."""
+    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
+        """The error record of a file (or band) that could not be measured.
+
+        Parameters
+        ----------
+        path : str
+            The file.
+        band : int, str or None
+            Its band (None: the only one, or the luminance).
+        exc : BaseException
+            What the measurement raised.
+        run_utc : str
+            The run's start, UTC, ISO 8601.
+
+        Returns
+        -------
+        Record
+            An error record with these settings, the reason and message.
+        """
         return Record.failed(path, band, self.target, self.method, exc, params=self.params(),
                              run_utc=run_utc)
 
@@ -121,7 +167,7 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
 
 
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
-                 *, run_utc: str | None = None, **options) -> list[Record]:
+                 *, run_utc: str | None = None, **options: Any) -> list[Record]:
     """Measure one image file as ``imgmtf measure FILE`` does: every
     requested band, one record each, the same records (and numbers) that
     ``imgmtf measure --format json FILE`` prints.
@@ -144,6 +190,8 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
         Also save the measurement figure here (``measure --plot``).
     run_utc : str, optional
         The time stamp of the records (default: now).
+    **options
+        The fields of :class:`MeasureSettings`, without ``settings``.
 
     Returns
     -------

@@ -90,10 +90,6 @@ class Intervals:
         object.__setattr__(self, "confidence", float(self.confidence))
         object.__setattr__(self, "seed", int(self.seed))
 
-    @property
-    def enabled(self) -> bool:
-        return self.method != "none"
-
     def as_dict(self) -> dict:
         out = {"method": self.method, "confidence": self.confidence}
         if self.method == "bootstrap":
@@ -148,8 +144,8 @@ def as_intervals(value) -> Intervals:
 
     Examples
     --------
-    >>> as_intervals("bootstrap").replicates, as_intervals("none").enabled
-    (200, False)
+    >>> as_intervals("bootstrap").replicates, as_intervals("none").method
+    (200, 'none')
     """
     if value is None or value is True:
         return Intervals()
@@ -167,7 +163,19 @@ def as_intervals(value) -> Intervals:
 
 @dataclass(frozen=True)
 class Interval:
-    """A confidence interval [low, high] (units of the figure)."""
+    """A confidence interval [low, high] (units of the figure).
+
+    Parameters
+    ----------
+    low, high : float
+        The ends, in the figure's unit (NaN for no interval).
+
+    Examples
+    --------
+    >>> from imgmtf import Interval
+    >>> 0.26 in Interval(0.25, 0.27), Interval.none()
+    (True, Interval(low=nan, high=nan))
+    """
 
     low: float
     high: float
@@ -286,19 +294,32 @@ def bootstrap_figures(settings: Intervals, distance: np.ndarray, rows: np.ndarra
 
     Parameters
     ----------
-    settings : the interval settings (method "bootstrap").
-    distance : every profile sample's distance from the target line (px).
-    rows : every sample's row.
-    span_px : the profile is needed within +-span_px of the line.
-    resample : ``resample(keep, weights, half_range)`` -> Resampled, the
+    settings : Intervals
+        The interval settings (method "bootstrap").
+    distance : numpy.ndarray
+        Every profile sample's distance from the target line (px).
+    rows : numpy.ndarray
+        Every sample's row.
+    span_px : float
+        The profile is needed within +-span_px of the line.
+    resample : callable
+        ``resample(keep, weights, half_range)`` -> Resampled, the
         estimator's own resampling of the samples selected by ``keep``
         under a stack of ``weights``.
-    windowed_profile : ``(grid, values, weights_of) -> profiles``: the
-        estimator's windowed LSF (or PRF) of each replicate, shape
-        (replicates, n); ``weights_of(mask)`` gives the replicates' weights
-        of the samples selected by ``mask`` (see :func:`row_weights`).
-    step : the profile's sample step (px).
-    divisor : the estimator's transfer correction (see :mod:`.spectrum`).
+    windowed_profile : callable
+        ``(grid, values, weights_of) -> profiles``: the estimator's
+        windowed LSF (or PRF) of each replicate, shape (replicates, n);
+        ``weights_of(mask)`` gives the replicates' weights of the samples
+        selected by ``mask`` (see :func:`row_weights`).
+    step : float
+        The profile's sample step (px).
+    divisor : callable
+        The estimator's transfer correction (see :mod:`.spectrum`).
+
+    Returns
+    -------
+    mtf_nyquist_ci, mtf50_ci_cy_px : Interval
+        The intervals of the MTF at Nyquist and of MTF50 (cy/px).
     """
     rng = np.random.default_rng(settings.seed)
     keep = np.abs(distance) <= span_px + 2.0
