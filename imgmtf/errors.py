@@ -12,7 +12,25 @@ and open()'s are).  Every public exception is importable from ``imgmtf``
 
 class ImgmtfError(Exception):
     """Base class of all deliberate imgmtf errors.  ``reason`` is a short
-    machine-readable code (what the scan reports for a rejected target)."""
+    machine-readable code (what the scan reports for a rejected target).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"error"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> try:
+    ...     imgmtf.measure_edge(np.full((50, 50), 100.0))
+    ... except imgmtf.ImgmtfError as error:
+    ...     print(error.reason, "|", error)
+    image | the image is flat: no contrast to measure
+    """
 
     reason = "error"
 
@@ -23,19 +41,65 @@ class ImgmtfError(Exception):
 
 
 class ParameterError(ImgmtfError, ValueError):
-    """A parameter is out of its valid range or of the wrong kind."""
+    """A parameter is out of its valid range or of the wrong kind.
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"parameter"``).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> imgmtf.Sensor(gsd_m=-1)
+    Traceback (most recent call last):
+    imgmtf.errors.ParameterError: sensor gsd_m must be finite and >= 0, got -1
+    """
 
     reason = "parameter"
 
 
 class ConfigError(ImgmtfError):
-    """A configuration file (sensor TOML) cannot be read or is malformed."""
+    """A configuration file (sensor TOML) cannot be read or is malformed.
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"config"``).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> imgmtf.Sensor.from_toml("missing.toml")
+    Traceback (most recent call last):
+    imgmtf.errors.ConfigError: missing.toml: cannot read sensor file: No such file or directory
+    """
 
     reason = "config"
 
 
 class FileWriteError(ImgmtfError, OSError):
-    """An output file cannot be written (an OSError, as open()'s is)."""
+    """An output file cannot be written (an OSError, as open()'s is).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"write"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> imgmtf.write_geotiff("no/such/folder/edge.tif", np.zeros((4, 4), np.uint16))
+    Traceback (most recent call last):
+    imgmtf.errors.FileWriteError: no/such/folder/edge.tif: cannot write: No such file or directory
+    """
 
     reason = "write"
 
@@ -44,30 +108,116 @@ class ImageReadError(ImgmtfError, OSError):
     """An image file cannot be opened or decoded, an OSError as rasterio's
     read errors are (``reason`` ``unreadable``;
     ``too-large`` for an image above the read limit, ``unsupported-type``
-    for complex pixels)."""
+    for complex pixels).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"unreadable"``).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> imgmtf.read_raster("missing.tif")
+    Traceback (most recent call last):
+    imgmtf.errors.ImageReadError: missing.tif: no such file
+    """
 
     reason = "unreadable"
 
 
 class ImageContentError(ImgmtfError):
-    """An image was read but cannot be measured (NaN, flat, too small...)."""
+    """An image was read but cannot be measured (NaN, flat, too small...).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"image"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> imgmtf.measure_edge(np.full((50, 50), np.nan))
+    Traceback (most recent call last):
+    imgmtf.errors.ImageContentError: every pixel is NaN or nodata: nothing to measure
+    """
 
     reason = "image"
 
 
 class TargetNotFoundError(ImageContentError):
-    """No usable edge or bar was found in the image."""
+    """No usable edge or bar was found in the image.
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"no-target"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> noise = 100.0 + np.random.default_rng(0).normal(0.0, 1.0, (50, 50))
+    >>> imgmtf.measure_pulse(noise)
+    Traceback (most recent call last):
+    imgmtf.errors.TargetNotFoundError: no bar found: no straight line stands out of the noise
+    """
 
     reason = "no-target"
 
 
 class MultipleTargetsError(ImageContentError):
-    """More than one edge or bar was found where one was expected."""
+    """More than one edge or bar was found where one was expected.
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"two-targets"``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import imgmtf
+    >>> band = np.full((60, 60), 200.0)
+    >>> band[:, 20:40] = 1200.0                      # a wide bar: two edges
+    >>> try:
+    ...     imgmtf.measure_edge(band)
+    ... except imgmtf.MultipleTargetsError as error:
+    ...     print(error.reason)
+    two-targets
+    """
 
     reason = "two-targets"
 
 
 class UnsuitableTargetError(ImageContentError):
-    """A target was found but cannot give a trustworthy MTF (angle, saturation...)."""
+    """A target was found but cannot give a trustworthy MTF (angle, saturation...).
+
+    Parameters
+    ----------
+    message : str, optional
+        One line naming the offending value or file.
+    reason : str, optional
+        A short machine-readable code (default ``"unsuitable"``).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 45.0), 60)
+    >>> try:
+    ...     imgmtf.measure_edge(chip.image)
+    ... except imgmtf.UnsuitableTargetError as error:
+    ...     print(error.reason)
+    angle
+    """
 
     reason = "unsuitable"
