@@ -6,6 +6,7 @@ import math
 import os
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import ImageContentError, ParameterError
 
@@ -18,7 +19,7 @@ MIN_BAR_WIDTH_PX = 0.2              # narrower, a bar's signal is below any nois
 MIN_FIRST_ZERO_CY_PX = 0.1      # a wider bar leaves too little usable band
 
 
-def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
+def luminance(rgb: ArrayLike, channel_axis: int = -1) -> np.ndarray:
     """The Rec. 709 luminance of a colour image, as ``imgmtf measure``
     computes it for an RGB(A) file: 0.2126 R + 0.7152 G + 0.0722 B of the
     stored values (gamma-encoded values stay encoded: no linearisation),
@@ -46,8 +47,8 @@ def luminance(rgb, channel_axis: int = -1) -> np.ndarray:
     ParameterError
         ``channel_axis`` is not an axis of a 3-D array.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> import imgmtf
     >>> rgba = np.zeros((20, 30, 4), np.uint8)
@@ -113,8 +114,8 @@ def as_array(image) -> np.ndarray:
     ParameterError
         ``image`` is a path (str or os.PathLike).
 
-    Example
-    -------
+    Examples
+    --------
     >>> as_array([[1, 2], [3, 4]]).shape
     (2, 2)
     """
@@ -245,8 +246,8 @@ def check_width(width_px: float) -> float:
         A width that is not a number of at least ``MIN_BAR_WIDTH_PX``, or one
         whose sinc has its first zero below ``MIN_FIRST_ZERO_CY_PX``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> check_width(3)
     3.0
     """

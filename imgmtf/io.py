@@ -72,8 +72,8 @@ class Raster:
         2000", "lossy WebP", "LERC"...), None for lossless or none: its
         loss is part of any MTF measured from the file.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> imgmtf.write_geotiff("edge.tif", imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 100).image)
     >>> raster = imgmtf.read_raster("edge.tif")
@@ -143,8 +143,8 @@ def write_geotiff(path: str | Path, image: np.ndarray, *, gsd_m: float = 1.0,
         The file cannot be written (no such folder, no permission, disk
         full...).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, gsd_m=0.5)
     >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
@@ -187,8 +187,8 @@ def write_png(path: str | Path, image: np.ndarray) -> None:
     FileWriteError
         The file cannot be written.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 40, bits=8)
     >>> imgmtf.write_png("chip.png", chip.image)
@@ -301,10 +301,20 @@ def raster_metadata(path: str | Path, band: int | None = None) -> dict[str, dict
         return {"default": dict(src.tags()), "imagery": imagery, "band": band_items}
 
 
-def read_raster(path: str | Path, band: int | None = None, window=None,
+def read_raster(path: str | Path, band: int | None = None, window: tuple[int, int, int, int] | None = None,
                 out_shape: tuple[int, int] | None = None) -> Raster:
     """Read one band of an image file (anything GDAL reads: GeoTIFF, PNG,
     JPEG, JP2, NITF...) as float64 DN.
+
+    With ``band=None`` a single-band file (or a grey one with alpha) gives
+    its band and an RGB or RGBA file (8/16-bit, colour-interpreted as
+    such) gives the Rec. 709 luminance of its stored values (alpha
+    ignored; no gamma decoding).  Any other multi-band file needs ``band``.  Nodata pixels become NaN.
+
+    ``window`` = (x, y, width, height) reads only that part of the image
+    (``Raster.origin`` is its top-left pixel), so a large scene is never
+    loaded whole for a small ROI.  ``out_shape`` = (rows, cols) reads the
+    window decimated (nearest), for overviews.
 
     Parameters
     ----------
@@ -322,16 +332,6 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     Raster
         The pixels with the file's GSD, tags, type and provenance.
 
-    With ``band=None`` a single-band file (or a grey one with alpha) gives
-    its band and an RGB or RGBA file (8/16-bit, colour-interpreted as
-    such) gives the Rec. 709 luminance of its stored values (alpha
-    ignored; no gamma decoding).  Any other multi-band file needs ``band``.  Nodata pixels become NaN.
-
-    ``window`` = (x, y, width, height) reads only that part of the image
-    (``Raster.origin`` is its top-left pixel), so a large scene is never
-    loaded whole for a small ROI.  ``out_shape`` = (rows, cols) reads the
-    window decimated (nearest), for overviews.
-
     Raises
     ------
     ImageReadError
@@ -342,8 +342,8 @@ def read_raster(path: str | Path, band: int | None = None, window=None,
     ParameterError
         A bad ``band``, ``window`` or ``out_shape``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 200)
     >>> imgmtf.write_geotiff("scene.tif", chip.image, gsd_m=2.0)

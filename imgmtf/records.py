@@ -26,7 +26,7 @@ from __future__ import annotations
 import csv
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from typing import IO, Any
@@ -97,8 +97,8 @@ class Record:
         A missing field (the constructors :meth:`measured` and
         :meth:`failed` fill them).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import imgmtf
     >>> from imgmtf.errors import ImageReadError
     >>> record = imgmtf.Record.failed("a.tif", None, "edge", "msg", ImageReadError("a.tif: no such file"),
@@ -124,21 +124,71 @@ class Record:
     imgmtf_version: str = __version__
 
     @classmethod
-    def measured(cls, path: str, band, summary: Mapping[str, Any], *, params: Mapping[str, Any],
-                 run_utc: str, status: str = "ok", **fields) -> Record:
+    def measured(cls, path: str, band: int | str | None, summary: Mapping[str, Any], *,
+                 params: Mapping[str, Any], run_utc: str, status: str = "ok", **fields: Any) -> Record:
         """A record of an estimate whose JSON summary is ``summary``; the
-        run's ``params`` are merged with the estimator's own."""
+        run's ``params`` are merged with the estimator's own.
+
+        Parameters
+        ----------
+        path : str
+            The input file.
+        band : int, str or None
+            1-based band, ``"luminance"`` for RGB, None when not known.
+        summary : mapping
+            The estimate's JSON summary (``to_dict()`` of a result).
+        params : mapping
+            The run's settings.
+        run_utc : str
+            The run's start, UTC, ISO 8601.
+        status : str, optional
+            ``ok`` (default) or ``accepted``.
+        **fields
+            Other fields of the record (``site``, ``plot``...).
+
+        Returns
+        -------
+        Record
+            The record, its figures the summary's.
+        """
         figures = {k: v for k, v in summary.items() if k not in _OWN_KEYS}
         return cls(str(path), band, summary.get("target", ""), summary.get("method", ""), status,
                    figures=figures, params={**params, **(summary.get("params") or {})},
                    run_utc=run_utc, **fields)
 
     @classmethod
-    def failed(cls, path: str, band, target: str, method: str, exc: BaseException, *,
-               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields) -> Record:
+    def failed(cls, path: str, band: int | str | None, target: str, method: str, exc: BaseException, *,
+               params: Mapping[str, Any], run_utc: str, status: str = "error", **fields: Any) -> Record:
         """A record of a target that could not be measured: the reason code
         of an imgmtf error, ``internal`` for any other exception; the
-        message names the file (prefixed when it does not)."""
+        message names the file (prefixed when it does not).
+
+        Parameters
+        ----------
+        path : str
+            The input file.
+        band : int, str or None
+            1-based band, ``"luminance"`` for RGB, None when not known.
+        target : str
+            ``"edge"`` or ``"pulse"``.
+        method : str
+            The resampling method.
+        exc : BaseException
+            What the measurement raised.
+        params : mapping
+            The run's settings.
+        run_utc : str
+            The run's start, UTC, ISO 8601.
+        status : str, optional
+            ``error`` (default) or ``rejected``.
+        **fields
+            Other fields of the record (``site``...).
+
+        Returns
+        -------
+        Record
+            The record, with its reason and message.
+        """
         message = " ".join(str(exc).split())
         if isinstance(exc, ImgmtfError):
             reason = exc.reason
@@ -166,13 +216,37 @@ class Record:
         """True for a measured (``ok``) or accepted record."""
         return self.status in OK_STATUSES
 
-    def get(self, key: str, default=None):
-        """A value of the flat JSON form (a field, a figure or a site key)."""
+    def get(self, key: str, default: Any = None) -> Any:
+        """A value of the flat JSON form (a field, a figure or a site key).
+
+        Parameters
+        ----------
+        key : str
+            The key (``mtf_nyquist``, ``status``, ``x0_px``...).
+        default : object, optional
+            What a missing key gives (default None).
+
+        Returns
+        -------
+        object
+            The value.
+        """
         return self.to_dict().get(key, default)
 
-    def with_(self, **changes) -> Record:
+    def with_(self, **changes: Any) -> Record:
         """A copy with fields changed (``figures``/``site`` given as
-        mappings are merged into the current ones)."""
+        mappings are merged into the current ones).
+
+        Parameters
+        ----------
+        **changes
+            The fields to change, by name.
+
+        Returns
+        -------
+        Record
+            The copy.
+        """
         for name in ("figures", "site"):
             if name in changes:
                 changes[name] = {**getattr(self, name), **changes[name]}
@@ -185,10 +259,21 @@ class Record:
                 "error": self.error, **self.figures, "plot": self.plot, "params": dict(self.params),
                 "imgmtf_version": self.imgmtf_version, "run_utc": self.run_utc}
 
-    def csv_row(self, columns=None) -> dict:
+    def csv_row(self, columns: Sequence[str] | None = None) -> dict:
         """The record flattened to ``columns`` (default :data:`CSV_COLUMNS`):
         intervals split into their bounds, lists and mappings as JSON,
-        missing values empty."""
+        missing values empty.
+
+        Parameters
+        ----------
+        columns : sequence of str, optional
+            The CSV's columns (default :data:`CSV_COLUMNS`).
+
+        Returns
+        -------
+        dict
+            Column -> value.
+        """
         flat = self.to_dict()
         columns = columns or CSV_COLUMNS
         if any(c in _CURVE_COLUMN_FREQUENCY for c in columns):
@@ -311,8 +396,8 @@ class CsvWriter:
     SIGTERM) keeps the rows written so far (see
     :func:`imgmtf.atomic.atomic_output`).
 
-    Example
-    -------
+    Examples
+    --------
     >>> with CsvWriter("summary.csv") as out:        # doctest: +SKIP
     ...     for record in records:
     ...         out.write(record)

@@ -159,11 +159,20 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
 
     Parameters
     ----------
-    path : the scene (any raster GDAL reads, up to 1 Gpx).
-    settings : how to scan (:class:`imgmtf.scene.settings.ScanSettings`).
-    workers, scheduler, progress : as for :func:`imgmtf.parallel.run_tasks`.
-    figures_dir : a folder (created) for one measurement figure per
-        accepted candidate, ``edge<id>.png`` (:func:`imgmtf.plot.plot_measurement`:
+    path : str
+        The scene (any raster GDAL reads, up to 1 Gpx).
+    settings : ScanSettings, optional
+        How to scan (:class:`imgmtf.ScanSettings`; default its defaults).
+    workers : int, optional
+        Local worker processes (default 1: none, the work runs here).
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"`` for a local
+        Dask cluster (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show a progress bar on stderr (default: when stderr is a terminal).
+    figures_dir : str, optional
+        A folder (created) for one measurement figure per accepted
+        candidate, ``edge<id>.png`` (:func:`imgmtf.plot.plot_measurement`:
         its locations, profile, LSF and MTF); its path is the record's
         ``plot``.
 
@@ -188,8 +197,8 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         records so far as its ``records`` attribute: candidates not yet
         measured are rejected with reason ``interrupted``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> records = scan_scene("data/scene.tif", ScanSettings(track_azimuth_deg=0.0))  # doctest: +SKIP
     >>> [(r.site["rank"], r.figures["mtf_nyquist"]) for r in records if r.ok]  # doctest: +SKIP
     [(1, 0.261544), (2, 0.266206)]

@@ -32,9 +32,22 @@ class ScanSettings:
         ROI extent either side of the target, across it (px).
     tile_px : int
         Side of the tiles read for detection (px).
-    method, band, pulse_width, intervals, saturation, track_azimuth_deg
-        As in :class:`imgmtf.batch.MeasureSettings`; without a track
-        azimuth, a scene in sensor geometry has its rows along track and a
+    method : str, optional
+        Resampling method (default "msg"; :class:`imgmtf.MeasureSettings`).
+    band : int, optional
+        1-based band scanned (default the only band, or RGB luminance).
+    pulse_width : (float, str), float or str, optional
+        A bar's width: (value, "px" or "m"), px, or "1.4px", "18.3m"; None
+        (default) to estimate it.
+    intervals : Intervals, str or int, optional
+        Confidence-interval settings, as :class:`imgmtf.MeasureSettings`
+        takes them.
+    saturation : (float, float), optional
+        (low, high) DN the sensor records (default an integer scene's type
+        range).
+    track_azimuth_deg : float, optional
+        The ground track's direction, degrees clockwise from up; without
+        it, a scene in sensor geometry has its rows along track and a
         map-projected one (with a CRS) an unknown direction.
 
     Raises
@@ -42,8 +55,8 @@ class ScanSettings:
     ParameterError
         A setting out of range.
 
-    Example
-    -------
+    Examples
+    --------
     >>> ScanSettings(min_length_px=30.0).as_dict()["min_length_px"]
     30.0
     """
