@@ -1,22 +1,59 @@
 """Figures of a sensor fit: measured against model MTF per edge, residuals."""
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
 
 from ..estimate.spectrum import NYQUIST
 from ._common import check_truth, expect, figure_axes
 from .sensor import plot_psf
 
+if TYPE_CHECKING:
+    from ..estimate.fit import SensorFit
 
-def plot_fit_edge(fit, index: int, ax=None, truth=None):
+
+def plot_fit_edge(fit: SensorFit, index: int, ax: Axes | None = None,
+                  truth: Callable[[np.ndarray], np.ndarray] | None = None) -> Figure | SubFigure:
     """One edge of a sensor fit: its measured (non-parametric) MTF against
     the fitted model's along its normal, the model's interval as a band
     (drawn, and magnified about Nyquist in an inset, where it is too
     narrow to see at full scale), and ``truth(f)`` (cy/px) when known (a
-    chip imgmtf simulated)."""
+    chip imgmtf simulated).
+
+    Parameters
+    ----------
+    fit : SensorFit
+        A sensor fit (:func:`imgmtf.fit_sensor`).
+    index : int
+        The edge, an index into ``fit.edges`` (negative from the end).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+    truth : callable, optional
+        The edge's true MTF as a function of frequency (cy/px), when known.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``fit`` is not a sensor fit, an ``index`` outside its edges, or ``truth`` not a function.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_fit_edge
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> plot_fit_edge(fit, 0).axes[0].get_xlabel()
+    'frequency along the normal (cy/px)'
+    """
     expect(fit, "fit")
     check_truth(truth)
     if not -len(fit.edges) <= index < len(fit.edges):
@@ -58,10 +95,36 @@ def plot_fit_edge(fit, index: int, ax=None, truth=None):
     return fig
 
 
-def plot_fit_residuals(fit, ax=None):
+def plot_fit_residuals(fit: SensorFit, ax: Axes | None = None) -> Figure | SubFigure:
     """Each edge's residuals (data - model) averaged in 0.25 px bins along
     its normal, in % of its step, with the noise's 2-sigma band of a bin
-    mean: structure outside it is what the misfit warning reports."""
+    mean: structure outside it is what the misfit warning reports.
+
+    Parameters
+    ----------
+    fit : SensorFit
+        A sensor fit (:func:`imgmtf.fit_sensor`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``fit`` is not a sensor fit.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_fit_residuals
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> plot_fit_residuals(fit).axes[0].get_ylabel()
+    'data - model (% of the step)'
+    """
     expect(fit, "fit")
     fig, ax = figure_axes(ax)
     for i, edge in enumerate(fit.edges):
@@ -92,11 +155,41 @@ def _short(source: str, width: int = 26) -> str:
     return name if len(name) <= width else name[: width // 2 - 2] + "..." + name[-(width // 2 - 1):]
 
 
-def plot_fit(fit, max_edges: int = 6, truths=None):
+def plot_fit(fit: SensorFit, max_edges: int = 6,
+             truths: Iterable[Callable[[np.ndarray], np.ndarray] | None] | None = None) -> Figure:
     """Measured against model MTF for each edge (the first ``max_edges``),
     the residuals along the normals, and the fitted sensor's 2-D PSF;
     ``truths`` the true MTF of each edge (a function of cy/px, or None)
-    when known."""
+    when known.
+
+    Parameters
+    ----------
+    fit : SensorFit
+        A sensor fit (:func:`imgmtf.fit_sensor`).
+    max_edges : int, optional
+        The most edges drawn, each in its panel (default 6).
+    truths : iterable of callable or None, optional
+        Each edge's true MTF (cy/px), in the order of ``fit.edges``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A panel per edge shown (:func:`plot_fit_edge`), the residuals
+        (:func:`plot_fit_residuals`) and the fitted PSF.
+
+    Raises
+    ------
+    ParameterError
+        ``fit`` is not a sensor fit, or a truth is not a function.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_fit
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> sum(ax.get_visible() for ax in plot_fit(fit).axes[:3])      # the edge, residuals, PSF
+    3
+    """
     expect(fit, "fit")
     truths = list(truths) if truths is not None else [None] * len(fit.edges)
     shown = min(len(fit.edges), max_edges)

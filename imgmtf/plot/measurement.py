@@ -2,26 +2,61 @@
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
+from numpy.typing import ArrayLike
 
 from ..estimate.spectrum import NYQUIST
 from ._common import check_truth, expect, figure_axes, title_once
 
+if TYPE_CHECKING:
+    from ..estimate.edge import EdgeResult
+    from ..estimate.pulse import PulseResult
+    from ..estimate.results import MTFResult
 
-def _view_px(result) -> float:
+
+def _view_px(result: MTFResult) -> float:
     """Half-width (px) of a profile view that shows the LSF's core and the
     start of its tails."""
     return float(min(max(6.0, 2.5 * result.lsf_half_width_px), np.abs(result.samples_x_px).max()))
 
 
-def plot_locations(result, ax=None):
+def plot_locations(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigure:
     """Per-row sub-pixel target locations and the fitted line (paper Fig.
     5a), at equal scale in both axes so that the tilt looks as it is, in
     the pixel coordinates of the image measured (its ROI's offset added:
     a file's with ``imgmtf measure --roi``, a scene's for a scan's edge);
-    the rows' RMS scatter about the line is in the legend."""
+    the rows' RMS scatter about the line is in the legend.
+
+    Parameters
+    ----------
+    result : EdgeResult or PulseResult
+        A measurement (:func:`imgmtf.measure_edge`, :func:`imgmtf.measure_pulse`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` is not a measurement.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_locations
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> plot_locations(imgmtf.measure_edge(chip.image)).axes[0].get_aspect()
+    1.0
+    """
     expect(result, "result")
     fig, ax = figure_axes(ax)
     g = result.geometry
@@ -51,18 +86,46 @@ def plot_locations(result, ax=None):
     return fig
 
 
-def plot_profile(result, ax=None):
+def plot_profile(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigure:
     """Over-sampled profile samples and the resampled profile: the ESF of an
     edge (paper Fig. 5b) or the PRF of a pulse, normalised; the LSF window's
-    flat core is shaded, its taper lighter."""
+    flat core is shaded, its taper lighter.
+
+    Parameters
+    ----------
+    result : EdgeResult or PulseResult
+        A measurement (:func:`imgmtf.measure_edge`, :func:`imgmtf.measure_pulse`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` is not a measurement.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_profile
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> plot_profile(imgmtf.measure_edge(chip.image)).axes[0].get_xlabel()
+    'distance from the line along the normal (px)'
+    """
     expect(result, "result")
     fig, ax = figure_axes(ax)
     if result.target == "edge":
-        lo, hi = result.levels_dn
-        x, profile, name = result.esf_x_px, result.esf, "ESF"
+        edge = cast("EdgeResult", result)
+        lo, hi = edge.levels_dn
+        x, profile, name = edge.esf_x_px, edge.esf, "ESF"
     else:
-        lo, hi = result.background_dn, result.peak_dn
-        x, profile, name = result.prf_x_px, result.prf, f"PRF, bar {result.pulse_width_px:.2f} px"
+        bar = cast("PulseResult", result)
+        lo, hi = bar.background_dn, bar.peak_dn
+        x, profile, name = bar.prf_x_px, bar.prf, f"PRF, bar {bar.pulse_width_px:.2f} px"
     ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
             color="0.6", label="pixels")
     ax.plot(x, profile, "-", color="C0", label=f"{result.method} profile")
@@ -83,8 +146,34 @@ def _window_bands(ax, result):
                    label="taper to the tail model" if sign > 0 else None)
 
 
-def plot_lsf(result, ax=None):
-    """The recovered LSF with its full width at half maximum marked."""
+def plot_lsf(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigure:
+    """The recovered LSF with its full width at half maximum marked.
+
+    Parameters
+    ----------
+    result : EdgeResult or PulseResult
+        A measurement (:func:`imgmtf.measure_edge`, :func:`imgmtf.measure_pulse`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` is not a measurement.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_lsf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> plot_lsf(imgmtf.measure_edge(chip.image)).axes[0].get_ylabel()
+    'LSF (1/px)'
+    """
     expect(result, "result")
     fig, ax = figure_axes(ax)
     x, lsf = result.lsf_x_px, result.lsf
@@ -100,10 +189,44 @@ def plot_lsf(result, ax=None):
     return fig
 
 
-def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str | None = None):
+def plot_mtf(result: MTFResult, ax: Axes | None = None, truth: Callable[[np.ndarray], np.ndarray] | None = None,
+             color: str | None = None, label: str | None = None) -> Figure | SubFigure:
     """The MTF along the normal with MTF at Nyquist and MTF50 marked with
     their confidence intervals, the frequencies beyond the noise limit
-    shaded, and ``truth(f)`` (cycles/pixel) overlaid when known."""
+    shaded, and ``truth(f)`` (cycles/pixel) overlaid when known.
+
+    Parameters
+    ----------
+    result : EdgeResult or PulseResult
+        A measurement (:func:`imgmtf.measure_edge`, :func:`imgmtf.measure_pulse`).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+    truth : callable, optional
+        The true MTF as a function of frequency (cy/px), when known (a chip
+        imgmtf rendered: :meth:`imgmtf.Chip.true_mtf`).
+    color : str, optional
+        The curve's matplotlib colour (default the axes' next).
+    label : str, optional
+        The curve's legend entry (default "measured").
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` is not a measurement, or ``truth`` is not a function.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_mtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> plot_mtf(imgmtf.measure_edge(chip.image), truth=chip.true_mtf).axes[0].get_xlabel()
+    'frequency along the normal (cy/px)'
+    """
     expect(result, "result")
     check_truth(truth)
     fig, ax = figure_axes(ax)
@@ -132,8 +255,14 @@ def plot_mtf(result, ax=None, truth=None, color: str | None = None, label: str |
     ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
     if result.gsd_m:
         gsd = result.gsd_m
-        ax.secondary_xaxis("top", functions=(lambda x: x / gsd, lambda x: x * gsd)).set_xlabel(
-            "frequency (cy/m)")
+
+        def per_metre(f_cy_px: ArrayLike) -> np.ndarray:
+            return np.divide(f_cy_px, gsd)
+
+        def per_pixel(f_cy_m: ArrayLike) -> np.ndarray:
+            return np.multiply(f_cy_m, gsd)
+
+        ax.secondary_xaxis("top", functions=(per_metre, per_pixel)).set_xlabel("frequency (cy/m)")
     title_once(ax, "MTF")
     ax.legend(fontsize="small")
     return fig
@@ -187,7 +316,8 @@ def missing_cause(result, figure: str) -> str:
 HEADER_WARNINGS = 3
 
 
-def plot_measurement(result, truth=None, title: str | None = None, warnings=None):
+def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray] | None = None,
+                     title: str | None = None, warnings: Iterable[str] | None = None) -> Figure:
     """Target locations, profile (ESF or PRF), LSF and MTF of one
     measurement, headed by ``title`` (the file), the figures a report
     quotes and its warnings; ``truth(f)`` overlays a known MTF.
@@ -195,7 +325,39 @@ def plot_measurement(result, truth=None, title: str | None = None, warnings=None
     ``warnings`` are those of the record the figure belongs to (default
     the result's; ``imgmtf measure`` adds the file's own, such as a
     photo's luminance): the header prints the first few and counts them
-    all, so that none is dropped unsaid."""
+    all, so that none is dropped unsaid.
+
+    Parameters
+    ----------
+    result : EdgeResult or PulseResult
+        A measurement (:func:`imgmtf.measure_edge`, :func:`imgmtf.measure_pulse`).
+    truth : callable, optional
+        The true MTF as a function of frequency (cy/px), when known (a chip
+        imgmtf rendered: :meth:`imgmtf.Chip.true_mtf`).
+    title : str, optional
+        The header's first line (the file measured).
+    warnings : iterable of str, optional
+        The warnings to print (default the result's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Four panels: :func:`plot_locations`, :func:`plot_profile`,
+        :func:`plot_lsf` and :func:`plot_mtf`.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` is not a measurement, or ``truth`` is not a function.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_measurement
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> len(plot_measurement(imgmtf.measure_edge(chip.image), truth=chip.true_mtf, title="chip").axes)
+    4
+    """
     expect(result, "result")
     check_truth(truth)
     fig = Figure(figsize=(12, 8.5), layout="constrained")

@@ -1,6 +1,9 @@
 """Figures of the paper's study (``imgmtf reproduce``)."""
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -8,10 +11,39 @@ from ..estimate.spectrum import NYQUIST
 from ..metrics import fwhm
 from ._common import figure_axes
 
+if TYPE_CHECKING:
+    from ..sensor.noise import GroundNoise
 
-def plot_noise_sweep(rows, methods, true_nyquist, title):
+
+def plot_noise_sweep(rows: Sequence[Mapping[str, Any]], methods: Sequence[str], true_nyquist: float,
+                     title: str) -> Figure:
     """MTF at Nyquist against measured SNR, one panel per method, the true
-    MTF as a line (paper Figs. 12 and 14)."""
+    MTF as a line (paper Figs. 12 and 14).
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        One per chip, ``results`` mapping each method to its (MTF at
+        Nyquist, SNR).
+    methods : sequence of str
+        The resampling methods, a panel each.
+    true_nyquist : float
+        The true MTF at Nyquist.
+    title : str
+        The noise swept ("System noise", "Ground noise"), heading each panel.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per method.
+
+    Examples
+    --------
+    >>> from imgmtf.plot import plot_noise_sweep
+    >>> rows = [{"results": {"msg": (0.27, 50.0)}}, {"results": {"msg": (0.26, 500.0)}}]
+    >>> plot_noise_sweep(rows, ["msg"], 0.2667, "System noise").axes[0].get_title()
+    'System noise: msg'
+    """
     fig = Figure(figsize=(4 * len(methods), 3.6), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(methods), sharey=True))
     for ax, method in zip(axes, methods):
@@ -26,12 +58,39 @@ def plot_noise_sweep(rows, methods, true_nyquist, title):
     return fig
 
 
-def plot_estimates(kind: str, curves: dict, methods, width_px: float = 0.0):
+def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: float = 0.0) -> Figure:
     """Each method's estimate of a noise-free chip against the truth (paper
     Figs. 9 and 10): the LSF of an edge (or the pulse response of a bar
     ``width_px`` wide), the MTF, and the MTF's error, as published (top) and
     with each method's own blur divided out (bottom, imgmtf's default).
-    ``curves`` as :func:`imgmtf.reproduce.estimator_tables` returns it."""
+    ``curves`` as :func:`imgmtf.reproduce.estimator_tables` returns it.
+
+    Parameters
+    ----------
+    kind : {"edge", "pulse"}
+        The target.
+    curves : dict
+        ``"truth"``: (x_px, profile, f_cy_px, mtf); ``"as published"`` and
+        ``"corrected"``: each method's measurement.
+    methods : sequence of str
+        The resampling methods drawn.
+    width_px : float, optional
+        The bar's width, px (a pulse; default 0).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two rows (as published, corrected) of three panels: the profile,
+        the MTF and its error.
+
+    Examples
+    --------
+    >>> from imgmtf.reproduce import estimator_tables                  # doctest: +SKIP
+    >>> from imgmtf.plot import plot_estimates                         # doctest: +SKIP
+    >>> rows, curves = estimator_tables(["msg"])                       # doctest: +SKIP
+    >>> len(plot_estimates("edge", curves["edge"], ["msg"]).axes)       # doctest: +SKIP
+    6
+    """
     fig = Figure(figsize=(15, 10.5), layout="constrained")
     axes = fig.subplots(2, 3)
     x_true, profile_true, f_true, mtf_true = curves["truth"]
@@ -78,10 +137,37 @@ def plot_estimates(kind: str, curves: dict, methods, width_px: float = 0.0):
     return fig
 
 
-def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20), oversampling: int = 20):
+def plot_ground_noise_layers(ground_noise: GroundNoise, seed: int | None, size: int = 200,
+                             grains: Sequence[int] = (1, 5, 10, 20), oversampling: int = 20) -> Figure:
     """Example ground-noise layers and the composite (paper Fig. 13), on a
     ``size`` x ``size`` grid of sub-pixel cells (``oversampling`` cells per
-    pixel)."""
+    pixel).
+
+    Parameters
+    ----------
+    ground_noise : GroundNoise
+        The noise model.
+    seed : int or None
+        The noise's seed.
+    size : int, optional
+        The grid's side, sub-pixel cells (default 200).
+    grains : sequence of int, optional
+        The layers shown, by grain (sub-pixel cells; default 1, 5, 10, 20).
+    oversampling : int, optional
+        Sub-pixel cells per pixel, for the title's size in px (default 20).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A panel per layer and one of their sum.
+
+    Examples
+    --------
+    >>> from imgmtf import GroundNoise
+    >>> from imgmtf.plot import plot_ground_noise_layers
+    >>> len(plot_ground_noise_layers(GroundNoise(), seed=1, size=40).axes)
+    5
+    """
     panels = len(grains) + 1
     fig = Figure(figsize=(3.1 * panels, 3.9), layout="constrained")
     axes = fig.subplots(1, panels)
@@ -96,12 +182,41 @@ def plot_ground_noise_layers(ground_noise, seed, size=200, grains=(1, 5, 10, 20)
     return fig
 
 
-def plot_threshold(found, relative, fraction, chips_per_level: int, thresholds: bool = True):
+def plot_threshold(found: Mapping[str, Mapping[str, Any]], relative: float, fraction: float, chips_per_level: int,
+                   thresholds: bool = True) -> Figure:
     """Fraction of estimates within +-``relative`` of the truth against SNR,
     per method, with its 95 % binomial (Wilson) interval for
     ``chips_per_level`` chips at each SNR, and the ``fraction`` criterion;
     each method's threshold in the legend unless ``thresholds`` is false (a
-    quick run: too few chips per level for one, as its report says)."""
+    quick run: too few chips per level for one, as its report says).
+
+    Parameters
+    ----------
+    found : mapping
+        Per method: ``fractions`` (SNR -> fraction of estimates within the
+        criterion) and ``threshold`` (the SNR from which they stay above
+        ``fraction``; NaN for none).
+    relative : float
+        The criterion's half-width, a fraction of the true MTF at Nyquist.
+    fraction : float
+        The fraction of estimates the criterion asks for.
+    chips_per_level : int
+        Chips measured at each SNR.
+    thresholds : bool, optional
+        Write each method's threshold in the legend (default True).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The fractions against SNR.
+
+    Examples
+    --------
+    >>> from imgmtf.plot import plot_threshold
+    >>> found = {"msg": {"fractions": {10.0: 0.2, 100.0: 0.9, 1000.0: 1.0}, "threshold": 100.0}}
+    >>> plot_threshold(found, 0.05, 0.9, 20).axes[0].get_legend_handles_labels()[1]
+    ['msg: threshold SNR 100', 'criterion: 90 %']
+    """
     fig, ax = figure_axes(None, (7, 5.2))
     z = 1.96
     for i, (method, info) in enumerate(found.items()):

@@ -1,8 +1,15 @@
 """The overview figure of a scene scan: every candidate coloured by its verdict."""
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
+
+if TYPE_CHECKING:
+    from ..records import Record
 
 _DIRECTION_SHORT = {"across-track": "across", "along-track": "along", "oblique": "oblique", "unknown": ""}
 
@@ -16,38 +23,46 @@ PALETTE = ("#ff7f0e", "#e0202a", "#b07cff", "#ffd92f", "#ff5ec4", "#17d4e8", "#c
 ACCEPTED = "#00ff00"
 
 
-def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=None, ax=None,
-              width_in: float = 10.0):
+def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Mapping[str, Any]],
+              summaries: Iterable[Record | Mapping[str, Any]] = (), levels: tuple[float, float] | None = None,
+              ax: Axes | None = None, width_in: float = 10.0) -> Figure | SubFigure:
     """The overview of a scan: the scene with every candidate drawn, coloured
     by its verdict and labelled with its id, as the table and the CSV list
     them.
 
     Parameters
     ----------
-    overview : 2-D array, the scene decimated by ``scale`` scene px per
-        overview px (DN).
-    scale : scene pixels per overview pixel.
-    records : the candidates' records (:class:`imgmtf.Record`, as
+    overview : numpy.ndarray, shape (rows, cols)
+        The scene decimated by ``scale`` scene px per overview px (DN).
+    scale : float
+        Scene pixels per overview pixel.
+    records : iterable of Record or mapping
+        The candidates' records (:class:`imgmtf.Record`, as
         :func:`imgmtf.scan_scene` returns them, or their ``to_dict()``):
         accepted ones are drawn as their tilted ROI (``roi_polygon_px``)
         and segment in green, above the rest; rejected ones as a line
         coloured by reason, outlined in black so that it reads on any
         background.  Each accepted candidate carries its id, and so do the
         rejected ones of a reason with at most ``MAX_LISTED`` candidates.
-    summaries : the per-target summaries (``scope`` "target", records or
+    summaries : iterable of Record or mapping, optional
+        The per-target summaries (``scope`` "target", records or
         dicts, as :func:`imgmtf.summarise_scan` returns them): each
         target is labelled at its centre with, per direction, MTF at
         Nyquist and MTF50 (cy/px).
-    levels : (black, white) DN of the display; default the 0.5 and 99.5
+    levels : (float, float), optional
+        (black, white) DN of the display; default the 0.5 and 99.5
         percentiles.
-    ax : an axes to draw on; a new figure, sized to the scene's aspect
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on; a new figure, sized to the scene's aspect
         with no blank margins, when None.
-    width_in : the new figure's width (inches), the legend's column to the
-        right of the image included.
+    width_in : float, optional
+        The new figure's width (inches), the legend's column to the right
+        of the image included (default 10).
 
     Returns
     -------
-    matplotlib.figure.Figure
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding the axes.
 
     Notes
     -----
@@ -68,10 +83,12 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     from matplotlib.lines import Line2D
 
     from ..records import Record
-    records = [r.to_dict() if isinstance(r, Record) else r for r in records]     # scan_scene's own output
-    summaries = [r.to_dict() if isinstance(r, Record) else r for r in summaries]
+    candidates: list[Mapping[str, Any]] = [r.to_dict() if isinstance(r, Record) else r
+                                           for r in records]     # scan_scene's own output
+    summary_rows: list[Mapping[str, Any]] = [r.to_dict() if isinstance(r, Record) else r for r in summaries]
     height, width = overview.shape
     extent_w, extent_h = width * scale, height * scale
+    fig: Figure | SubFigure
     if ax is None:
         margins = (0.7, 2.6, 0.55, 0.45)            # left, right (the legend), bottom, top (in)
         image_w = width_in - margins[0] - margins[1]
@@ -89,8 +106,8 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
     ax.tick_params(labelsize=7)
     ax.set_xlabel("column (px)", fontsize=7)
     ax.set_ylabel("row (px)", fontsize=7)
-    accepted = [r for r in records if r.get("status") == "accepted"]
-    rejected = [r for r in records if r.get("status") != "accepted"]
+    accepted = [r for r in candidates if r.get("status") == "accepted"]
+    rejected = [r for r in candidates if r.get("status") != "accepted"]
     outline = [patheffects.Stroke(linewidth=3.2, foreground="black"), patheffects.Normal()]
     labels = _Labels(ax, extent_w)
     handles = []
@@ -120,7 +137,7 @@ def plot_scan(overview: np.ndarray, scale: float, records, summaries=(), levels=
                                  label=_legend_label("accepted", accepted)))
         for r in accepted:          # each accepted half-edge's id, as in the table and the CSV
             labels.add(r, (0.85, 1.0, 0.85, 0.95), "#004d00", zorder=7, weight="bold")
-    targets = [s for s in summaries if s.get("scope") == "target"]
+    targets = [s for s in summary_rows if s.get("scope") == "target"]
     for target_id in sorted({s["target_id"] for s in targets}):
         rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
         lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"
@@ -191,7 +208,7 @@ class _Labels:
                      bbox={"boxstyle": "round,pad=0.15", "fc": face, "ec": "black", "lw": 0.4})
 
 
-def _label(summary: dict) -> str:
+def _label(summary: Mapping[str, Any]) -> str:
     """A summary's line in its target's label: a combined direction and its
     normal, or the sensor model's fit across or along track (and whether it
     fits)."""

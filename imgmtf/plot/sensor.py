@@ -1,21 +1,54 @@
 """Figures of the sensor model: its PSF, LSFs and every stage's MTF."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure, SubFigure
 
 from ..estimate.spectrum import NYQUIST
 from ._common import expect, figure_axes
 
+if TYPE_CHECKING:
+    from ..sensor.model import Sensor
 
-def _view_radius_m(sensor) -> float:
+
+def _view_radius_m(sensor: Sensor) -> float:
     """Half-width (m) of the view that shows the PSF's core and shoulders."""
     return 1.5 * max(sensor.fwhm_m("across"), sensor.fwhm_m("along"), sensor.gsd_m)
 
 
-def plot_psf(sensor, ax=None, oversampling: int = 20):
+def plot_psf(sensor: Sensor, ax: Axes | None = None, oversampling: int = 20) -> Figure | SubFigure:
     """The system PSF image (paper Fig. 2a), axes in metres, its core and
-    shoulders shown in a square of 3 FWHM."""
+    shoulders shown in a square of 3 FWHM.
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor model.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+    oversampling : int, optional
+        PSF samples per GSD in each axis (default 20).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``sensor`` is not a Sensor.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.plot import plot_psf
+    >>> plot_psf(Sensor()).axes[0].get_xlabel()
+    'across track x (m)'
+    """
     expect(sensor, "sensor")
     fig, ax = figure_axes(ax)
     psf = sensor.psf(oversampling)
@@ -29,8 +62,33 @@ def plot_psf(sensor, ax=None, oversampling: int = 20):
     return fig
 
 
-def plot_sensor_lsf(sensor, ax=None):
-    """Across- and along-track LSFs with their FWHM (paper Fig. 2b, c)."""
+def plot_sensor_lsf(sensor: Sensor, ax: Axes | None = None) -> Figure | SubFigure:
+    """Across- and along-track LSFs with their FWHM (paper Fig. 2b, c).
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor model.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``sensor`` is not a Sensor.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.plot import plot_sensor_lsf
+    >>> plot_sensor_lsf(Sensor()).axes[0].get_legend_handles_labels()[1]
+    ['across track, FWHM 1.240 m', 'along track, FWHM 1.251 m']
+    """
     expect(sensor, "sensor")
     fig, ax = figure_axes(ax)
     for direction in ("across", "along"):
@@ -44,9 +102,36 @@ def plot_sensor_lsf(sensor, ax=None):
     return fig
 
 
-def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
+def plot_sensor_mtf(sensor: Sensor, ax: Axes | None = None, direction: str | None = None) -> Figure | SubFigure:
     """The system MTF with its value at Nyquist (paper Fig. 3): across and
-    along track, or in one ``direction`` with each stage's MTF beside it."""
+    along track, or in one ``direction`` with each stage's MTF beside it.
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor model.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+    direction : {"across", "along"}, optional
+        One axis, with each stage's MTF; default both axes, the system's only.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``sensor`` is not a Sensor.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.plot import plot_sensor_mtf
+    >>> plot_sensor_mtf(Sensor(), direction="across").axes[0].get_legend_handles_labels()[1]
+    ['optics: 0.4721', 'detector: 0.6366', 'motion: 1.0000', 'electronics: 0.8869', 'system: 0.2665']
+    """
     expect(sensor, "sensor")
     fig, ax = figure_axes(ax)
     f = np.linspace(0, 1.0, 401)
@@ -67,9 +152,33 @@ def plot_sensor_mtf(sensor, ax=None, direction: str | None = None):
     return fig
 
 
-def plot_sensor(sensor):
+def plot_sensor(sensor: Sensor) -> Figure:
     """PSF, LSFs, and each stage's MTF beside the system's across and along
-    track (the paper's Figs. 2-3)."""
+    track (the paper's Figs. 2-3).
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor model.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Four panels: :func:`plot_psf`, :func:`plot_sensor_lsf` and
+        :func:`plot_sensor_mtf` across and along track.
+
+    Raises
+    ------
+    ParameterError
+        ``sensor`` is not a Sensor.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> from imgmtf.plot import plot_sensor
+    >>> len(plot_sensor(Sensor()).axes)          # four panels and the PSF's colour bar
+    5
+    """
     expect(sensor, "sensor")
     fig = Figure(figsize=(17, 4.4), layout="constrained")
     axes = fig.subplots(1, 4)
