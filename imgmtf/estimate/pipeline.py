@@ -137,18 +137,35 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
 
     Parameters
     ----------
-    roi : (x, y, width, height) crop, px, or None.
-    mask : boolean array of the image's shape, True for the pixels that
-        belong to the chip (a tilted ROI, a target cut out of its fill);
-        None for all.
-    gsd_m : ground sample distance (m) or None.
-    saturation : (low, high) DN the sensor records, or None for an
-        integer image's type range (floats: none declared).
-    dtype : the type the values were stored as when ``image`` is a float
-        copy (a file's samples), for quantisation and integer limits.
-    track_azimuth_deg : direction of the ground track in the image,
-        degrees clockwise from the image's up direction (0: rows along
-        track, as in L0/L1 products); None when unknown (map-projected).
+    kind : TargetKind
+        What the target brings (:class:`imgmtf.estimate.edge.EdgeKind`,
+        :class:`imgmtf.estimate.pulse.PulseKind`).
+    image : array_like
+        2-D image, DN.
+    settings : Settings
+        The estimator's settings (:func:`make_settings`).
+    roi : (int, int, int, int), optional
+        (x, y, width, height) crop, px.
+    mask : numpy.ndarray of bool, optional
+        Of the image's shape, True for the pixels that belong to the chip
+        (a tilted ROI, a target cut out of its fill); None for all.
+    gsd_m : float, optional
+        Ground sample distance (m).
+    saturation : (float, float), optional
+        (low, high) DN the sensor records, or None for an integer image's
+        type range (floats: none declared).
+    dtype : numpy dtype, optional
+        The type the values were stored as when ``image`` is a float copy
+        (a file's samples), for quantisation and integer limits.
+    track_azimuth_deg : float or None, optional
+        Direction of the ground track in the image, degrees clockwise from
+        the image's up direction (0: rows along track, as in L0/L1
+        products); None when unknown (map-projected).
+
+    Returns
+    -------
+    Measurement
+        The figures and arrays the kind turns into its result.
 
     Raises
     ------

@@ -3,7 +3,10 @@ or held by the likelihood ratio."""
 from __future__ import annotations
 
 import importlib
+import os
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,12 +19,17 @@ from .model import Model, hold_keys, initial_stages, listed, parameter_covarianc
 from .report import fit_report
 from .results import SensorFit
 
+if TYPE_CHECKING:
+    from ..edge import EdgeResult
+
 #: a parameter stays free only if holding it costs this much chi-square
 #: (in units of the reduced chi-square): p = 0.001 for one degree of freedom
 LIKELIHOOD_RATIO = 10.8
 
 
-def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_m: float | None = None,
+def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
+               stages: str | Sequence[str] | None = None, start: Sensor | None = None,
+               hold: str | Sequence[str] = (), gsd_m: float | None = None,
                band: int | None = None, roi: tuple[int, int, int, int] | None = None,
                confidence: float = 0.95) -> SensorFit:
     """Fit a sensor's stages to the profiles of one or more edges.
@@ -38,7 +46,7 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     start : Sensor, optional
         Starting (and held) values of the stages it has; other stages
         start from their defaults scaled to the GSD.
-    hold : sequence of str
+    hold : str or sequence of str, optional
         Parameters held at their starting values: "stage" or "stage.name".
     gsd_m : float, optional
         Ground sample distance (m); default the first file's, else 1
@@ -49,12 +57,15 @@ def fit_sensor(edges, *, stages=None, start: Sensor | None = None, hold=(), gsd_
     roi : (int, int, int, int), optional
         (x, y, width, height) window, px, taken from every file or array
         (only it is read from a file); not for EdgeResults.
-    confidence : float
-        Of the intervals, in (0, 1).
+    confidence : float, optional
+        Of the intervals, in (0, 1) (default 0.95).
 
     Returns
     -------
     SensorFit
+        The fitted sensor, each parameter with its standard error, the
+        model's MTF across and along track with intervals, and each edge's
+        measured and modelled MTF.
 
     Raises
     ------

@@ -4,6 +4,7 @@ model's MTF with its delta-method band."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from statistics import NormalDist
 
 import numpy as np
@@ -57,14 +58,19 @@ def initial_stages(names: list[str], start: Sensor | None, gsd: float) -> list[S
     return out
 
 
-def check_names(stages=None, hold=(), start: Sensor | None = None) -> list[str]:
+def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[str] = (),
+                start: Sensor | None = None) -> list[str]:
     """The stages a fit frees, and the parameters it holds, checked before
     any data are read (the CLI's --stages and --hold: a usage error).
 
     Parameters
     ----------
-    stages, hold, start
-        As :func:`fit_sensor` takes them.
+    stages : str or sequence of str, optional
+        Stage names to fit, as :func:`imgmtf.fit_sensor` takes them.
+    hold : str or sequence of str, optional
+        Parameters held: "stage" or "stage.name".
+    start : Sensor, optional
+        The starting sensor, whose stages are fitted when ``stages`` is None.
 
     Returns
     -------

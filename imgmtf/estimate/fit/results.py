@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...sensor.model import Sensor
 from .model import Model, model_mtf_band
@@ -65,20 +66,34 @@ class EdgeFit:
     constrains : str
         "across" (|angle| < 45 deg) or "along": the image axis whose
         parameters the edge mostly constrains.
+    gsd_m : float
+        The edge's pixel, m (1 when unknown: parameters then in pixels).
+    rows_used : int
+        The rows of the edge measured.
+    snr : float
+        Its contrast over its noise.
     mtf_nyquist, mtf_nyquist_ci : float, (float, float)
         The fitted model's MTF at 0.5 cy/px along the normal, and its interval.
     mtf50_cy_px : float
         The model's MTF50 along the normal, cycles per pixel.
     measured_mtf_nyquist : float
         The non-parametric estimate of the same edge, for comparison.
-    noise_dn, step_dn, levels_dn, offset_px :
-        Noise (measured without the model), fitted step R - L, levels (L, R)
-        and sub-pixel offset of the edge.
+    noise_dn, step_dn : float
+        Noise (measured without the model) and fitted step R - L, DN.
+    levels_dn : (float, float)
+        The fitted levels (L, R), DN.
+    offset_px : float
+        The edge's fitted sub-pixel offset, px.
     reduced_chi_square : float
         Of this edge's residuals against its noise.
     misfit_p, misfit_fraction : float
         P-value of the residuals binned along the normal (small: structure),
         and the size of that structure, RMS as a fraction of the step.
+    samples_x_px, residuals_dn : numpy.ndarray
+        Each profile sample's distance to the edge (px) and its residual
+        against the model (DN).
+    measurement : EdgeResult
+        The non-parametric measurement of the edge.
     """
 
     source: str
@@ -174,10 +189,26 @@ class SensorFit:
         return any(e.misfit_p < MISFIT_P and e.misfit_fraction > MISFIT_FRACTION for e in self.edges) or any(
             p.note == "at the bound of its range" for p in self.parameters)
 
-    def mtf_band(self, f_cy_px, angle_deg: float, gsd_m: float | None = None):
+    def mtf_band(self, f_cy_px: ArrayLike, angle_deg: float,
+                 gsd_m: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The model's MTF along the normal of an edge tilted ``angle_deg``,
         at ``f_cy_px`` cycles per pixel of ``gsd_m`` (default the sensor's),
-        with its lower and upper confidence bounds: ``(mtf, low, high)``."""
+        with its lower and upper confidence bounds: ``(mtf, low, high)``.
+
+        Parameters
+        ----------
+        f_cy_px : array_like
+            Frequencies along the normal, cy/px.
+        angle_deg : float
+            The edge's tilt from the column axis, deg.
+        gsd_m : float, optional
+            The pixel, m (default the fitted sensor's).
+
+        Returns
+        -------
+        mtf, low, high : numpy.ndarray
+            The model's MTF and the ends of its interval at each frequency.
+        """
         gsd = self.sensor.gsd_m if gsd_m is None else gsd_m
         return model_mtf_band(self._model, self._u, self._covariance, np.asarray(f_cy_px, float),
                          angle_deg, gsd, self.confidence)
