@@ -40,47 +40,6 @@ SECTIONS_AND_TYPES = {
 #: EX01: a section to write) is asked of the public API only
 WRITTEN_RIGHT = {"GL06", "GL07", "PR02", "PR03", "PR04", "PR07", "PR08", "PR10", "RT03"}
 
-#: names whose docstrings do not pass yet: shrink these, never grow them
-KNOWN_FAILING_API = {
-    "ConfigError", "FileWriteError", "ImageContentError", "ImageReadError", "ImgmtfError", "Interval",
-    "MeasureSettings", "MultipleTargetsError", "ParameterError", "Raster", "Record", "ScanSettings",
-    "TargetNotFoundError", "UnsuitableTargetError", "fit_sensor", "luminance", "measure_file",
-    "plot.plot_estimates", "plot.plot_fit", "plot.plot_fit_edge", "plot.plot_fit_residuals",
-    "plot.plot_ground_noise_layers", "plot.plot_locations", "plot.plot_lsf", "plot.plot_measurement",
-    "plot.plot_mtf", "plot.plot_noise_sweep", "plot.plot_profile", "plot.plot_psf", "plot.plot_scan",
-    "plot.plot_sensor", "plot.plot_sensor_lsf", "plot.plot_sensor_mtf", "plot.plot_threshold", "read_raster",
-    "scan_scene", "write_geotiff", "write_png",
-}
-KNOWN_FAILING = {
-    "imgmtf.estimate.fit.fitting.fit_sensor", "imgmtf.estimate.fit.model.check_names",
-    "imgmtf.estimate.fit.results.EdgeFit", "imgmtf.estimate.intervals.bootstrap_figures",
-    "imgmtf.estimate.pipeline.run", "imgmtf.inputs.as_array", "imgmtf.inputs.check_width",
-    "imgmtf.inputs.luminance", "imgmtf.io.Raster", "imgmtf.io.read_raster", "imgmtf.io.write_geotiff",
-    "imgmtf.io.write_png", "imgmtf.plot.scan.plot_scan", "imgmtf.records.CsvWriter", "imgmtf.records.Record",
-    "imgmtf.scene.measure.scan_scene", "imgmtf.scene.settings.ScanSettings",
-}
-#: public classes' methods whose parameters are not documented yet: shrink this too
-KNOWN_UNDOCUMENTED_METHODS = {
-    "imgmtf.batch.MeasureSettings.failed", "imgmtf.estimate.fit.results.SensorFit.mtf_band",
-    "imgmtf.records.Record.csv_row", "imgmtf.records.Record.failed", "imgmtf.records.Record.get",
-    "imgmtf.records.Record.measured", "imgmtf.records.Record.with_",
-}
-#: public functions and methods still without full type hints: shrink this too
-KNOWN_UNANNOTATED = {
-    "imgmtf.batch.MeasureSettings.estimator", "imgmtf.batch.MeasureSettings.failed",
-    "imgmtf.batch.measure_file", "imgmtf.estimate.fit.fitting.fit_sensor",
-    "imgmtf.estimate.fit.results.SensorFit.mtf_band", "imgmtf.inputs.luminance", "imgmtf.io.read_raster",
-    "imgmtf.plot.fit.plot_fit", "imgmtf.plot.fit.plot_fit_edge", "imgmtf.plot.fit.plot_fit_residuals",
-    "imgmtf.plot.measurement.plot_locations", "imgmtf.plot.measurement.plot_lsf",
-    "imgmtf.plot.measurement.plot_measurement", "imgmtf.plot.measurement.plot_mtf",
-    "imgmtf.plot.measurement.plot_profile", "imgmtf.plot.paper.plot_estimates",
-    "imgmtf.plot.paper.plot_ground_noise_layers", "imgmtf.plot.paper.plot_noise_sweep",
-    "imgmtf.plot.paper.plot_threshold", "imgmtf.plot.scan.plot_scan", "imgmtf.plot.sensor.plot_psf",
-    "imgmtf.plot.sensor.plot_sensor", "imgmtf.plot.sensor.plot_sensor_lsf",
-    "imgmtf.plot.sensor.plot_sensor_mtf", "imgmtf.records.Record.csv_row", "imgmtf.records.Record.get",
-    "imgmtf.records.Record.with_",
-}
-
 #: the functions and classes of the public API (not its constants: METHODS,
 #: __version__), and the figures (imgmtf.plot)
 API = sorted([name for name in imgmtf.__all__ if inspect.isfunction(getattr(imgmtf, name))
@@ -169,17 +128,12 @@ def public(name: str):
 def test_the_public_api_documents_its_parameters_returns_and_examples(name):
     full = qualified(public(name))
     found = problems(full, SECTIONS_AND_TYPES)
-    if name in KNOWN_FAILING_API:
-        assert found, f"{name} passes now: take it out of KNOWN_FAILING_API"
-        pytest.xfail(f"{name}: {len(found)} docstring problems left")
     assert not found, f"{full}:\n" + "\n".join(found)
 
 
 def test_every_docstring_with_sections_writes_them_as_numpydoc_reads_them():
     found = {name: problems(name, WRITTEN_RIGHT) for name in package_members()}
-    passing = sorted(name for name in KNOWN_FAILING if not found.get(name))
-    assert not passing, f"these pass now: take them out of KNOWN_FAILING: {passing}"
-    found = {name: errors for name, errors in found.items() if errors and name not in KNOWN_FAILING}
+    found = {name: errors for name, errors in found.items() if errors}
     assert not found, "\n".join(f"{name}:\n  " + "\n  ".join(errors) for name, errors in found.items())
 
 
@@ -197,9 +151,7 @@ def test_the_public_classes_methods_document_their_parameters():
                 continue
             method = f"{qualified(cls)}.{attribute}"
             found[method] = problems(method, WRITTEN_RIGHT | {"PR01"})
-    passing = sorted(name for name in KNOWN_UNDOCUMENTED_METHODS if not found.get(name))
-    assert not passing, f"these pass now: take them out of KNOWN_UNDOCUMENTED_METHODS: {passing}"
-    found = {name: errors for name, errors in found.items() if errors and name not in KNOWN_UNDOCUMENTED_METHODS}
+    found = {name: errors for name, errors in found.items() if errors}
     assert not found, "\n".join(f"{name}:\n  " + "\n  ".join(errors) for name, errors in found.items())
 
 
@@ -223,8 +175,6 @@ def test_the_public_api_and_every_stage_are_annotated():
             if inspect.isfunction(member) and (not attribute.startswith("_") or attribute in ("__init__", "__call__"))]
         for function in functions:
             missing = unannotated(function)
-            if missing and qualified(function) not in KNOWN_UNANNOTATED:
+            if missing:
                 found[qualified(function)] = missing
-    passing = sorted(name for name in KNOWN_UNANNOTATED if not unannotated(load(name)))
-    assert not passing, f"these are annotated now: take them out of KNOWN_UNANNOTATED: {passing}"
     assert not found, "\n".join(f"{name}: {', '.join(missing)}" for name, missing in found.items())
