@@ -23,7 +23,7 @@ def _odd_kernel(ctx, param, value):
     return value
 
 
-@click.command(short_help="Restore images to a target MTF with a filter designed from the fitted sensor.")
+@click.command(short_help="Restore images to a target MTF (MTF compensation).")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--sensor", "sensor_path", required=True, type=click.Path(dir_okay=False),
               help="the sensor to compensate: a TOML file (imgmtf fit --out)")
