@@ -224,8 +224,8 @@ def find_edge(image: np.ndarray, min_votes: int = 10, min_contrast: float = 3.0,
     """
     noise = robust_noise(image) if noise is None else noise
     scored = [(ln, step_contrast(image, ln)) for ln in find_lines(image) if ln.votes >= min_votes]
-    lines = [ln for ln, contrast in sorted(((ln, c) for ln, c in scored if c >= min_contrast * noise),
-                                           key=lambda lc: -lc[0].votes * lc[1])]
+    strong = [(ln, contrast) for ln, contrast in scored if contrast >= min_contrast * noise]
+    lines = [ln for ln, contrast in sorted(strong, key=lambda pair: -pair[0].votes * pair[1])]
     if not lines:
         raise TargetNotFoundError("no straight edge found: no line of strong contrast "
                                   "stands out of the noise")
