@@ -10,7 +10,7 @@ import re
 import pytest
 
 import imgmtf
-from imgmtf.cli.errors import OPTION_HINTS, refusal_hint
+from imgmtf.cli.hints import CHIP, HINTS, SCAN, option_hints, refusal_hint, rejection_hint
 
 PACKAGE = pathlib.Path(imgmtf.__file__).parent
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z-]+")
@@ -42,8 +42,30 @@ def test_no_library_message_names_a_command_line_option():
     ("too-large", "--roi"), ("bands", "--band"), ("bar-width", "--pulse-width"), ("fit", "--stages"),
 ])
 def test_the_cli_answers_a_reason_with_its_option(reason, option):
-    assert option in refusal_hint(reason, "a message") and option in OPTION_HINTS[reason]
+    answers = option_hints(CHIP, reason)
+    assert option in refusal_hint(reason, "a message") and len(answers) == 1 and option in answers[0]
 
 
 def test_a_reason_no_option_answers_gets_no_option():
     assert refusal_hint("unreadable", "cannot read") == ""
+
+
+@pytest.mark.parametrize("reason, message, option", [
+    ("too-short", "the line is 12 px long, shorter than the minimum 20 px", "--min-length"),
+    ("two-targets", "its ROI reaches another edge", "--margin"),
+    ("not-an-edge", "a bar, not an edge", "--target pulse"), ("not-a-bar", "a lone edge", "--target edge"),
+])
+def test_a_scan_answers_a_rejection_with_the_option_that_moves_its_limit(reason, message, option):
+    assert option in rejection_hint(reason, message) and "imgmtf scan" not in rejection_hint(reason, message)
+
+
+def test_a_scan_names_no_option_where_none_moves_the_limit():
+    # too few rows clear of the junctions shares its reason with a too-short line
+    assert rejection_hint("too-short", "too few rows clear of the junctions") == ""
+    assert rejection_hint("fill", "the ROI holds fill") == ""
+
+
+def test_every_hint_is_for_a_command_that_shows_it_and_names_an_option():
+    assert {h.command for h in HINTS} == {CHIP, SCAN}
+    assert all(FLAG.search(h.text) for h in HINTS)
+    assert len({(h.command, h.reason, h.words) for h in HINTS}) == len(HINTS)   # one answer per refusal

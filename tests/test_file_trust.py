@@ -111,7 +111,7 @@ def test_noise_is_no_block_grid():
 
 
 def test_refusals_a_scan_solves_point_to_it_and_others_do_not(tmp_path):
-    from imgmtf.cli.errors import refusal_hint
+    from imgmtf.cli.hints import refusal_hint
     assert "imgmtf scan a.tif" in refusal_hint("fill", "", "a.tif") and "--force" in refusal_hint("fill", "", "a.tif")
     assert "imgmtf scan" in refusal_hint("not-straight", "the edge bends: two straight pieces meet inside the chip")
     assert "imgmtf scan" not in refusal_hint("not-straight", "the per-row edge locations scatter")

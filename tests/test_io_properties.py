@@ -103,7 +103,7 @@ def test_huge_declared_image_is_refused_by_name_and_read_through_a_window(tmp_pa
     outcome = read_outcome(path)
     assert outcome.reason == "too-large"
     assert "200000 x 200000 px" in str(outcome) and "window" in str(outcome)
-    from imgmtf.cli.errors import refusal_hint
+    from imgmtf.cli.hints import refusal_hint
     assert "--roi" in refusal_hint(outcome.reason, str(outcome))         # the CLI names the option
     info = raster_info(path)
     assert (info.width, info.height) == (200_000, 200_000)

@@ -1,7 +1,8 @@
 """How the CLI reports: a malformed option (out of range, or contradicting
 another) as exit 2, a deliberate imgmtf error as one line and exit 1,
 an interrupt as exit 130 or 143, an internal error as one line (its
-traceback with ``IMGMTF_DEBUG=1``); the hint it adds to a refusal."""
+traceback with ``IMGMTF_DEBUG=1``), a refusal with the hint
+:mod:`imgmtf.cli.hints` gives."""
 from __future__ import annotations
 
 import os
@@ -11,6 +12,7 @@ from contextlib import contextmanager
 import click
 
 from ..errors import ImgmtfError
+from .hints import refusal_hint
 
 
 @contextmanager
@@ -48,30 +50,6 @@ def option_errors():
         yield
     except ParameterError as exc:
         raise click.UsageError(one_line(exc)) from None
-
-
-# refusals a scan of the whole file resolves: it finds each edge and bar
-# and measures them one by one, away from fill and from each other
-SCAN_SOLVES = frozenset({"fill", "two-targets"})
-# the option that answers a refusal, by its reason code: the library's message
-# says what is wrong with the data, the command line what to do about it
-OPTION_HINTS = {"two-targets": "--roi X,Y,W,H crops it to one target", "not-an-edge": "--target pulse measures a bar",
-                "not-a-bar": "--target edge measures an edge", "too-large": "--roi X,Y,W,H measures a window",
-                "bands": "--band N chooses one, --band all measures each", "bar-width": "--pulse-width gives it",
-                "fit": "--stages fits fewer, --hold holds some", "no-signal": "--signal-std gives it"}
-
-
-def refusal_hint(reason, message: str = "", path: str | None = None) -> str:
-    """What the CLI adds to a refusal: the option that answers its reason,
-    ``imgmtf scan`` where the chip holds fill, several edges or a
-    checkerboard's corner, and the flag that overrules the gate."""
-    from ..estimate.gate import FORCIBLE
-    hints = [OPTION_HINTS[reason]] if reason in OPTION_HINTS else []
-    if reason in SCAN_SOLVES or (reason == "not-straight" and "meet inside the chip" in message):
-        hints.append(f"imgmtf scan {path or 'FILE'} finds and measures each edge in it")
-    if reason in FORCIBLE:
-        hints.append("--force measures it anyway")
-    return f" ({'; '.join(hints)})" if hints else ""
 
 
 def one_line(exc: BaseException) -> str:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from .errors import refusal_hint
+from .hints import refusal_hint, rejection_hint
 
 
 class TextRows:
@@ -197,12 +197,6 @@ def print_target_fits(fitted) -> None:
 
 SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
 
-#: what the CLI adds to a scan's rejection: the option that moves the limit (a
-#: too-short line, not too few rows clear of the junctions, which no option moves)
-SCAN_REASON_HINTS = {("too-short", "shorter than the minimum"): "--min-length sets the minimum",
-                     ("two-targets", ""): "--margin sets the ROI's reach",
-                     ("not-an-edge", ""): "--target pulse measures bars",
-                     ("not-a-bar", ""): "--target edge measures edges"}
 MAX_EXAMPLE_IDS = 5
 
 
@@ -225,9 +219,7 @@ def _rejection(row: dict) -> str:
     """A rejected candidate's message without the scene's name (the table's
     heading names it), with the option that moves its limit."""
     message = row["error"].removeprefix(row["path"] + ": ")
-    hint = next((h for (reason, words), h in SCAN_REASON_HINTS.items() if row["reason"] == reason and words in message),
-                None)
-    return message + (f" ({hint})" if hint else "")
+    return message + rejection_hint(row["reason"], message)
 
 
 def plural(count: int, noun: str) -> str:
