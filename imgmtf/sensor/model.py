@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike
 from ..errors import ConfigError, FileWriteError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing, fwhm
+from .lines import LineResponse, reference_transfer
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 
 DIRECTIONS = ("across", "along")
@@ -284,7 +285,7 @@ class Sensor:
                 f"the sensor's blur spans {half:.3g} px of {gsd:g} m: its line response would need "
                 f"{n:.3g} samples (over {MAX_LINE_SAMPLES}); check the stage parameters against the GSD")
         f = np.fft.rfftfreq(n, d=step_px)
-        remainder = self.normal_transfer(f, angle_deg, gsd) - _reference_transfer(reference, f)
+        remainder = self.normal_transfer(f, angle_deg, gsd) - reference_transfer(reference, f)
         lsf = np.fft.fftshift(np.fft.irfft(remainder, n)) / step_px
         with np.errstate(divide="ignore", invalid="ignore"):
             integral = np.where(f > 0, remainder / (2j * np.pi * np.where(f > 0, f, 1.0)), 0.0)
@@ -558,49 +559,6 @@ def check_gsd(name: str, gsd_m: object) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class LineResponse:
-    """Edge (ESF) and line (LSF) spread functions along one normal, in
-    pixels: a closed-form reference (a Cauchy LSF b / pi (b^2 + x^2) for a
-    sensor with diffraction, else a Gaussian of about the LSF's width) plus
-    a remainder sampled every ``step_px`` from ``start_px``, zero beyond its
-    grid.  The ESF rises from 0 to 1; both are exact to about 1e-7."""
-
-    start_px: float
-    step_px: float
-    esf_remainder: np.ndarray
-    lsf_remainder: np.ndarray
-    reference: tuple[str, float]
-
-    def esf(self, d_px: ArrayLike) -> np.ndarray:
-        """Edge response at signed distances ``d_px`` (cubic Hermite between
-        grid samples, whose slopes are the LSF)."""
-        d = np.asarray(d_px, float)
-        t = (d - self.start_px) / self.step_px
-        n = self.esf_remainder.size
-        k = np.clip(np.floor(t).astype(np.intp), 0, n - 2)
-        u = np.clip(t - k, 0.0, 1.0)
-        y, s, h = self.esf_remainder, self.lsf_remainder, self.step_px
-        value = ((1 + 2 * u) * (1 - u) ** 2 * y[k] + u * (1 - u) ** 2 * h * s[k]
-                 + u * u * (3 - 2 * u) * y[k + 1] + u * u * (u - 1) * h * s[k + 1])
-        value = np.where((t < 0) | (t > n - 1), 0.0, value)
-        kind, width = self.reference
-        if kind == "cauchy":
-            return value + 0.5 + np.arctan(d / width) / np.pi
-        from scipy.special import ndtr
-        return value + ndtr(d / width)
-
-    def lsf(self, d_px: ArrayLike) -> np.ndarray:
-        """Line spread function (1/px) at signed distances ``d_px``."""
-        d = np.asarray(d_px, float)
-        grid = self.start_px + self.step_px * np.arange(self.lsf_remainder.size)
-        value = np.interp(d, grid, self.lsf_remainder, left=0.0, right=0.0)
-        kind, width = self.reference
-        if kind == "cauchy":
-            return value + width / (np.pi * (width**2 + d**2))
-        return value + np.exp(-0.5 * (d / width) ** 2) / (width * math.sqrt(2 * math.pi))
-
-
-@dataclass(frozen=True, eq=False)
 class SampledPSF:
     """A PSF on a square grid (what :meth:`Sensor.psf` returns).
 
@@ -649,13 +607,6 @@ def _paper_stages(keywords: dict) -> list[Stage]:
         default = {f.name: f.default for f in fields(cls)}[name]
         values.setdefault(cls, {})[name] = check_number(f"sensor parameter {key}", keywords.get(key, default))
     return [cls(**params) for cls, params in values.items() if any(params.values())]
-
-
-def _reference_transfer(reference: tuple[str, float], f: np.ndarray) -> np.ndarray:
-    kind, width = reference
-    if kind == "cauchy":
-        return np.exp(-2 * np.pi * width * f)
-    return np.exp(-2 * np.pi**2 * width**2 * f**2)
 
 
 def _toml_number(value: float) -> str:
