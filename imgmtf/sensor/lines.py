@@ -1,13 +1,22 @@
 """A line response: the edge and line spread functions along one normal,
 a closed-form reference plus a remainder sampled on a fine grid (what
-:meth:`imgmtf.sensor.model.Sensor.line_response` returns)."""
+:meth:`imgmtf.sensor.model.Sensor.line_response` returns), and that grid
+(:class:`LineGrid`), on which the remainders of many transfers are made
+in one inverse FFT."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from ..errors import ParameterError
+
+#: largest 1-D line (samples) a sensor may ask for
+MAX_LINE_SAMPLES = 1 << 23
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,14 +37,7 @@ class LineResponse:
         """Edge response at signed distances ``d_px`` (cubic Hermite between
         grid samples, whose slopes are the LSF)."""
         d = np.asarray(d_px, float)
-        t = (d - self.start_px) / self.step_px
-        n = self.esf_remainder.size
-        k = np.clip(np.floor(t).astype(np.intp), 0, n - 2)
-        u = np.clip(t - k, 0.0, 1.0)
-        y, s, h = self.esf_remainder, self.lsf_remainder, self.step_px
-        value = ((1 + 2 * u) * (1 - u) ** 2 * y[k] + u * (1 - u) ** 2 * h * s[k]
-                 + u * u * (3 - 2 * u) * y[k + 1] + u * u * (u - 1) * h * s[k + 1])
-        value = np.where((t < 0) | (t > n - 1), 0.0, value)
+        value = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d)
         kind, width = self.reference
         if kind == "cauchy":
             return value + 0.5 + np.arctan(d / width) / np.pi
@@ -61,3 +63,178 @@ def reference_transfer(reference: tuple[str, float], f: np.ndarray) -> np.ndarra
     if kind == "cauchy":
         return np.exp(-2 * np.pi * width * f)
     return np.exp(-2 * np.pi**2 * width**2 * f**2)
+
+
+@dataclass(frozen=True, eq=False)
+class LineGrid:
+    """The fine grid of a line response (what
+    :meth:`imgmtf.sensor.model.Sensor.line_grid` sizes): ``size`` samples
+    every ``step_px`` px, centred on the edge, and the closed-form
+    ``reference`` whose transfer is taken out of the sensor's before the
+    inverse FFT.
+
+    Examples
+    --------
+    >>> grid = LineGrid(0.25, 8, ("gaussian", 1.0))
+    >>> grid.start_px, grid.frequencies_cy_px.tolist()
+    (-1.0, [0.0, 0.5, 1.0, 1.5, 2.0])
+    """
+
+    step_px: float
+    size: int
+    reference: tuple[str, float]
+
+    @property
+    def start_px(self) -> float:
+        """The first sample's signed distance from the edge, px."""
+        return -(self.size // 2) * self.step_px
+
+    @cached_property
+    def frequencies_cy_px(self) -> np.ndarray:
+        """The grid's non-negative DFT frequencies, cy/px (``size // 2 + 1``)."""
+        return np.fft.rfftfreq(self.size, d=self.step_px)
+
+    def response(self, transfer: np.ndarray) -> LineResponse:
+        """The line response of a sensor whose transfer along the normal at
+        :attr:`frequencies_cy_px` is ``transfer``.
+
+        Parameters
+        ----------
+        transfer : numpy.ndarray
+            The transfer (1 at zero), one value per frequency.
+
+        Returns
+        -------
+        LineResponse
+            Its edge and line spread functions.
+        """
+        esf, lsf = self.remainders(transfer - reference_transfer(self.reference, self.frequencies_cy_px))
+        return LineResponse(self.start_px, self.step_px, esf, lsf, self.reference)
+
+    def remainders(self, spectra: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The ESF and LSF (1/px) on the grid of the spectra ``spectra``
+        (each row's zero-frequency value 0), all in one inverse FFT; each
+        ESF starts from 0 at the grid's first sample.
+
+        Parameters
+        ----------
+        spectra : numpy.ndarray, shape (..., size // 2 + 1)
+            Transfers (or their differences) at :attr:`frequencies_cy_px`.
+
+        Returns
+        -------
+        esf, lsf : numpy.ndarray, shape (..., size)
+            Their edge and line spread functions on the grid.
+        """
+        f, n = self.frequencies_cy_px, self.size
+        lsf = np.fft.fftshift(np.fft.irfft(spectra, n), axes=-1) / self.step_px
+        with np.errstate(divide="ignore", invalid="ignore"):
+            integral = np.where(f > 0, spectra / (2j * np.pi * np.where(f > 0, f, 1.0)), 0.0)
+        esf = np.fft.fftshift(np.fft.irfft(integral, n), axes=-1) / self.step_px
+        return esf - esf[..., :1], lsf
+
+
+def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
+            d_px: np.ndarray) -> np.ndarray:
+    """Cubic Hermite interpolation of gridded ``values`` with their
+    ``slopes`` (per px) at ``d_px``; zero beyond the grid.
+
+    Parameters
+    ----------
+    start_px, step_px : float
+        The grid's first sample and step, px.
+    values, slopes : numpy.ndarray, shape (..., n)
+        Samples on the grid, and their derivatives, one row per function.
+    d_px : numpy.ndarray
+        Where to interpolate, px.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., len(d_px))
+        Each row's values at ``d_px`` (the shared weights computed once).
+
+    Examples
+    --------
+    >>> grid = np.arange(5.0)
+    >>> hermite(0.0, 1.0, grid**2, 2 * grid, np.array([1.5, 9.0])).tolist()   # exact for a cubic
+    [2.25, 0.0]
+    """
+    d = np.asarray(d_px, float)
+    t = ((d - start_px) / step_px).ravel()
+    n = values.shape[-1]
+    inside = np.flatnonzero((t >= 0) & (t <= n - 1))      # beyond the grid: zero, nothing to compute
+    k = np.minimum(t[inside].astype(np.intp), n - 2)
+    u = t[inside] - k
+    h = step_px
+    out = np.zeros(values.shape[:-1] + t.shape)
+    out[..., inside] = ((1 + 2 * u) * (1 - u) ** 2 * values[..., k] + u * (1 - u) ** 2 * h * slopes[..., k]
+                        + u * u * (3 - 2 * u) * values[..., k + 1] + u * u * (u - 1) * h * slopes[..., k + 1])
+    return out.reshape(values.shape[:-1] + d.shape)
+
+
+class _Blur(Protocol):
+    """What :func:`line_grid` reads of a sensor."""
+
+    def tail_length_m(self) -> float: ...
+
+    def support_radius_m(self) -> float: ...
+
+    def normal_transfer(self, f_cy_px: ArrayLike, angle_deg: float, gsd_m: float | None = None) -> np.ndarray: ...
+
+
+def line_grid(sensor: _Blur, angle_deg: float, gsd: float, *, reach_px: float = 0.0,
+              step_px: float = 1.0 / 64.0) -> LineGrid:
+    """The grid a sensor's line response along the normal of an edge tilted
+    ``angle_deg`` is sampled on: its step, its size (the PSF's support plus
+    ``reach_px`` on each side, rounded up to a power of two, at least 256)
+    and the closed-form reference that takes the LSF's tails.
+
+    Parameters
+    ----------
+    sensor : Sensor
+        The sensor (:class:`imgmtf.Sensor`).
+    angle_deg : float
+        The edge's tilt from the column axis, deg.
+    gsd : float
+        The pixel, m.
+    reach_px : float, optional
+        Distance from the edge, px, the grid must cover beyond the PSF's
+        support (default 0).
+    step_px : float, optional
+        The grid's step, px (default 1/64; finer where a Cauchy tail
+        needs it).
+
+    Returns
+    -------
+    LineGrid
+        The grid.
+
+    Raises
+    ------
+    ParameterError
+        When the grid would exceed ``MAX_LINE_SAMPLES``.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> grid = line_grid(Sensor(), 0.0, 1.0)
+    >>> grid.step_px, grid.size, grid.reference[0]
+    (0.015625, 2048, 'gaussian')
+    """
+    tail_px = sensor.tail_length_m() / gsd
+    if tail_px > 0:
+        # the Cauchy reference must have decayed (to 1e-9) at the grid's Nyquist
+        step_px = min(step_px, math.pi * tail_px / math.log(1e9))
+        reference = ("cauchy", tail_px)
+    else:
+        # any smooth reference of about the LSF's width keeps the remainder small
+        delta = 1e-3
+        variance = (1.0 - float(sensor.normal_transfer(delta, angle_deg, gsd))) / (2 * math.pi**2 * delta**2)
+        reference = ("gaussian", min(max(math.sqrt(max(variance, 0.0)), 0.1), 10.0))
+    half = reach_px + sensor.support_radius_m() / gsd + 8 * reference[1] + 4.0
+    n = 1 << max(int(math.ceil(math.log2(2 * half / step_px))), 8)
+    if n > MAX_LINE_SAMPLES:
+        raise ParameterError(
+            f"the sensor's blur spans {half:.3g} px of {gsd:g} m: its line response would need "
+            f"{n:.3g} samples (over {MAX_LINE_SAMPLES}); check the stage parameters against the GSD")
+    return LineGrid(step_px, n, reference)

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike
 from ..errors import ConfigError, FileWriteError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing, fwhm
-from .lines import LineResponse, reference_transfer
+from .lines import LineResponse, line_grid
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 
 DIRECTIONS = ("across", "along")
@@ -46,9 +46,8 @@ DIRECTIONS = ("across", "along")
 GSD_RANGE_M = (1e-12, 1e15)
 #: the paper's stages, what ``imgmtf fit`` fits by default
 PAPER_STAGES = ("optics", "detector", "motion", "electronics")
-#: largest 2-D grid (cells) and 1-D line (samples) a sensor may ask for
+#: largest 2-D grid (cells) a sensor may ask for (its 1-D lines: :data:`.lines.MAX_LINE_SAMPLES`)
 MAX_GRID_CELLS = 1 << 24
-MAX_LINE_SAMPLES = 1 << 23
 
 # keyword of the generic sensor -> (stage, parameter); a stage whose
 # parameters are all 0 is left out (cut-off 0 meant no electronics filter)
@@ -268,29 +267,8 @@ class Sensor:
             When the grid would exceed ``MAX_LINE_SAMPLES``.
         """
         gsd = self._gsd(gsd_m)
-        tail_px = self.tail_length_m() / gsd
-        if tail_px > 0:
-            # the Cauchy reference must have decayed (to 1e-9) at the grid's Nyquist
-            step_px = min(step_px, math.pi * tail_px / math.log(1e9))
-            reference = ("cauchy", tail_px)
-        else:
-            # any smooth reference of about the LSF's width keeps the remainder small
-            delta = 1e-3
-            variance = (1.0 - float(self.normal_transfer(delta, angle_deg, gsd))) / (2 * math.pi**2 * delta**2)
-            reference = ("gaussian", min(max(math.sqrt(max(variance, 0.0)), 0.1), 10.0))
-        half = reach_px + self.support_radius_m() / gsd + 8 * reference[1] + 4.0
-        n = 1 << max(int(math.ceil(math.log2(2 * half / step_px))), 8)
-        if n > MAX_LINE_SAMPLES:
-            raise ParameterError(
-                f"the sensor's blur spans {half:.3g} px of {gsd:g} m: its line response would need "
-                f"{n:.3g} samples (over {MAX_LINE_SAMPLES}); check the stage parameters against the GSD")
-        f = np.fft.rfftfreq(n, d=step_px)
-        remainder = self.normal_transfer(f, angle_deg, gsd) - reference_transfer(reference, f)
-        lsf = np.fft.fftshift(np.fft.irfft(remainder, n)) / step_px
-        with np.errstate(divide="ignore", invalid="ignore"):
-            integral = np.where(f > 0, remainder / (2j * np.pi * np.where(f > 0, f, 1.0)), 0.0)
-        esf = np.fft.fftshift(np.fft.irfft(integral, n)) / step_px
-        return LineResponse(-(n // 2) * step_px, step_px, esf - esf[0], lsf, reference)
+        grid = line_grid(self, angle_deg, gsd, reach_px=reach_px, step_px=step_px)
+        return grid.response(self.normal_transfer(grid.frequencies_cy_px, angle_deg, gsd))
 
     def normal_lsf(self, angle_deg: float, gsd_m: float | None = None,
                    samples_per_px: int = 400) -> tuple[np.ndarray, np.ndarray]:

@@ -120,7 +120,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         notes[model.free[worst]] = ("held", f"not determined by the data (within one standard error its blur "
                                             f"length spans {undetermined[worst]:.2g} px); "
                                             "held at its starting value")
-        z = model.hold(z, worst)
+        z = model.hold(z, worst, covariance)
     # hold, best-known first, each parameter the data do not need (holding it
     # at its starting value costs less than the likelihood-ratio threshold),
     # but keep one free parameter on each axis an edge sees
@@ -129,7 +129,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
             continue            # the last free parameter of an axis: its uncertainty belongs in the intervals
         index = model.free.index(key)
         trial = model.copy()
-        z_held = trial.hold(z, index)
+        z_held = trial.hold(z, index, covariance)
         try:
             z_held, jacobian_held = trial.solve(z_held)
         except ImgmtfError:

@@ -11,15 +11,19 @@ import numpy as np
 
 from ...errors import ImgmtfError, ParameterError
 from ...metrics import first_crossing
+from ...sensor.lines import LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .data import EdgeData
+from .responses import esf_changes, line_responses
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
 DETERMINED_RELATIVE = 0.5
 #: ... and than this many pixels
 DETERMINED_PX = 0.2
+#: up to this many edges the Jacobian is dense (see :attr:`Model.sparse`)
+DENSE_EDGES = 8
 
 
 def stage_names(names, start: Sensor | None) -> list[str]:
@@ -124,6 +128,7 @@ class Model:
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
+        self._stages_made: dict[tuple, Stage] = {}
 
     # -- which parameters are free ------------------------------------------------
     def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
@@ -163,8 +168,14 @@ class Model:
                 axes.update(("x", "y") if self.specs[k].axis == "xy" else (self.specs[k].axis,))
         return self.seen_axes() <= axes
 
-    def hold(self, z: np.ndarray, index: int) -> np.ndarray:
+    def hold(self, z: np.ndarray, index: int, covariance: np.ndarray | None = None) -> np.ndarray:
+        """Hold free parameter ``index`` at its starting value; ``z`` without
+        it.  With the fit's ``covariance`` the others move to their
+        linearised optimum given the held value (each by its regression on
+        the held one), the refit's starting point: a few steps from its end."""
         key = self.free.pop(index)
+        if covariance is not None and covariance[index, index] > 0:
+            z = z + covariance[:, index] / covariance[index, index] * (self.start[key] - z[index])
         self.values[key] = self.start[key]
         return np.delete(z, index)
 
@@ -192,22 +203,35 @@ class Model:
         for key, twin in self.ties.items():
             coords[key] = coords[twin]
         stages = []
-        for stage in self.stages:
-            own = {k.split(".", 1)[1]: v for k, v in coords.items() if k.split(".")[0] == stage.name}
-            stages.append(stage.with_fit_coordinates(own, self.gsd) if own else stage)
+        if len(self._stages_made) > 1024:
+            self._stages_made.clear()
+        for index, stage in enumerate(self.stages):
+            own = {k.split(".", 1)[1]: float(v) for k, v in coords.items() if k.split(".")[0] == stage.name}
+            if not own:
+                stages.append(stage)
+                continue
+            # a Jacobian's shifts change one stage each: the others are made once
+            made = (index, *own.items())
+            if made not in self._stages_made:
+                self._stages_made[made] = stage.with_fit_coordinates(own, self.gsd)
+            stages.append(self._stages_made[made])
         return Sensor(self.gsd, stages)
 
-    def responses(self, u: np.ndarray):
+    def responses(self, u: np.ndarray) -> list[LineResponse]:
         """Each edge's line response for stage coordinates ``u``; the last
         ones kept, since the solver asks for the residuals and then the
         Jacobian at the same point."""
         key = (tuple(self.free), u.tobytes())
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
-            self._last_responses = (key, [sensor.line_response(d.normal_angle_deg, d.gsd_m,
-                                                               reach_px=float(np.abs(d.x).max()) + 2.0)
+            self._last_responses = (key, [line_responses([sensor], d.normal_angle_deg, d.gsd_m, self.reach(d))[0]
                                           for d in self.data])
         return self._last_responses[1]
+
+    @staticmethod
+    def reach(d: EdgeData) -> float:
+        """How far from the edge its line response must be exact, px."""
+        return float(np.abs(d.x).max()) + 2.0
 
     # -- least squares ------------------------------------------------------------
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
@@ -220,38 +244,59 @@ class Model:
         return np.concatenate(out)
 
     def jacobian(self, z: np.ndarray):
+        """The residuals' Jacobian at ``z``, sparse: the stage columns by
+        forward differences of each edge's response (all shifts in one
+        inverse FFT, :func:`.responses.line_responses`), the levels' and
+        offset's columns exact."""
         u = z[: self.n_free]
-        base = self.responses(u)
-        offsets = [z[self.n_free + 3 * e + 2] for e in range(len(self.data))]
-        base_esf = [r.esf(d.x - x0) for d, r, x0 in zip(self.data, base, offsets)]
         _, upper = self.bounds()
-        columns = []
+        steps = np.empty(self.n_free)
+        shifted = []
         for k in range(self.n_free):
             h = 1e-3 * max(u[k], 0.05 * upper[k] ** 0.5)
-            h = -h if u[k] + h > upper[k] else h
-            shifted = u.copy()
-            shifted[k] += h
-            moved = self.responses(shifted)
-            columns.append(np.concatenate([
-                -(z[self.n_free + 3 * e + 1] - z[self.n_free + 3 * e]) / d.noise
-                * (m.esf(d.x - x0) - esf) / h
-                for e, (d, m, x0, esf) in enumerate(zip(self.data, moved, offsets, base_esf))]))
+            steps[k] = -h if u[k] + h > upper[k] else h
+            moved = u.copy()
+            moved[k] += steps[k]
+            shifted.append(self.sensor(moved))
+        sensor = self.sensor(u)
+        stage_columns, blocks, base = [], [], []
+        for e, d in enumerate(self.data):
+            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
+            response, esf_change, lsf_change = line_responses([sensor, *shifted], d.normal_angle_deg, d.gsd_m,
+                                                              self.reach(d))
+            base.append(response)
+            changes = esf_changes(response, esf_change, lsf_change, d.x - x0)
+            stage_columns.append(changes.T * (-(hi - lo) / d.noise / steps))
+            esf = response.esf(d.x - x0)
+            blocks.append(np.column_stack([(esf - 1) / d.noise, -esf / d.noise,
+                                           (hi - lo) / d.noise * response.lsf(d.x - x0)]))
+        self._last_responses = ((tuple(self.free), u.tobytes()), base)
+        if not self.sparse:
+            jacobian = np.zeros((sum(d.x.size for d in self.data), self.n_free + 3 * len(self.data)))
+            jacobian[:, : self.n_free] = np.concatenate(stage_columns)
+            row = 0
+            for e, block in enumerate(blocks):
+                jacobian[row: row + len(block), self.n_free + 3 * e: self.n_free + 3 * e + 3] = block
+                row += len(block)
+            return jacobian
         # each edge's levels and offset act on its own samples only: a sparse
         # Jacobian, whose size grows with the edges, not with their square
         from scipy import sparse
-        n = sum(d.x.size for d in self.data)
-        stage = np.stack(columns, axis=1) if columns else np.zeros((n, 0))
-        blocks = []
-        for e, (d, b, esf) in enumerate(zip(self.data, base, base_esf)):
-            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            blocks.append(np.stack([-(1 - esf), -esf, (hi - lo) * b.lsf(d.x - x0)], axis=1) / d.noise)
-        return sparse.hstack([sparse.csr_array(stage), sparse.block_diag(blocks)], format="csr")
+        return sparse.hstack([sparse.csr_array(np.concatenate(stage_columns)), sparse.block_diag(blocks)],
+                             format="csr")
+
+    @property
+    def sparse(self) -> bool:
+        """Whether the Jacobian is sparse (solved by LSMR): with many edges.
+        A few edges' dense Jacobian is smaller than LSMR's iterations cost
+        (least squares then solves it exactly, by its SVD)."""
+        return len(self.data) > DENSE_EDGES
 
     def solve(self, z: np.ndarray, max_iterations: int = 200):
         """Bounded least squares from ``z`` (SciPy's trust-region
-        reflective ``least_squares``, with :meth:`jacobian`, sparse, the
-        columns scaled by their norms, the steps by LSMR).  Returns the
-        solution and its Jacobian.
+        reflective ``least_squares``, with :meth:`jacobian`, the columns
+        scaled by their norms, the steps exact or, for a sparse Jacobian, by
+        LSMR).  Returns the solution and its Jacobian.
 
         Raises
         ------
@@ -262,9 +307,10 @@ class Model:
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
         if max_iterations > 0:
+            solver = {"tr_solver": "lsmr", "tr_options": {"atol": 1e-12, "btol": 1e-12}} if self.sparse else {}
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
                                    x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations,
-                                   tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12})
+                                   **solver)
             if result.status > 0:
                 return result.x, result.jac
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
@@ -307,7 +353,8 @@ def parameter_covariance(jacobian, reduced_chi_square: float) -> np.ndarray:
     the reduced chi-square when the residuals exceed the noise (never down:
     on noise-free integer chips the noise is the quantisation's, 1/sqrt(12)
     DN, which flat plateaus do not show)."""
-    return np.linalg.pinv((jacobian.T @ jacobian).toarray()) * max(reduced_chi_square, 1.0)
+    normal = jacobian.T @ jacobian
+    return np.linalg.pinv(normal.toarray() if hasattr(normal, "toarray") else normal) * max(reduced_chi_square, 1.0)
 
 
 

@@ -1,0 +1,61 @@
+"""sensor/lines.py: the line response's grid, its batched inverse FFT and
+the Hermite interpolation, against closed forms."""
+import math
+
+import numpy as np
+import pytest
+from scipy.special import ndtr
+
+import imgmtf as im
+from imgmtf.sensor import stages as st
+from imgmtf.sensor.lines import LineGrid, hermite, line_grid, reference_transfer
+
+
+def test_hermite_is_exact_for_cubics_and_zero_beyond_the_grid():
+    x = np.arange(-3.0, 3.01, 0.5)
+    values, slopes = x**3 - 2 * x, 3 * x**2 - 2
+    d = np.array([-2.9, -0.26, 0.0, 1.13, 2.99, 3.2, -3.1])
+    inside = np.abs(d) <= 3
+    out = hermite(-3.0, 0.5, np.stack([values, 2 * values]), np.stack([slopes, 2 * slopes]), d)
+    assert out.shape == (2, d.size)
+    np.testing.assert_allclose(out[0, inside], d[inside] ** 3 - 2 * d[inside], atol=1e-12)
+    np.testing.assert_allclose(out[1], 2 * out[0], atol=1e-12)
+    assert not out[:, ~inside].any()
+
+
+def test_remainders_of_a_gaussian_give_its_closed_form_esf_and_lsf():
+    """A Gaussian transfer of width s against a reference of another width:
+    the remainders plus the reference's closed form are Phi(x/s) and the
+    normal density, every row of a batch alike."""
+    grid = LineGrid(1 / 64, 4096, ("gaussian", 0.8))
+    f = grid.frequencies_cy_px
+    widths = np.array([0.5, 0.7, 1.1])
+    spectra = np.exp(-2 * np.pi**2 * widths[:, None] ** 2 * f**2) - reference_transfer(grid.reference, f)
+    esf, lsf = grid.remainders(spectra)
+    x = grid.start_px + grid.step_px * np.arange(grid.size)
+    for row, s in enumerate(widths):
+        np.testing.assert_allclose(esf[row] + ndtr(x / 0.8), ndtr(x / s), atol=1e-9)
+        density = np.exp(-0.5 * (x / s) ** 2) / (s * math.sqrt(2 * math.pi))
+        np.testing.assert_allclose(lsf[row] + np.exp(-0.5 * (x / 0.8) ** 2) / (0.8 * math.sqrt(2 * math.pi)),
+                                   density, atol=1e-9)
+
+
+def test_line_grid_covers_the_support_and_reach_and_takes_the_tail():
+    gaussian = im.Sensor(1.0, [st.GaussianOptics(0.5, 0.5)])
+    grid = line_grid(gaussian, 0.0, 1.0)
+    assert grid.reference == ("gaussian", pytest.approx(0.5, rel=1e-3))
+    assert grid.size * grid.step_px / 2 >= gaussian.support_radius_m() + 8 * 0.5 + 4
+    assert grid.size & (grid.size - 1) == 0
+    far = line_grid(gaussian, 0.0, 1.0, reach_px=100.0)
+    assert far.size * far.step_px / 2 >= 100 + gaussian.support_radius_m()
+    airy = im.Sensor(1.0, [st.Diffraction(16.0)])
+    assert line_grid(airy, 0.0, 1.0).reference == ("cauchy", airy.tail_length_m())
+
+
+def test_a_grid_response_is_the_sensors_line_response():
+    sensor = im.Sensor()
+    grid = line_grid(sensor, 6.0, 1.0, reach_px=10.0)
+    mine = grid.response(sensor.normal_transfer(grid.frequencies_cy_px, 6.0))
+    theirs = sensor.line_response(6.0, reach_px=10.0)
+    d = np.linspace(-12, 12, 97)
+    assert np.array_equal(mine.esf(d), theirs.esf(d)) and np.array_equal(mine.lsf(d), theirs.lsf(d))
