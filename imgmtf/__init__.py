@@ -32,7 +32,7 @@ _LAZY = {
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
-    "fit_sensor": "estimate.fit", "SensorFit": "estimate.fit",
+    "fit_sensor": "sensor_fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records", "measure_file": "batch", "MeasureSettings": "batch",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",

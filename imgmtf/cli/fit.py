@@ -46,8 +46,9 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
     the store with the model's across- and along-track rows (those some
     edge constrains)."""
     from ..batch import expand_inputs
-    from ..estimate.fit import check_names, fit_sensor
+    from ..estimate.fit import check_names
     from ..sensor.model import Sensor
+    from ..sensor_fit import fit_sensor
     with reported_errors():
         start = Sensor.from_toml(sensor_path) if sensor_path else None
         with option_errors():

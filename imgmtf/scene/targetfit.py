@@ -180,7 +180,7 @@ def _fit_task(task) -> list[Record]:
 
 
 def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
-    from ..estimate.fit import fit_sensor
+    from ..sensor_fit import fit_sensor
     records = [r for r, _ in members]
     first = records[0]
     edges = [e for _, e in members if not isinstance(e, str)]

@@ -45,8 +45,7 @@ and MTF50, and a misfit warning when the residuals, binned along the
 normal, show structure the noise cannot explain.
 """
 from .data import profile_noise
-from .fitting import fit_sensor
 from .model import check_names
 from .results import EdgeFit, FittedParameter, SensorFit
 
-__all__ = ["EdgeFit", "FittedParameter", "SensorFit", "check_names", "fit_sensor", "profile_noise"]
+__all__ = ["EdgeFit", "FittedParameter", "SensorFit", "check_names", "profile_noise"]
