@@ -1,9 +1,9 @@
-"""The sensor fitted to edges: files, arrays or measurements
-(:func:`fit_sensor`, the public entry point; the method is
-:mod:`imgmtf.estimate.fit`'s)."""
+"""The sensor fitted to edges given as files, arrays or measurements
+(:func:`fit_sensor`, the public entry point): the files are read here, with
+their band, window, GSD and sample type, and the fit itself is
+:func:`imgmtf.estimate.fit.fit_edges` (arrays and results only)."""
 from __future__ import annotations
 
-import importlib
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -11,13 +11,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._blas import one_blas_thread
 from .errors import ParameterError
-from .estimate.fit.data import edge_data
-from .estimate.fit.fitting import run_fit
-from .estimate.fit.model import Model, initial_stages, listed, stage_names
+from .estimate.fit.data import EdgeImage
+from .estimate.fit.fitting import checked_arguments, fit_edges
+from .estimate.fit.model import listed
 from .estimate.fit.results import SensorFit
-from .inputs import check_number
+from .inputs import check_roi
 from .sensor.model import Sensor
 
 if TYPE_CHECKING:
@@ -81,21 +80,33 @@ def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
     >>> abs(fit.edges[0].mtf_nyquist - 0.2667) < 0.002
     True
     """
-    if not (isinstance(confidence, (int, float, np.floating)) and 0 < confidence < 1):
-        raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
-    if gsd_m is not None:
-        gsd_m = check_number("gsd_m", gsd_m, positive=True)
-    if start is not None and not isinstance(start, Sensor):
-        raise ParameterError(f"start must be a Sensor, got {start!r}")
-    names = stage_names(stages, start)
     from .estimate.edge import EdgeResult
+    checked_arguments(stages, start, gsd_m, confidence)        # before any file is read
     if isinstance(edges, (str, Path, np.ndarray, EdgeResult)):
         edges = [edges]
     items = listed("edges", edges, "files, arrays or EdgeResults")
-    data = [edge_data(item, k, gsd_m, band, roi) for k, item in enumerate(items)]
-    if not data:
-        raise ParameterError("no edges to fit")
-    gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
-    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
-    with one_blas_thread():
-        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
+    return fit_edges([_read(item, k, band, roi) for k, item in enumerate(items)], stages=stages, start=start,
+                     hold=hold, gsd_m=gsd_m, confidence=confidence)
+
+
+def _read(item, k: int, band: int | None, roi: tuple[int, int, int, int] | None):
+    """Edge ``k`` (0-based) as the fit takes it: a file read (its window
+    ``roi``) with its GSD and sample type, an array's window; measurements
+    (and what is no image) as they are."""
+    from .estimate.edge import EdgeResult
+    from .estimate.results import MTFResult
+    if isinstance(item, EdgeResult) and roi is not None:
+        raise ParameterError(f"edge {k + 1}: an EdgeResult is already measured: a roi applies to "
+                             "files and arrays")
+    if isinstance(item, MTFResult):
+        return item
+    if isinstance(item, (str, Path)):
+        from .io import read_raster
+        raster = read_raster(item, band, window=roi)
+        return EdgeImage(raster.data, str(item), raster.gsd_m, raster.dtype)
+    if roi is None:
+        return item
+    image = np.asarray(item)
+    source = f"array {k + 1}"
+    left, top, width, height = check_roi(roi, image.shape[:2], source)
+    return EdgeImage(image[top: top + height, left: left + width], source, None, image.dtype)

@@ -72,7 +72,7 @@ def test_profile_noise_needs_no_model():
 def test_a_fit_that_does_not_converge_is_an_imgmtf_error(pair):
     from imgmtf.estimate.fit.data import edge_data
     from imgmtf.estimate.fit.model import Model, initial_stages
-    data = [edge_data(pair[0].image, 0, None, None, None)]
+    data = [edge_data(pair[0].image, 0, None)]
     model = Model(1.0, initial_stages(["optics"], None, 1.0), data)
     with pytest.raises(ImgmtfError, match="did not converge"):
         model.solve(model.initial_vector(), max_iterations=0)
@@ -201,3 +201,22 @@ def test_cli_bad_input_is_one_line_and_exit_1(tmp_path, args, message):
     result = CliRunner().invoke(main, [a.format(tmp=tmp_path) for a in args])
     assert result.exit_code == 1 and message in result.stderr
     assert "Traceback" not in result.output and len(result.stderr.strip().splitlines()) == 1
+
+
+def test_the_estimator_takes_images_and_measurements_and_opens_no_file(pair, tmp_path):
+    """estimate/fit takes arrays, EdgeImages (an array with its file's GSD
+    and sample type) and EdgeResults; imgmtf.fit_sensor reads the files."""
+    from imgmtf.estimate.fit import EdgeImage, fit_edges
+    from imgmtf.io import write_geotiff
+    image = np.round(pair[0].image).astype(np.uint16)
+    path = tmp_path / "edge.tif"
+    write_geotiff(path, image, gsd_m=2.0)
+    with pytest.raises(ParameterError, match="edge 1: a file .*imgmtf.fit_sensor reads files"):
+        fit_edges([str(path)])
+    from_file = im.fit_sensor([path], stages="optics,detector", hold="detector")
+    given = fit_edges([EdgeImage(image.astype(float), str(path), 2.0, "uint16")], stages="optics,detector",
+                      hold="detector")
+    assert given.edges[0].source == from_file.edges[0].source == str(path)
+    assert given.edges[0].gsd_m == from_file.edges[0].gsd_m == 2.0
+    assert given.edges[0].noise_dn == from_file.edges[0].noise_dn           # the uint16 quantisation floor alike
+    assert given.edges[0].mtf_nyquist == from_file.edges[0].mtf_nyquist

@@ -180,7 +180,7 @@ def _fit_task(task) -> list[Record]:
 
 
 def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
-    from ..sensor_fit import fit_sensor
+    from ..estimate.fit import fit_edges
     records = [r for r, _ in members]
     first = records[0]
     edges = [e for _, e in members if not isinstance(e, str)]
@@ -188,7 +188,7 @@ def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Rec
     try:
         if not edges:
             raise ImgmtfError(f"no half-edge could be measured again: {members[0][1]}", reason="unsuitable")
-        fit = fit_sensor(edges, stages=stages, confidence=_confidence(first))
+        fit = fit_edges(edges, stages=stages, confidence=_confidence(first))
     except ImgmtfError as exc:
         what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
         return [Record(first.path, first.band, "edge", first.method, "rejected", exc.reason,

@@ -1,9 +1,10 @@
 """Fit a sensor's stages to the edge profiles of one or more images.
 
-The parametric estimate.  Each edge is measured as usual
-(:func:`imgmtf.measure_edge`) for its geometry only: every pixel's signed
-distance from the edge along its normal and its value.  The model of the
-edge is then
+The parametric estimate (:func:`fit_edges`: arrays and measurements; the
+public :func:`imgmtf.fit_sensor` reads files and calls it).  Each edge is
+measured as usual (:func:`imgmtf.measure_edge`) for its geometry only:
+every pixel's signed distance from the edge along its normal and its
+value.  The model of the edge is then
 
     DN = L + (R - L) ESF(x - x0),
 
@@ -44,8 +45,9 @@ with a delta-method interval, the across- and along-track MTF at Nyquist
 and MTF50, and a misfit warning when the residuals, binned along the
 normal, show structure the noise cannot explain.
 """
-from .data import profile_noise
+from .data import EdgeImage, profile_noise
+from .fitting import fit_edges
 from .model import check_names
 from .results import EdgeFit, FittedParameter, SensorFit
 
-__all__ = ["EdgeFit", "FittedParameter", "SensorFit", "check_names", "profile_noise"]
+__all__ = ["EdgeFit", "EdgeImage", "FittedParameter", "SensorFit", "check_names", "fit_edges", "profile_noise"]

@@ -1,17 +1,53 @@
-"""What each edge gives the fit: its samples' distances and values, its noise."""
+"""What each edge gives the fit: its samples' distances and values, its
+noise; from an image (an array, or an :class:`EdgeImage` with what its
+file said) or a measurement.  No file is opened here: :func:`imgmtf.fit_sensor`
+reads them."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from ...errors import ImgmtfError, ParameterError
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
+
+
+@dataclass(frozen=True, eq=False)
+class EdgeImage:
+    """An image of one edge and what its file said of it: an input of the
+    fit where an array alone does not say enough (what
+    :func:`imgmtf.fit_sensor` makes of a file).
+
+    Attributes
+    ----------
+    image : numpy.ndarray, shape (rows, cols)
+        The pixels, DN.
+    source : str
+        What messages and results name it by (the file).
+    gsd_m : float or None
+        The pixel, m, when known.
+    dtype : numpy dtype or str, optional
+        The stored sample type when ``image`` is not in it (a file's pixels
+        read as floats): an integer type sets the saturation levels and the
+        quantisation's noise floor (default ``image``'s own).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> EdgeImage(np.zeros((2, 2)), "chip.tif", 0.5, "uint16").source
+    'chip.tif'
+    """
+
+    image: np.ndarray
+    source: str
+    gsd_m: float | None = None
+    dtype: DTypeLike | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,32 +63,28 @@ class EdgeData:
     measurement: EdgeResult
 
 
-def edge_data(item, k: int, gsd_m, band, roi) -> EdgeData:
-    from ...inputs import check_roi, saturation_levels
+def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | None) -> EdgeData:
+    """What edge ``k`` (0-based) gives the fit: an image measured (its
+    geometry only), or a measurement taken as it is."""
+    from ...inputs import saturation_levels
     from ..edge import EdgeResult, measure_edge
     from ..intervals import Bootstrap
     from ..results import MTFResult
     if isinstance(item, MTFResult) and not isinstance(item, EdgeResult):
         raise ParameterError(f"edge {k + 1}: a {type(item).__name__}; the fit takes edges (an EdgeResult, "
                              "an image array or a file)")
+    if isinstance(item, (str, os.PathLike)):
+        raise ParameterError(f"edge {k + 1}: a file ({item}); the fit takes images and measurements: "
+                             "imgmtf.fit_sensor reads files")
     if isinstance(item, EdgeResult):
-        if roi is not None:
-            raise ParameterError(f"edge {k + 1}: an EdgeResult is already measured: a roi applies to "
-                                 "files and arrays")
         source, result, integer = f"edge {k + 1}", item, False
     else:
-        if isinstance(item, (str, Path)):
-            from ...io import read_raster
-            raster = read_raster(item, band, window=roi)
-            source, image, gsd, dtype = str(item), raster.data, raster.gsd_m, np.dtype(raster.dtype)
-        else:
-            image = np.asarray(item)
-            source, gsd, dtype = f"array {k + 1}", None, image.dtype
-            if roi is not None:
-                left, top, width, height = check_roi(roi, image.shape[:2], source)
-                image = image[top: top + height, left: left + width]
+        if not isinstance(item, EdgeImage):
+            item = EdgeImage(np.asarray(item), f"array {k + 1}")
+        source = item.source
+        dtype = np.dtype(item.dtype if item.dtype is not None else item.image.dtype)
         try:
-            result = measure_edge(image, gsd_m=gsd_m if gsd_m is not None else gsd,
+            result = measure_edge(item.image, gsd_m=gsd_m if gsd_m is not None else item.gsd_m,
                                   saturation=saturation_levels(dtype), bootstrap=Bootstrap(0))
         except ImgmtfError as exc:
             # name the input, keeping the error's class, reason and checks

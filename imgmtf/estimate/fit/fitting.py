@@ -1,15 +1,109 @@
-"""The driver: the model fitted, and its stages freed or held by the
-likelihood ratio."""
+"""The driver: the edges' data made, the model set up, fitted, and its
+stages freed or held by the likelihood ratio."""
 from __future__ import annotations
 
-from ...errors import ImgmtfError
-from .model import Model, hold_keys, parameter_covariance
+import importlib
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..._blas import one_blas_thread
+from ...errors import ImgmtfError, ParameterError
+from ...inputs import check_number
+from ...sensor.model import Sensor
+from .data import EdgeImage, edge_data
+from .model import Model, hold_keys, initial_stages, listed, parameter_covariance, stage_names
 from .report import fit_report
 from .results import SensorFit
+
+if TYPE_CHECKING:
+    from ..edge import EdgeResult
 
 #: a parameter stays free only if holding it costs this much chi-square
 #: (in units of the reduced chi-square): p = 0.001 for one degree of freedom
 LIKELIHOOD_RATIO = 10.8
+
+
+def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
+              stages: str | Sequence[str] | None = None, start: Sensor | None = None,
+              hold: str | Sequence[str] = (), gsd_m: float | None = None,
+              confidence: float = 0.95) -> SensorFit:
+    """Fit a sensor's stages to the profiles of one or more edges, given as
+    images or measurements (:func:`imgmtf.fit_sensor` reads files and
+    takes windows, then calls this).
+
+    Parameters
+    ----------
+    edges : sequence
+        Each a 2-D array (DN), an :class:`EdgeImage` (an array with what
+        its file said: source, GSD, sample type) or an
+        :class:`imgmtf.EdgeResult` already measured; one edge per image.
+    stages : str or sequence of str, optional
+        Stage names to fit (comma-separated or a list; see
+        :data:`imgmtf.sensor.stages.STAGES`); default the stages of
+        ``start``, or the paper's four.
+    start : Sensor, optional
+        Starting (and held) values of the stages it has; other stages
+        start from their defaults scaled to the GSD.
+    hold : str or sequence of str, optional
+        Parameters held at their starting values: "stage" or "stage.name".
+    gsd_m : float, optional
+        Ground sample distance (m); default the first edge's that knows
+        it, else 1 (parameters then in pixels).
+    confidence : float, optional
+        Of the intervals, in (0, 1) (default 0.95).
+
+    Returns
+    -------
+    SensorFit
+        The fitted sensor, each parameter with its standard error, the
+        model's MTF across and along track with intervals, and each edge's
+        measured and modelled MTF.
+
+    Raises
+    ------
+    ParameterError
+        Unknown stage or parameter names, no edges, bad ``confidence``.
+    ImgmtfError
+        An image with no measurable edge (the message names it), or a fit
+        that does not converge.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 60).image for a in (6.0, 84.0)]
+    >>> fit = fit_edges([imgmtf.measure_edge(chip) for chip in chips])
+    >>> abs(fit.edges[0].mtf_nyquist - 0.2667) < 0.002
+    True
+    """
+    names, gsd_m = checked_arguments(stages, start, gsd_m, confidence)
+    items = listed("edges", edges, "arrays or EdgeResults")
+    data = [edge_data(item, k, gsd_m) for k, item in enumerate(items)]
+    if not data:
+        raise ParameterError("no edges to fit")
+    gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
+    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
+    with one_blas_thread():
+        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
+
+
+def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, gsd_m: float | None,
+                      confidence: float) -> tuple[list[str], float | None]:
+    """The stages' names and the GSD, checked before any data are read.
+
+    Raises
+    ------
+    ParameterError
+        A bad ``confidence``, ``gsd_m`` or ``start``, unknown stages.
+    """
+    if not (isinstance(confidence, (int, float, np.floating)) and 0 < confidence < 1):
+        raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
+    if gsd_m is not None:
+        gsd_m = check_number("gsd_m", gsd_m, positive=True)
+    if start is not None and not isinstance(start, Sensor):
+        raise ParameterError(f"start must be a Sensor, got {start!r}")
+    return stage_names(stages, start), gsd_m
 
 
 def run_fit(model: Model, hold, confidence: float) -> SensorFit:
