@@ -9,7 +9,8 @@ import rasterio
 from rasterio.transform import Affine
 
 import imgmtf as im
-from imgmtf.restore.apply import OutputType, TileTask, measure_noise, plan_tiles, restore_array, restore_tile
+from imgmtf.restore.apply import OutputType, TileTask, measure_noise, plan_tiles, restore_tile
+from imgmtf.restore.convolve import restore_array
 from imgmtf.sensor.stages import Detector, GaussianOptics
 
 

@@ -207,7 +207,7 @@ class RestorationFilter:
         ImageContentError
             An image that is not 2-D real numbers.
         """
-        from .apply import restore_array
+        from .convolve import restore_array
         return restore_array(image, self.taps, fill=fill)
 
     def to_dict(self) -> dict:
