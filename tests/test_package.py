@@ -1,3 +1,5 @@
+import numpy as np
+
 import imgmtf
 
 
@@ -26,3 +28,49 @@ def test_every_public_exception_is_importable_from_the_package():
     for name in found:
         assert name in imgmtf.__all__ and issubclass(getattr(imgmtf, name), imgmtf.ImgmtfError)
     assert imgmtf.QualityError.__name__ == "QualityError"
+
+
+def _imports(path, package, modules):
+    """The package's modules that the module at ``path`` imports anywhere in
+    it (in functions and under TYPE_CHECKING too), by their dotted names."""
+    import ast
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            base = package[:len(package) - node.level + 1] if node.level else []
+            base = ".".join(base + ([node.module] if node.module else [])) if node.level else node.module or ""
+            found |= {f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base for a in node.names}
+        elif isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+    resolved = set()
+    for name in found:
+        while name and name not in modules:        # a name imported from a module: the module
+            name = name.rpartition(".")[0]
+        resolved.add(name)
+    return resolved - {""}
+
+
+def test_no_import_cycle_between_modules():
+    # the data flows one way through the house: a module never imports one
+    # that imports it, however indirectly (a package's own __init__ aside)
+    import pathlib
+
+    from scipy.sparse import csr_array
+    from scipy.sparse.csgraph import connected_components
+    root = pathlib.Path(imgmtf.__file__).parent
+    paths = {}
+    for path in root.rglob("*.py"):
+        parts = ["imgmtf", *path.relative_to(root).with_suffix("").parts]
+        paths[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    names = sorted(paths)
+    index = {name: k for k, name in enumerate(names)}
+    edges = [(index[name], index[target]) for name in names
+             for target in _imports(paths[name], name.split(".") if paths[name].name == "__init__.py"
+                                    else name.split(".")[:-1], paths)
+             if target != name and not name.startswith(target + ".")]
+    rows, cols = zip(*edges)
+    graph = csr_array((np.ones(len(edges)), (rows, cols)), shape=(len(names), len(names)))
+    count, labels = connected_components(graph, directed=True, connection="strong")
+    cycles = [sorted(n for n, label in zip(names, labels) if label == c) for c in range(count)
+              if np.count_nonzero(labels == c) > 1]
+    assert len(names) > 80 and len(edges) > 200 and cycles == []
