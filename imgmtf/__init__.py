@@ -34,7 +34,7 @@ _LAZY = {
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "sensor_fit", "SensorFit": "estimate.fit",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
-    "Record": "records", "measure_file": "batch", "MeasureSettings": "batch",
+    "Record": "records", "measure_file": "batch", "MeasureSettings": "measure_settings",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "fit_targets": "scene.targetfit", "scan_scenes": "scene.series",
     "run_selftest": "selftest",

@@ -86,7 +86,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         from ..parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:
             prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
-        from ..batch import MeasureSettings, expand_inputs, measure_files
+        from ..batch import expand_inputs, measure_files
+        from ..measure_settings import MeasureSettings
         from ..records import CsvWriter, JsonLinesWriter, utc_now
         with option_errors():
             settings = MeasureSettings(kind, method, band, roi, pulse_width,

@@ -26,7 +26,6 @@ from typing import Any
 import numpy as np
 
 from ..atomic import ensure_folder
-from ..batch import pulse_width_px
 from ..errors import ImageContentError, ImgmtfError, ParameterError
 from ..estimate import gate
 from ..estimate.detection import robust_noise
@@ -34,6 +33,7 @@ from ..estimate.geometry import direction_label
 from ..figures import with_figure
 from ..inputs import MIN_SIZE_PX, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
+from ..measure_settings import pulse_width_px
 from ..parallel import run_tasks
 from ..records import Record, utc_now
 from .detect import (

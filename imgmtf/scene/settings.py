@@ -3,10 +3,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..batch import MeasureSettings
 from ..errors import ParameterError
 from ..estimate.intervals import Intervals, as_intervals
 from ..inputs import check_number, parse_length
+from ..measure_settings import MeasureSettings
 
 MIN_TILE_PX = 256
 MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit

@@ -1,0 +1,146 @@
+"""How to measure every file of a batch (:class:`MeasureSettings`), the
+settings a scan's measurements read too: below both :mod:`imgmtf.batch`
+and :mod:`imgmtf.scene`."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from .errors import ParameterError
+from .estimate.intervals import Intervals, as_intervals
+from .estimate.resampling import check_method
+from .inputs import check_width, parse_length
+from .records import Record
+from .transfer import parse_transfer
+
+if TYPE_CHECKING:
+    from .estimate.results import MTFResult
+
+
+@dataclass(frozen=True)
+class MeasureSettings:
+    """How to measure every file of a batch.
+
+    Parameters
+    ----------
+    target : {"edge", "pulse"}, optional
+        The target (default "edge").
+    method : str, optional
+        Resampling method (see :data:`imgmtf.estimate.resampling.METHODS`;
+        default "msg").
+    band : int or str, optional
+        1-based band, "all" for every band, None (default) for the only
+        band or RGB luminance.
+    roi : (int, int, int, int), optional
+        (x, y, width, height) window read from every file, px.
+    pulse_width : (float, str), float or str, optional
+        (value, "px" or "m"), a number of px, a string as the CLI takes it
+        ("1.4", "1.4px", "18.3m"), or None (default) to estimate it.
+    intervals : Intervals, str or int, optional
+        Confidence-interval settings (linearised by default): an
+        :class:`~imgmtf.Intervals`, or what ``--intervals`` takes
+        ("influence", "bootstrap", "none"), or a number of bootstrap
+        replicates (0: none).
+    force : bool, optional
+        Measure even where a quality check fails (each a warning).
+    saturation : (float, float), optional
+        (low, high) DN the sensor records; None for an integer file's type
+        range (floats: none declared).
+    track_azimuth_deg : float, optional
+        The ground track's direction in the image, degrees clockwise from
+        up; None: rows along track for images in sensor geometry, unknown
+        for map-projected ones.
+    transfer : str, optional
+        How the stored values relate to light, "linear" (as stored), "srgb"
+        or "gamma:G" (:mod:`imgmtf.transfer`): linearised before measuring.
+
+    Raises
+    ------
+    ParameterError
+        A setting out of range, or a pulse width for an edge.
+
+    Examples
+    --------
+    >>> from imgmtf import MeasureSettings
+    >>> settings = MeasureSettings(target="pulse", pulse_width="18.3m", intervals="none")
+    >>> settings.pulse_width, settings.intervals.method
+    ((18.3, 'm'), 'none')
+    """
+
+    target: str = "edge"
+    method: str = "msg"
+    band: int | str | None = None
+    roi: tuple[int, int, int, int] | None = None
+    pulse_width: tuple[float, str] | None = None
+    intervals: Intervals = field(default_factory=Intervals)
+    force: bool = False
+    saturation: tuple[float, float] | None = None
+    track_azimuth_deg: float | None = None
+    transfer: str = "linear"
+
+    def __post_init__(self):
+        object.__setattr__(self, "intervals", as_intervals(self.intervals))
+        if self.pulse_width is not None:
+            object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
+        if self.target not in ("edge", "pulse"):
+            raise ParameterError(f"target must be 'edge' or 'pulse', got {self.target!r}")
+        if self.pulse_width is not None and self.target != "pulse":
+            raise ParameterError("a pulse width applies to pulse targets only")
+        if self.pulse_width is not None and self.pulse_width[1] == "px":
+            check_width(self.pulse_width[0])
+        check_method(self.method)   # an unknown method fails here, before any file is read
+        object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
+
+    def estimator(self) -> Callable[..., MTFResult]:
+        # the estimators load SciPy and OpenCV: imported by the processes
+        # that measure (imgmtf.cli.measure.MEASURING_MODULES), not by a batch's parent
+        from .estimate.edge import EdgeEstimator
+        from .estimate.pulse import PulseEstimator
+        kind = EdgeEstimator if self.target == "edge" else PulseEstimator
+        return kind(self.method, intervals=self.intervals, force=self.force, transfer=self.transfer)
+
+    def params(self) -> dict:
+        """The run's settings, as records carry them."""
+        return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
+                "band": self.band, "force": self.force,
+                "saturation": list(self.saturation) if self.saturation else None,
+                "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
+                "pulse_width": list(self.pulse_width) if self.pulse_width else None}
+
+    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
+        """The error record of a file (or band) that could not be measured.
+
+        Parameters
+        ----------
+        path : str
+            The file.
+        band : int, str or None
+            Its band (None: the only one, or the luminance).
+        exc : BaseException
+            What the measurement raised.
+        run_utc : str
+            The run's start, UTC, ISO 8601.
+
+        Returns
+        -------
+        Record
+            An error record with these settings, the reason and message.
+        """
+        return Record.failed(path, band, self.target, self.method, exc, params=self.params(),
+                             run_utc=run_utc)
+
+
+def pulse_width_px(width, raster) -> float | None:
+    """A pulse width (value, unit) in pixels for this raster (metres need
+    its GSD)."""
+    if width is None:
+        return None
+    value, unit = width
+    if unit == "px":
+        return value
+    if raster.gsd_m is None:
+        raise ParameterError(f"{raster.path}: a width in metres needs a georeferenced image "
+                             "(its GSD is unknown); give the width in px")
+    check_width(value / raster.gsd_m)
+    return value / raster.gsd_m
