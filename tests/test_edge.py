@@ -184,3 +184,14 @@ def test_confident_snr_scales_with_rows():
     h = gaussian_pixel_transfer(0.5, 6.0)
     quiet = measure_edge(exact_edge_chip(h, 6.0, noise_std=9.0, seed=2))     # SNR ~110, 100 rows
     assert quiet.snr > confident_snr(quiet.rows_used) and not quiet.warnings
+
+
+def test_the_figures_read_the_esf_between_its_levels_and_the_lsf():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    r = measure_edge(exact_edge_chip(h, 6.0, low=1200, high=200))
+    x, esf, levels = r.normalised_profile()
+    assert r.width_px == 0.0 and x is r.esf_x_px
+    assert levels == pytest.approx((1200.0, 200.0), abs=0.5)
+    assert esf[0] == pytest.approx(0.0, abs=0.01) and esf[-1] == pytest.approx(1.0, abs=0.01)
+    x_lsf, lsf, fwhm = r.lsf_like()
+    assert x_lsf is r.lsf_x_px and lsf is r.lsf and fwhm == r.fwhm_px

@@ -191,3 +191,14 @@ def test_row_centres_of_a_noisy_bar_are_centroids_over_its_own_reach():
         expected.append(geometry.location_sd_px)
     assert max(scatter) < 0.35
     assert np.mean(scatter) == pytest.approx(np.mean(expected), rel=0.3)
+
+
+def test_the_figures_read_the_pulse_response_between_background_and_peak():
+    h = gaussian_pixel_transfer(0.5, 6.0)
+    r = measure_pulse(exact_pulse_chip(h, 6.0, 1.6), width_px=1.6)
+    x, profile, (background, peak) = r.normalised_profile()
+    assert r.width_px == 1.6 and x is r.prf_x_px
+    assert background == pytest.approx(200.0, abs=0.5) and 200.0 < peak < 1200.0
+    assert profile.max() == pytest.approx(1.0, abs=0.01)
+    x_lsf, lsf, fwhm = r.lsf_like()
+    assert x_lsf is r.prf_x_px and lsf is r.prf and fwhm == r.prf_fwhm_px

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
 from .._blas import one_blas_thread
+from ..kinds.edge import EDGE
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
 from .geometry import TargetGeometry, locate_edge
@@ -70,12 +71,21 @@ class EdgeResult(MTFResult):
     (0.67, 'rising', 1.0)
     """
 
-    target: ClassVar[str] = "edge"
+    target: ClassVar[str] = EDGE.name
     rer: float
     esf_x_px: np.ndarray
     esf: np.ndarray
     levels_dn: tuple[float, float]
     bright_side: str
+
+    def normalised_profile(self) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """The ESF (0 to 1), its positions along the normal (px) and its
+        two levels (DN)."""
+        return self.esf_x_px, self.esf, self.levels_dn
+
+    def lsf_like(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """The LSF, its positions along the normal (px) and its FWHM (px)."""
+        return self.lsf_x_px, self.lsf, self.fwhm_px
 
     def _specific(self) -> dict:
         return {"rer": finite(self.rer), "levels_dn": [finite(v) for v in self.levels_dn],
@@ -85,8 +95,8 @@ class EdgeResult(MTFResult):
 class EdgeKind(TargetKind):
     """What an edge brings to the pipeline."""
 
-    name = "edge"
-    profile = "edge"
+    registered = EDGE
+    profile = gate.STEP_PROFILE
     tail_power = 1
     monotone = True
     subtracts_background = False

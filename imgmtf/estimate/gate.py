@@ -65,6 +65,10 @@ MAX_MTF_EXCESS = 0.05           # MTF above 1 + this (plus 3 noise sd) refuses t
 MIXED_SHARE = 0.25              # a profile with a step and a bar each this share of its range: two targets
 EDGE_STEP_RATIO = 0.5           # |right - left| / largest excursion: above it a step, below a bar
 
+# the profile shapes classify_profile tells apart (a kind wants one), and the refusal of the other
+STEP_PROFILE, BAR_PROFILE = "edge", "bar"
+WRONG_PROFILE = {STEP_PROFILE: ("not-an-edge", "the profile rises and falls back: a bar, not an edge"),
+                 BAR_PROFILE: ("not-a-bar", "the profile is a step, not a bar")}
 
 @dataclass(frozen=True)
 class Check:
@@ -282,13 +286,13 @@ def rows_check(rows_used: int, name: str) -> Check:
 
 # -- on the profile -------------------------------------------------------------
 def classify_profile(values: np.ndarray) -> str:
-    """"edge" or "bar": a step keeps most of its largest excursion between
-    its two ends; a bar returns to where it started.  ``values`` is the
-    resampled profile across the target."""
+    """``STEP_PROFILE`` or ``BAR_PROFILE``: a step keeps most of its largest
+    excursion between its two ends; a bar returns to where it started.
+    ``values`` is the resampled profile across the target."""
     n_side = max(values.size // 8, 2)
     left, right = values[:n_side].mean(), values[-n_side:].mean()
     excursion = np.max(np.abs(values - left))
-    return "edge" if excursion > 0 and abs(right - left) >= EDGE_STEP_RATIO * excursion else "bar"
+    return STEP_PROFILE if excursion > 0 and abs(right - left) >= EDGE_STEP_RATIO * excursion else BAR_PROFILE
 
 
 def mixed_profile(values: np.ndarray) -> bool:
@@ -309,17 +313,17 @@ def mixed_profile(values: np.ndarray) -> bool:
 
 
 def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Check:
-    """Is the profile the kind of target asked for?  Where it is not and it
-    holds a step and a bar at once (``values`` given), the reason is the
-    second feature beside the target, not the kind."""
+    """Is the profile's shape ``kind`` (:func:`classify_profile`) the one the
+    target asked for wants?  Where it is not and it holds a step and a bar
+    at once (``values`` given), the reason is the second feature beside the
+    target, not the kind."""
+    reason, message = WRONG_PROFILE[wanted]
     if kind == wanted:
-        return Check(f"not-a-{'bar' if wanted == 'bar' else 'n-edge'}", True, f"the profile is a {kind}")
+        return Check(reason, True, f"the profile is a {kind}")
     if values is not None and mixed_profile(values):
         return Check("two-targets", False, f"the profile holds a step and a bar: a second feature (a road, a "
-                     f"shadow, another {'edge' if wanted == 'bar' else 'bar'}) lies beside the target")
-    if wanted == "edge":
-        return Check("not-an-edge", False, "the profile rises and falls back: a bar, not an edge")
-    return Check("not-a-bar", False, "the profile is a step, not a bar")
+                     f"shadow, another {kind}) lies beside the target")      # of two shapes, the other
+    return Check(reason, False, message)
 
 
 def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum, noise_free,

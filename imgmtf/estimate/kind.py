@@ -1,4 +1,5 @@
-"""What differs between target kinds (:class:`TargetKind`: an edge, a bar),
+"""How the shared pipeline measures each kind of target (:class:`TargetKind`:
+an edge, a bar; the kinds themselves are registered in :mod:`imgmtf.kinds`),
 the levels and scale a kind reads off its profile (:class:`Shape`), a bar's
 width as read (:class:`WidthReading`), and the refusal of a profile of the
 other kind."""
@@ -12,16 +13,20 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import UnsuitableTargetError
+from ..kinds import Kind
 from . import gate
 from .detection import Line
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
 
 
 class TargetKind:
-    """What differs between targets; see :class:`imgmtf.estimate.edge.EdgeKind`
-    and :class:`imgmtf.estimate.pulse.PulseKind`, the two implementations.
+    """How the pipeline measures one registered kind of target (its
+    :class:`imgmtf.kinds.Kind`, ``registered``, names this class as its
+    ``measuring`` part); see :class:`imgmtf.estimate.edge.EdgeKind` and
+    :class:`imgmtf.estimate.pulse.PulseKind`, the two implementations.
 
-    Attributes: ``name`` is the target as a user names it ("edge", "bar");
+    Attributes: ``registered`` the kind's entry in :mod:`imgmtf.kinds`
+    (``name`` is its noun, what messages call the target: "edge", "bar");
     ``profile`` what its profile must look like
     (:func:`.gate.classify_profile`); ``tail_power`` p of its profile's
     tails, level + A / |s|^p; ``monotone`` whether the profile only rises
@@ -32,12 +37,17 @@ class TargetKind:
     spectrum is bridged rather than divided.
     """
 
-    name: ClassVar[str]
+    registered: ClassVar[Kind]
     profile: ClassVar[str]
     tail_power: ClassVar[int]
     monotone: ClassVar[bool]
     subtracts_background: ClassVar[bool]
     restore_min_divisor: ClassVar[float]
+
+    @property
+    def name(self) -> str:
+        """What messages call the target: its registered kind's noun."""
+        return self.registered.noun
 
     def seed(self, data: np.ndarray, noise: float) -> tuple[Line, list[gate.Check]]:
         """The target's line in the chip and the gate's checks of what else

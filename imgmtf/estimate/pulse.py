@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, DTypeLike
 from .._blas import one_blas_thread
 from ..errors import TargetNotFoundError, UnsuitableTargetError
 from ..inputs import check_width
+from ..kinds.pulse import PULSE
 from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
@@ -76,7 +77,7 @@ class PulseResult(MTFResult):
     (1.5, False, 'bright')
     """
 
-    target: ClassVar[str] = "pulse"
+    target: ClassVar[str] = PULSE.name
     pulse_width_px: float
     width_estimated: bool
     usable_band_cy_px: float
@@ -85,6 +86,21 @@ class PulseResult(MTFResult):
     prf_fwhm_px: float
     background_dn: float
     peak_dn: float
+
+    @property
+    def width_px(self) -> float:
+        """The bar's width used, px (``pulse_width_px``)."""
+        return self.pulse_width_px
+
+    def normalised_profile(self) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """The pulse response (0 to a unit peak), its positions along the
+        normal (px), and the background and peak levels (DN)."""
+        return self.prf_x_px, self.prf, (self.background_dn, self.peak_dn)
+
+    def lsf_like(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """The pulse response (peak 1), its positions along the normal (px)
+        and its FWHM (px)."""
+        return self.prf_x_px, self.prf, self.prf_fwhm_px
 
     def _specific(self) -> dict:
         return {"pulse_width_px": finite(self.pulse_width_px), "width_estimated": self.width_estimated,
@@ -97,8 +113,8 @@ class PulseKind(TargetKind):
     """What a bar brings to the pipeline; ``width_px`` the bar's width, or
     None to estimate it from the profile."""
 
-    name = "bar"
-    profile = "bar"
+    registered = PULSE
+    profile = gate.BAR_PROFILE
     tail_power = 2
     monotone = False
     subtracts_background = True

@@ -142,6 +142,25 @@ class MTFResult:
             raise ValueError("this result carries no MTF function")
         return self.mtf_function(f_cy_px)
 
+    @property
+    def width_px(self) -> float:
+        """The target's width along its normal, px (0: a target without
+        one, an edge)."""
+        return 0.0
+
+    def normalised_profile(self) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """The profile across the target (an edge's ESF, a bar's pulse
+        response) normalised to run from 0 to 1, its positions along the
+        normal (px), and the levels (DN) it is normalised between: each
+        target's result says which."""
+        raise NotImplementedError
+
+    def lsf_like(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """The LSF-like profile the MTF is the transform of (an edge's LSF,
+        a bar's pulse response), its positions along the normal (px) and
+        its FWHM (px)."""
+        raise NotImplementedError
+
     def _specific(self) -> dict:
         return {}
 

@@ -24,8 +24,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..errors import ParameterError
-
-KINDS = ("edge", "pulse")
+from ..kinds import get_kind, kinds_with_width
 
 
 @dataclass(frozen=True)
@@ -35,7 +34,8 @@ class Target:
     Parameters
     ----------
     kind : {"edge", "pulse"}
-        An edge (a step between two levels) or a bar of ``width_px``.
+        An edge (a step between two levels) or a bar of ``width_px``: a
+        name in :data:`imgmtf.kinds.KINDS`.
     angle_deg : float
         Angle of the target's normal from the image's x (column) axis,
         towards +y (down), in (-90, 90] degrees: the tilt of the edge from
@@ -76,8 +76,7 @@ class Target:
     width_px: float = 0.0
 
     def __post_init__(self):
-        if self.kind not in KINDS:
-            raise ParameterError(f"target kind must be one of {KINDS}, got {self.kind!r}")
+        kind = get_kind(self.kind)
         for name in ("angle_deg", "low_dn", "high_dn", "offset_px", "width_px"):
             value = getattr(self, name)
             if isinstance(value, (bool, np.bool_)) or not isinstance(
@@ -86,10 +85,11 @@ class Target:
             object.__setattr__(self, name, float(value))
         if not -90.0 < self.angle_deg <= 90.0:
             raise ParameterError(f"target angle must be in (-90, 90] degrees, got {self.angle_deg}")
-        if self.kind == "pulse" and self.width_px <= 0:
-            raise ParameterError(f"pulse width must be > 0 pixels, got {self.width_px}")
-        if self.kind == "edge" and self.width_px != 0:
-            raise ParameterError("an edge target has no width; use kind='pulse'")
+        if kind.has_width and self.width_px <= 0:
+            raise ParameterError(f"{kind.name} width must be > 0 pixels, got {self.width_px}")
+        if not kind.has_width and self.width_px != 0:
+            wide = " or ".join(f"kind={other.name!r}" for other in kinds_with_width())
+            raise ParameterError(f"an {kind.name} target has no width; use {wide}")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -130,8 +130,5 @@ class Target:
         numpy.ndarray
             The target's values there, DN.
         """
-        if self.kind == "edge":
-            inside = esf(d_px)
-        else:
-            inside = esf(d_px + self.width_px / 2.0) - esf(d_px - self.width_px / 2.0)
+        inside = get_kind(self.kind).scene_response(d_px, esf, self.width_px)
         return self.low_dn + (self.high_dn - self.low_dn) * inside

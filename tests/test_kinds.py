@@ -1,0 +1,99 @@
+"""The registry of target kinds (imgmtf.kinds): lookup, its refusal of an
+unknown kind, each kind's facts and parts."""
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import imgmtf
+from imgmtf.errors import ParameterError
+from imgmtf.kinds import KINDS, Kind, get_kind, kind_names, kinds_with_width
+from imgmtf.kinds.edge import EDGE
+from imgmtf.kinds.pulse import PULSE
+from imgmtf.records import SUMMARY_COLUMNS
+
+
+def test_lookup_returns_the_registered_kinds_in_order():
+    assert kind_names() == ("edge", "pulse")
+    assert get_kind("edge") is EDGE and get_kind("pulse") is PULSE
+    assert all(KINDS[name].name == name for name in KINDS)
+    assert kinds_with_width() == (PULSE,)
+
+
+@pytest.mark.parametrize("name", ["star", "Edge", "", None, 3])
+def test_an_unknown_kind_is_refused_naming_the_kinds_there_are(name):
+    with pytest.raises(ParameterError, match=r"target kind must be one of \('edge', 'pulse'\), got ") as info:
+        get_kind(name)
+    assert isinstance(info.value, ValueError)
+    with pytest.raises(ParameterError, match=r"^target must be one of"):
+        get_kind(name, "target")
+
+
+def test_each_kind_names_its_parts_and_they_name_it_back():
+    for kind in KINDS.values():
+        result, measuring = kind.load("result"), kind.load("measuring")
+        assert result.target == kind.name
+        assert measuring.registered is kind
+        assert type(kind.make_estimator("msg")).__name__ == kind.estimator.rpartition(":")[2]
+        assert set(kind.record_fields) <= set(SUMMARY_COLUMNS)
+        assert kind.column.field in kind.record_fields
+
+
+def test_the_facts_of_an_edge_and_of_a_bar():
+    assert (EDGE.noun, EDGE.has_width, EDGE.column.heading, EDGE.column.unit) == ("edge", False, "RER", "")
+    assert (PULSE.noun, PULSE.has_width, PULSE.column.heading, PULSE.column.unit) == ("bar", True, "W", "px")
+    assert EDGE.fits_sensor and not PULSE.fits_sensor
+    assert EDGE.lone_line is None and PULSE.lone_line == ("not-a-bar", "a lone edge, not the two sides of a bar")
+    assert EDGE.masked_by is None and PULSE.masked_by == "the bar's sinc"
+    assert EDGE.estimator_keywords(None) == {} and PULSE.estimator_keywords(None) == {"width_px": None}
+    assert EDGE.described.format(width_px=0.0) == "edge"
+    assert PULSE.profile_label.format(width_px=1.5) == "PRF, bar 1.50 px"
+
+
+def test_scene_responses_are_an_edge_response_and_the_difference_of_two():
+    d = np.linspace(-3.0, 3.0, 13)
+
+    def esf(x):                 # a 2 px linear ramp
+        return np.clip(0.5 + x / 2.0, 0.0, 1.0)
+    assert np.array_equal(EDGE.scene_response(d, esf, 0.0), esf(d))
+    bar = PULSE.scene_response(d, esf, 1.0)
+    assert bar.max() == pytest.approx(0.5) and bar[0] == 0.0 and bar[-1] == 0.0      # 1 px bar, 2 px blur
+    assert np.allclose(bar, bar[::-1])
+
+
+def test_each_kinds_column_is_in_its_measurement():
+    sensor = imgmtf.Sensor()
+    for kind in KINDS.values():
+        width = 1.5 if kind.has_width else 0.0
+        chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width), 60)
+        result = kind.make_estimator("msg", intervals=imgmtf.Intervals("none"))(
+            chip.image, **kind.estimator_keywords(width or None))
+        figures = result.to_dict(curves=False)
+        assert figures["target"] == kind.name and figures[kind.column.field] is not None
+
+
+def test_a_registered_kind_is_a_target_the_sensor_renders(monkeypatch):
+    line = replace(PULSE, name="line", noun="line")              # one new kind, one registration
+    monkeypatch.setitem(KINDS, "line", line)
+    assert "line" in kind_names()
+    target = imgmtf.Target("line", 6.0, 0.0, 1.0, width_px=1.0)
+    d = np.array([-5.0, 0.0, 5.0])
+    assert np.allclose(target.image_values(d, lambda x: (x > 0).astype(float)), [0.0, 1.0, 0.0])
+    with pytest.raises(ParameterError, match="line width must be > 0 pixels"):
+        imgmtf.Target("line", 6.0)
+
+
+def test_the_registry_loads_nothing_numerical_and_nothing_above_it():
+    code = ("import sys, imgmtf.kinds; print(sorted(m for m in sys.modules if m.startswith('imgmtf') or "
+            "m in ('numpy', 'scipy', 'cv2', 'matplotlib')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert eval(out.stdout) == ["imgmtf", "imgmtf.errors", "imgmtf.kinds", "imgmtf.kinds.edge",
+                                "imgmtf.kinds.kind", "imgmtf.kinds.pulse"]
+
+
+def test_kind_is_a_frozen_record_of_facts():
+    with pytest.raises(AttributeError):
+        EDGE.name = "step"              # type: ignore[misc]
+    assert isinstance(EDGE, Kind)
