@@ -19,7 +19,7 @@ from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .figures import with_figure
 from .inputs import saturation_levels
 from .io import raster_info, read_raster
-from .measure_settings import MeasureSettings, pulse_width_px
+from .measure_settings import MeasureSettings
 from .parallel import run_tasks
 from .records import Record, utc_now
 
@@ -179,10 +179,7 @@ def measure_raster(raster, settings: MeasureSettings):
         track = 0.0                          # sensor geometry: rows along track
     common = dict(gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
                   saturation=settings.saturation or saturation_levels(raster.dtype))
-    if settings.target == "edge":
-        result = estimator(raster.data, **common)
-    else:
-        result = estimator(raster.data, width_px=pulse_width_px(settings.pulse_width, raster), **common)
+    result = estimator(raster.data, **settings.target_keywords(raster), **common)
     x0, y0 = raster.origin
     x, y, w, h = result.roi
     return replace(result, roi=(x + x0, y + y0, w, h))

@@ -11,11 +11,13 @@ from .errors import ParameterError
 from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
 from .inputs import check_width, parse_length
+from .kinds import get_kind
 from .records import Record
 from .transfer import parse_transfer
 
 if TYPE_CHECKING:
     from .estimate.results import MTFResult
+    from .io import Raster
 
 
 @dataclass(frozen=True)
@@ -83,9 +85,7 @@ class MeasureSettings:
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
         if self.pulse_width is not None:
             object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
-        if self.target not in ("edge", "pulse"):
-            raise ParameterError(f"target must be 'edge' or 'pulse', got {self.target!r}")
-        if self.pulse_width is not None and self.target != "pulse":
+        if not get_kind(self.target, "target").has_width and self.pulse_width is not None:
             raise ParameterError("a pulse width applies to pulse targets only")
         if self.pulse_width is not None and self.pulse_width[1] == "px":
             check_width(self.pulse_width[0])
@@ -95,10 +95,30 @@ class MeasureSettings:
     def estimator(self) -> Callable[..., MTFResult]:
         # the estimators load SciPy and OpenCV: imported by the processes
         # that measure (imgmtf.cli.measure.MEASURING_MODULES), not by a batch's parent
-        from .estimate.edge import EdgeEstimator
-        from .estimate.pulse import PulseEstimator
-        kind = EdgeEstimator if self.target == "edge" else PulseEstimator
-        return kind(self.method, intervals=self.intervals, force=self.force, transfer=self.transfer)
+        return get_kind(self.target).make_estimator(self.method, intervals=self.intervals, force=self.force,
+                                                    transfer=self.transfer)
+
+    def target_keywords(self, raster: Raster) -> dict:
+        """What the target's estimator takes beyond the keywords every
+        kind's takes (:meth:`imgmtf.kinds.Kind.estimator_keywords`).
+
+        Parameters
+        ----------
+        raster : imgmtf.io.Raster
+            The raster measured (a width in metres needs its GSD).
+
+        Returns
+        -------
+        dict
+            ``{"width_px": ...}`` for a kind with a width (None: estimated
+            from the profile), nothing for an edge.
+
+        Raises
+        ------
+        ParameterError
+            A width in metres on a raster without a GSD.
+        """
+        return get_kind(self.target).estimator_keywords(pulse_width_px(self.pulse_width, raster))
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
@@ -131,7 +151,7 @@ class MeasureSettings:
                              run_utc=run_utc)
 
 
-def pulse_width_px(width, raster) -> float | None:
+def pulse_width_px(width: tuple[float, str] | None, raster: Raster) -> float | None:
     """A pulse width (value, unit) in pixels for this raster (metres need
     its GSD)."""
     if width is None:

@@ -22,9 +22,9 @@ import numpy as np
 from .errors import FileWriteError, ImgmtfError
 from .estimate.edge import EdgeEstimator
 from .estimate.intervals import NO_INTERVALS
-from .estimate.pulse import PulseEstimator
 from .estimate.resampling import METHODS
 from .estimate.results import MTFResult
+from .kinds import get_kind
 from .metrics import fwhm
 from .parallel import run_tasks
 from .sensor.model import Sensor
@@ -40,7 +40,7 @@ CRITERION_RELATIVE = 0.05       # an estimate is good within +-5 % of the true M
 CRITERION_FRACTION = 0.95       # ... and a method is trustworthy when 95 % are
 THRESHOLD_SNRS = (10, 15, 20, 25, 30, 40, 50, 60, 70, 80, 90, 100, 125, 150, 200)
 GROUND_SNRS = (5, 10, 15, 20, 30, 40, 50, 70, 100, 150, 200)
-# the paper's Tables 1 and 2: % difference from the model
+# the paper's Tables 1 and 2 (% difference from the model), per target kind it studies
 PAPER_TABLE = {
     "edge": {"spline": (21.6, -51.9), "sliding": (5.8, -12.6), "msg": (0.5, -1.9)},
     "pulse": {"spline": (-1.23, -50.8), "sliding": (-0.26, -10.9), "msg": (-0.07, -4.1)},
@@ -108,8 +108,9 @@ def estimator_tables(methods) -> tuple[list[dict], dict]:
     renderer = Renderer(sensor, CHIP_PX)
     rows: list[dict] = []
     curves: dict = {}
-    for kind in ("edge", "pulse"):
-        width = PULSE_WIDTH_PX if kind == "pulse" else 0.0
+    for kind in PAPER_TABLE:
+        target = get_kind(kind)
+        width = PULSE_WIDTH_PX if target.has_width else 0.0
         chip = renderer(Target(kind, ANGLE_DEG, 200.0, 1200.0, 0.0, width))
         true_nyq = float(chip.true_mtf(0.5))
         x, profile = _true_profile(sensor, width)
@@ -121,14 +122,9 @@ def estimator_tables(methods) -> tuple[list[dict], dict]:
                      "paper_fwhm_diff_pct": "", "paper_mtf_diff_pct": ""})
         for correct in (False, True):
             for method in methods:
-                r: MTFResult
-                if kind == "edge":
-                    r = EdgeEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(chip.image)
-                    fw = r.fwhm_px
-                else:
-                    pulse = PulseEstimator(method, correct=correct, intervals=NO_INTERVALS, force=True)(
-                        chip.image, width_px=width)
-                    r, fw = pulse, pulse.prf_fwhm_px
+                estimator = target.make_estimator(method, correct=correct, intervals=NO_INTERVALS, force=True)
+                r: MTFResult = estimator(chip.image, **target.estimator_keywords(width))
+                fw = r.lsf_like()[2]        # the paper's FWHM: an edge's LSF's, a bar's pulse response's
                 curves[kind]["corrected" if correct else "as published"][method] = r
                 paper = PAPER_TABLE[kind].get(method, ("", "")) if not correct else ("", "")
                 rows.append({"target": kind, "method": method, "corrected": "yes" if correct else "no",
@@ -210,8 +206,9 @@ def run_study(out: str | Path, *, quick: bool = False, workers: int = 1, seed: i
     from . import plot
     figures = {
         "fig02_03_sensor.png": plot.plot_sensor(sensor),
-        "fig09_edge_estimates.png": plot.plot_estimates("edge", curves["edge"], methods),
-        "fig10_pulse_estimates.png": plot.plot_estimates("pulse", curves["pulse"], methods, PULSE_WIDTH_PX),
+        "fig09_edge_estimates.png": plot.plot_estimates("edge", curves["edge"], methods, paper_figure=9),
+        "fig10_pulse_estimates.png": plot.plot_estimates("pulse", curves["pulse"], methods, PULSE_WIDTH_PX,
+                                                         paper_figure=10),
         "fig12_system_noise.png": plot.plot_noise_sweep(system, methods, true_nyq, "System noise"),
         "fig13_ground_noise_layers.png": plot.plot_ground_noise_layers(GroundNoise(), seed),
         "fig14_ground_noise.png": plot.plot_noise_sweep(ground, methods, true_nyq, "Ground noise"),

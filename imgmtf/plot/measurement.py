@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import textwrap
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -11,11 +11,10 @@ from matplotlib.figure import Figure, SubFigure
 from numpy.typing import ArrayLike
 
 from ..estimate.spectrum import NYQUIST
+from ..kinds import get_kind
 from ._common import check_truth, expect, figure_axes, title_once
 
 if TYPE_CHECKING:
-    from ..estimate.edge import EdgeResult
-    from ..estimate.pulse import PulseResult
     from ..estimate.results import MTFResult
 
 
@@ -118,14 +117,8 @@ def plot_profile(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigur
     """
     expect(result, "result")
     fig, ax = figure_axes(ax)
-    if result.target == "edge":
-        edge = cast("EdgeResult", result)
-        lo, hi = edge.levels_dn
-        x, profile, name = edge.esf_x_px, edge.esf, "ESF"
-    else:
-        bar = cast("PulseResult", result)
-        lo, hi = bar.background_dn, bar.peak_dn
-        x, profile, name = bar.prf_x_px, bar.prf, f"PRF, bar {bar.pulse_width_px:.2f} px"
+    x, profile, (lo, hi) = result.normalised_profile()
+    name = get_kind(result.target).profile_label.format(width_px=result.width_px)
     ax.plot(result.samples_x_px, (result.samples_dn - lo) / (hi - lo), ".", ms=1.5,
             color="0.6", label="pixels")
     ax.plot(x, profile, "-", color="C0", label=f"{result.method} profile")
@@ -301,12 +294,12 @@ def missing_cause(result, figure: str) -> str:
     """
     f, mtf = result.frequencies_cy_px, result.mtf
     masked = ~np.isfinite(mtf)
-    by_sinc = "masked by the bar's sinc"
+    masking = get_kind(result.target).masked_by      # what zeroes the kind's divisor, if anything
     if figure == "mtf_nyquist":
-        return by_sinc if result.target == "pulse" and masked[np.argmin(np.abs(f - NYQUIST))] else "undefined"
+        return f"masked by {masking}" if masking and masked[np.argmin(np.abs(f - NYQUIST))] else "undefined"
     first_masked = int(np.argmax(masked)) if masked.any() else mtf.size
-    if result.target == "pulse" and masked.any() and np.all(mtf[:first_masked] > 0.5):
-        return by_sinc
+    if masking and masked.any() and np.all(mtf[:first_masked] > 0.5):
+        return f"masked by {masking}"
     if first_masked and np.all(mtf[:first_masked] > 0.5):
         return f"undefined: the MTF stays above 0.5 up to {f[first_masked - 1]:g} cy/px"
     return "undefined"

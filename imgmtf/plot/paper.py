@@ -8,6 +8,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..estimate.spectrum import NYQUIST
+from ..kinds import get_kind
 from ..metrics import fwhm
 from ._common import figure_axes
 
@@ -58,7 +59,8 @@ def plot_noise_sweep(rows: Sequence[Mapping[str, Any]], methods: Sequence[str], 
     return fig
 
 
-def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: float = 0.0) -> Figure:
+def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: float = 0.0,
+                   paper_figure: int | None = None) -> Figure:
     """Each method's estimate of a noise-free chip against the truth (paper
     Figs. 9 and 10): the LSF of an edge (or the pulse response of a bar
     ``width_px`` wide), the MTF, and the MTF's error, as published (top) and
@@ -76,6 +78,8 @@ def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: fl
         The resampling methods drawn.
     width_px : float, optional
         The bar's width, px (a pulse; default 0).
+    paper_figure : int, optional
+        The paper's figure these estimates reproduce, named in the title.
 
     Returns
     -------
@@ -94,8 +98,9 @@ def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: fl
     fig = Figure(figsize=(15, 10.5), layout="constrained")
     axes = fig.subplots(2, 3)
     x_true, profile_true, f_true, mtf_true = curves["truth"]
-    name = "LSF (1/px)" if kind == "edge" else "pulse response (peak 1)"
-    view = 4.0 if kind == "edge" else 4.0 + width_px / 2
+    target = get_kind(kind)
+    name = f"{target.lsf_label} ({target.lsf_scale})"
+    view = 4.0 + width_px / 2
     for row, variant in zip(axes, ("as published", "corrected")):
         profile_ax, mtf_ax, error_ax = row
         profile_ax.plot(x_true, profile_true, color="k", lw=2.4, alpha=0.35,
@@ -104,20 +109,20 @@ def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: fl
                     label=f"true: {float(np.interp(NYQUIST, f_true, mtf_true)):.4f}")
         for i, method in enumerate(methods):
             r = curves[variant][method]
-            x, profile = (r.lsf_x_px, r.lsf) if kind == "edge" else (r.prf_x_px, r.prf)
+            x, profile, _ = r.lsf_like()
             colour = f"C{i}"
             profile_ax.plot(x, profile, color=colour, lw=1.0, label=f"{method}: FWHM {fwhm(x, profile):.3f} px")
             mtf_ax.plot(r.frequencies_cy_px, r.mtf, color=colour, lw=1.0, label=f"{method}: {r.mtf_nyquist:.4f}")
             error_ax.plot(r.frequencies_cy_px, r.mtf - np.interp(r.frequencies_cy_px, f_true, mtf_true),
                           color=colour, lw=1.0, label=method)
         profile_ax.set(xlim=(-view, view), xlabel="distance along the normal (px)", ylabel=name,
-                       title=f"{'LSF' if kind == 'edge' else 'pulse response'}, {variant}")
+                       title=f"{target.lsf_label}, {variant}")
         masked = np.isnan(curves[variant][methods[0]].mtf)
-        if kind == "pulse" and masked.any():
+        if target.masked_by and masked.any():
             f_masked = curves[variant][methods[0]].frequencies_cy_px[masked]
             for ax in (mtf_ax, error_ax):
                 ax.axvspan(f_masked.min(), f_masked.max(), color="0.5", alpha=0.12, lw=0,
-                           label="masked: the bar's sinc zero" if ax is mtf_ax else None)
+                           label=f"masked: {target.masked_by} zero" if ax is mtf_ax else None)
         mtf_ax.set(xlim=(0, 1), ylim=(0, 1.05), xlabel="frequency along the normal (cy/px)", ylabel="MTF",
                    title=f"MTF, {variant}")
         error_ax.axhline(0, color="k", lw=0.8)
@@ -130,9 +135,9 @@ def plot_estimates(kind: str, curves: dict, methods: Sequence[str], width_px: fl
         profile_ax.legend(**below)
         mtf_ax.legend(**below, title="MTF at Nyquist", title_fontsize="small")
         error_ax.legend(**{**below, "ncols": 4})
-    target = "edge" if kind == "edge" else f"{width_px:g} px bar"
-    fig.suptitle(f"Estimates of a noise-free {target} (40 x 40 px, 6 deg, the paper's sensor) by each method "
-                 f"against the truth (paper Fig. {9 if kind == 'edge' else 10})\ntop: as published, each "
+    reproduced = "" if paper_figure is None else f" (paper Fig. {paper_figure})"
+    fig.suptitle(f"Estimates of a noise-free {target.described.format(width_px=width_px)} (40 x 40 px, 6 deg, "
+                 f"the paper's sensor) by each method against the truth{reproduced}\ntop: as published, each "
                  "method's own blur left in; bottom: corrected, each method's blur divided out (imgmtf's default)")
     return fig
 
