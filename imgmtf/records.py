@@ -35,6 +35,7 @@ import numpy as np
 
 from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
+from .kinds import KINDS
 from .version import __version__
 
 OK_STATUSES = ("ok", "accepted", "combined", "fitted")
@@ -297,7 +298,7 @@ class Record:
 # The summary columns of measure and batch rows: provenance, outcome,
 # figures (units in the names; MTF values are dimensionless, 1 at zero
 # frequency).
-SUMMARY_COLUMNS = (
+SUMMARY_COLUMNS: tuple[str, ...] = (
     "path", "band", "target", "method", "status", "reason", "error",
     "direction", "normal_angle_deg", "tilt_deg", "polarity", "rows_used", "snr",
     "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high",
@@ -305,6 +306,11 @@ SUMMARY_COLUMNS = (
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px",
     "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
+# each kind of target's own figures (imgmtf.kinds.Kind.record_fields) are
+# columns too: the edge's and the bar's sit among the figures above, where
+# they always were; a kind registered later adds its own after them
+SUMMARY_COLUMNS += tuple(name for kind in KINDS.values() for name in kind.record_fields
+                         if name not in SUMMARY_COLUMNS)
 # The MTF curve, one column per frequency along the normal: 0 to 1 cy/px
 # in steps of 0.05 (0.25 and 0.5 cy/px among them), so that a spreadsheet
 # can plot and compare the rows; JSON Lines carry the whole curve (0.01 cy/px).
@@ -328,6 +334,11 @@ CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # rows add the ``stages`` fitted, their ``reduced_chi_square``, whether the
 # model does not fit (``misfit``, with the smallest p-value of the
 # half-edges' residual structure, ``misfit_p``)
+#: a scan row's ``scope``: one candidate (a half-edge, or a bar: named
+#: "edge" whatever the target kind), or a summary of a target or of the scene
+CANDIDATE_SCOPE = "edge"
+TARGET_SCOPE = "target"
+SCENE_SCOPE = "scene"
 SCAN_COLUMNS = (
     "id", "rank", "scope", "target_id", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "line_length_px",
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation", "verdict_by",

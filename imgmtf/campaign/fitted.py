@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..records import Record, utc_now
+from ..records import SCENE_SCOPE, Record, utc_now
 
 if TYPE_CHECKING:
     from ..estimate.fit import SensorFit
@@ -43,7 +43,7 @@ def fit_summaries(fit: SensorFit, path: str, band: int | str | None = None, *, p
                      "fwhm_px": fit.sensor.fwhm_m(axis) / fit.sensor.gsd_m,
                      "n_edges": len(edges), "constrained": True, "misfit": fit.misfit,
                      "gsd_m": edges[0].gsd_m if edges else None, "warnings": list(fit.warnings)},
-            site={"scope": "scene"}, plot=plot,
+            site={"scope": SCENE_SCOPE}, plot=plot,
             params={"stages": [s.name for s in fit.sensor.stages], "confidence": fit.confidence},
             run_utc=run_utc or utc_now()))
     return rows

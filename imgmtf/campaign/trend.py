@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from ..atomic import atomic_output
 from ..errors import FileWriteError, ParameterError
+from ..records import CANDIDATE_SCOPE, SCENE_SCOPE
 
 YEAR_S = 365.25 * 86400.0
 # figure -> its interval's columns in the targets layer (None: it has none)
@@ -171,7 +172,7 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
     for key, by_acquisition in groups.items():
         points: list[Mapping] = []
         for members in by_acquisition.values():
-            scene = [r for r in members if r.get("scope") == "scene"]
+            scene = [r for r in members if r.get("scope") == SCENE_SCOPE]
             points += scene or members
         out[key] = sorted(points, key=lambda r: parse_utc(r["acquired_utc"]))
     return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
@@ -207,7 +208,7 @@ def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> 
     its measured edges (status ``ok``), each a point of method ``edge``."""
     targets = list(targets)
     summarised = {row.get("acquisition_id") for row in targets}
-    chips = [{**row, "method": "edge", "scope": "edge"} for row in edges
+    chips = [{**row, "method": "edge", "scope": CANDIDATE_SCOPE} for row in edges
              if row.get("acquisition_id") not in summarised and row.get("status") == "ok"]
     return [*targets, *chips]
 

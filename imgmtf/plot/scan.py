@@ -8,6 +8,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
+from ..records import TARGET_SCOPE
+
 if TYPE_CHECKING:
     from ..records import Record
 
@@ -137,7 +139,7 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
                                  label=_legend_label("accepted", accepted)))
         for r in accepted:          # each accepted half-edge's id, as in the table and the CSV
             labels.add(r, (0.85, 1.0, 0.85, 0.95), "#004d00", zorder=7, weight="bold")
-    targets = [s for s in summary_rows if s.get("scope") == "target"]
+    targets = [s for s in summary_rows if s.get("scope") == TARGET_SCOPE]
     for target_id in sorted({s["target_id"] for s in targets}):
         rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
         lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"

@@ -25,7 +25,7 @@ from .._stats import t_quantile
 from ..errors import ParameterError
 from ..estimate.geometry import direction_label
 from ..estimate.results import finite
-from ..records import Record
+from ..records import SCENE_SCOPE, TARGET_SCOPE, Record
 
 FAMILY_SPREAD_DEG = 20.0        # normals of one direction family differ by at most this
 FAMILY_GAP_DEG = 10.0           # a gap this wide between sorted normals separates two families
@@ -189,8 +189,8 @@ def summarise_scan(records: list[Record]) -> list[Record]:
     targets = sorted({int(r.site["target_id"]) for r in accepted if r.site.get("target_id") is not None})
     for target in targets:
         members = [(r, f) for r, f in zip(accepted, families) if r.site.get("target_id") == target]
-        out += _family_records(members, {"scope": "target", "target_id": target})
-    out += _family_records(list(zip(accepted, families)), {"scope": "scene"})
+        out += _family_records(members, {"scope": TARGET_SCOPE, "target_id": target})
+    out += _family_records(list(zip(accepted, families)), {"scope": SCENE_SCOPE})
     return out
 
 
@@ -272,7 +272,7 @@ def _summary(group: list[Record], site: dict) -> Record:
         curve = _weighted_average(curves, weights)
         figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
     where = dict(site)
-    if site["scope"] == "target":
+    if site["scope"] == TARGET_SCOPE:
         ends = np.array([[r.site[k] for k in ("x0_px", "y0_px", "x1_px", "y1_px")] for r in group]).reshape(-1, 2)
         where.update(x_px=round(float(ends[:, 0].mean()), 2), y_px=round(float(ends[:, 1].mean()), 2))
     return Record(first.path, first.band, first.target, first.method, "combined", figures=figures, site=where,

@@ -17,7 +17,7 @@ from ..atomic import atomic_output, ensure_folder
 from ..errors import FileWriteError
 from ..figures import save_figure
 from ..io import RasterInfo, read_raster
-from ..records import SCAN_CSV_COLUMNS, Record, json_safe, write_csv
+from ..records import CANDIDATE_SCOPE, SCAN_CSV_COLUMNS, Record, json_safe, write_csv
 from ..version import __version__
 from .detect import display_levels
 
@@ -56,7 +56,7 @@ def to_geojson(records: Sequence[Record], info: RasterInfo, summaries: Sequence[
     else:           # RFC 7946 geometry is longitude/latitude: pixels there would be misplaced
         coordinates = "none: the scene has no CRS; pixel coordinates (x right, y down) are in the properties"
         points = [[] for _ in pixels]
-    features = [{"type": "Feature", "id": r.get("id") if r.get("scope") == "edge" else f"{r['scope']}-{k}",
+    features = [{"type": "Feature", "id": r.get("id") if r.get("scope") == CANDIDATE_SCOPE else f"{r['scope']}-{k}",
                  "geometry": _geometry(p),
                  "properties": {key: value for key, value in r.items() if key not in _CURVES}}
                 for k, (r, p) in enumerate(zip(rows, points))]

@@ -33,9 +33,9 @@ from ..estimate.geometry import direction_label
 from ..figures import with_figure
 from ..inputs import MIN_SIZE_PX, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
-from ..measure_settings import pulse_width_px
+from ..kinds import get_kind
 from ..parallel import run_tasks
-from ..records import Record, utc_now
+from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .detect import (
     BAR_MAX_SEPARATION_PX,
     HalfEdge,
@@ -296,7 +296,7 @@ def _candidates(halves: list[HalfEdge], settings: ScanSettings) -> list[tuple[Ha
     long_enough = [h for h in halves if h.line_length_px >= settings.min_length_px / 2]
     lone, bars = pair_bars([h.segment for h in long_enough])
     out: list[tuple[HalfEdge, tuple[str, str] | None]] = []
-    lone_verdict = ("not-a-bar", "a lone edge, not the two sides of a bar") if settings.target == "pulse" else None
+    lone_verdict = get_kind(settings.target).lone_line
     out += [(long_enough[i], lone_verdict) for i in lone]
     for i, j, bar in bars:
         a, b = long_enough[i], long_enough[j]
@@ -413,21 +413,17 @@ def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record
 def _confident_snr(target: str, rows: int) -> float:
     """The SNR from which the estimator trusts a target of this kind and
     length (:meth:`imgmtf.estimate.kind.TargetKind.confident_snr`)."""
-    from ..estimate.edge import EdgeKind
-    from ..estimate.pulse import PulseKind
-    return (EdgeKind if target == "edge" else PulseKind).confident_snr(rows)
+    return get_kind(target).load("measuring").confident_snr(rows)
 
 
 def _estimate(chip, mask, raster, context: Context, plan: Plan):
     """The estimator's result on the masked chip."""
     settings = context.settings
-    estimator = settings.measure_settings().estimator()
+    measuring = settings.measure_settings()
     common = {"mask": mask, "gsd_m": raster.gsd_m, "dtype": raster.dtype,
               "track_azimuth_deg": context.track_azimuth_deg,
               "saturation": settings.saturation or saturation_levels(raster.dtype)}
-    if settings.target == "edge":
-        return estimator(chip, **common)
-    return estimator(chip, width_px=pulse_width_px(settings.pulse_width, raster), **common)
+    return measuring.estimator()(chip, **measuring.target_keywords(raster), **common)
 
 
 def _clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
@@ -504,7 +500,7 @@ def _candidate_record(half: HalfEdge, context: Context) -> Record:
     """A candidate's record before it is screened: where it lies."""
     segment, info, settings = half.segment, context.info, context.settings
     site = {
-        "scope": "edge",
+        "scope": CANDIDATE_SCOPE,
         "x0_px": round(segment.x0, 2), "y0_px": round(segment.y0, 2),
         "x1_px": round(segment.x1, 2), "y1_px": round(segment.y1, 2),
         "length_px": round(segment.length_px, 1), "line_length_px": round(half.line_length_px, 1),
@@ -513,7 +509,7 @@ def _candidate_record(half: HalfEdge, context: Context) -> Record:
         "ends": [_end(j) for j in half.junctions],
         "roi": list(plan_roi(half, settings).bbox(info.width, info.height)),
     }
-    if segment.width_px > 0 or settings.target == "pulse":
+    if segment.width_px > 0 or get_kind(settings.target).has_width:
         site["bar_width_px"] = round(segment.width_px, 2)
     if not info.transform.is_identity:
         (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)

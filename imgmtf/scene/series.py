@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ImgmtfError, ParameterError
+from ..kinds import get_kind
 from ..records import INTERNAL, Record
 from .settings import ScanSettings
 from .targetfit import DEFAULT_STAGES
@@ -194,7 +195,7 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                 raise
             return SceneOutcome(path, tuple(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
-        if settings.target == "edge" and stages:
+        if get_kind(settings.target).fits_sensor and stages:
             summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
     except ImgmtfError as exc:
         message = " ".join(str(exc).split())

@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike
 
 from ..errors import ImgmtfError, ParameterError
 from ..estimate.results import finite
-from ..records import Record
+from ..kinds import get_kind
+from ..records import CANDIDATE_SCOPE, SCENE_SCOPE, TARGET_SCOPE, Record
 
 #: the stages fitted to a target's half-edges by default: blur and pixel,
 #: what a target's few edges determine on both axes
@@ -99,17 +100,17 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
         raise ParameterError(f"records must be a list of a scan's Records, got {records!r}") from None
     if any(not isinstance(r, Record) for r in records):
         raise ParameterError("records must be a scan's Records (imgmtf.scan_scene)")
-    accepted = [r for r in records if r.ok and r.target == "edge" and r.site.get("scope") == "edge"
+    accepted = [r for r in records if r.ok and get_kind(r.target).fits_sensor and r.site.get("scope") == CANDIDATE_SCOPE
                 and r.site.get("target_id") is not None and r.site.get("roi_polygon_px")]
     if not accepted or track_of(accepted[0]) is None:
         return []
     from ..parallel import run_tasks
     targets = sorted({int(r.site["target_id"]) for r in accepted})
     # each task measures its half-edges again itself (an EdgeResult does not travel between processes)
-    tasks = [([r for r in accepted if r.site["target_id"] == target], {"scope": "target", "target_id": target},
+    tasks = [([r for r in accepted if r.site["target_id"] == target], {"scope": TARGET_SCOPE, "target_id": target},
               stages) for target in targets]
     if len(targets) > 1:        # the scene's fit, the longest, first: the targets' fill the other workers
-        tasks.insert(0, (accepted, {"scope": "scene"}, stages))
+        tasks.insert(0, (accepted, {"scope": SCENE_SCOPE}, stages))
     fitted = list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
                             description="fitting targets"))
     return [row for rows in fitted[1:] + fitted[:1] for row in rows] if len(targets) > 1 else fitted[0]
@@ -190,8 +191,8 @@ def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Rec
             raise ImgmtfError(f"no half-edge could be measured again: {members[0][1]}", reason="unsuitable")
         fit = fit_edges(edges, stages=stages, confidence=_confidence(first))
     except ImgmtfError as exc:
-        what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
-        return [Record(first.path, first.band, "edge", first.method, "rejected", exc.reason,
+        what = f"target {site['target_id']}" if site["scope"] == TARGET_SCOPE else "the scene"
+        return [Record(first.path, first.band, first.target, first.method, "rejected", exc.reason,
                        f"{first.path}: the sensor model could not be fitted to {what}: {' '.join(str(exc).split())}",
                        figures={"summary": "fit"}, site=where, params=_params(first, stages), run_utc=first.run_utc)]
     used = [r for r, e in members if not isinstance(e, str)]
@@ -239,14 +240,14 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
     if frequencies:
         curve, _, _ = fit.mtf_band(np.asarray(frequencies, float), angle)
         figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
-    return Record(first.path, first.band, "edge", first.method, "fitted", figures=figures, site=site,
+    return Record(first.path, first.band, first.target, first.method, "fitted", figures=figures, site=site,
                   params=_params(first, stages), run_utc=first.run_utc)
 
 
 def _warnings(fit, site: dict, ids: list):
     """The fit's own warnings, the misfit said first and for the target;
     an edge named by the scan's id (the fit numbers its inputs 1, 2...)."""
-    what = f"target {site['target_id']}" if site["scope"] == "target" else "the scene"
+    what = f"target {site['target_id']}" if site["scope"] == TARGET_SCOPE else "the scene"
     if fit.misfit:
         yield (f"the sensor model ({', '.join(s.name for s in fit.sensor.stages)}) does not fit {what}'s "
                "half-edges: its across/along-track figures may be biased")
@@ -277,7 +278,7 @@ def _params(record: Record, stages) -> dict:
 def _where(records: list[Record], site: dict) -> dict:
     """A target's site: its centre, the mean of its half-edges' ends."""
     where = dict(site)
-    if site["scope"] == "target":
+    if site["scope"] == TARGET_SCOPE:
         ends = np.array([[r.site[k] for k in ("x0_px", "y0_px", "x1_px", "y1_px")] for r in records]).reshape(-1, 2)
         where.update(x_px=round(float(ends[:, 0].mean()), 2), y_px=round(float(ends[:, 1].mean()), 2))
     return where
