@@ -8,6 +8,7 @@ from dataclasses import asdict
 import click
 
 from ..errors import ParameterError
+from ..kinds import get_kind, kind_names
 from .campaign import CampaignWriter, campaign_options
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .files import check_figure_file, check_output_file
@@ -21,6 +22,7 @@ from .options import (
     parse_band,
     parse_pair,
     parse_roi,
+    width_refusal,
 )
 from .tables import TextRows
 
@@ -35,7 +37,7 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 
 @click.command(short_help="Measure the MTF of the edge or bar in image files or folders.")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
-@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width, 0.2 to 10 px: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
                    "estimated from the profile when omitted")
@@ -80,8 +82,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
     the store with its chip's row as it completes."""
     if plot_path and plot_dir:
         raise click.UsageError("give --plot or --plot-dir, not both")
-    if pulse_width and kind != "pulse":
-        raise click.UsageError("--pulse-width applies to --target pulse only")
+    if pulse_width and not get_kind(kind).has_width:
+        raise click.UsageError(width_refusal())
     with reported_errors():
         from ..parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:

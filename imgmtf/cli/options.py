@@ -6,6 +6,8 @@ import math
 
 import click
 
+from ..kinds import kinds_with_width
+
 MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
 MIN_REPLICATES, MAX_REPLICATES = 20, 5000     # as imgmtf.estimate.intervals checks them
 
@@ -103,6 +105,13 @@ def length_option(default_unit: str):
         except ParameterError as exc:
             raise click.BadParameter(str(exc)) from None
     return parse
+
+
+def width_refusal() -> str:
+    """Why ``--pulse-width`` is refused beside a ``--target`` without a
+    width: it applies to the kinds of target that have one."""
+    wide = " or ".join(f"--target {kind.name}" for kind in kinds_with_width())
+    return f"--pulse-width applies to {wide} only"
 
 
 def parse_pair(ctx, param, value):

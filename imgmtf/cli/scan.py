@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from ..errors import ParameterError
+from ..kinds import get_kind, kind_names
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
     FiniteFloat,
@@ -17,6 +18,7 @@ from .options import (
     length_option,
     parallel_options,
     parse_pair,
+    width_refusal,
 )
 from .tables import print_scan
 
@@ -25,7 +27,7 @@ DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without impo
 
 @click.command(short_help="Find, measure and combine every edge or bar in a scene.")
 @click.argument("scenes", nargs=-1, required=True, type=click.Path())
-@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
               help="shortest straight line worth measuring, px (a checkerboard's inner line counts whole, "
                    "both halves)")
@@ -84,8 +86,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     scanned or has no usable target; on Ctrl-C or SIGTERM the results so
     far are reported and kept (130 or 143): every scene finished is in the
     store."""
-    if pulse_width and kind != "pulse":
-        raise click.UsageError("--pulse-width applies to --target pulse only")
+    if pulse_width and not get_kind(kind).has_width:
+        raise click.UsageError(width_refusal())
     if max_length < min_length:
         raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
     if edge_figures and not out_dir:

@@ -14,9 +14,10 @@ from pathlib import Path
 import click
 
 from ..errors import ParameterError
+from ..kinds import get_kind, kind_names
 from .errors import option_errors, reported_errors
 from .files import check_output_file, load_sensor
-from .options import FiniteFloat, length_option
+from .options import FiniteFloat, length_option, width_refusal
 
 # Bounds of the size-like options (see docs): what a run may allocate.
 DEFAULT_LEVELS_DN = {16: (200.0, 1200.0), 8: (30.0, 210.0)}    # simulate's dark and bright sides
@@ -33,7 +34,7 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 
 
 @click.command(short_help="Render an edge or bar chip through the sensor (GeoTIFF, PNG).")
-@click.option("--target", "kind", type=click.Choice(["edge", "pulse"]), default="edge", show_default=True)
+@click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
               help="angle of the edge's normal from the x (column) axis, degrees in (-90, 90], which "
                    "is the edge's tilt from vertical: near 0 across track, near 90 along track "
@@ -118,17 +119,18 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
             raise click.BadParameter(f"{out}: simulate writes a GeoTIFF (.tif, .tiff), which records the GSD and "
                                      "how the chip was made, or a PNG (.png, pixels only); "
                                      f"got {suffix or 'no suffix'}", param_hint="'--out'")
-        if kind == "pulse" and pulse_width is None:
-            raise click.UsageError("a pulse target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
-        if kind == "edge" and pulse_width is not None:
-            raise click.UsageError("--pulse-width applies to --target pulse only")
+        target_kind = get_kind(kind)
+        if target_kind.has_width and pulse_width is None:
+            raise click.UsageError(f"a {kind} target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
+        if not target_kind.has_width and pulse_width is not None:
+            raise click.UsageError(width_refusal())
         check_output_file(out)
         sensor = load_sensor(sensor_path)
         gsd_m = sensor.gsd_m if gsd is None else gsd
         # simulate reads no input: a value the renderer refuses is a bad option (exit 2)
         with option_errors():
             width_px = 0.0
-            if kind == "pulse":
+            if target_kind.has_width:
                 value, unit = pulse_width
                 width_px = value if unit == "px" else value / gsd_m
                 from ..inputs import MIN_BAR_WIDTH_PX
@@ -147,7 +149,7 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
         else:
             write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
         clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
-        width = f" {width_px:g} px wide" if kind == "pulse" else ""
+        width = f" {width_px:g} px wide" if target_kind.has_width else ""
         click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind}{width} at {angle:g} deg, "
                    f"GSD {chip.gsd_m:g} m; true MTF at Nyquist along the normal "
                    f"{float(chip.true_mtf(0.5)):.4f}{clipped}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from ..kinds import get_kind
 from .hints import refusal_hint, rejection_hint
 
 
@@ -17,13 +18,13 @@ class TextRows:
         self.path_width = max(path_width, 4)
 
     def header(self, confidence: float) -> None:
-        last = "RER" if self.kind == "edge" else "W"
+        last = get_kind(self.kind).column
         first = f"{'path':<{self.path_width}}" + (f" {'band':>4}" if self.bands else "")
         blank = " " * len(first)
         click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
-                   f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last:>6}")
+                   f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last.heading:>6}")
         click.echo(f"{blank} {'deg':>7} {'deg':>5} {'':>7} {'':>5} {'':>7} {'':>17} "
-                   f"{'cy/px':>7} {'px':>6} {'' if self.kind == 'edge' else 'px':>6}")
+                   f"{'cy/px':>7} {'px':>6} {last.unit:>6}")
 
     def write(self, record) -> None:
         click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands))
@@ -40,7 +41,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
     if record["status"] == "error":
         hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
         return f"{first} error: {record['error']}{hint}"
-    last = record.get("rer") if kind == "edge" else record.get("pulse_width_px")
+    last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
     direction = record.get("direction") or "-"
