@@ -1,8 +1,11 @@
 """The registry of target kinds (imgmtf.kinds): lookup, its refusal of an
-unknown kind, each kind's facts and parts."""
+unknown kind, each kind's facts and parts, and the rule it exists for: no
+module outside the registry compares a kind's name."""
+import ast
 import subprocess
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +16,41 @@ from imgmtf.kinds import KINDS, Kind, get_kind, kind_names, kinds_with_width
 from imgmtf.kinds.edge import EDGE
 from imgmtf.kinds.pulse import PULSE
 from imgmtf.records import SUMMARY_COLUMNS
+
+PACKAGE = Path(imgmtf.__file__).parent
+MAX_REGISTRY_COMPARISONS = 4
+
+
+def kind_comparisons(path: Path, names: set[str]) -> list[int]:
+    """The lines of ``path`` that compare a value with one of ``names``
+    (==, !=, in, is, and match's case patterns)."""
+    lines = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Compare):
+            operands = [node.left, *node.comparators]
+            values = [e for o in operands for e in (o.elts if isinstance(o, (ast.Tuple, ast.List, ast.Set)) else [o])]
+            if any(isinstance(v, ast.Constant) and v.value in names for v in values):
+                lines.add(node.lineno)
+        elif isinstance(node, ast.MatchValue) and isinstance(node.value, ast.Constant) and node.value.value in names:
+            lines.add(node.lineno)
+    return sorted(lines)
+
+
+def test_the_comparison_finder_finds_every_form(tmp_path):
+    path = tmp_path / "probe.py"
+    path.write_text('if kind == "edge":\n    pass\nok = "pulse" != kind\nok = kind in ("edge", "x")\n'
+                    'match kind:\n    case "pulse":\n        pass\nok = kind == "bar"\nname = "edge"\n')
+    assert kind_comparisons(path, {"edge", "pulse"}) == [1, 3, 4, 6]
+
+
+def test_no_module_outside_the_registry_compares_a_kind_name():
+    names = set(KINDS)
+    found = {str(path.relative_to(PACKAGE)): lines for path in sorted(PACKAGE.rglob("*.py"))
+             if (lines := kind_comparisons(path, names))}
+    outside = {path: lines for path, lines in found.items() if not path.startswith("kinds/")}
+    assert outside == {}, f"ask imgmtf.kinds.get_kind(name) for the kind's facts instead: {outside}"
+    inside = sum(len(lines) for lines in found.values())
+    assert inside <= MAX_REGISTRY_COMPARISONS
 
 
 def test_lookup_returns_the_registered_kinds_in_order():
