@@ -63,6 +63,7 @@ from .outliers import isolated_outliers
 from .profile_checks import run_profile_checks
 from .quantisation import dequantise
 from .resampling import resample_profile
+from .saturation import saturation_checks
 from .settings import Settings
 from .spectrum import (
     MIN_TRANSFER,
@@ -346,7 +347,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     # the gate
     side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", m, None)
                   for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
-    checks += gate.saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
+    checks += saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
                                      noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
                                      bright_core=kind.peak_mask(s, shape), monotone=kind.monotone,
                                      contrast=contrast, bar_edge_px=None if shape.extra.get("width_estimated", True)

@@ -1,0 +1,229 @@
+"""The saturation checks: a side or a bar's peak clipped at the levels the
+sensor records (an integer type's limits, or a saturation range given), or
+at a level no limit declares, seen as a side held at one exact value, a
+pile-up of samples at the extreme, or a bar's peak cut flat.
+
+Reason ``saturated`` (see :mod:`.gate` for every reason the gate gives).
+"""
+from __future__ import annotations
+
+from statistics import NormalDist
+
+import numpy as np
+
+from .gate import Check
+
+SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
+PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
+HELD_PLATEAU = 0.98             # share of a side's samples beyond where it first meets its extreme still there
+MIN_HELD_SAMPLES = 10
+MIRROR_QUANTA = 2.0             # ...or this many quanta
+HELD_BAND_PX = 0.5
+PIVOT_BAND_PX = 0.1
+MIRROR_CLIP = 0.005             # the other side's distance from its level there (of the contrast): clipped
+FLAT_PEAK = 0.3                 # fraction of a noise-free bar's peak at exactly one value: clipped flat...
+FLAT_SHOULDER = 0.02            # ...unless it is reached gradually, through samples this far below (of the height)
+
+
+def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum, noise_free,
+                      bright_core=None, monotone=True, contrast=None, bar_edge_px=None) -> list[Check]:
+    """Clipping on either side (``sides``: list of (name, mask, level)) or,
+    for a bar, at its peak (``bright_core``: mask of the peak samples).
+    ``limits`` = (low, high) DN the sensor records (integer type limits or
+    the user's), or None.  Clipping no limit declares (float data, 12 bits
+    in 16) shows, where a side holds one exact value from some distance
+    on (a noise-free plateau, or noise cut off), as that value held where
+    the other side has not yet arrived at its own level
+    (:func:`_held_plateau`; ``monotone`` profiles only): a clip cuts the
+    profile off while it still changes, a noise-free level is approached
+    as smoothly as the other side's.  With noise and no such plateau, as
+    a pile-up at one value.  ``contrast``: the step (DN), read off the
+    values where not given; ``bar_edge_px``: a bar's half-width where it is
+    known (given, not read off the profile), the pivot of its top's mirror."""
+    checks = []
+    sides = list(sides)
+    for name, mask, _ in sides:
+        if limits is None or mask.sum() < 5:
+            continue
+        low, high = limits
+        at_limit = float(np.mean((values[mask] <= low) | (values[mask] >= high)))
+        checks.append(Check("saturated", at_limit <= SATURATED_SIDE,
+                            f"the {name} side is saturated ({100 * at_limit:.0f} % of its samples at {low:g} "
+                            f"or {high:g} DN): its true level is unknown", at_limit, SATURATED_SIDE))
+    if monotone:
+        halves = (distance < centre, distance > centre)      # the sides are listed left, right
+        if contrast is None:
+            contrast = abs(float(np.median(values[halves[1]]) - np.median(values[halves[0]])))
+        for (name, mask, _), half, other in zip(sides, halves, halves[::-1]):
+            held = _held_plateau(distance, values, half, other, centre, name, contrast, quantum)
+            if held is not None:
+                checks.append(held)
+            elif not noise_free and mask.sum() >= 5:
+                checks.append(_pile_up(name, values, mask, quantum, contrast))
+    elif not noise_free:
+        for name, mask, _ in sides:
+            if mask.sum() >= 5:
+                checks.append(_pile_up(name, values, mask, quantum))
+    if bright_core is not None and bright_core.sum() >= 5:
+        v = values[bright_core]
+        background = float(np.median(values[~bright_core]))
+        outward = 1.0 if v.mean() >= background else -1.0
+        extreme = v.max() if outward > 0 else v.min()
+        if limits is not None and (extreme <= limits[0] or extreme >= limits[1]):
+            checks.append(Check("saturated", False, f"the bar's peak reaches the saturation limit {extreme:g} DN: "
+                                "its true height is unknown", extreme, None))
+        elif noise_free:
+            checks.append(_held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px)
+                          or _flat_top(v, extreme, outward, abs(extreme - background)))
+        else:
+            checks.append(_pile_up("peak", values, bright_core, quantum))
+    return checks or [Check("saturated", True, "no side reaches a saturation limit")]
+
+
+def _held_plateau(distance, values, half, other, centre, name, contrast, quantum) -> Check | None:
+    """A side that holds one exact value from a distance r0 on (r0 where
+    the run of 0.5-px bands each with at least ``HELD_PLATEAU`` of its
+    samples at the side's extreme begins, holding ``MIN_HELD_SAMPLES``), checked
+    against the other side at r0: an unclipped profile has arrived there
+    too (within ``MIRROR_CLIP`` of the contrast, or ``MIRROR_QUANTA`` quanta); a clip
+    holds its value where the other side is still on its way.  None where
+    the side holds no such plateau (noise)."""
+    s = np.abs(distance - centre)
+    v, sv = values[half], s[half]
+    if v.size < 5 or not other.any() or contrast <= 0:
+        return None
+    outward = 1.0 if v.mean() >= np.median(values[other]) else -1.0
+    extreme = v.max() if outward > 0 else v.min()
+    # r0: the nearest distance beyond which the side holds its extreme
+    # (a generator's last-digit wobble near the plateau aside)
+    band = np.floor(sv / HELD_BAND_PX).astype(int)
+    counts = np.bincount(band)
+    share = np.bincount(band, weights=(v == extreme).astype(float)) / np.maximum(counts, 1)
+    failing = np.nonzero((counts > 0) & (share < HELD_PLATEAU))[0]
+    first = failing[-1] + 1 if failing.size else 0          # the bands from here out all hold it
+    if counts[first:].sum() < MIN_HELD_SAMPLES:
+        return None
+    r0 = float(sv[band >= first].min())
+    so, vo = s[other], values[other]
+    level = float(np.median(vo[so >= 0.5 * (r0 + so.max())])) if (so >= r0).any() else float(np.median(vo))
+    gap = _gap_at(so, vo, r0, level, contrast)
+    if gap is None:
+        return None
+    limit = max(MIRROR_CLIP, MIRROR_QUANTA * quantum / contrast)
+    return Check("saturated", gap <= limit,
+                 f"the {name} side holds exactly {extreme:g} DN from {r0:.2f} px out, where the other side is "
+                 f"still {100 * gap:.1f} % of the contrast from its level (at most {100 * limit:.1f} %): clipped",
+                 gap, limit)
+
+
+def _gap_at(distance, values, at_px, level, scale) -> float | None:
+    """How far (a fraction of ``scale``) the samples at ``at_px`` from the
+    centre (their median, within 0.25 px, widened to 2 px for at least 3
+    samples) stand from ``level``; None where none lie near."""
+    width = 0.25
+    near = np.abs(distance - at_px) <= width
+    while near.sum() < 3 and width < 2.0:
+        width *= 2
+        near = np.abs(distance - at_px) <= width
+    if not near.any():
+        return None
+    return abs(float(np.median(values[near])) - level) / scale
+
+
+def _flat_top(peak_values, extreme, outward, height) -> Check:
+    """A noise-free bar's peak clipped flat: much of it at exactly one value,
+    met steeply (few samples within ``FLAT_SHOULDER`` of the bar's height
+    below it).  A bar wider than its blur has a flat top of its own, but
+    reaches it gradually, through a shoulder of samples just below.
+    ``height``: the peak's height above the background (DN)."""
+    at_top = peak_values == extreme
+    below = outward * (extreme - peak_values)
+    shoulder = np.count_nonzero((below > 0) & (below <= FLAT_SHOULDER * height))
+    ratio = at_top.sum() / max(shoulder, 1)
+    clipped = at_top.mean() > FLAT_PEAK and ratio > PILE_UP
+    return Check("saturated", not clipped,
+                 f"{100 * at_top.mean():.0f} % of the bar's peak sits at exactly {extreme:g} DN, {ratio:.1f} x as "
+                 f"many samples as within {100 * FLAT_SHOULDER:g} % of its height below it: its top is clipped "
+                 "flat", ratio, PILE_UP)
+
+
+def _held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px=None) -> Check | None:
+    """A noise-free bar whose top holds one exact value out to r_top from
+    its centre, checked as an edge's held side is: mirrored about the bar's
+    side h (``bar_edge_px`` where the width is known, else where the side is
+    steepest), the background at 2 h - r_top has arrived at its
+    level too when the top is the bar's own (a bar wider than its blur; the
+    top sums both sides' tails, the background at most as much), and is
+    still on its way when a clip cut the top off.  None where the top holds
+    no run of exact values from the centre (the steepness test decides)."""
+    s = np.abs(distance - centre)
+    band = np.floor(s / HELD_BAND_PX).astype(int)
+    counts = np.bincount(band)
+    at = np.bincount(band, weights=(values == extreme).astype(float))
+    holding = (counts > 0) & (at >= HELD_PLATEAU * counts)
+    if counts.size < 4 or not holding[0]:
+        return None
+    run = int(np.argmin(holding)) if not holding.all() else holding.size
+    top = band < run
+    if top.sum() < MIN_HELD_SAMPLES:
+        return None
+    far = s >= 0.75 * s.max()
+    background = float(np.median(values[far]))
+    height = outward * (extreme - background)
+    if height <= 0:
+        return None
+    # the pivot: the bar's side at its steepest (a clip leaves it where it was)
+    fine = np.floor(s / PIVOT_BAND_PX).astype(int)
+    fine_counts = np.bincount(fine)
+    filled = fine_counts > 0
+    centres = (np.nonzero(filled)[0] + 0.5) * PIVOT_BAND_PX
+    means = np.bincount(fine, weights=values)[filled] / fine_counts[filled]
+    slope = outward * np.diff(means) / np.diff(centres)
+    steepest = int(np.argmin(slope))
+    if slope[steepest] >= 0:
+        return None
+    pivot = bar_edge_px or 0.5 * (centres[steepest] + centres[steepest + 1])
+    r_top = float(s[(values == extreme) & (s < pivot)].max())      # where the top's exact value ends
+    mirror = 2.0 * pivot - r_top
+    gap = _gap_at(s, values, mirror, background, height)
+    if gap is None:
+        return None
+    limit = max(MIRROR_CLIP, MIRROR_QUANTA * quantum / height)
+    return Check("saturated", gap <= limit,
+                 f"the bar's top holds exactly {extreme:g} DN out to {r_top:.2f} px from its centre, where (mirrored "
+                 f"about its side, {pivot:.2f} px out) the background is still "
+                 f"{100 * gap:.1f} % of the height from its level (at most {100 * limit:.1f} %): its top is "
+                 "clipped flat", gap, limit)
+
+
+def _pile_up(name, values, mask, quantum, contrast=None) -> Check:
+    """With noise, clipping piles samples up at exactly the extreme value:
+    many there, few at the nearest value present inside it (one quantum
+    where the values are dense); a natural noise tail thins out instead.
+
+    Given the ``contrast`` (an edge's side), a clip that trims only the
+    noise's outer tail (the side's median inside it) passes when it moves
+    the side's level by less than ``MIRROR_CLIP`` of the contrast: for a
+    normal noise of sd sigma cut at z sd beyond the level, by
+    sigma (phi(z) - z P(Z > z)) (a generator's last-digit wobble at a
+    flat white level piles up so, harmlessly)."""
+    v = values[mask]
+    outward = 1.0 if v.mean() >= np.median(values[~mask]) else -1.0
+    extreme = v.max() if outward > 0 else v.min()
+    at_extreme = v == extreme
+    inside = outward * (extreme - v)
+    # the nearest value present inside it: the quantum, or wider where the
+    # values are sparser (a generator's own rounding steps)
+    nearest = float(inside[inside > 0].min()) if (inside > 0).any() else 1.0
+    q = max(quantum, nearest)
+    just_inside = np.count_nonzero((inside > 0) & (inside <= 1.5 * q))
+    ratio = at_extreme.sum() / max(just_inside, 1)
+    share = float(at_extreme.mean())
+    clipped = share > 0.05 and ratio > PILE_UP
+    if clipped and contrast and share < 0.5:
+        sigma = 1.4826 * float(np.median(np.abs(v - np.median(v))))
+        z = NormalDist().inv_cdf(1.0 - share)
+        clipped = sigma * (NormalDist().pdf(z) - z * share) > MIRROR_CLIP * contrast
+    return Check("saturated", not clipped,
+                 f"{100 * share:.0f} % of the {name} side's samples sit at exactly "
+                 f"{extreme:g} DN, {ratio:.1f} x as many as just inside it: clipped", ratio, PILE_UP)
