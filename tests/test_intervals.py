@@ -7,7 +7,8 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.estimate.intervals import Bootstrap, percentile_interval, row_weights, spectral_figures
+from imgmtf.estimate.intervals import Bootstrap
+from imgmtf.estimate.intervals.bootstrap import percentile_interval, row_weights, spectral_figures
 from imgmtf.estimate.resampling import resample_profile
 
 from conftest import exact_edge_chip, gaussian_pixel_transfer

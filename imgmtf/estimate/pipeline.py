@@ -36,7 +36,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._stats import t_quantile
 from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
 from ..metrics import fwhm
@@ -51,13 +50,9 @@ from .geometry import (
     profile_samples,
     vertical_frame,
 )
-from .intervals import (
-    Interval,
-    bootstrap_figures,
-    influence_sd,
-    influence_sds,
-    linearised_interval,
-)
+from .intervals import Interval
+from .intervals.bootstrap import bootstrap_intervals
+from .intervals.influence import influence_intervals
 from .kind import TargetKind, refuse_other_kind
 from .outliers import isolated_outliers
 from .profile_checks import run_profile_checks
@@ -82,22 +77,6 @@ TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as
 LONG_TAIL_SHARE = 0.03            # tails beyond the core holding more of the signal keep the clean window
 INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
 CORE_STEP_PX = 0.5                # the core grows in these steps while the tail model misfits
-# The estimator's own error where noise is not the whole error, added in
-# quadrature to the interval: on exact chips the worst error at Nyquist is
-# about 0.0005 for Gaussian-type blurs; the tail model's share of the
-# signal is uncertain to about a tenth of itself.
-SYSTEMATIC_NYQUIST = 0.0008
-SYSTEMATIC_MTF50 = 0.001          # relative
-TAIL_MODEL_UNCERTAINTY = 0.1
-# A rebuilt staircase (a noise-free quantised edge) is off by up to 0.01 at
-# Nyquist and 0.5 % in MTF50 on 12-30 DN edges, and its residuals are nil
-SYSTEMATIC_DEQUANTISED = 0.005
-SYSTEMATIC_DEQUANTISED_MTF50 = 0.003      # relative
-# The window narrowed for noise cuts the LSF a little: at its narrowest (a
-# third narrower) MTF50 reads about 1 % and MTF at Nyquist 0.002 high
-NARROW_WINDOW_NYQUIST = 0.009
-NARROW_WINDOW_MTF50 = 0.03                # relative
-LEVERAGE_CAP = 0.9
 BACKGROUND_FRACTION = 2.0 / 3.0   # a bar's background is read from the samples beyond this share of the range
 WIDTH_SHARE_WARNING = 0.5         # an estimated width making more of the variance at Nyquist is worth a warning
 MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
@@ -378,7 +357,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     # intervals
     nyquist_ci = mtf50_ci = Interval.none()
     if settings.intervals.method == "influence":
-        nyquist_ci, mtf50_ci, width_share = _influence_intervals(
+        nyquist_ci, mtf50_ci, width_share = influence_intervals(
             settings.intervals, mtf, mtf_nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
             tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share, rebuilt is not None,
             narrowed, width_influence)
@@ -392,7 +371,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
             warnings.append(f"the bootstrap holds the bar's width ({shape.extra['width_px']:.3f} px, read "
                             "off its profile) fixed, so its intervals leave out the width's uncertainty: "
                             "give the width if it is known, or use the default (influence) intervals")
-        nyquist_ci, mtf50_ci = _bootstrap_intervals(
+        nyquist_ci, mtf50_ci = bootstrap_intervals(
             settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
     # an MTF (a modulus) and a frequency are never negative: ends below 0 are raised to 0 (docs/method.md)
     nyquist_ci, mtf50_ci = nyquist_ci.clipped_at_zero(), mtf50_ci.clipped_at_zero()
@@ -471,135 +450,3 @@ def _normal_angle(geometry: TargetGeometry) -> float:
         return vertical
     angle = 90.0 - vertical
     return angle - 180.0 if angle > 90.0 else angle
-
-
-def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
-                         tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share,
-                         dequantised, narrowed, width_influence):
-    """Linearised intervals for MTF at Nyquist and MTF50 (see
-    :mod:`.intervals`).
-
-    The transform F(f) = sum_k e_k(f) [w_k lsf_k + (1 - w_k) model_k] is
-    linear in the samples: through the LSF operator and the resampling
-    (their adjoints) where the window holds data, through each side's tail
-    amplitude (its least-squares operator), and for a bar through the
-    background under the window.  Each figure is |F(f)| / |F(0)| divided by
-    the corrections, so its gradient follows, and with each sample's
-    residual (scaled up by its leverage) gives the row influences.  Where
-    the divisor rests on a width read off the same samples
-    (``width_influence``: its :class:`WidthReading` and a function giving
-    dR(f) / dv), its
-    pull joins the gradient, widened where Fieller's set for the zero is
-    wider than the linearised one; the share of the variance at Nyquist it
-    makes is returned third (None without it)."""
-    step = float(x[1] - x[0])
-    width_share = None
-    freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
-    e = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                   # (n_f, n_x)
-    left = x < c
-    model = np.where(left, amplitudes[0], amplitudes[1]) * tail_shape
-    transform = e @ (w * lsf + (1.0 - w) * model)
-    weighted = (e * w)[:, data_at]
-    on_grid = lsf_adjoint(np.concatenate([weighted.real, weighted.imag]))
-    full = np.zeros((on_grid.shape[0], resampled.grid.size))
-    full[:, span[0]: span[1]] = on_grid
-    through = resampled.adjoint(full)
-    n_f = freqs.size
-    grad_f = through[:n_f] + 1j * through[n_f:]                                  # dF(f) / dv
-    for i, side in enumerate(sides):
-        in_side = left if i == 0 else ~left
-        per_amplitude = e @ ((1.0 - w) * tail_shape * in_side)
-        idx = np.nonzero(side.mask)[0]
-        grad_f[:, idx] += per_amplitude[:, None] * (to_amplitude[i] @ side.operator)[None, :]
-        if kind.subtracts_background:
-            grad_f[:, idx] -= 0.5 * (e @ w)[:, None] * side.operator[0][None, :]
-    f0 = transform[0].real
-    run_grid, run_values = resampled.grid[span[0]: span[1]], resampled.values[span[0]: span[1]]
-    # each sample's residual from the profile: the resampled one where it
-    # was resampled, the side's model beyond
-    far = np.abs(d - c) ** -float(kind.tail_power)
-    model_dn = np.where(d < c, sides[0].coef[0] + sides[0].coef[1] * far, sides[1].coef[0] + sides[1].coef[1] * far)
-    inside = (d >= run_grid[0]) & (d <= run_grid[-1])
-    residual = v - np.where(inside, np.interp(d, run_grid, run_values), model_dn)
-    if resampled.leverage is not None:
-        residual = residual / np.sqrt(1.0 - np.minimum(resampled.leverage, LEVERAGE_CAP))
-    width_pull = None
-    if width_influence is not None:
-        reading, spectrum_pull = width_influence
-        dspectrum_dv = spectrum_pull()
-        dwidth_dv = reading.width_change(dspectrum_dv[0])
-        width_sd, n_rows = influence_sd(dwidth_dv * residual, row)
-        spectrum_sd, _ = influence_sds(dspectrum_dv[1:] * residual, row)
-        t = t_quantile(0.5 + intervals.confidence / 2, max(n_rows - 1, 1))
-        spread = reading.spread_px(spectrum_sd, t)
-        widen = max(1.0, spread / (t * width_sd)) if width_sd > 0 else 1.0
-        width_pull = (widen * dwidth_dv, reading.log_slope)
-    out = []
-    for j in range(1, n_f):
-        fj, f = transform[j], freqs[j]
-        ratio = abs(fj) / abs(f0)
-        # the MTF is this ratio divided by the corrections: scale the gradient alike
-        scale = float(mtf(np.array([f]))[0]) / ratio if ratio else 0.0
-        grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
-        if width_pull is not None:
-            dwidth_dv, log_slope = width_pull
-            if j == 1:
-                fixed_sd, _ = influence_sd(grad * residual, row)
-            # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
-            grad = grad - float(mtf(np.array([f]))[0]) * float(log_slope(f)) * dwidth_dv
-        sd, n_rows = influence_sd(grad * residual, row)
-        if j == 1 and width_pull is not None:
-            width_share = 1.0 - (fixed_sd / sd) ** 2 if sd > 0 else 0.0
-        if j == 1:
-            systematic = (SYSTEMATIC_NYQUIST + TAIL_MODEL_UNCERTAINTY * abs(tail_share) * abs(nyquist)
-                          + (SYSTEMATIC_DEQUANTISED if dequantised else 0.0) + NARROW_WINDOW_NYQUIST * narrowed)
-            out.append(linearised_interval(nyquist, sd, n_rows, intervals.confidence, systematic))
-        else:
-            h = 1e-3
-            slope = float(mtf(np.array([f50 + h]))[0] - mtf(np.array([f50 - h]))[0]) / (2 * h)
-            sd50 = sd / abs(slope) if slope else math.inf
-            systematic = f50 * (SYSTEMATIC_MTF50 + TAIL_MODEL_UNCERTAINTY * abs(tail_share)
-                                + (SYSTEMATIC_DEQUANTISED_MTF50 if dequantised else 0.0)
-                                + NARROW_WINDOW_MTF50 * narrowed)
-            out.append(linearised_interval(f50, sd50, n_rows, intervals.confidence, systematic))
-    while len(out) < 2:
-        out.append(Interval.none())
-    return out[0], out[1], width_share
-
-
-def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, x, span_px):
-    """Bootstrap intervals: every replicate re-resamples the rows it drew
-    (within ``span_px`` of the line), refits its sides' levels and tails,
-    and is windowed onto the lattice ``x`` as the estimate is."""
-    s = d - c
-    masks = [s <= -start[0], s >= start[1]]
-    to_amplitude = kind.lsf_tail_amplitudes()
-    step = float(x[1] - x[0])
-    sx = x - c
-    shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
-
-    def resample(keep, weights, span):
-        return resample_profile(d[keep], v[keep], method=settings.method, step=settings.step_px,
-                                half_range=span, weights=weights, **settings.method_options)
-
-    def windowed(grid_b, values_b, weights_of):
-        coefs = []
-        for mask in masks:
-            u = np.abs(s[mask]) ** -float(kind.tail_power)
-            design = np.column_stack([np.ones_like(u), u])
-            wts = weights_of(mask)
-            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
-            rhs = np.einsum("ri,ij,i->rj", wts, design, v[mask])
-            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
-        background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
-        x_data, lsf_data, _ = kind.lsf(grid_b, values_b, background[:, None])
-        first = int(round((x_data[0] - x[0]) / step))
-        lsf = np.zeros((lsf_data.shape[0], x.size))
-        lsf[:, first: first + x_data.size] = lsf_data
-        in_data = np.zeros(x.size, bool)
-        in_data[first: first + x_data.size] = True
-        amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
-        w = flat_top_window(x, c, core, taper) * in_data
-        model = np.where(sx < 0, amp[0][:, None], amp[1][:, None]) * shape
-        return w * lsf + (1.0 - w) * model
-    return bootstrap_figures(settings.intervals, d, row, span_px, resample, windowed, step, divisor)
