@@ -26,7 +26,8 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
-from .kind import Shape, TargetKind, WidthReading
+from .intervals.width import WidthReading
+from .kind import Shape, TargetKind
 from .pipeline import BACKGROUND_FRACTION, TAPER_FACTOR, run
 from .results import MTFResult, finite
 from .settings import make_settings
@@ -329,7 +330,7 @@ def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast
     profile normalised by ``contrast_dn`` (its values minus the background,
     over the peak's height in DN): R(f) and its pull on the profile's
     values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
-    about it, for the intervals (:class:`imgmtf.estimate.kind.WidthReading`).
+    about it, for the intervals (:class:`imgmtf.estimate.intervals.width.WidthReading`).
 
     Examples
     --------
