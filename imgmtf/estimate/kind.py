@@ -93,6 +93,12 @@ class TargetKind:
         """The samples of a bar's peak (None for an edge)."""
         raise NotImplementedError
 
+    def known_half_width_px(self, shape: Shape) -> float | None:
+        """Half the target's width (px) where the caller gave it (a bar's),
+        the pivot of the saturation check's mirror of its top; None where
+        it is unknown or read off the profile."""
+        return None
+
     def read_width(self, grid: np.ndarray, shape: Shape) -> WidthReading | None:
         """Where the divisor rests on a width read off the profile (a bar's
         estimated width), how it was read (:class:`WidthReading`), so that

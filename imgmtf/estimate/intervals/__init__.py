@@ -1,6 +1,15 @@
-"""Confidence intervals for MTF figures.
+"""Confidence intervals for MTF figures: a registry of methods
+(:data:`METHODS`, name -> function) behind one dispatcher,
+:func:`intervals`, and their settings (:class:`Intervals`).
 
-Two methods behind one setting (:class:`Intervals`):
+A method is a function ``method(estimate, **options) -> FigureIntervals``
+taking the :class:`Estimate` (the pipeline's records of the estimate) and
+any of the options ``confidence``, ``replicates`` and ``seed`` it names;
+adding one is a module beside :mod:`.influence` and :mod:`.bootstrap` and
+one entry in :data:`METHODS` (the CLI's ``--intervals`` choices follow it,
+a test checks).
+
+``none`` gives no intervals (NaN ends).
 
 ``influence`` (the default) linearises the estimate: with the target line,
 the LSF window and the corrections held fixed, every stage from the pixel
@@ -26,16 +35,48 @@ The interval's coverage is measured on noisy chips of known MTF by
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import inspect
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from ...errors import ParameterError
-from .interval import Interval
+from .bootstrap import bootstrap_intervals
+from .influence import influence_intervals
+from .interval import Estimate, FigureIntervals, Interval
 
-__all__ = ["MAX_REPLICATES", "METHODS", "NO_INTERVALS", "Bootstrap", "Interval", "Intervals", "as_intervals"]
+__all__ = ["MAX_REPLICATES", "METHODS", "NO_INTERVALS", "Bootstrap", "Estimate", "FigureIntervals", "Interval",
+           "Intervals", "as_intervals", "intervals", "no_intervals"]
 
-METHODS = ("influence", "bootstrap", "none")
+
+def no_intervals(estimate: Estimate) -> FigureIntervals:
+    """No intervals: the method ``none``.
+
+    Parameters
+    ----------
+    estimate : Estimate
+        The estimate (unread).
+
+    Returns
+    -------
+    FigureIntervals
+        NaN ends for both figures.
+
+    Examples
+    --------
+    >>> no_intervals(None).mtf_nyquist              # it reads nothing of the estimate
+    Interval(low=nan, high=nan)
+    """
+    return FigureIntervals.none()
+
+
+#: the interval methods by name: linearised (row influence), a bootstrap over rows, none
+METHODS: dict[str, Callable[..., FigureIntervals]] = {
+    "influence": influence_intervals,
+    "bootstrap": bootstrap_intervals,
+    "none": no_intervals,
+}
 MAX_REPLICATES = 5000           # 200 are plenty; more only costs memory and time
 
 
@@ -157,3 +198,55 @@ def as_intervals(value) -> Intervals:
         return Bootstrap(int(value))
     raise ParameterError(f"intervals must be None, an Intervals, one of {', '.join(map(repr, METHODS))}, or a "
                          f"number of bootstrap replicates; got {value!r}")
+
+
+def intervals(estimate: Estimate, method: str = "influence", *, confidence: float = 0.95, replicates: int = 200,
+              seed: int = 0) -> FigureIntervals:
+    """The intervals of an estimate's MTF at Nyquist and MTF50 by ``method``.
+
+    The options are checked as :class:`Intervals` checks them and each
+    method is given those it names (``none`` none, ``influence`` the
+    confidence, ``bootstrap`` all three).  Ends below 0 are raised to 0:
+    an MTF (a modulus) and a frequency are never negative.
+
+    Parameters
+    ----------
+    estimate : Estimate
+        The estimate (:attr:`imgmtf.estimate.pipeline.Measurement.estimate`).
+    method : str, optional
+        A key of :data:`METHODS`: "influence" (default), "bootstrap" or "none".
+    confidence : float, optional
+        Coverage the intervals aim at, in (0, 1).
+    replicates : int, optional
+        Bootstrap replicates (20 to 5000).
+    seed : int, optional
+        The bootstrap's random seed.
+
+    Returns
+    -------
+    FigureIntervals
+        The intervals of the MTF at Nyquist and of MTF50 (cy/px), and what
+        the method says of them.
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or an option out of range.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.pipeline import run
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=5.0, seed=1)
+    >>> estimate = run(EdgeKind(), chip.image, make_settings(intervals="none")).estimate
+    >>> linear, none = intervals(estimate), intervals(estimate, "none")
+    >>> float(chip.true_mtf(0.5)) in linear.mtf_nyquist, none.mtf_nyquist
+    (True, Interval(low=nan, high=nan))
+    """
+    chosen = Intervals(method, confidence, replicates, seed)
+    function = METHODS[chosen.method]
+    named = inspect.signature(function).parameters
+    options = {name: value for name, value in asdict(chosen).items() if name != "method" and name in named}
+    return function(estimate, **options).clipped_at_zero()

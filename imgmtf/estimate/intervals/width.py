@@ -17,7 +17,9 @@ class WidthReading:
     about its centre).  ``freqs`` (cy/px): f0, then a grid about it;
     ``on_grid``: dR(f) / d value, one row per frequency over the profile's
     grid; ``per_background``: dR(f) / d background level; ``values``: R at
-    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW."""
+    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW;
+    ``background_sides``: masks of the samples whose two sides' means the
+    background level is the mean of (none: no background)."""
 
     width_px: float
     freqs: np.ndarray
@@ -26,6 +28,20 @@ class WidthReading:
     values: np.ndarray
     slope: float
     log_slope: Callable[[np.ndarray], np.ndarray]
+    background_sides: tuple[np.ndarray, ...] = ()
+
+    def sample_pull(self, adjoint: Callable[[np.ndarray], np.ndarray], grid_size: int,
+                    span: tuple[int, int]) -> np.ndarray:
+        """dR(f) / dv for every sample v, one row per frequency of ``freqs``:
+        through the adjoint of the resampling (onto ``grid_size`` points,
+        of which ``span`` is the profile the width was read from) and
+        through the background level."""
+        full = np.zeros((self.freqs.size, grid_size))
+        full[:, span[0]: span[1]] = self.on_grid
+        pull = adjoint(full)
+        for side in self.background_sides:
+            pull[:, side] += 0.5 * self.per_background[:, None] / max(int(side.sum()), 1)
+        return pull
 
     def width_change(self, spectrum_change_at_zero):
         """The change of W (px) a change dR of R at f0 makes: the zero moves
