@@ -68,3 +68,21 @@ def test_a_read_widths_pull_on_the_samples_matches_finite_differences():
         changed[i] += 1.0
         np.testing.assert_allclose(spectrum(changed) - base, pull[:, i], rtol=1e-6, atol=1e-12)
     assert np.abs(pull[:, far]).max() > 0                  # it moves R through the background alone
+
+
+def test_one_pass_through_the_resampling_serves_the_figures_and_a_read_width_alike():
+    """A width read off the profile the LSF came from shares its pass
+    backwards through the resampling; read off another (a profile widened
+    after), it takes its own: the same intervals either way."""
+    from imgmtf.estimate.intervals import intervals
+    from imgmtf.estimate.pipeline import run
+    from imgmtf.estimate.pulse import PulseKind
+    from imgmtf.estimate.settings import make_settings
+    from imgmtf.estimate.state import Profile
+    chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, width_px=1.5), 60, noise_std_dn=4.0, seed=3)
+    estimate = run(PulseKind(), chip.image, make_settings(intervals="none")).estimate
+    assert estimate.shape_profile.resampled is estimate.profile.resampled
+    apart = replace(estimate, shape_profile=Profile(replace(estimate.shape_profile.resampled),
+                                                    estimate.shape_profile.span))
+    shared, separate = intervals(estimate), intervals(apart)
+    assert shared == separate and shared.mtf_nyquist.width > 0

@@ -36,9 +36,19 @@ class WidthReading:
         through the adjoint of the resampling (onto ``grid_size`` points,
         of which ``span`` is the profile the width was read from) and
         through the background level."""
+        return self.background_pull(adjoint(self.grid_weights(grid_size, span)))
+
+    def grid_weights(self, grid_size: int, span: tuple[int, int]) -> np.ndarray:
+        """dR(f) / d value over a resampling's whole grid of ``grid_size``
+        points, ``span`` the profile's run of it (zero beyond)."""
         full = np.zeros((self.freqs.size, grid_size))
         full[:, span[0]: span[1]] = self.on_grid
-        pull = adjoint(full)
+        return full
+
+    def background_pull(self, pull: np.ndarray) -> np.ndarray:
+        """``pull`` (dR(f) / dv through the resampling, one row per
+        frequency) with the background level's share added (in place):
+        each side's samples pull it by half their mean."""
         for side in self.background_sides:
             pull[:, side] += 0.5 * self.per_background[:, None] / max(int(side.sum()), 1)
         return pull
