@@ -150,7 +150,6 @@ def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replica
     x = lsf.x_px
     step = float(x[1] - x[0])
     from_centre = x - centre
-    shape = np.where(np.abs(from_centre) > 1e-9, 1.0 / np.maximum(from_centre * from_centre, 1e-18), 0.0)
 
     def windowed(grid_b, values_b, weights_of):
         coefs = []
@@ -170,7 +169,7 @@ def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replica
         in_data[first: first + x_data.size] = True
         amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
         w = flat_top_window(x, centre, window.core_px, window.taper_px) * in_data
-        model = np.where(from_centre < 0, amp[0][:, None], amp[1][:, None]) * shape
+        model = np.where(from_centre < 0, amp[0][:, None], amp[1][:, None]) * lsf.tail_shape
         return w * profiles + (1.0 - w) * model
     nyquist, fifty = bootstrap_figures(distance, samples.rows, float(estimate.profile.grid[-1]),
                                        estimate.resample, windowed, step, estimate.spectrum.divisor,
