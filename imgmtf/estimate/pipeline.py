@@ -247,6 +247,36 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
     the other kind of target it turns out to be (:func:`.kind.refuse_other_kind`)
     or a failed check of the chip or the seed (fill, a second target),
     which are raised instead unless ``force``.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind.
+    chip : Chip
+        The prepared chip.
+    force : bool, optional
+        Raise the failure itself rather than a failed earlier check.
+
+    Returns
+    -------
+    Located
+        The line, the rows, the samples and the checks so far.
+
+    Raises
+    ------
+    ImgmtfError
+        No target of the kind, or one that cannot be followed.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> located = locate_target(EdgeKind(), m.chip)
+    >>> located.rows_used, located.geometry.slope == m.located.geometry.slope
+    (60, True)
     """
     checks = list(chip.checks)
     try:
@@ -274,7 +304,33 @@ def rebuild_staircase(kind: TargetKind, samples: Samples, quantum_dn: float) -> 
     """The values the profile is built from: a noise-free quantised
     profile's staircase rebuilt as the smooth ESF it samples (monotone
     kinds only; :func:`.quantisation.dequantise`), or ``samples`` as they
-    are.  The gate reads the raw values either way."""
+    are.  The gate reads the raw values either way.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind (only a monotone profile's staircase is rebuilt).
+    samples : Samples
+        The samples, their values as recorded.
+    quantum_dn : float
+        The values' step, DN (0: not quantised).
+
+    Returns
+    -------
+    Samples
+        ``samples`` with ``values_dn`` rebuilt and ``dequantised`` set, or
+        ``samples`` itself.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> rebuild_staircase(EdgeKind(), m.located.samples, m.chip.quantum_dn) is m.located.samples  # noisy
+    True
+    """
     rebuilt = dequantise(samples.distance_px, samples.raw_dn, quantum_dn) if kind.monotone else None
     return samples if rebuilt is None else replace(samples, values_dn=rebuilt, dequantised=True)
 
@@ -285,7 +341,40 @@ def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
     it where a level still drifts at the span's end), checked to be of the
     kind's shape, and what the kind reads off it.  A failure is explained
     by a failed fill or second-target check among ``known`` where there is
-    one (unless ``settings.force``)."""
+    one (unless ``settings.force``).
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind.
+    samples : Samples
+        The profile's samples.
+    settings : Settings
+        The resampling method, its step and options; ``force``.
+    known : sequence of Check, optional
+        The gate's checks so far.
+
+    Returns
+    -------
+    Profile, Shape
+        The resampled profile and what the kind read off it.
+
+    Raises
+    ------
+    ImgmtfError
+        A profile not of the kind's shape, or one the kind cannot read.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> profile, shape = read_profile(EdgeKind(), m.estimate.samples, make_settings())
+    >>> shape.centre == m.shape.centre, round(shape.scale_px, 2)
+    (True, 1.32)
+    """
     reach = samples.reach_px
     try:
         profile = resample_samples(samples, settings, min(reach, INITIAL_SPAN_PX), kind.name)
@@ -312,7 +401,40 @@ def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
 def resample_samples(samples: Samples, settings: Settings, span_px: float, name: str) -> Profile:
     """The samples resampled by the chosen method within ``span_px`` of the
     line, kept over the central run of finite values (gaps at the far ends
-    come from sparse samples); ``name`` names the target in a refusal."""
+    come from sparse samples).
+
+    Parameters
+    ----------
+    samples : Samples
+        The profile's samples.
+    settings : Settings
+        The resampling method, its step (px) and options.
+    span_px : float
+        How far from the line the profile is resampled, px.
+    name : str
+        The target as a user names it, for a refusal.
+
+    Returns
+    -------
+    Profile
+        The resampled profile over its central run.
+
+    Raises
+    ------
+    UnsuitableTargetError
+        The profile has gaps at the target (too few sub-pixel samples).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> profile = resample_samples(m.estimate.samples, make_settings(), 4.0, "edge")
+    >>> float(profile.grid[0]), float(profile.grid[-1])
+    (-4.0, 4.0)
+    """
     resampled = resample_profile(samples.distance_px, samples.values_dn, method=settings.method,
                                  step=settings.step_px, half_range=span_px, **settings.method_options)
     return Profile(resampled, _central_run(resampled.values, name))
@@ -321,7 +443,38 @@ def resample_samples(samples: Samples, settings: Settings, span_px: float, name:
 def widen_profile(profile: Profile, samples: Samples, shape: Shape, window: Window, settings: Settings,
                   name: str) -> Profile:
     """``profile``, or the samples resampled farther out where the window's
-    core and taper reach past it (and the samples reach farther)."""
+    core and taper reach past it (and the samples reach farther).
+
+    Parameters
+    ----------
+    profile : Profile
+        The profile as first resampled.
+    samples : Samples
+        The profile's samples.
+    shape : Shape
+        What the kind read off the profile (its centre).
+    window : Window
+        The LSF window.
+    settings : Settings
+        The resampling method and its step.
+    name : str
+        The target as a user names it, for a refusal.
+
+    Returns
+    -------
+    Profile
+        ``profile``, or one reaching past the window.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> widen_profile(m.profile, m.estimate.samples, m.shape, m.estimate.window, make_settings(), "edge") is m.profile
+    True
+    """
     grid, reach = profile.grid, samples.reach_px
     window_end = abs(shape.centre) + window.core_px + window.taper_px + 3.0 * settings.step_px
     if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
@@ -335,7 +488,45 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
     between the system's LSF and that profile (the kind's, times the
     resampling method's where ``settings.correct``); the white-noise
     level it is judged against, where it falls into that noise, the
-    recovered LSF and the figures."""
+    recovered LSF and the figures.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind (its divisor and noise gain).
+    samples : Samples
+        The profile's samples (their density).
+    profile : Profile
+        The resampled profile (its method's transfer).
+    shape : Shape
+        What the kind read off the profile.
+    noise : Noise
+        The profile's noise and SNR.
+    window : Window
+        The LSF window.
+    lsf : TailedLSF
+        The windowed LSF-like profile.
+    settings : Settings
+        Whether the resampling's transfer is divided out (``correct``).
+
+    Returns
+    -------
+    Spectrum
+        The MTF (cy/px, 1 at zero frequency), its noise, the recovered LSF
+        and the figures.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> e = m.estimate
+    >>> spectrum = transform(EdgeKind(), e.samples, e.profile, m.shape, m.noise, e.window, e.lsf, make_settings())
+    >>> spectrum.mtf_nyquist == e.spectrum.mtf_nyquist
+    True
+    """
     divisor = kind.divisor(lsf.step_px, profile.resampled.transfer if settings.correct else None, shape)
     mtf = corrected_mtf(lsf.combined, lsf.step_px, divisor)
     density = samples.distance_px.size / (2.0 * samples.half_range_px)
@@ -353,7 +544,52 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     """The quality gate: every check (saturation, the sides, SNR, MTF above
     its noise, the figures, then the registered profile checks) added to
     those run so far, enforced (failures raise unless ``settings.force``),
-    and the warnings the result must carry."""
+    and the warnings the result must carry.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind.
+    chip : Chip
+        The prepared chip (its limits, quantum, noise and warnings).
+    located : Located
+        The line, its rows and the checks so far.
+    samples : Samples
+        The profile's samples (the gate reads their raw values).
+    shape : Shape
+        What the kind read off the profile.
+    noise : Noise
+        The profile's noise and SNR.
+    window : Window
+        The LSF window.
+    spectrum : Spectrum
+        The MTF and its figures.
+    settings : Settings
+        The SNR threshold and ``force``.
+
+    Returns
+    -------
+    list of Check, list of str
+        Every check run, and the warnings.
+
+    Raises
+    ------
+    ImgmtfError
+        A failed check, unless ``settings.force``.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> e = m.estimate
+    >>> checks, warnings = judge(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window,
+    ...                          e.spectrum, make_settings())
+    >>> all(check.passed for check in checks), warnings
+    (True, [])
+    """
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
     contrast, quantum_dn = noise.contrast_dn, chip.quantum_dn
