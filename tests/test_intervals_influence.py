@@ -43,7 +43,8 @@ def test_a_read_widths_pull_on_the_samples_matches_finite_differences():
     """R(f), the bar's spectrum the width is read from, is linear in the
     samples (through the resampling and the background): changing one
     sample by 1 DN changes R by that sample's pull."""
-    from imgmtf.estimate.pipeline import INITIAL_SPAN_PX, resample_samples, run
+    from imgmtf.estimate.pipeline import run
+    from imgmtf.estimate.profile import INITIAL_SPAN_PX, resample_samples
     from imgmtf.estimate.pulse import PulseKind
     from imgmtf.estimate.settings import make_settings
     chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200, 1200, width_px=1.5), 60, noise_std_dn=2.0, seed=1)

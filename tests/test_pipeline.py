@@ -160,7 +160,8 @@ def test_the_stages_rerun_from_the_records_give_the_records():
 
     from imgmtf.estimate.chip import prepare_chip
     from imgmtf.estimate.edge import EdgeKind
-    from imgmtf.estimate.pipeline import locate_target, read_profile, rebuild_staircase, widen_profile
+    from imgmtf.estimate.pipeline import locate_target
+    from imgmtf.estimate.profile import read_profile, rebuild_staircase, widen_profile
     chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=3.0, seed=2)
     settings = make_settings(intervals="none")
     m = _stages_of(chip)
@@ -181,7 +182,7 @@ def test_the_stages_rerun_from_the_records_give_the_records():
 
 def test_a_noise_free_quantised_edge_has_its_staircase_rebuilt():
     from imgmtf.estimate.edge import EdgeKind
-    from imgmtf.estimate.pipeline import rebuild_staircase
+    from imgmtf.estimate.profile import rebuild_staircase
     chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, low=30, high=60, dtype=np.uint8)
     m = _stages_of(chip)
     assert m.estimate.samples.dequantised and m.params["dequantised"]

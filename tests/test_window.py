@@ -8,7 +8,8 @@ import pytest
 import imgmtf as im
 from imgmtf.estimate.edge import EdgeKind
 from imgmtf.estimate.kind import Shape
-from imgmtf.estimate.pipeline import resample_samples, run
+from imgmtf.estimate.pipeline import run
+from imgmtf.estimate.profile import resample_samples
 from imgmtf.estimate.settings import make_settings
 from imgmtf.estimate.state import Samples, Window
 from imgmtf.estimate.window import TAPER_FACTOR, blend_tails, choose_window, measure_noise

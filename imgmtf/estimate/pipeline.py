@@ -5,44 +5,39 @@ Every estimate runs the same stages; a target kind (:class:`.kind.TargetKind`:
 :class:`imgmtf.estimate.edge.EdgeKind`, :class:`imgmtf.estimate.pulse.PulseKind`)
 supplies only what differs:
 
-=========================  ==========  ====================================================
-stage                      record      what it does
-=========================  ==========  ====================================================
-:func:`.chip.prepare_chip`  Chip        validation, crop, mask, linearisation, left-out
-                                       pixels, quantum, pixel noise, fill check
-:func:`locate_target`       Located     the kind seeds its line and locates it row by row
-                                       (an edge by a Fermi fit, a bar by centroids); a
-                                       robust line through the locations; every pixel's
-                                       signed distance from it and its value
-:func:`rebuild_staircase`   Samples     a noise-free quantised edge's staircase rebuilt as
-                                       the smooth ESF it samples (:mod:`.quantisation`)
-:func:`read_profile`        Profile,    the samples smoothed onto a uniform grid by the
-                            Shape       chosen method (:mod:`.resampling`), classified as an
-                                       edge or a bar; the kind's levels, centre and width
-:func:`.window.measure_noise`  Noise    the sides' scatter about their model, at least the
-                                       quantisation floor q / sqrt(12); the SNR
-:func:`.window.choose_window`  Window   the LSF window's core (from the target's width, the
-                                       SNR and the tails) and taper
-:func:`widen_profile`       Profile     resampled farther where the window reaches past it
-:func:`.window.blend_tails`  TailedLSF  the kind's LSF-like profile (an ESF's central
-                                       difference, a pulse response above its background)
-                                       kept as measured in the window, each side's tail
-                                       model (a / x^2) beyond it (:mod:`.window`)
-:func:`transform`           Spectrum    the transform divided by the transfer between the
-                                       system's LSF and that profile (the kind's and the
-                                       resampling method's); its figures
-:func:`judge`               checks,     the quality gate (:mod:`.gate`) and the registered
-                            warnings    profile checks (:mod:`.profile_checks`)
-:func:`.intervals.intervals`  FigureIntervals  the figures' intervals by the chosen
-                                       method (:mod:`.intervals`)
-=========================  ==========  ====================================================
+1. :func:`.chip.prepare_chip` -> :class:`.state.Chip`: validation, crop, mask,
+   linearisation, left-out pixels, quantum, pixel noise, fill check;
+2. :func:`locate_target` -> ``Located``: the kind seeds its line and locates
+   it row by row (an edge by a Fermi fit, a bar by centroids); a robust line
+   through the locations; every pixel's signed distance from it and its value;
+3. :func:`.profile.rebuild_staircase` -> ``Samples``: a noise-free quantised
+   edge's staircase rebuilt as the smooth ESF it samples (:mod:`.quantisation`);
+4. :func:`.profile.read_profile` -> ``Profile``, ``Shape``: the samples smoothed
+   onto a uniform grid by the chosen method (:mod:`.resampling`), classified
+   as an edge or a bar; the kind's levels, centre and width;
+5. :func:`.window.measure_noise` -> ``Noise``: the sides' scatter about their
+   model, at least the quantisation floor q / sqrt(12); the SNR;
+6. :func:`.window.choose_window` -> ``Window``: the LSF window's core (from the
+   target's width, the SNR and the tails) and taper;
+7. :func:`.profile.widen_profile` -> ``Profile``: resampled farther where the
+   window reaches past it;
+8. :func:`.window.blend_tails` -> ``TailedLSF``: the kind's LSF-like profile (an
+   ESF's central difference, a pulse response above its background) kept as
+   measured in the window, each side's tail model (a / x^2) beyond it;
+9. :func:`transform` -> ``Spectrum``: the transform divided by the transfer
+   between the system's LSF and that profile (the kind's and the resampling
+   method's); its figures;
+10. :func:`judge` -> checks, warnings: the quality gate (:mod:`.gate`) and the
+    registered profile checks (:mod:`.profile_checks`);
+11. :func:`.intervals.intervals` -> ``FigureIntervals``: the figures' intervals
+    by the chosen method (:mod:`.intervals`).
 """
 from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, replace
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -56,8 +51,8 @@ from .evidence import Evidence
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
 from .intervals import Estimate, FigureIntervals, intervals
 from .kind import Shape, TargetKind, refuse_other_kind
+from .profile import read_profile, rebuild_staircase, widen_profile
 from .profile_checks import run_profile_checks
-from .quantisation import dequantise
 from .resampling import Resampled, resample_profile
 from .settings import Settings
 from .spectrum import (
@@ -73,9 +68,7 @@ from .spectrum import (
 from .state import Chip, Located, Noise, Profile, Samples, Spectrum, TailedLSF, Window
 from .window import blend_tails, choose_window, measure_noise
 
-INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
 MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
-EXPLAINING_REASONS = ("fill", "two-targets")   # checks that explain a profile's odd shape better than it does
 
 
 @dataclass(frozen=True, eq=False)
@@ -300,188 +293,6 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
                    tuple(checks))
 
 
-def rebuild_staircase(kind: TargetKind, samples: Samples, quantum_dn: float) -> Samples:
-    """The values the profile is built from: a noise-free quantised
-    profile's staircase rebuilt as the smooth ESF it samples (monotone
-    kinds only; :func:`.quantisation.dequantise`), or ``samples`` as they
-    are.  The gate reads the raw values either way.
-
-    Parameters
-    ----------
-    kind : TargetKind
-        The target's kind (only a monotone profile's staircase is rebuilt).
-    samples : Samples
-        The samples, their values as recorded.
-    quantum_dn : float
-        The values' step, DN (0: not quantised).
-
-    Returns
-    -------
-    Samples
-        ``samples`` with ``values_dn`` rebuilt and ``dequantised`` set, or
-        ``samples`` itself.
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> m = run(EdgeKind(), chip.image, make_settings())
-    >>> rebuild_staircase(EdgeKind(), m.located.samples, m.chip.quantum_dn) is m.located.samples  # noisy
-    True
-    """
-    rebuilt = dequantise(samples.distance_px, samples.raw_dn, quantum_dn) if kind.monotone else None
-    return samples if rebuilt is None else replace(samples, values_dn=rebuilt, dequantised=True)
-
-
-def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
-                 known: Sequence[gate.Check] = ()) -> tuple[Profile, Shape]:
-    """The profile resampled within ``INITIAL_SPAN_PX`` of the line (all of
-    it where a level still drifts at the span's end), checked to be of the
-    kind's shape, and what the kind reads off it.  A failure is explained
-    by a failed fill or second-target check among ``known`` where there is
-    one (unless ``settings.force``).
-
-    Parameters
-    ----------
-    kind : TargetKind
-        The target's kind.
-    samples : Samples
-        The profile's samples.
-    settings : Settings
-        The resampling method, its step and options; ``force``.
-    known : sequence of Check, optional
-        The gate's checks so far.
-
-    Returns
-    -------
-    Profile, Shape
-        The resampled profile and what the kind read off it.
-
-    Raises
-    ------
-    ImgmtfError
-        A profile not of the kind's shape, or one the kind cannot read.
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> m = run(EdgeKind(), chip.image, make_settings())
-    >>> profile, shape = read_profile(EdgeKind(), m.estimate.samples, make_settings())
-    >>> shape.centre == m.shape.centre, round(shape.scale_px, 2)
-    (True, 1.32)
-    """
-    reach = samples.reach_px
-    try:
-        profile = resample_samples(samples, settings, min(reach, INITIAL_SPAN_PX), kind.name)
-        kind_check = gate.kind_check(gate.classify_profile(profile.values), kind.profile, profile.values)
-        if not kind_check.passed:
-            raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
-        try:
-            shape = kind.shape(profile.grid, profile.values, samples.distance_px, samples.values_dn,
-                               samples.half_range_px)
-        except UnsuitableTargetError:
-            if profile.grid[-1] >= reach - settings.step_px:
-                raise
-            # a profile still rising at the span's end (a drifting level): all of it
-            profile = resample_samples(samples, settings, reach, kind.name)
-            shape = kind.shape(profile.grid, profile.values, samples.distance_px, samples.values_dn,
-                               samples.half_range_px)
-    except ImgmtfError:
-        if not settings.force:
-            gate.enforce([check for check in known if check.reason in EXPLAINING_REASONS], force=False)
-        raise
-    return profile, shape
-
-
-def resample_samples(samples: Samples, settings: Settings, span_px: float, name: str) -> Profile:
-    """The samples resampled by the chosen method within ``span_px`` of the
-    line, kept over the central run of finite values (gaps at the far ends
-    come from sparse samples).
-
-    Parameters
-    ----------
-    samples : Samples
-        The profile's samples.
-    settings : Settings
-        The resampling method, its step (px) and options.
-    span_px : float
-        How far from the line the profile is resampled, px.
-    name : str
-        The target as a user names it, for a refusal.
-
-    Returns
-    -------
-    Profile
-        The resampled profile over its central run.
-
-    Raises
-    ------
-    UnsuitableTargetError
-        The profile has gaps at the target (too few sub-pixel samples).
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> m = run(EdgeKind(), chip.image, make_settings())
-    >>> profile = resample_samples(m.estimate.samples, make_settings(), 4.0, "edge")
-    >>> float(profile.grid[0]), float(profile.grid[-1])
-    (-4.0, 4.0)
-    """
-    resampled = resample_profile(samples.distance_px, samples.values_dn, method=settings.method,
-                                 step=settings.step_px, half_range=span_px, **settings.method_options)
-    return Profile(resampled, _central_run(resampled.values, name))
-
-
-def widen_profile(profile: Profile, samples: Samples, shape: Shape, window: Window, settings: Settings,
-                  name: str) -> Profile:
-    """``profile``, or the samples resampled farther out where the window's
-    core and taper reach past it (and the samples reach farther).
-
-    Parameters
-    ----------
-    profile : Profile
-        The profile as first resampled.
-    samples : Samples
-        The profile's samples.
-    shape : Shape
-        What the kind read off the profile (its centre).
-    window : Window
-        The LSF window.
-    settings : Settings
-        The resampling method and its step.
-    name : str
-        The target as a user names it, for a refusal.
-
-    Returns
-    -------
-    Profile
-        ``profile``, or one reaching past the window.
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> m = run(EdgeKind(), chip.image, make_settings())
-    >>> widen_profile(m.profile, m.estimate.samples, m.shape, m.estimate.window, make_settings(), "edge") is m.profile
-    True
-    """
-    grid, reach = profile.grid, samples.reach_px
-    window_end = abs(shape.centre) + window.core_px + window.taper_px + 3.0 * settings.step_px
-    if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
-        return resample_samples(samples, settings, min(reach, window_end + 1.0), name)
-    return profile
-
-
 def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape, noise: Noise, window: Window,
               lsf: TailedLSF, settings: Settings) -> Spectrum:
     """The MTF: the windowed profile's transform divided by the transfer
@@ -678,18 +489,3 @@ def _resample_weighted(samples: Samples, settings: Settings, keep: np.ndarray, w
     return resample_profile(samples.distance_px[keep], samples.values_dn[keep], method=settings.method,
                             step=settings.step_px, half_range=half_range_px, weights=weights,
                             **settings.method_options)
-
-
-def _central_run(values: np.ndarray, name: str) -> tuple[int, int]:
-    """The [start, stop) of the longest run of finite resampled values
-    around the target (gaps at the far ends come from sparse samples)."""
-    good = np.isfinite(values)
-    mid = values.size // 2
-    if not good[max(mid - 5, 0): mid + 6].all():
-        raise UnsuitableTargetError(f"the {name} profile has gaps at the target: too few sub-pixel "
-                                    "samples (target too short or angle unsuitable)")
-    bad_left = np.nonzero(~good[:mid])[0]
-    bad_right = np.nonzero(~good[mid:])[0]
-    start = int(bad_left[-1] + 1) if bad_left.size else 0
-    stop = int(mid + bad_right[0]) if bad_right.size else values.size
-    return start, stop
