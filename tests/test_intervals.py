@@ -1,5 +1,5 @@
-"""Bootstrap intervals: the weighting is exact, the spectral figures match
-closed forms, and intervals behave as intervals should."""
+"""Intervals: their settings, the registry and its dispatcher, and
+intervals that behave as intervals should."""
 import math
 
 import numpy as np
@@ -7,41 +7,10 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.estimate.intervals import Bootstrap, percentile_interval, row_weights, spectral_figures
-from imgmtf.estimate.resampling import resample_profile
+from imgmtf.estimate.intervals import Bootstrap
+from imgmtf.estimate.intervals.bootstrap import percentile_interval
 
 from conftest import exact_edge_chip, gaussian_pixel_transfer
-
-
-def test_row_weights_resample_whole_rows():
-    rows = np.repeat(np.arange(30), 7)
-    weights = row_weights(rows, 50, np.random.default_rng(0))(np.ones(rows.size, bool))
-    assert weights.shape == (50, rows.size)
-    per_row = weights.reshape(50, 30, 7)
-    assert (per_row == per_row[..., :1]).all()                # a row's samples share its count
-    assert (per_row[..., 0].sum(axis=1) == 30).all()          # as many rows drawn as there are
-
-
-@pytest.mark.parametrize("method", ["msg", "sliding", "spline", "iso"])
-def test_integer_weights_equal_repeated_samples(method):
-    rng = np.random.default_rng(1)
-    d = rng.uniform(-6, 6, 1500)
-    v = np.tanh(d) + rng.normal(0, 0.02, d.size)
-    w = rng.integers(0, 3, d.size).astype(float)
-    weighted = resample_profile(d, v, method=method, half_range=4, weights=np.stack([w, w]))
-    repeated = resample_profile(np.repeat(d, w.astype(int)), np.repeat(v, w.astype(int)),
-                                method=method, half_range=4)
-    tol = 1e-9 if method != "spline" else 2e-3   # the spline's smoothing follows the sample count
-    np.testing.assert_allclose(weighted.values[1], repeated.values, atol=tol, equal_nan=True)
-
-
-def test_spectral_figures_of_a_gaussian_lsf_match_closed_forms():
-    sigma, step = 0.6, 0.05
-    x = np.arange(-6, 6 + step / 2, step)
-    lsf = np.exp(-x**2 / (2 * sigma**2))
-    nyquist, fifty = spectral_figures(np.stack([lsf, 2 * lsf]), step, lambda f: np.ones_like(f))
-    np.testing.assert_allclose(nyquist, math.exp(-2 * math.pi**2 * sigma**2 * 0.25), atol=1e-9)
-    np.testing.assert_allclose(fifty, math.sqrt(math.log(2) / 2) / (math.pi * sigma), rtol=2e-4)
 
 
 def test_percentile_interval_and_settings():
@@ -112,3 +81,78 @@ def test_an_mtf_interval_never_runs_below_zero():
     assert im.Interval(-0.5, 0.2).clipped_at_zero() == im.Interval(0.0, 0.2)
     assert im.Interval(0.1, 0.2).clipped_at_zero() == im.Interval(0.1, 0.2)
     assert math.isnan(im.Interval.none().clipped_at_zero().low)
+
+
+# -- the registry and its dispatcher ---------------------------------------------
+def _estimate(target="edge", noise=8.0, seed=5):
+    """A rendered 64 x 64 chip's estimate (its intervals not computed) and its true MTF at Nyquist."""
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import run
+    from imgmtf.estimate.pulse import PulseKind
+    from imgmtf.estimate.settings import make_settings
+    shape = im.Target("edge", 6.0, 200, 1200) if target == "edge" else im.Target("pulse", 6.0, 200, 1200,
+                                                                                  width_px=1.5)
+    chip = im.render(im.Sensor(), shape, 64, noise_std_dn=noise, seed=seed)
+    kind = EdgeKind() if target == "edge" else PulseKind(1.5)
+    return run(kind, chip.image, make_settings(intervals="none")).estimate, float(chip.true_mtf(0.5))
+
+
+def test_the_dispatcher_runs_the_method_it_names_with_the_options_it_takes():
+    from imgmtf.estimate.intervals import intervals
+    from imgmtf.estimate.intervals.bootstrap import bootstrap_intervals
+    from imgmtf.estimate.intervals.influence import influence_intervals
+    estimate, _ = _estimate()
+    assert intervals(estimate) == influence_intervals(estimate).clipped_at_zero()
+    assert intervals(estimate, "influence", confidence=0.9) == influence_intervals(estimate, confidence=0.9)
+    # the seed reaches the bootstrap and nothing else
+    assert intervals(estimate, "influence", seed=3) == intervals(estimate, "influence")
+    boot = intervals(estimate, "bootstrap", replicates=40, seed=3)
+    assert boot == bootstrap_intervals(estimate, replicates=40, seed=3)
+    assert boot != intervals(estimate, "bootstrap", replicates=40, seed=4)
+    narrower = intervals(estimate, "influence", confidence=0.5).mtf_nyquist
+    wider = intervals(estimate, "influence").mtf_nyquist
+    assert wider.low < narrower.low < narrower.high < wider.high
+
+
+def test_an_unknown_method_or_option_out_of_range_is_refused():
+    from imgmtf.estimate.intervals import intervals
+    estimate, _ = _estimate()
+    with pytest.raises(ParameterError, match="'jackknife'"):
+        intervals(estimate, "jackknife")
+    with pytest.raises(ParameterError, match="replicates"):
+        intervals(estimate, "bootstrap", replicates=5)
+    with pytest.raises(ParameterError, match="confidence"):
+        intervals(estimate, "influence", confidence=1.5)
+
+
+def test_none_gives_no_interval():
+    from imgmtf.estimate.intervals import FigureIntervals, intervals
+    estimate, _ = _estimate()
+    found = intervals(estimate, "none")
+    assert all(math.isnan(end) for end in (found.mtf_nyquist.low, found.mtf_nyquist.high,
+                                           found.mtf50_cy_px.low, found.mtf50_cy_px.high))
+    assert found.warnings == () and found == FigureIntervals.none()
+
+
+def test_influence_and_bootstrap_agree_on_a_rendered_bar():
+    """Both cover the truth, and their widths agree within what 200
+    replicates and the linearisation allow (a third); an edge's are
+    compared in test_pipeline.py."""
+    from imgmtf.estimate.intervals import intervals
+    estimate, true_nyquist = _estimate("bar")
+    linear, boot = intervals(estimate, "influence"), intervals(estimate, "bootstrap")
+    for found in (linear, boot):
+        assert true_nyquist in found.mtf_nyquist
+        assert found.mtf_nyquist.low < estimate.spectrum.mtf_nyquist < found.mtf_nyquist.high
+        assert found.mtf50_cy_px.low < estimate.spectrum.mtf50_cy_px < found.mtf50_cy_px.high
+    assert boot.mtf_nyquist.width == pytest.approx(linear.mtf_nyquist.width, rel=0.35)
+    assert boot.mtf50_cy_px.width == pytest.approx(linear.mtf50_cy_px.width, rel=0.35)
+
+
+def test_every_registered_method_is_a_choice_of_the_cli_and_of_the_settings():
+    from imgmtf.cli.options import interval_options
+    from imgmtf.estimate.intervals import METHODS, Intervals
+    choices = next(p for p in interval_options(lambda **kw: None).__click_params__
+                   if p.name == "interval_method").type.choices
+    assert list(choices) == list(METHODS)
+    assert all(Intervals(name).method == name for name in METHODS)

@@ -144,3 +144,92 @@ def test_a_mask_leaves_the_fill_around_a_tilted_target_out():
     assert abs(r.mtf_nyquist - h(0.5)) < 0.02 and r.normal_angle_deg == pytest.approx(angle, abs=0.1)
     with pytest.raises(ParameterError, match="mask"):
         im.measure_edge(chip, mask=np.ones((3, 3), bool))
+
+
+# -- the stages ----------------------------------------------------------------
+def _stages_of(chip_image, kind=None, **options):
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import run
+    return run(kind or EdgeKind(), chip_image, make_settings(intervals="none", **options))
+
+
+def test_the_stages_rerun_from_the_records_give_the_records():
+    """Each named stage, given the records before it, gives the record the
+    run kept: the stages are the run."""
+    from dataclasses import replace
+
+    from imgmtf.estimate.chip import prepare_chip
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import locate_target
+    from imgmtf.estimate.profile import read_profile, rebuild_staircase, widen_profile
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=3.0, seed=2)
+    settings = make_settings(intervals="none")
+    m = _stages_of(chip)
+    kind = EdgeKind()
+    prepared = prepare_chip(chip, settings)
+    np.testing.assert_array_equal(prepared.pixels, m.chip.pixels)
+    located = locate_target(kind, prepared)
+    assert located.rows_used == m.located.rows_used == 100 and located.rows_total == 100
+    assert located.geometry.slope == m.located.geometry.slope
+    samples = rebuild_staircase(kind, located.samples, prepared.quantum_dn)
+    assert samples is located.samples                         # noisy: no staircase to rebuild
+    profile, shape = read_profile(kind, samples, settings)
+    assert shape.centre == m.shape.centre and profile.span == m.estimate.shape_profile.span
+    assert widen_profile(profile, samples, shape, m.estimate.window, settings, "edge") is profile
+    wide = replace(m.estimate.window, core_px=20.0)
+    assert widen_profile(profile, samples, shape, wide, settings, "edge").grid[-1] > profile.grid[-1]
+
+
+def test_a_noise_free_quantised_edge_has_its_staircase_rebuilt():
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.profile import rebuild_staircase
+    chip = exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, low=30, high=60, dtype=np.uint8)
+    m = _stages_of(chip)
+    assert m.estimate.samples.dequantised and m.params["dequantised"]
+    rebuilt = rebuild_staircase(EdgeKind(), m.located.samples, 1.0)
+    assert rebuilt.dequantised and not np.array_equal(rebuilt.values_dn, rebuilt.raw_dn)
+    np.testing.assert_array_equal(rebuilt.raw_dn, m.located.samples.raw_dn)
+
+
+def test_the_transform_divides_out_the_central_difference_and_nothing_else_uncorrected():
+    """A Gaussian LSF laid on the lattice in place of the measured one:
+    the uncorrected MTF times the central difference's transfer is the
+    Gaussian's exp(-2 pi^2 sigma^2 f^2)."""
+    from dataclasses import replace
+
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import transform
+    from imgmtf.estimate.spectrum import edge_divisor
+    m = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0))
+    e, sigma = m.estimate, 0.6
+    lsf = replace(e.lsf, combined=np.exp(-e.lsf.x_px ** 2 / (2 * sigma ** 2)))
+    spectrum = transform(EdgeKind(), e.samples, e.profile, m.shape, m.noise, e.window, lsf,
+                         make_settings(correct=False))
+    f = np.array([0.1, 0.25, 0.5])
+    expected = np.exp(-2 * np.pi ** 2 * sigma ** 2 * f ** 2)
+    np.testing.assert_allclose(spectrum.mtf(f) * np.abs(edge_divisor(lsf.step_px, None)(f)), expected, atol=2e-4)
+    assert spectrum.fwhm_px == pytest.approx(2 * math.sqrt(2 * math.log(2)) * sigma, rel=2e-3)
+
+
+def test_the_gate_stage_passes_a_clean_chip_and_warns_of_a_noisy_one():
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import judge
+    m = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=3.0, seed=1))
+    e = m.estimate
+    checks, warnings = judge(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window, e.spectrum,
+                             make_settings())
+    assert all(check.passed for check in checks) and warnings == []
+    low = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=60.0, seed=1))
+    e = low.estimate
+    checks, warnings = judge(EdgeKind(), low.chip, low.located, e.samples, low.shape, low.noise, e.window,
+                             e.spectrum, make_settings())
+    assert [w for w in warnings if w.startswith(f"SNR {low.noise.snr:.0f} is below 79")]    # 125 sqrt(40 / 100)
+
+
+def test_the_measurement_fills_every_field_a_result_has_but_the_kinds_own():
+    from dataclasses import fields
+
+    from imgmtf.estimate.results import MTFResult
+    m = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0))
+    assert set(m.result_fields()) == {f.name for f in fields(MTFResult)} - {"method", "params", "polarity",
+                                                                              "warnings"}

@@ -152,7 +152,7 @@ def test_a_read_width_carries_its_uncertainty_into_the_interval_and_says_so():
 
 
 def test_fieller_spread_of_a_read_width_matches_its_closed_form():
-    from imgmtf.estimate.kind import WidthReading
+    from imgmtf.estimate.intervals.width import WidthReading
     f0, slope, sd, t = 0.6, -0.25, 0.004, 2.0
     freqs = np.concatenate([[f0], np.arange(0.3, 0.96, 0.02)])
     reading = WidthReading(1 / f0, freqs, np.zeros((freqs.size, 3)), np.zeros(freqs.size),

@@ -219,13 +219,13 @@ class EdgeEstimator:
         with one_blas_thread():         # small matrices: threads cost more than they save
             m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
                     dtype=dtype, track_azimuth_deg=track_azimuth_deg)
-        f, a = m.figures, m.arrays
-        left, right = f["side_levels"]
+        left, right = m.estimate.lsf.side_levels_dn
         return EdgeResult(
             **m.result_fields(), method=self.settings.method, params=m.params,
             polarity="rising" if right > left else "falling", warnings=m.warnings,
-            bright_side=_bright_side(right > left, f["transposed"]), rer=f["rer"], esf_x_px=a["grid"],
-            esf=(a["values"] - left) / (right - left), levels_dn=(float(left), float(right)))
+            bright_side=_bright_side(right > left, m.located.transposed), rer=m.shape.extra["rer"],
+            esf_x_px=m.profile.grid, esf=(m.profile.values - left) / (right - left),
+            levels_dn=(float(left), float(right)))
 
 
 def measure_edge(image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None, mask: np.ndarray | None = None,

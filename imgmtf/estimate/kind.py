@@ -1,11 +1,10 @@
 """How the shared pipeline measures each kind of target (:class:`TargetKind`:
 an edge, a bar; the kinds themselves are registered in :mod:`imgmtf.kinds`),
-the levels and scale a kind reads off its profile (:class:`Shape`), a bar's
-width as read (:class:`WidthReading`), and the refusal of a profile of the
-other kind."""
+the levels and scale a kind reads off its profile (:class:`Shape`), and the
+refusal of a profile of the other kind.  A width a kind reads off its
+profile (a bar's) is a :class:`.intervals.width.WidthReading`."""
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -17,6 +16,7 @@ from ..kinds import Kind
 from . import gate
 from .detection import Line
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
+from .intervals.width import WidthReading
 
 
 class TargetKind:
@@ -103,58 +103,17 @@ class TargetKind:
         """The samples of a bar's peak (None for an edge)."""
         raise NotImplementedError
 
+    def known_half_width_px(self, shape: Shape) -> float | None:
+        """Half the target's width (px) where the caller gave it (a bar's),
+        the pivot of the saturation check's mirror of its top; None where
+        it is unknown or read off the profile."""
+        return None
+
     def read_width(self, grid: np.ndarray, shape: Shape) -> WidthReading | None:
         """Where the divisor rests on a width read off the profile (a bar's
         estimated width), how it was read (:class:`WidthReading`), so that
         its own noise joins the intervals; None where the divisor is known."""
         return None
-
-
-@dataclass(frozen=True, eq=False)
-class WidthReading:
-    """A width W (px) read off the profile as the first zero f0 = 1 / W of
-    R(f), a linear functional of the profile's values (a bar's spectrum
-    about its centre).  ``freqs`` (cy/px): f0, then a grid about it;
-    ``on_grid``: dR(f) / d value, one row per frequency over the profile's
-    grid; ``per_background``: dR(f) / d background level; ``values``: R at
-    ``freqs``; ``slope``: R'(f0); ``log_slope(f)``: d ln|divisor(f)| / dW."""
-
-    width_px: float
-    freqs: np.ndarray
-    on_grid: np.ndarray
-    per_background: np.ndarray
-    values: np.ndarray
-    slope: float
-    log_slope: Callable[[np.ndarray], np.ndarray]
-
-    def width_change(self, spectrum_change_at_zero):
-        """The change of W (px) a change dR of R at f0 makes: the zero moves
-        by -dR / R'(f0), and W = 1 / f0 by dR / (R'(f0) f0^2)."""
-        f_zero = float(self.freqs[0])
-        return spectrum_change_at_zero / (self.slope * f_zero * f_zero)
-
-    def spread_px(self, spectrum_sd: np.ndarray, t: float) -> float:
-        """Half the width (px) of the set of W whose zero 1 / W the data
-        cannot tell from f0: the run of the grid about f0 where
-        |R(f)| <= t sd(R(f)) (Fieller's interval for a zero, which stays
-        honest where R is shallow and the linearised one is not); inf when
-        the run reaches the grid's low end (no zero is read at all)."""
-        f, margin = self.freqs[1:], t * spectrum_sd - np.abs(self.values[1:])
-        inside = margin >= 0
-        k = int(np.clip(np.searchsorted(f, self.freqs[0]), 1, f.size - 1))
-        k = k if inside[k] else k - 1
-        if not inside[k]:
-            return 0.0
-        outside = np.flatnonzero(~inside)
-        below, above = outside[outside < k], outside[outside > k]
-        if below.size == 0:
-            return math.inf
-
-        def edge(i, j):      # where the margin crosses 0 between grid points i (inside) and j (outside)
-            return f[i] + (f[j] - f[i]) * margin[i] / (margin[i] - margin[j])
-        f_low = edge(below[-1] + 1, below[-1])
-        f_high = edge(above[0] - 1, above[0]) if above.size else f[-1]
-        return 0.5 * (1.0 / f_low - 1.0 / f_high)
 
 
 @dataclass(frozen=True)

@@ -1,139 +1,161 @@
-"""One profile pipeline for edges and bars.
+"""One profile pipeline for edges and bars: a short sequence of named
+stages over a small typed state (:mod:`.state`, one record a stage).
 
 Every estimate runs the same stages; a target kind (:class:`.kind.TargetKind`:
 :class:`imgmtf.estimate.edge.EdgeKind`, :class:`imgmtf.estimate.pulse.PulseKind`)
 supplies only what differs:
 
-1. chip: validation, fill check (:mod:`imgmtf.inputs`, :mod:`.gate`);
-2. seed and geometry: the kind finds its line and locates it row by row
-   (an edge by a Fermi fit, a bar by centroids); a robust line through the
-   locations (:mod:`.geometry`);
-3. samples: every pixel's signed distance from the line and its value;
-4. resample: the over-sampled profile smoothed onto a uniform grid by the
-   chosen method (:mod:`.resampling`); the profile is classified as an
-   edge or a bar;
-5. normalise: the kind's levels (an edge's two sides, a bar's background
-   and peak), the noise and SNR from the sides' scatter about their model,
-   with the quantisation floor q / sqrt(12);
-6. window and tails: the kind's LSF-like profile (an ESF's central
-   difference, a pulse response above its background) is kept as measured
-   over a core chosen from its width and the SNR; beyond it, out to the
-   end of the data, it is replaced by a model fitted to each side's samples
-   (level + A / |x|^p, whose LSF-like tail falls as a / x^2: the asymptote
-   of every blur with a hard-edged aperture, diffraction and stray light
-   among them), blended in under the window's taper.  The tails are so
-   kept whole without their noise; a blur without tails fits a = 0;
-7. divide: the transform divided by the transfer of everything between
-   the system's LSF and that profile (the kind's: the central difference or
-   the bar's sinc, times the resampling method's);
-8. figures, quality gate and intervals (:mod:`.spectrum`, :mod:`.gate`,
-   :mod:`.intervals`).
+1. :func:`.chip.prepare_chip` -> :class:`.state.Chip`: validation, crop, mask,
+   linearisation, left-out pixels, quantum, pixel noise, fill check;
+2. :func:`locate_target` -> ``Located``: the kind seeds its line and locates
+   it row by row (an edge by a Fermi fit, a bar by centroids); a robust line
+   through the locations; every pixel's signed distance from it and its value;
+3. :func:`.profile.rebuild_staircase` -> ``Samples``: a noise-free quantised
+   edge's staircase rebuilt as the smooth ESF it samples (:mod:`.quantisation`);
+4. :func:`.profile.read_profile` -> ``Profile``, ``Shape``: the samples smoothed
+   onto a uniform grid by the chosen method (:mod:`.resampling`), classified
+   as an edge or a bar; the kind's levels, centre and width;
+5. :func:`.window.measure_noise` -> ``Noise``: the sides' scatter about their
+   model, at least the quantisation floor q / sqrt(12); the SNR;
+6. :func:`.window.choose_window` -> ``Window``: the LSF window's core (from the
+   target's width, the SNR and the tails) and taper;
+7. :func:`.profile.widen_profile` -> ``Profile``: resampled farther where the
+   window reaches past it;
+8. :func:`.window.blend_tails` -> ``TailedLSF``: the kind's LSF-like profile (an
+   ESF's central difference, a pulse response above its background) kept as
+   measured in the window, each side's tail model (a / x^2) beyond it;
+9. :func:`transform` -> ``Spectrum``: the transform divided by the transfer
+   between the system's LSF and that profile (the kind's and the resampling
+   method's); its figures;
+10. :func:`judge` -> checks, warnings: the quality gate (:mod:`.gate`) and the
+    registered profile checks (:mod:`.profile_checks`);
+11. :func:`.intervals.intervals` -> ``FigureIntervals``: the figures' intervals
+    by the chosen method (:mod:`.intervals`).
 """
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
-from .._stats import t_quantile
-from ..errors import ImgmtfError, ParameterError, TargetNotFoundError, UnsuitableTargetError
-from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
+from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
-from ..transfer import full_scale
 from . import gate
-from .detection import robust_noise
+from .chip import prepare_chip
 from .evidence import Evidence
-from .geometry import (
-    TargetGeometry,
-    check_angle,
-    direction_label,
-    profile_samples,
-    vertical_frame,
-)
-from .intervals import (
-    Interval,
-    bootstrap_figures,
-    influence_sd,
-    influence_sds,
-    linearised_interval,
-)
-from .kind import TargetKind, refuse_other_kind
-from .outliers import isolated_outliers
+from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
+from .intervals import Estimate, FigureIntervals, intervals
+from .kind import Shape, TargetKind, refuse_other_kind
+from .profile import read_profile, rebuild_staircase, widen_profile
 from .profile_checks import run_profile_checks
-from .quantisation import dequantise
-from .resampling import resample_profile
+from .resampling import Resampled, resample_profile
 from .saturation import saturation_checks
 from .settings import Settings
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
     corrected_mtf,
-    flat_top_window,
     mtf50,
     mtf_area,
     noise_limited_frequency,
     restore_lsf,
     white_noise_mtf_sd,
 )
-from .tails import fit_side, model_reach, outer_samples, tail_integral
+from .state import Chip, Located, Noise, Profile, Samples, Spectrum, TailedLSF, Window
+from .window import blend_tails, choose_window, measure_noise
 
-TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
-TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
-LONG_TAIL_SHARE = 0.03            # tails beyond the core holding more of the signal keep the clean window
-INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
-CORE_STEP_PX = 0.5                # the core grows in these steps while the tail model misfits
-# The estimator's own error where noise is not the whole error, added in
-# quadrature to the interval: on exact chips the worst error at Nyquist is
-# about 0.0005 for Gaussian-type blurs; the tail model's share of the
-# signal is uncertain to about a tenth of itself.
-SYSTEMATIC_NYQUIST = 0.0008
-SYSTEMATIC_MTF50 = 0.001          # relative
-TAIL_MODEL_UNCERTAINTY = 0.1
-# A rebuilt staircase (a noise-free quantised edge) is off by up to 0.01 at
-# Nyquist and 0.5 % in MTF50 on 12-30 DN edges, and its residuals are nil
-SYSTEMATIC_DEQUANTISED = 0.005
-SYSTEMATIC_DEQUANTISED_MTF50 = 0.003      # relative
-# The window narrowed for noise cuts the LSF a little: at its narrowest (a
-# third narrower) MTF50 reads about 1 % and MTF at Nyquist 0.002 high
-NARROW_WINDOW_NYQUIST = 0.009
-NARROW_WINDOW_MTF50 = 0.03                # relative
-LEVERAGE_CAP = 0.9
-BACKGROUND_FRACTION = 2.0 / 3.0   # a bar's background is read from the samples beyond this share of the range
-WIDTH_SHARE_WARNING = 0.5         # an estimated width making more of the variance at Nyquist is worth a warning
 MASK_SCAN_STEP_CY_PX = 0.005      # where a divisor's zeros hide the MTF is looked for on this grid, to 2 cy/px
 
 
-
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Measurement:
-    """The pipeline's output, which each kind turns into its result type."""
+    """The pipeline's output, which each kind turns into its result type.
 
-    figures: dict
-    arrays: dict
-    checks: tuple
-    warnings: tuple
-    params: dict
+    Attributes
+    ----------
+    chip : Chip
+        The pixels measured.
+    located : Located
+        The target's line and per-row locations.
+    shape : Shape
+        What the kind read off the profile (levels, centre, width, its own figures).
+    noise : Noise
+        The profile's noise and SNR.
+    estimate : Estimate
+        The samples, profile, window, tails and spectrum (what the intervals read).
+    intervals : FigureIntervals
+        The figures' intervals.
+    checks : tuple of Check
+        Every quality check run.
+    warnings : tuple of str
+        What the result must say.
+    params : dict
+        The settings used (provenance).
+    frequencies_cy_px : numpy.ndarray
+        Where the MTF is reported, cy/px.
+    """
 
-    def result_fields(self) -> dict:
+    chip: Chip
+    located: Located
+    shape: Shape
+    noise: Noise
+    estimate: Estimate
+    intervals: FigureIntervals
+    checks: tuple[gate.Check, ...]
+    warnings: tuple[str, ...]
+    params: dict[str, Any]
+    frequencies_cy_px: np.ndarray
+
+    @property
+    def profile(self) -> Profile:
+        """The resampled profile (an edge's ESF, a bar's PRF), DN on px."""
+        return self.estimate.profile
+
+    def result_fields(self) -> dict[str, Any]:
         """The :class:`.results.MTFResult` fields every kind fills alike;
         the kind adds ``method``, ``params``, ``polarity``, ``warnings`` and
-        its own."""
-        f, a = self.figures, self.arrays
+        its own.
+
+        Returns
+        -------
+        dict
+            Field name to value.
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> from imgmtf.estimate.edge import EdgeKind
+        >>> from imgmtf.estimate.settings import make_settings
+        >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60)
+        >>> fields = run(EdgeKind(), chip.image, make_settings()).result_fields()
+        >>> fields["direction"], fields["rows_used"]
+        ('across-track', 60)
+        """
+        geometry, spectrum = self.located.geometry, self.estimate.spectrum
+        normal = normal_angle(geometry)
         return dict(
-            normal_angle_deg=f["normal_angle_deg"], tilt_deg=f["tilt_deg"], direction=f["direction"],
-            orientation=f["orientation"], rows_used=f["rows_used"], rows_total=f["rows_total"], snr=f["snr"],
-            noise_dn=f["noise_dn"], mtf_nyquist=f["mtf_nyquist"], mtf50_cy_px=f["mtf50_cy_px"],
-            mtf_nyquist_ci=f["mtf_nyquist_ci"], mtf50_ci_cy_px=f["mtf50_ci_cy_px"], fwhm_px=f["fwhm_px"],
-            mtfa=f["mtfa"], gsd_m=f["gsd_m"], frequencies_cy_px=a["frequencies"], mtf=a["mtf"],
-            lsf_x_px=a["lsf_x"], lsf=a["lsf"], samples_x_px=a["samples_x"], samples_dn=a["samples_dn"],
-            geometry=a["geometry"], roi=f["roi"], noise_limit_cy_px=f["noise_limit_cy_px"],
-            lsf_half_width_px=f["lsf_half_width_px"], tail_fraction=f["tail_fraction"], checks=self.checks,
-            mtf_function=a["mtf_function"])
+            normal_angle_deg=normal, tilt_deg=geometry.tilt_deg,
+            direction=direction_label(normal, self.chip.track_azimuth_deg),
+            orientation="horizontal" if self.located.transposed else "vertical",
+            rows_used=self.located.rows_used, rows_total=self.located.rows_total, snr=self.noise.snr,
+            noise_dn=self.noise.noise_dn, mtf_nyquist=spectrum.mtf_nyquist, mtf50_cy_px=spectrum.mtf50_cy_px,
+            mtf_nyquist_ci=self.intervals.mtf_nyquist, mtf50_ci_cy_px=self.intervals.mtf50_cy_px,
+            fwhm_px=spectrum.fwhm_px, mtfa=mtf_area(spectrum.mtf), gsd_m=self.chip.gsd_m,
+            frequencies_cy_px=self.frequencies_cy_px, mtf=spectrum.mtf(self.frequencies_cy_px),
+            lsf_x_px=spectrum.lsf_x_px, lsf=spectrum.lsf, samples_x_px=self.estimate.samples.distance_px,
+            samples_dn=self.estimate.samples.raw_dn, geometry=geometry, roi=self.chip.roi,
+            noise_limit_cy_px=spectrum.noise_limit_cy_px, lsf_half_width_px=self.estimate.window.core_px,
+            tail_fraction=self.estimate.lsf.tail_share, checks=self.checks, mtf_function=spectrum.mtf)
 
 
-def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd_m=None, saturation=None,
-        dtype=None, track_azimuth_deg: float | None = 0.0) -> Measurement:
+def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[int, int, int, int] | None = None,
+        mask: np.ndarray | None = None, gsd_m: float | None = None, saturation: tuple[float, float] | None = None,
+        dtype: DTypeLike | None = None, track_azimuth_deg: float | None = 0.0) -> Measurement:
     """Measure the target of ``kind`` in ``image`` (2-D array, DN).
 
     Parameters
@@ -144,7 +166,7 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     image : array_like
         2-D image, DN.
     settings : Settings
-        The estimator's settings (:func:`make_settings`).
+        The estimator's settings (:func:`imgmtf.estimate.settings.make_settings`).
     roi : (int, int, int, int), optional
         (x, y, width, height) crop, px.
     mask : numpy.ndarray of bool, optional
@@ -166,307 +188,273 @@ def run(kind: TargetKind, image, settings: Settings, *, roi=None, mask=None, gsd
     Returns
     -------
     Measurement
-        The figures and arrays the kind turns into its result.
+        The records of every stage, which the kind turns into its result.
 
     Raises
     ------
     ImgmtfError
         Every refusal: unusable input, no target, a failed quality check.
-    """
-    array = as_array(image)
-    stored = np.dtype(dtype) if dtype is not None else array.dtype
-    data, (x0, y0) = prepare_image(array, roi, mask)
-    gsd_m = None if gsd_m is None else check_number("gsd_m", gsd_m, positive=True)
-    if track_azimuth_deg is not None:
-        track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
-    limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
-    decoded = []
-    if not settings.transfer.is_linear:
-        # linear light in the same DN scale; the type's limits stay put, its
-        # quantum does not (the decoded steps are uneven)
-        scale = full_scale(stored)
-        data = settings.transfer.linearise(data, scale)
-        limits = None if limits is None else (float(settings.transfer.linearise(np.array(limits[0]), scale)),
-                                              float(settings.transfer.linearise(np.array(limits[1]), scale)))
-        stored = np.dtype(np.float64)
-        decoded.append(f"the values were linearised ({settings.transfer}, full scale {scale:g} DN) before "
-                       "measuring")
-    q = quantum(data, stored)
-    checks = [gate.fill_check(data, stored)]
-    pixel_noise = robust_noise(data)
-    rows, cols = data.shape
-    chosen = None if mask is None else np.asarray(mask)[y0:y0 + rows, x0:x0 + cols]
-    left_out = _left_out_pixels(data, chosen, pixel_noise)
 
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> abs(m.estimate.spectrum.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002, m.located.rows_used
+    (True, 60)
+    """
+    chip = prepare_chip(image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+                        track_azimuth_deg=track_azimuth_deg)
+    located = locate_target(kind, chip, force=settings.force)
+    samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
+    read, shape = read_profile(kind, samples, settings, located.checks)
+    noise = measure_noise(kind, samples, shape, chip.quantum_dn)
+    window = choose_window(kind, samples, shape, noise, settings, chip.quantum_dn)
+    profile = widen_profile(read, samples, shape, window, settings, kind.name)
+    lsf = blend_tails(kind, samples, profile, shape, window)
+    spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
+    checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings)
+    estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
+                        kind.subtracts_background, kind.lsf, functools.partial(_resample_weighted, samples, settings),
+                        kind.read_width(read.grid, shape), kind.name)
+    found = intervals(estimate, **asdict(settings.intervals))
+    warnings += found.warnings
+    if chip.track_azimuth_deg is None:
+        warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
+                        "track, so the direction is unknown; give the track's azimuth to label it")
+    params = {**settings.as_dict(), **profile.resampled.params, "lsf_half_width_px": window.core_px,
+              "lsf_taper_px": window.taper_px, "track_azimuth_deg": chip.track_azimuth_deg,
+              "dequantised": samples.dequantised, **chip.left_out_px}
+    return Measurement(chip, located, shape, noise, estimate, found, tuple(checks), tuple(warnings), params,
+                       settings.frequencies_cy_px)
+
+
+def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Located:
+    """The kind's target in the chip: its seed line, its per-row locations
+    and the robust line through them (in the vertical frame), every
+    pixel's signed distance from that line as a profile sample, and the
+    gate's checks of the line and its rows.
+
+    Where the target cannot be followed, the failure explains less than
+    the other kind of target it turns out to be (:func:`.kind.refuse_other_kind`)
+    or a failed check of the chip or the seed (fill, a second target),
+    which are raised instead unless ``force``.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind.
+    chip : Chip
+        The prepared chip.
+    force : bool, optional
+        Raise the failure itself rather than a failed earlier check.
+
+    Returns
+    -------
+    Located
+        The line, the rows, the samples and the checks so far.
+
+    Raises
+    ------
+    ImgmtfError
+        No target of the kind, or one that cannot be followed.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> located = locate_target(EdgeKind(), m.chip)
+    >>> located.rows_used, located.geometry.slope == m.located.geometry.slope
+    (60, True)
+    """
+    checks = list(chip.checks)
     try:
-        line, seed_checks = kind.seed(data, pixel_noise)
+        line, seed_checks = kind.seed(chip.pixels, chip.noise_dn)
         checks += seed_checks
-        work, seed_x, transposed = vertical_frame(data, line)
+        frame, seed_x, transposed = vertical_frame(chip.pixels, line)
         try:
-            geometry = kind.locate(work, seed_x, transposed)
+            geometry = kind.locate(frame, seed_x, transposed)
             check_angle(geometry, kind.name)
-            d, v, row, half_range = profile_samples(work, geometry, kind.name)
+            distance, values, rows, half_range = profile_samples(frame, geometry, kind.name)
         except (TargetNotFoundError, UnsuitableTargetError):
-            refuse_other_kind(kind, work, seed_x)
+            refuse_other_kind(kind, frame, seed_x)
             raise
     except ImgmtfError:
-        # what the gate already knows (fill, a second target) explains more
-        # than the failure it caused further on
-        if not settings.force:
+        if not force:
             gate.enforce(checks, force=False)
         raise
-    rows_used = int(geometry.kept.sum())
     checks += gate.line_checks(geometry, geometry.location_sd_px, kind.name)
-    checks.append(gate.rows_check(rows_used, kind.name))
+    checks.append(gate.rows_check(int(geometry.kept.sum()), kind.name))
+    return Located(geometry, transposed, int(frame.shape[0]), Samples(distance, values, values, rows, half_range),
+                   tuple(checks))
 
-    # the values the profile is built from: a noise-free quantised edge's
-    # staircase rebuilt as the smooth ESF it samples; the gate reads the raw ones
-    rebuilt = dequantise(d, v, q) if kind.monotone else None
-    raw, v = v, (v if rebuilt is None else rebuilt)
-    # the profile is resampled where the LSF window needs data: a central
-    # span first, widened below if the window's core and taper reach past it
-    reach = half_range - 0.6
 
-    def resample(span_px):
-        r = resample_profile(d, v, method=settings.method, step=settings.step_px, half_range=span_px,
-                             **settings.method_options)
-        return (r, *_central_run(r.grid, r.values, kind.name))
-    try:
-        resampled, grid, values, span = resample(min(reach, INITIAL_SPAN_PX))
-        kind_check = gate.kind_check(gate.classify_profile(values), kind.profile, values)
-        if not kind_check.passed:
-            raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
-        try:
-            shape = kind.shape(grid, values, d, v, half_range)
-        except UnsuitableTargetError:
-            if grid[-1] >= reach - settings.step_px:
-                raise
-            # a profile still rising at the span's end (a drifting level): all of it
-            resampled, grid, values, span = resample(reach)
-            shape = kind.shape(grid, values, d, v, half_range)
-    except ImgmtfError:
-        if not settings.force:       # fill or a second target explain the profile's shape
-            gate.enforce([c for c in checks if c.reason in ("fill", "two-targets")], force=False)
-        raise
-    c = shape.centre
-    s = d - c
-    # the samples' pull on a width read off this profile (see TargetKind.read_width)
-    width_influence = None
-    reading = kind.read_width(grid, shape)
-    if reading is not None and resampled.adjoint is not None:
-        def spectrum_pull(reading=reading, resampled=resampled, span=span):
-            """dR(f) / dv for the reading's frequencies, through the
-            resampling the width was read from (built only for intervals)."""
-            full = np.zeros((reading.freqs.size, resampled.grid.size))
-            full[:, span[0]: span[1]] = reading.on_grid
-            pull = resampled.adjoint(full)
-            for side in outer_samples(d, half_range, BACKGROUND_FRACTION):
-                pull[:, side] += 0.5 * reading.per_background[:, None] / max(int(side.sum()), 1)
-            return pull
-        width_influence = (reading, spectrum_pull)
+def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape, noise: Noise, window: Window,
+              lsf: TailedLSF, settings: Settings) -> Spectrum:
+    """The MTF: the windowed profile's transform divided by the transfer
+    between the system's LSF and that profile (the kind's, times the
+    resampling method's where ``settings.correct``); the white-noise
+    level it is judged against, where it falls into that noise, the
+    recovered LSF and the figures.
 
-    # noise and SNR: each side's scatter about its own level and tail
-    plateau = [fit_side(s, v, side & (np.abs(s) >= shape.plateau_px), kind.tail_power)
-               for side in (s < 0, s > 0)]
-    side_sd = [p.sd for p in plateau if math.isfinite(p.sd)]
-    noise = max(float(np.mean(side_sd)) if side_sd else math.nan, q / math.sqrt(12.0))
-    contrast = abs(shape.high - shape.low)
-    snr = contrast / noise if noise > 0 else math.inf
-    if not math.isfinite(noise):
-        snr = math.nan
-    threshold = settings.snr_threshold or kind.confident_snr(rows_used)
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind (its divisor and noise gain).
+    samples : Samples
+        The profile's samples (their density).
+    profile : Profile
+        The resampled profile (its method's transfer).
+    shape : Shape
+        What the kind read off the profile.
+    noise : Noise
+        The profile's noise and SNR.
+    window : Window
+        The LSF window.
+    lsf : TailedLSF
+        The windowed LSF-like profile.
+    settings : Settings
+        Whether the resampling's transfer is divided out (``correct``).
 
-    # the LSF window's core and taper, and the tails beyond them
-    core = settings.lsf_half_width_px or kind.core_px(shape, snr, settings.lsf_window_factor)
-    if settings.lsf_half_width_px is None and settings.lsf_window_factor is None:
-        # a noise-free quantised profile rounds neighbouring samples alike:
-        # its residuals do not average down below the rounding's own q / sqrt(12)
-        floor = q / math.sqrt(12.0) if noise < 0.5 * q else 0.0
-        core = max(core, max(model_reach(s, v, side, core, kind.tail_power, CORE_STEP_PX, floor)
-                             for side in (-1, 1)))
-    taper_snr = snr
-    if settings.lsf_half_width_px is None and settings.lsf_window_factor is None:
-        # a long tail (diffraction, a real lens) is the model's weakest part
-        # near the core: there the narrow low-SNR window costs more bias than
-        # it saves noise, so such a profile (one whose tails stand out of
-        # their own noise) keeps the clean window
-        tails = [tail_integral(s, v, side, core, half_range, kind) for side in (-1, 1)]
-        share = sum(abs(area) for area, _ in tails) / contrast
-        share_sd = math.hypot(*(sd for _, sd in tails)) / contrast
-        if share > LONG_TAIL_SHARE and share > 3.0 * share_sd:
-            core = max(core, kind.core_px(shape, math.inf, None))
-            taper_snr = math.inf
-    taper = kind.taper_factor(taper_snr) * core if settings.lsf_half_width_px is None else TAPER_FACTOR * core
-    # how much narrower than the clean window the noise made it: its truncation bias joins the budget
-    narrowed = max(0.0, 1.0 - core / kind.core_px(shape, math.inf, None))
-    cut = settings.lsf_half_width_px is not None and settings.lsf_half_width_px < shape.scale_px
-    window_end = abs(c) + core + taper + 3.0 * settings.step_px
-    if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
-        resampled, grid, values, span = resample(min(reach, window_end + 1.0))
-    start = [min(core, TAIL_FIT_MAX_START * (half_range + c)), min(core, TAIL_FIT_MAX_START * (half_range - c))]
-    sides = [fit_side(s, v, (s <= -start[0]), kind.tail_power), fit_side(s, v, (s >= start[1]), kind.tail_power)]
-    if any(not np.isfinite(sf.coef).all() for sf in sides):
-        raise UnsuitableTargetError(f"a side of the {kind.name} holds too few samples for its level")
-    background = 0.5 * (sides[0].coef[0] + sides[1].coef[0])
-    x_data, lsf_data, lsf_adjoint = kind.lsf(grid, values, background)
-    step = float(grid[1] - grid[0])
-    # the LSF-like profile out to the data's reach: measured within the
-    # window, the tail model beyond it (the same lattice as the grid)
-    x = np.arange(-np.floor(reach / step), np.floor(reach / step) + 1) * step
-    data_at = slice(int(round((x_data[0] - x[0]) / step)), int(round((x_data[0] - x[0]) / step)) + x_data.size)
-    lsf = np.zeros_like(x)
-    lsf[data_at] = lsf_data
-    in_data = np.zeros(x.size, bool)
-    in_data[data_at] = True
-    to_amplitude = kind.lsf_tail_amplitudes()
-    amplitudes = [float(to_amplitude[i] @ sides[i].coef) for i in range(2)]
-    w = flat_top_window(x, c, core, taper) * in_data
-    sx = x - c
-    tail_shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
-    model = np.where(sx < 0, amplitudes[0], amplitudes[1]) * tail_shape
-    combined: np.ndarray = w * lsf + (1.0 - w) * model
-    divisor = kind.divisor(step, resampled.transfer if settings.correct else None, shape)
-    mtf = corrected_mtf(combined, step, divisor)
-    total = float(np.sum(combined) * step)
-    if total == 0 or not math.isfinite(total):
-        raise UnsuitableTargetError(f"the {kind.name}'s profile has no net signal")
-    tail_share = float(np.sum((1.0 - w) * model) * step) / total
+    Returns
+    -------
+    Spectrum
+        The MTF (cy/px, 1 at zero frequency), its noise, the recovered LSF
+        and the figures.
 
-    density = d.size / (2.0 * half_range)
-    white = white_noise_mtf_sd(snr, 2.0 * core + taper, density, kind.noise_gain(shape, contrast))
-
-    def noise_sd(f):
-        # the noise is divided by the corrections as the MTF is
-        f = np.atleast_1d(np.asarray(f, float))
-        return white(f) / np.maximum(np.abs(divisor(f) / divisor(np.zeros(1))), MIN_TRANSFER)
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> e = m.estimate
+    >>> spectrum = transform(EdgeKind(), e.samples, e.profile, m.shape, m.noise, e.window, e.lsf, make_settings())
+    >>> spectrum.mtf_nyquist == e.spectrum.mtf_nyquist
+    True
+    """
+    divisor = kind.divisor(lsf.step_px, profile.resampled.transfer if settings.correct else None, shape)
+    mtf = corrected_mtf(lsf.combined, lsf.step_px, divisor)
+    density = samples.distance_px.size / (2.0 * samples.half_range_px)
+    white = white_noise_mtf_sd(noise.snr, 2.0 * window.core_px + window.taper_px, density,
+                               kind.noise_gain(shape, noise.contrast_dn))
+    noise_sd = functools.partial(_corrected_noise_sd, white=white, divisor=divisor)
     noise_limit = noise_limited_frequency(mtf, noise_sd)
-    x_c, lsf_c = restore_lsf(combined, x, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
-    mtf_nyquist = float(mtf(np.array([NYQUIST]))[0])
-    f50 = mtf50(mtf)
+    lsf_x, restored = restore_lsf(lsf.combined, lsf.x_px, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
+    return Spectrum(divisor, mtf, noise_sd, noise_limit, lsf_x, restored, float(mtf(np.array([NYQUIST]))[0]),
+                    mtf50(mtf), fwhm(lsf_x, restored))
 
-    # the gate
-    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", m, None)
-                  for i, m in enumerate((s <= -shape.plateau_px, s >= shape.plateau_px))]
-    checks += saturation_checks(d, raw, c, shape.scale_px, kind.saturation_sides(side_masks), limits, q,
-                                     noise_free=noise <= max(1.5 * q / math.sqrt(12.0), 1e-9 * contrast),
-                                     bright_core=kind.peak_mask(s, shape), monotone=kind.monotone,
-                                     contrast=contrast, bar_edge_px=None if shape.extra.get("width_estimated", True)
-                                     else 0.5 * shape.extra["width_px"])
-    checks += gate.side_checks(d, raw, row.astype(float), c, shape.plateau_px, contrast,
-                               pixel_noise, kind.tail_power)
-    snr_failures, snr_warnings = gate.snr_checks(snr, threshold, rows_used, kind.name)
+
+def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
+          window: Window, spectrum: Spectrum, settings: Settings) -> tuple[list[gate.Check], list[str]]:
+    """The quality gate: every check (saturation, the sides, SNR, MTF above
+    its noise, the figures, then the registered profile checks) added to
+    those run so far, enforced (failures raise unless ``settings.force``),
+    and the warnings the result must carry.
+
+    Parameters
+    ----------
+    kind : TargetKind
+        The target's kind.
+    chip : Chip
+        The prepared chip (its limits, quantum, noise and warnings).
+    located : Located
+        The line, its rows and the checks so far.
+    samples : Samples
+        The profile's samples (the gate reads their raw values).
+    shape : Shape
+        What the kind read off the profile.
+    noise : Noise
+        The profile's noise and SNR.
+    window : Window
+        The LSF window.
+    spectrum : Spectrum
+        The MTF and its figures.
+    settings : Settings
+        The SNR threshold and ``force``.
+
+    Returns
+    -------
+    list of Check, list of str
+        Every check run, and the warnings.
+
+    Raises
+    ------
+    ImgmtfError
+        A failed check, unless ``settings.force``.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> e = m.estimate
+    >>> checks, warnings = judge(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window,
+    ...                          e.spectrum, make_settings())
+    >>> all(check.passed for check in checks), warnings
+    (True, [])
+    """
+    distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
+    offsets = distance - centre
+    contrast, quantum_dn = noise.contrast_dn, chip.quantum_dn
+    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
+                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
+    sides = kind.saturation_sides(side_masks)
+    checks = list(located.checks)
+    checks += saturation_checks(distance, raw, centre, shape.scale_px, sides, chip.limits, quantum_dn,
+                                noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
+                                bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone,
+                                contrast=contrast, bar_edge_px=kind.known_half_width_px(shape))
+    checks += gate.side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
+                               chip.noise_dn, kind.tail_power)
+    threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
+    snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    checks.append(gate.mtf_excess_check(mtf, noise_sd, noise_limit))
-    fwhm_px = fwhm(x_c, lsf_c)
-    # where a divisor's zeros hide the MTF (a bar's sinc), a figure there is rightly missing
-    f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
-    hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
-    first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
-    checks.append(gate.figures_check(
-        mtf_nyquist, f50, fwhm_px, nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
-        mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
+    checks.append(gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px))
+    checks.append(_figures_check(spectrum))
     # the registered checks come last: a failure above (a sharpened halo) names the cause better
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     profile_checks, profile_warnings = run_profile_checks(Evidence(
-        d, raw, row, c, shape.scale_px, shape.plateau_px, shape.low, shape.high, noise, q, kind.tail_power,
-        kind.name, kind.profile, (side_names[0], side_names[1]), geometry))
+        distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
+        noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile, (side_names[0], side_names[1]),
+        located.geometry))
     checks += profile_checks
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + left_out[1] + decoded
-    if cut:
-        warnings.append(f"the LSF window's core ({core:.2f} px) is narrower than the {kind.name}'s width "
+    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + list(chip.warnings)
+    if window.cut:
+        warnings.append(f"the LSF window's core ({window.core_px:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
-
-    # intervals
-    nyquist_ci = mtf50_ci = Interval.none()
-    if settings.intervals.method == "influence":
-        nyquist_ci, mtf50_ci, width_share = _influence_intervals(
-            settings.intervals, mtf, mtf_nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
-            tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share, rebuilt is not None,
-            narrowed, width_influence)
-        if width_share is not None and width_share > WIDTH_SHARE_WARNING:
-            warnings.append(
-                f"the bar's width, read off its profile ({shape.extra['width_px']:.3f} px), is uncertain "
-                f"enough to make {100 * width_share:.0f} % of the variance at Nyquist: give the width "
-                "if it is known")
-    elif settings.intervals.method == "bootstrap":
-        if width_influence is not None:
-            warnings.append(f"the bootstrap holds the bar's width ({shape.extra['width_px']:.3f} px, read "
-                            "off its profile) fixed, so its intervals leave out the width's uncertainty: "
-                            "give the width if it is known, or use the default (influence) intervals")
-        nyquist_ci, mtf50_ci = _bootstrap_intervals(
-            settings, kind, d, v, row, c, core, taper, start, divisor, x, float(grid[-1]))
-    # an MTF (a modulus) and a frequency are never negative: ends below 0 are raised to 0 (docs/method.md)
-    nyquist_ci, mtf50_ci = nyquist_ci.clipped_at_zero(), mtf50_ci.clipped_at_zero()
-
-    figures = dict(
-        normal_angle_deg=_normal_angle(geometry), tilt_deg=geometry.tilt_deg,
-        direction=direction_label(_normal_angle(geometry), track_azimuth_deg),
-        orientation="horizontal" if transposed else "vertical",
-        rows_used=rows_used, rows_total=int(work.shape[0]), snr=snr, noise_dn=noise,
-        mtf_nyquist=mtf_nyquist, mtf50_cy_px=f50, mtf_nyquist_ci=nyquist_ci, mtf50_ci_cy_px=mtf50_ci,
-        fwhm_px=fwhm_px, mtfa=mtf_area(mtf), gsd_m=gsd_m, noise_limit_cy_px=noise_limit,
-        lsf_half_width_px=core, tail_fraction=tail_share, roi=(x0, y0, data.shape[1], data.shape[0]),
-        centre_px=c, levels=(shape.low, shape.high), side_levels=(sides[0].coef[0], sides[1].coef[0]),
-        scale_px=shape.scale_px, transposed=transposed, **shape.extra)
-    arrays = dict(grid=grid, values=values, lsf_x=x_c, lsf=lsf_c, samples_x=d, samples_dn=raw,
-                  geometry=geometry, mtf_function=mtf, frequencies=settings.frequencies_cy_px,
-                  mtf=mtf(settings.frequencies_cy_px))
-    if track_azimuth_deg is None:
-        warnings.append("the image is not in sensor geometry (map-projected): its rows are not along "
-                        "track, so the direction is unknown; give the track's azimuth to label it")
-    params = {**settings.as_dict(), **resampled.params, "lsf_half_width_px": core, "lsf_taper_px": taper,
-              "track_azimuth_deg": track_azimuth_deg, "dequantised": rebuilt is not None,
-              **left_out[0]}
-    return Measurement(figures, arrays, tuple(checks), tuple(warnings), params)
+    return checks, warnings
 
 
-def _left_out_pixels(data: np.ndarray, mask, noise: float) -> tuple[dict, list[str]]:
-    """Leave isolated hot and dead pixels out of ``data`` (set to NaN, in
-    place) and count them and the NaN or nodata pixels among those the
-    caller's ``mask`` (cropped to ``data``) keeps: (params, warnings)
-    saying so."""
-    nodata = int(np.count_nonzero(np.isnan(data) if mask is None else np.isnan(data) & mask))
-    hot = isolated_outliers(data, noise)
-    data[hot] = np.nan
-    counts = {"nodata_px": nodata, "outlier_px": int(hot.sum())}
-    said = []
-    if nodata:
-        said.append(f"{nodata} NaN or nodata pixel(s) inside the chip are left out of the estimate")
-    if hot.any():
-        said.append(f"{int(hot.sum())} isolated outlying pixel(s) (hot or dead) are left out of the estimate")
-    return {k: v for k, v in counts.items() if v}, said
-
-
-def _saturation(value) -> tuple[float, float]:
-    try:
-        low, high = value
-    except (TypeError, ValueError):
-        raise ParameterError(f"saturation must be two numbers (low, high) in DN, got {value!r}") from None
-    low = check_number("saturation low", low, signed=True)
-    high = check_number("saturation high", high, signed=True)
-    if not low < high:
-        raise ParameterError(f"saturation low must be below high, got ({low:g}, {high:g})")
-    return low, high
-
-
-def _central_run(grid, values, name):
-    """The longest run of finite resampled values around the target
-    (gaps at the far ends come from sparse samples)."""
-    good = np.isfinite(values)
-    mid = grid.size // 2
-    if not good[max(mid - 5, 0): mid + 6].all():
-        raise UnsuitableTargetError(f"the {name} profile has gaps at the target: too few sub-pixel "
-                                    "samples (target too short or angle unsuitable)")
-    bad_left = np.nonzero(~good[:mid])[0]
-    bad_right = np.nonzero(~good[mid:])[0]
-    lo = bad_left[-1] + 1 if bad_left.size else 0
-    hi = mid + bad_right[0] if bad_right.size else grid.size
-    return grid[lo:hi], values[lo:hi], (lo, hi)
-
-
-def _normal_angle(geometry: TargetGeometry) -> float:
+def normal_angle(geometry: TargetGeometry) -> float:
     """Angle (deg, in (-90, 90]) of the target's normal from the image's x
-    axis (y down): the tilt of the target from the column axis."""
+    axis (y down): the tilt of the target from the column axis.
+
+    Parameters
+    ----------
+    geometry : TargetGeometry
+        The target's line in the vertical frame.
+
+    Returns
+    -------
+    float
+        The normal's angle, degrees.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60)
+    >>> round(normal_angle(imgmtf.measure_edge(chip.image).geometry), 1)
+    6.0
+    """
     vertical = -math.degrees(math.atan(geometry.slope))
     if not geometry.transposed:
         return vertical
@@ -474,133 +462,30 @@ def _normal_angle(geometry: TargetGeometry) -> float:
     return angle - 180.0 if angle > 90.0 else angle
 
 
-def _influence_intervals(intervals, mtf, nyquist, f50, resampled, span, x, data_at, lsf, c, w, lsf_adjoint,
-                         tail_shape, sides, to_amplitude, amplitudes, kind, d, v, row, tail_share,
-                         dequantised, narrowed, width_influence):
-    """Linearised intervals for MTF at Nyquist and MTF50 (see
-    :mod:`.intervals`).
-
-    The transform F(f) = sum_k e_k(f) [w_k lsf_k + (1 - w_k) model_k] is
-    linear in the samples: through the LSF operator and the resampling
-    (their adjoints) where the window holds data, through each side's tail
-    amplitude (its least-squares operator), and for a bar through the
-    background under the window.  Each figure is |F(f)| / |F(0)| divided by
-    the corrections, so its gradient follows, and with each sample's
-    residual (scaled up by its leverage) gives the row influences.  Where
-    the divisor rests on a width read off the same samples
-    (``width_influence``: its :class:`WidthReading` and a function giving
-    dR(f) / dv), its
-    pull joins the gradient, widened where Fieller's set for the zero is
-    wider than the linearised one; the share of the variance at Nyquist it
-    makes is returned third (None without it)."""
-    step = float(x[1] - x[0])
-    width_share = None
-    freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
-    e = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                   # (n_f, n_x)
-    left = x < c
-    model = np.where(left, amplitudes[0], amplitudes[1]) * tail_shape
-    transform = e @ (w * lsf + (1.0 - w) * model)
-    weighted = (e * w)[:, data_at]
-    on_grid = lsf_adjoint(np.concatenate([weighted.real, weighted.imag]))
-    full = np.zeros((on_grid.shape[0], resampled.grid.size))
-    full[:, span[0]: span[1]] = on_grid
-    through = resampled.adjoint(full)
-    n_f = freqs.size
-    grad_f = through[:n_f] + 1j * through[n_f:]                                  # dF(f) / dv
-    for i, side in enumerate(sides):
-        in_side = left if i == 0 else ~left
-        per_amplitude = e @ ((1.0 - w) * tail_shape * in_side)
-        idx = np.nonzero(side.mask)[0]
-        grad_f[:, idx] += per_amplitude[:, None] * (to_amplitude[i] @ side.operator)[None, :]
-        if kind.subtracts_background:
-            grad_f[:, idx] -= 0.5 * (e @ w)[:, None] * side.operator[0][None, :]
-    f0 = transform[0].real
-    run_grid, run_values = resampled.grid[span[0]: span[1]], resampled.values[span[0]: span[1]]
-    # each sample's residual from the profile: the resampled one where it
-    # was resampled, the side's model beyond
-    far = np.abs(d - c) ** -float(kind.tail_power)
-    model_dn = np.where(d < c, sides[0].coef[0] + sides[0].coef[1] * far, sides[1].coef[0] + sides[1].coef[1] * far)
-    inside = (d >= run_grid[0]) & (d <= run_grid[-1])
-    residual = v - np.where(inside, np.interp(d, run_grid, run_values), model_dn)
-    if resampled.leverage is not None:
-        residual = residual / np.sqrt(1.0 - np.minimum(resampled.leverage, LEVERAGE_CAP))
-    width_pull = None
-    if width_influence is not None:
-        reading, spectrum_pull = width_influence
-        dspectrum_dv = spectrum_pull()
-        dwidth_dv = reading.width_change(dspectrum_dv[0])
-        width_sd, n_rows = influence_sd(dwidth_dv * residual, row)
-        spectrum_sd, _ = influence_sds(dspectrum_dv[1:] * residual, row)
-        t = t_quantile(0.5 + intervals.confidence / 2, max(n_rows - 1, 1))
-        spread = reading.spread_px(spectrum_sd, t)
-        widen = max(1.0, spread / (t * width_sd)) if width_sd > 0 else 1.0
-        width_pull = (widen * dwidth_dv, reading.log_slope)
-    out = []
-    for j in range(1, n_f):
-        fj, f = transform[j], freqs[j]
-        ratio = abs(fj) / abs(f0)
-        # the MTF is this ratio divided by the corrections: scale the gradient alike
-        scale = float(mtf(np.array([f]))[0]) / ratio if ratio else 0.0
-        grad = (np.real(np.conj(fj) * grad_f[j]) / (abs(fj) * abs(f0)) - ratio * grad_f[0].real / f0) * scale
-        if width_pull is not None:
-            dwidth_dv, log_slope = width_pull
-            if j == 1:
-                fixed_sd, _ = influence_sd(grad * residual, row)
-            # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
-            grad = grad - float(mtf(np.array([f]))[0]) * float(log_slope(f)) * dwidth_dv
-        sd, n_rows = influence_sd(grad * residual, row)
-        if j == 1 and width_pull is not None:
-            width_share = 1.0 - (fixed_sd / sd) ** 2 if sd > 0 else 0.0
-        if j == 1:
-            systematic = (SYSTEMATIC_NYQUIST + TAIL_MODEL_UNCERTAINTY * abs(tail_share) * abs(nyquist)
-                          + (SYSTEMATIC_DEQUANTISED if dequantised else 0.0) + NARROW_WINDOW_NYQUIST * narrowed)
-            out.append(linearised_interval(nyquist, sd, n_rows, intervals.confidence, systematic))
-        else:
-            h = 1e-3
-            slope = float(mtf(np.array([f50 + h]))[0] - mtf(np.array([f50 - h]))[0]) / (2 * h)
-            sd50 = sd / abs(slope) if slope else math.inf
-            systematic = f50 * (SYSTEMATIC_MTF50 + TAIL_MODEL_UNCERTAINTY * abs(tail_share)
-                                + (SYSTEMATIC_DEQUANTISED_MTF50 if dequantised else 0.0)
-                                + NARROW_WINDOW_MTF50 * narrowed)
-            out.append(linearised_interval(f50, sd50, n_rows, intervals.confidence, systematic))
-    while len(out) < 2:
-        out.append(Interval.none())
-    return out[0], out[1], width_share
+def _figures_check(spectrum: Spectrum) -> gate.Check:
+    """The figures' check, knowing where a divisor's zeros (a bar's sinc)
+    hide the MTF: a figure there is rightly missing."""
+    mtf, divisor = spectrum.mtf, spectrum.divisor
+    f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
+    hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
+    first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
+    return gate.figures_check(
+        spectrum.mtf_nyquist, spectrum.mtf50_cy_px, spectrum.fwhm_px,
+        nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
+        mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5)
 
 
-def _bootstrap_intervals(settings, kind, d, v, row, c, core, taper, start, divisor, x, span_px):
-    """Bootstrap intervals: every replicate re-resamples the rows it drew
-    (within ``span_px`` of the line), refits its sides' levels and tails,
-    and is windowed onto the lattice ``x`` as the estimate is."""
-    s = d - c
-    masks = [s <= -start[0], s >= start[1]]
-    to_amplitude = kind.lsf_tail_amplitudes()
-    step = float(x[1] - x[0])
-    sx = x - c
-    shape = np.where(np.abs(sx) > 1e-9, 1.0 / np.maximum(sx * sx, 1e-18), 0.0)
+def _corrected_noise_sd(f: ArrayLike, *, white: Callable, divisor: Callable) -> np.ndarray:
+    """The MTF's noise at ``f`` (cy/px): the white noise divided by the
+    corrections as the MTF is."""
+    f = np.atleast_1d(np.asarray(f, float))
+    return white(f) / np.maximum(np.abs(divisor(f) / divisor(np.zeros(1))), MIN_TRANSFER)
 
-    def resample(keep, weights, span):
-        return resample_profile(d[keep], v[keep], method=settings.method, step=settings.step_px,
-                                half_range=span, weights=weights, **settings.method_options)
 
-    def windowed(grid_b, values_b, weights_of):
-        coefs = []
-        for mask in masks:
-            u = np.abs(s[mask]) ** -float(kind.tail_power)
-            design = np.column_stack([np.ones_like(u), u])
-            wts = weights_of(mask)
-            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
-            rhs = np.einsum("ri,ij,i->rj", wts, design, v[mask])
-            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
-        background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
-        x_data, lsf_data, _ = kind.lsf(grid_b, values_b, background[:, None])
-        first = int(round((x_data[0] - x[0]) / step))
-        lsf = np.zeros((lsf_data.shape[0], x.size))
-        lsf[:, first: first + x_data.size] = lsf_data
-        in_data = np.zeros(x.size, bool)
-        in_data[first: first + x_data.size] = True
-        amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
-        w = flat_top_window(x, c, core, taper) * in_data
-        model = np.where(sx < 0, amp[0][:, None], amp[1][:, None]) * shape
-        return w * lsf + (1.0 - w) * model
-    return bootstrap_figures(settings.intervals, d, row, span_px, resample, windowed, step, divisor)
+def _resample_weighted(samples: Samples, settings: Settings, keep: np.ndarray, weights: np.ndarray,
+                       half_range_px: float) -> Resampled:
+    """The samples ``keep`` selects resampled as the estimate's profile was,
+    under a stack of ``weights`` (the bootstrap's replicates)."""
+    return resample_profile(samples.distance_px[keep], samples.values_dn[keep], method=settings.method,
+                            step=settings.step_px, half_range=half_range_px, weights=weights,
+                            **settings.method_options)

@@ -27,12 +27,14 @@ from ..metrics import fwhm
 from . import gate
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
-from .kind import Shape, TargetKind, WidthReading
-from .pipeline import BACKGROUND_FRACTION, TAPER_FACTOR, run
+from .intervals.width import WidthReading
+from .kind import Shape, TargetKind
+from .pipeline import run
 from .results import MTFResult, finite
 from .settings import make_settings
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 from .tails import outer_samples
+from .window import TAPER_FACTOR
 
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
 ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
@@ -44,6 +46,7 @@ BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of eac
 OUTER_PX = 5                    # a row window's pixels this far from the centre are background
 REACH_MARGIN_PX = 2             # a row window reaches this far beyond where the bar's profile fades to 5 %
 WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-width at 10 %
+BACKGROUND_FRACTION = 2.0 / 3.0  # a bar's background is read from the samples beyond this share of the range
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
@@ -145,7 +148,8 @@ class PulseKind(TargetKind):
         return locate_pulse(work, seed_x, transposed)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
-        left, right = (float(v[side].mean()) for side in outer_samples(d, half_range, BACKGROUND_FRACTION))
+        background_sides = outer_samples(d, half_range, BACKGROUND_FRACTION)
+        left, right = (float(v[side].mean()) for side in background_sides)
         background = (left + right) / 2
         centre = int(np.argmin(np.abs(grid)))
         sign = 1.0 if values[centre] >= background else -1.0
@@ -167,7 +171,7 @@ class PulseKind(TargetKind):
         return Shape(0.0, h10, float(background), float(background + sign * height),
                      min(1.5 * h10 + 1.0, half_range - 1.0),
                      {"width_px": width, "width_estimated": self.width_px is None, "prf01": prf01,
-                      "sign": sign, "area_px": area, "h10": h10})
+                      "sign": sign, "area_px": area, "h10": h10, "background_sides": background_sides})
 
     def core_px(self, shape, snr, factor):
         return _core_px(shape.scale_px, shape.extra["width_px"], factor)
@@ -199,10 +203,14 @@ class PulseKind(TargetKind):
     def peak_mask(self, s, shape):
         return np.abs(s - shape.centre) <= max(0.5 * shape.extra["width_px"], 0.5)
 
+    def known_half_width_px(self, shape):
+        return None if shape.extra["width_estimated"] else 0.5 * shape.extra["width_px"]
+
     def read_width(self, grid, shape):
         if not shape.extra["width_estimated"]:
             return None
-        return width_reading(grid, shape.extra["prf01"], shape.extra["width_px"], shape.high - shape.low)
+        return width_reading(grid, shape.extra["prf01"], shape.extra["width_px"], shape.high - shape.low,
+                             shape.extra["background_sides"])
 
 
 class PulseEstimator:
@@ -250,20 +258,19 @@ class PulseEstimator:
         with one_blas_thread():         # small matrices: threads cost more than they save
             m = run(PulseKind(width_px), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
                     dtype=dtype, track_azimuth_deg=track_azimuth_deg)
-        f, a = m.figures, m.arrays
-        width = f["width_px"]
+        extra = m.shape.extra
+        width = extra["width_px"]
         band = usable_band(width)
         warnings = list(m.warnings)
         if band < NYQUIST:
             warnings.append(f"the bar's sinc falls below {MIN_TRANSFER} at {band:.3f} cy/px, before "
                             "Nyquist: MTF values near its zeros are masked (NaN)")
-        background, peak = f["levels"]
         return PulseResult(
             **m.result_fields(), method=self.settings.method, params={**m.params, "pulse_width_px": width},
-            polarity="bright" if f["sign"] > 0 else "dark", warnings=tuple(warnings), pulse_width_px=float(width),
-            width_estimated=f["width_estimated"], usable_band_cy_px=band, prf_x_px=a["grid"],
-            prf=f["prf01"], prf_fwhm_px=fwhm(a["grid"], f["prf01"]), background_dn=float(background),
-            peak_dn=float(peak))
+            polarity="bright" if extra["sign"] > 0 else "dark", warnings=tuple(warnings), pulse_width_px=float(width),
+            width_estimated=extra["width_estimated"], usable_band_cy_px=band, prf_x_px=m.profile.grid,
+            prf=extra["prf01"], prf_fwhm_px=fwhm(m.profile.grid, extra["prf01"]), background_dn=float(m.shape.low),
+            peak_dn=float(m.shape.high))
 
 
 def measure_pulse(image: ArrayLike, *, width_px: float | None = None, roi: tuple[int, int, int, int] | None = None,
@@ -340,12 +347,15 @@ def usable_band(width_px: float) -> float:
     return float(f[np.argmax(np.abs(np.sinc(f * width_px)) < MIN_TRANSFER)])
 
 
-def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast_dn: float) -> WidthReading:
+def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast_dn: float,
+                  background_sides: tuple[np.ndarray, ...] = ()) -> WidthReading:
     """How :func:`estimate_width` read ``width_px`` off ``prf01``, the
     profile normalised by ``contrast_dn`` (its values minus the background,
     over the peak's height in DN): R(f) and its pull on the profile's
     values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
-    about it, for the intervals (:class:`imgmtf.estimate.kind.WidthReading`).
+    about it, for the intervals (:class:`imgmtf.estimate.intervals.width.WidthReading`);
+    ``background_sides`` the masks of the samples the background is the
+    mean of the two sides' means of.
 
     Examples
     --------
@@ -367,7 +377,7 @@ def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast
     slope = -float(np.sum(2 * np.pi * grid * np.sin(2 * np.pi * f_zero * grid) * prf01)) * step
     on_grid = cosines / contrast_dn             # prf01 = (values - background) / contrast
     return WidthReading(width_px, freqs, on_grid, -on_grid.sum(axis=1), cosines @ prf01, slope,
-                        lambda f: sinc_log_slope(f, width_px))
+                        lambda f: sinc_log_slope(f, width_px), background_sides)
 
 
 def sinc_log_slope(f, width_px: float):

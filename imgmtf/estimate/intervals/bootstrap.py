@@ -1,0 +1,183 @@
+"""Bootstrap intervals: the rows redrawn with replacement, every replicate
+re-estimated, the percentile interval of the re-estimates."""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ...metrics import first_crossing
+from ..spectrum import MIN_TRANSFER, NYQUIST, flat_top_window
+from .interval import Estimate, FigureIntervals, Interval
+
+FREQUENCY_STEP_CY_PX = 0.0025   # a bootstrap replicate's MTF50 is read on this grid
+
+
+def row_weights(rows: np.ndarray, replicates: int, rng: np.random.Generator):
+    """Bootstrap weights: ``weights_of(mask)`` -> array (replicates,
+    mask.sum()), each selected sample weighted by how often its row
+    (``rows`` labels each sample's row) was drawn when as many rows as there
+    are were drawn with replacement, the same draws for every mask."""
+    ids, inverse = np.unique(rows, return_inverse=True)
+    n = ids.size
+    draws = rng.integers(0, n, size=(replicates, n)) + n * np.arange(replicates)[:, None]
+    counts = np.bincount(draws.ravel(), minlength=replicates * n).reshape(replicates, n).astype(float)
+
+    def weights_of(mask: np.ndarray) -> np.ndarray:
+        return counts[:, inverse[mask]]
+    return weights_of
+
+
+def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.ndarray, np.ndarray]:
+    """MTF at Nyquist and MTF50 (cy/px) of every windowed profile (rows of
+    ``profiles``, sampled every ``step`` px): |DFT| normalised at zero,
+    divided by |divisor(f)| (NaN where it is below ``MIN_TRANSFER``), as
+    :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile."""
+    f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
+    x = np.arange(profiles.shape[-1]) * step
+    modulus = np.abs(profiles @ np.exp(-2j * np.pi * x[:, None] * f[None, :]))
+    div = np.abs(divisor(f) / divisor(np.zeros(1)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mtf = np.where(div >= MIN_TRANSFER, modulus / modulus[:, :1] / np.where(div > 0, div, 1), np.nan)
+    nyquist = mtf[:, int(round(NYQUIST / FREQUENCY_STEP_CY_PX))]
+    return nyquist, first_crossing(f, mtf, 0.5)
+
+
+def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:
+    """Central percentile interval of the finite ``samples``; NaN when fewer
+    than 90 % of them are finite (the figure is not defined often enough
+    for an interval to mean anything)."""
+    samples = np.asarray(samples, float)
+    finite = samples[np.isfinite(samples)]
+    if finite.size < 0.9 * samples.size or finite.size == 0:
+        return Interval.none()
+    tail = 50.0 * (1.0 - confidence)
+    low, high = np.percentile(finite, [tail, 100.0 - tail])
+    return Interval(float(low), float(high))
+
+
+def bootstrap_figures(distance: np.ndarray, rows: np.ndarray, span_px: float, resample: Callable,
+                      windowed_profile: Callable, step: float, divisor: Callable, *, confidence: float = 0.95,
+                      replicates: int = 200, seed: int = 0) -> tuple[Interval, Interval]:
+    """Intervals for MTF at Nyquist and MTF50 (cy/px) by resampling rows.
+
+    Parameters
+    ----------
+    distance : numpy.ndarray
+        Every profile sample's distance from the target line (px).
+    rows : numpy.ndarray
+        Every sample's row.
+    span_px : float
+        The profile is needed within +-span_px of the line.
+    resample : callable
+        ``resample(keep, weights, half_range)`` -> Resampled, the
+        estimator's own resampling of the samples selected by ``keep``
+        under a stack of ``weights``.
+    windowed_profile : callable
+        ``(grid, values, weights_of) -> profiles``: the estimator's
+        windowed LSF (or PRF) of each replicate, shape (replicates, n);
+        ``weights_of(mask)`` gives the replicates' weights of the samples
+        selected by ``mask`` (see :func:`row_weights`).
+    step : float
+        The profile's sample step (px).
+    divisor : callable
+        The estimator's transfer correction (see :mod:`.spectrum`).
+    confidence : float, optional
+        Coverage the intervals aim at, in (0, 1).
+    replicates : int, optional
+        How many times the rows are redrawn.
+    seed : int, optional
+        The redrawing's random seed.
+
+    Returns
+    -------
+    mtf_nyquist_ci, mtf50_ci_cy_px : Interval
+        The intervals of the MTF at Nyquist and of MTF50 (cy/px).
+    """
+    rng = np.random.default_rng(seed)
+    keep = np.abs(distance) <= span_px + 2.0
+    weights_of = row_weights(rows, replicates, rng)
+    resampled = resample(keep, weights_of(keep), span_px)
+    profiles = windowed_profile(resampled.grid, resampled.values, weights_of)
+    complete = np.isfinite(profiles).all(axis=1)
+    nyquist, fifty = spectral_figures(np.where(complete[:, None], profiles, 0.0), step, divisor)
+    nyquist[~complete] = np.nan
+    fifty[~complete] = np.nan
+    return percentile_interval(nyquist, confidence), percentile_interval(fifty, confidence)
+
+
+def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replicates: int = 200,
+                        seed: int = 0) -> FigureIntervals:
+    """Bootstrap intervals for MTF at Nyquist and MTF50: every replicate
+    re-resamples the rows it drew (as far out as the profile reaches),
+    refits its sides' levels and tails, and is windowed onto the estimate's
+    lattice as the estimate is.  A width read off the profile is held
+    fixed (a warning says so).
+
+    Parameters
+    ----------
+    estimate : Estimate
+        The estimate (:attr:`imgmtf.estimate.pipeline.Measurement.estimate`).
+    confidence : float, optional
+        Coverage the intervals aim at, in (0, 1).
+    replicates : int, optional
+        How many times the rows are redrawn.
+    seed : int, optional
+        The redrawing's random seed, so that one image always gets one interval.
+
+    Returns
+    -------
+    FigureIntervals
+        The percentile intervals of the MTF at Nyquist and of MTF50 (cy/px).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.pipeline import run
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=5.0, seed=1)
+    >>> estimate = run(EdgeKind(), chip.image, make_settings(intervals="none")).estimate
+    >>> found = bootstrap_intervals(estimate, replicates=50)
+    >>> float(chip.true_mtf(0.5)) in found.mtf_nyquist, found.mtf_nyquist.width < 0.05
+    (True, True)
+    """
+    samples, lsf, window = estimate.samples, estimate.lsf, estimate.window
+    distance, values, centre = samples.distance_px, samples.values_dn, estimate.centre_px
+    offsets = distance - centre
+    masks = [offsets <= -lsf.tail_starts_px[0], offsets >= lsf.tail_starts_px[1]]
+    to_amplitude = lsf.to_amplitude
+    x = lsf.x_px
+    step = float(x[1] - x[0])
+    from_centre = x - centre
+
+    def windowed(grid_b, values_b, weights_of):
+        coefs = []
+        for mask in masks:
+            u = np.abs(offsets[mask]) ** -float(estimate.tail_power)
+            design = np.column_stack([np.ones_like(u), u])
+            wts = weights_of(mask)
+            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
+            rhs = np.einsum("ri,ij,i->rj", wts, design, values[mask])
+            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
+        background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
+        x_data, lsf_data, _ = estimate.lsf_of(grid_b, values_b, background[:, None])
+        first = int(round((x_data[0] - x[0]) / step))
+        profiles = np.zeros((lsf_data.shape[0], x.size))
+        profiles[:, first: first + x_data.size] = lsf_data
+        in_data = np.zeros(x.size, bool)
+        in_data[first: first + x_data.size] = True
+        amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
+        w = flat_top_window(x, centre, window.core_px, window.taper_px) * in_data
+        model = np.where(from_centre < 0, amp[0][:, None], amp[1][:, None]) * lsf.tail_shape
+        return w * profiles + (1.0 - w) * model
+    nyquist, fifty = bootstrap_figures(distance, samples.rows, float(estimate.profile.grid[-1]),
+                                       estimate.resample, windowed, step, estimate.spectrum.divisor,
+                                       confidence=confidence, replicates=replicates, seed=seed)
+    warnings: tuple[str, ...] = ()
+    read = estimate.shape_profile.resampled
+    if estimate.width is not None and read.adjoint is not None:
+        warnings = (f"the bootstrap holds the {estimate.target}'s width ({estimate.width.width_px:.3f} px, read "
+                    "off its profile) fixed, so its intervals leave out the width's uncertainty: "
+                    "give the width if it is known, or use the default (influence) intervals",)
+    return FigureIntervals(nyquist, fifty, warnings)
