@@ -74,3 +74,12 @@ def test_no_import_cycle_between_modules():
     cycles = [sorted(n for n, label in zip(names, labels) if label == c) for c in range(count)
               if np.count_nonzero(labels == c) > 1]
     assert len(names) > 80 and len(edges) > 200 and cycles == []
+
+
+def test_no_module_over_600_lines():
+    # a room with one job stays small enough to read: a module that grows past
+    # this has taken on a second job and is split (docs/architecture.md)
+    import pathlib
+    root = pathlib.Path(imgmtf.__file__).parent
+    long = {str(p.relative_to(root)): n for p in root.rglob("*.py") if (n := len(p.read_text().splitlines())) > 600}
+    assert long == {}
