@@ -14,22 +14,36 @@ folder): 4096 x 4096 px, 16-bit, rows along track, no CRS.
 * everything drawn from ``numpy.random.default_rng(SEED)``, SEED = 20240512,
   so the scene is the same on every machine.
 
-Timed, in this process, after one warm-up run of each:
+The second scene, a chart like MTF Mapper's own (built once in the
+cache): 1400 x 1400 px, 16-bit, four dark squares (8000 DN, 380 px
+a side) rotated 4, 7.5, 11 and 14.5 deg on a 40000 DN field, each rendered
+exactly by the generic sensor (:func:`imgmtf.sensor.scenes.render_quadrants`
+with four equal quadrants), 40 DN of noise: 16 edges.
+
+Timed, in this process, after one warm-up run of each, the best of
+``--runs``, every figure of a ratio measured in the same run:
 
 1. LSD: the scene read in the same 1024 px tiles (32 px overlap) as scan
    reads them, scaled to 8 bits with the same levels, and
    ``cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD).detect`` on each;
 2. ``imgmtf.scene.measure.scan_scene`` (detection, screening, measurement,
    intervals of the accepted, combination) with 1 worker;
-3. the ``imgmtf scan`` command, without and with ``--out`` (a new process:
-   its start-up, about 1 s of imports, and its outputs included).
+3. the ``imgmtf scan`` command (a new process: its start-up, about 1 s of
+   imports, and its outputs included), as a user runs it (the targets'
+   sensor fits included), with ``--fit-stages none`` and with
+   ``--workers 2``;
+4. on the chart, ``imgmtf scan CHART`` against ``mtf_mapper -q -l CHART
+   DIR`` (MTF Mapper 0.7.38; ``--mtfmapper PATH`` or the ``MTF_MAPPER``
+   environment variable, else ``mtf_mapper`` on the PATH; the comparison
+   is skipped, saying so, when it is not found), each a new process.
 
 Printed: the load average (the machine is shared: time when it is low),
-both times, their ratio (budget: scan within 3 x LSD, aim 1.5 x), the
-number of candidates by reason, and how many of the 14 edges were accepted
-with their MTF at Nyquist against the truth.
+the times and their ratios (budgets: ``imgmtf scan`` within 2 x LSD, aim
+1.5 x; within 3 x MTF Mapper, aim 2 x), the number of candidates by
+reason, how many of the 14 edges were accepted with their MTF at Nyquist
+against the truth, and how many of the chart's 16 edges each tool measured.
 
-usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli]
+usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH]
 """
 from __future__ import annotations
 
@@ -52,6 +66,10 @@ from imgmtf.sensor.scenes import texture
 SEED = 20240512
 SIZE = 4096
 N_EDGES = 14
+CHART_SIZE = 1400
+CHART_ANGLES = (4.0, 7.5, 11.0, 14.5)     # the squares' tilts, deg
+CHART_SQUARE_PX = 380.0
+CHART_DARK_DN, CHART_FIELD_DN, CHART_NOISE_DN = 8000.0, 40000.0, 40.0
 
 
 def _parcels(image: np.ndarray, rng: np.random.Generator, count: int = 600) -> None:
@@ -143,39 +161,125 @@ def lsd_only(path: Path) -> int:
     return found
 
 
-def timed(fn, runs: int):
-    fn()
-    best, out = math.inf, None
+def build_chart(path: Path) -> None:
+    """Write the chart of four dark squares to ``path`` (GeoTIFF, no CRS)."""
+    from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
+    rng = np.random.default_rng(SEED)
+    cell = CHART_SIZE // 2
+    image = np.zeros((CHART_SIZE, CHART_SIZE), np.uint16)
+    for k, angle in enumerate(CHART_ANGLES):
+        row, col = divmod(k, 2)
+        centre = tuple(cell / 2 - 0.5 + rng.uniform(-3, 3, 2))
+        square = QuadrantTarget(centre, angle, (CHART_DARK_DN,) * 4, CHART_SQUARE_PX / 2)
+        image[row * cell:(row + 1) * cell, col * cell:(col + 1) * cell] = render_quadrants(
+            im.Sensor(), (cell, cell), square, field_dn=CHART_FIELD_DN, noise_std_dn=CHART_NOISE_DN,
+            seed=int(rng.integers(1 << 31))).image
+    im.write_geotiff(path, image, provenance={"seed": SEED, "angles_deg": list(CHART_ANGLES),
+                                              "imgmtf_version": im.__version__})
+
+
+def chart(cache: Path) -> Path:
+    path = cache / f"scan_speed_chart_{CHART_SIZE}_{SEED}.tif"
+    if not path.exists():
+        build_chart(path)
+    return path
+
+
+def mtf_mapper(given: str | None) -> str | None:
+    """MTF Mapper's executable: ``given``, else $MTF_MAPPER, else on the PATH; None if none runs."""
+    candidate = given or os.environ.get("MTF_MAPPER") or shutil.which("mtf_mapper")
+    return candidate if candidate and os.path.isfile(candidate) and os.access(candidate, os.X_OK) else None
+
+
+def timed_together(jobs: dict, runs: int, warm: set[str]) -> dict[str, tuple[float, object]]:
+    """Each job's best time (s) and last output over ``runs`` rounds, every
+    round running every job in turn, so that the figures of a ratio share
+    the machine's load; the jobs in ``warm`` are run once before."""
+    for name in warm:
+        jobs[name]()
+    best = {name: (math.inf, None) for name in jobs}
     for _ in range(runs):
-        t = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, out
+        for name, fn in jobs.items():
+            t = time.perf_counter()
+            out = fn()
+            best[name] = (min(best[name][0], time.perf_counter() - t), out)
+    return best
+
+
+def command(*args: str) -> list[str]:
+    return [shutil.which("imgmtf") or "imgmtf", *args]
+
+
+def run_quietly(args: list[str]) -> subprocess.CompletedProcess:
+    return subprocess.run(args, capture_output=True, text=True, check=False)
+
+
+def accepted_edges(run: subprocess.CompletedProcess) -> int:
+    """Accepted half-edges in ``imgmtf scan --format json``'s rows."""
+    rows = [json.loads(line) for line in run.stdout.splitlines() if line.startswith("{")]
+    return sum(r.get("scope") == "edge" and r.get("status") == "accepted" for r in rows)
+
+
+def mtf_mapper_edges(out: str) -> int:
+    path = Path(out) / "edge_sfr_values.txt"
+    return len(path.read_text().splitlines()) if path.exists() else 0
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()))
-    parser.add_argument("--runs", type=int, default=3, help="timed runs of each; the best is kept")
-    parser.add_argument("--no-cli", action="store_true", help="skip the imgmtf scan command")
+    parser.add_argument("--runs", type=int, default=3, help="timed rounds; each figure's best is kept")
+    parser.add_argument("--no-cli", action="store_true", help="skip the imgmtf scan command (and the chart)")
+    parser.add_argument("--mtfmapper", metavar="PATH",
+                        help="MTF Mapper's mtf_mapper (default: $MTF_MAPPER, else on the PATH)")
     args = parser.parse_args()
     from imgmtf.scene.measure import scan_scene
     path, truth = scene(args.cache)
+    peer = None if args.no_cli else mtf_mapper(args.mtfmapper)
+    chart_path = None if args.no_cli else chart(args.cache)
     print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
-    lsd_s, segments = timed(lambda: lsd_only(path), args.runs)
-    scan_s, records = timed(lambda: scan_scene(str(path)), args.runs)
+    with tempfile.TemporaryDirectory() as work:
+        jobs = {"lsd": lambda: lsd_only(path), "scan_scene": lambda: scan_scene(str(path))}
+        if not args.no_cli:
+            jobs.update({
+                "cli": lambda: run_quietly(command("scan", str(path))),
+                "cli_nofit": lambda: run_quietly(command("scan", str(path), "--fit-stages", "none")),
+                "cli_workers": lambda: run_quietly(command("scan", str(path), "--workers", "2")),
+                "cli_out": lambda: run_quietly(command("scan", str(path), "--out", work)),
+                "chart": lambda: run_quietly(command("scan", str(chart_path), "--format", "json")),
+                "chart_nofit": lambda: run_quietly(command("scan", str(chart_path), "--format", "json",
+                                                           "--fit-stages", "none")),
+            })
+            if peer:
+                jobs["mtf_mapper"] = lambda: (run_quietly([peer, "-q", "-l", str(chart_path), work]),
+                                              mtf_mapper_edges(work))
+        times = timed_together(jobs, args.runs, warm={"lsd", "scan_scene"})
+    lsd_s, segments = times["lsd"]
+    scan_s, records = times["scan_scene"]
     print(f"LSD (read + 8 bits + detect, {segments} segments): {lsd_s:6.2f} s")
-    print(f"scan_scene, 1 worker ({len(records)} candidates):       {scan_s:6.2f} s   "
-          f"{scan_s / lsd_s:.2f} x LSD (budget 3 x, aim 1.5 x)")
+    print(f"{f'scan_scene, 1 worker ({len(records)} candidates):':52s} {scan_s:6.2f} s   {scan_s / lsd_s:.2f} x LSD")
     if not args.no_cli:
-        command = [shutil.which("imgmtf") or "imgmtf", "scan", str(path)]
-        with tempfile.TemporaryDirectory() as out:
-            for label, extra in (("imgmtf scan SCENE (a new process, text table)", []),
-                                 ("imgmtf scan SCENE --out DIR (CSV, GeoJSON, overview)", ["--out", out])):
-                def run(extra=extra):
-                    subprocess.run(command + extra, capture_output=True, check=False)
-                cli_s, _ = timed(run, 1)
-                print(f"{label + ':':52s} {cli_s:6.2f} s   {cli_s / lsd_s:.2f} x LSD")
+        for name, label in (("cli", "imgmtf scan SCENE (new process, fits, text table)"),
+                            ("cli_nofit", "imgmtf scan SCENE --fit-stages none"),
+                            ("cli_workers", "imgmtf scan SCENE --workers 2"),
+                            ("cli_out", "imgmtf scan SCENE --out DIR (CSV, GeoJSON, PNG)")):
+            seconds = times[name][0]
+            budget = "   (budget 2 x, aim 1.5 x)" if name == "cli" else ""
+            print(f"{label + ':':52s} {seconds:6.2f} s   {seconds / lsd_s:.2f} x LSD{budget}")
+        print(f"chart {CHART_SIZE} x {CHART_SIZE}, {len(CHART_ANGLES)} dark squares, "
+              f"{4 * len(CHART_ANGLES)} edges:")
+        if peer:
+            peer_s, (_, peer_edges) = times["mtf_mapper"]
+            print(f"  {'mtf_mapper -q -l CHART DIR:':50s} {peer_s:6.2f} s   {peer_edges} edges measured")
+        else:
+            peer_s = None
+            print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
+        for name, label in (("chart", "imgmtf scan CHART (fits)"),
+                            ("chart_nofit", "imgmtf scan CHART --fit-stages none")):
+            seconds, run = times[name]
+            ratio = f"   {seconds / peer_s:.2f} x MTF Mapper" if peer_s else ""
+            budget = " (budget 3 x, aim 2 x)" if peer_s and name == "chart" else ""
+            print(f"  {label + ':':50s} {seconds:6.2f} s   {accepted_edges(run)} edges accepted{ratio}{budget}")
     print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     reasons = Counter(r.reason or r.status for r in records)
     print("candidates: " + ", ".join(f"{k} {v}" for k, v in reasons.most_common()))
