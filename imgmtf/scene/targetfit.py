@@ -106,11 +106,15 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
         return []
     from ..parallel import run_tasks
     targets = sorted({int(r.site["target_id"]) for r in accepted})
-    # each task measures its half-edges again itself (an EdgeResult does not travel between processes)
-    tasks = [([r for r in accepted if r.site["target_id"] == target], {"scope": TARGET_SCOPE, "target_id": target},
-              stages) for target in targets]
+    groups = [([r for r in accepted if r.site["target_id"] == target], {"scope": TARGET_SCOPE, "target_id": target})
+              for target in targets]
     if len(targets) > 1:        # the scene's fit, the longest, first: the targets' fill the other workers
-        tasks.insert(0, (accepted, {"scope": SCENE_SCOPE}, stages))
+        groups.insert(0, (accepted, {"scope": SCENE_SCOPE}))
+    # on workers, each task measures its half-edges again itself (an EdgeResult does not travel between
+    # processes); run here, each half-edge is measured again once, for its target's fit and the scene's
+    again = dict(zip(map(id, accepted), _measured(accepted))) if workers == 1 and scheduler is None else None
+    tasks = [(members, site, stages, None if again is None else [again[id(r)] for r in members])
+             for members, site in groups]
     fitted = list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
                             description="fitting targets"))
     return [row for rows in fitted[1:] + fitted[:1] for row in rows] if len(targets) > 1 else fitted[0]
@@ -176,8 +180,10 @@ def _turned(normal_deg: float, track_deg: float) -> float:
 
 
 def _fit_task(task) -> list[Record]:
-    records, site, stages = task
-    return _fit_rows(list(zip(records, _measured(records))), site, stages)
+    """One fit: (its half-edges' records, its site, the stages, and the
+    half-edges measured again, or None to measure them here)."""
+    records, site, stages, measured = task
+    return _fit_rows(list(zip(records, measured if measured is not None else _measured(records))), site, stages)
 
 
 def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
