@@ -127,12 +127,16 @@ class Junction:
 
 
 # -- LSD ----------------------------------------------------------------------------
-def detect_segments(path: str, settings: ScanSettings | None = None) -> tuple[np.ndarray, np.ndarray]:
+def detect_segments(path: str, settings: ScanSettings | None = None, *, workers: int = 1,
+                    scheduler: str | None = None, progress: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every straight piece LSD finds in the scene's tiles, at least
     ``MIN_SEGMENT_PX`` long, with the pieces of one line merged
     (:func:`merge_segments`): (segments as rows x0, y0, x1, y1 in scene
     pixels in LSD's orientation, and the fraction of each segment's length
     along which fill or nodata lies beside it, within ``FILL_SIDE_PX``).
+    The tiles are read and searched one task each
+    (:func:`imgmtf.parallel.run_tasks`: ``workers``, ``scheduler`` and
+    ``progress`` as there).
 
     Raises
     ------
@@ -140,26 +144,17 @@ def detect_segments(path: str, settings: ScanSettings | None = None) -> tuple[np
         The scene is too large (reason ``too-large``), flat or all nodata
         (``image``), or unreadable.
     """
+    from ..parallel import run_tasks
     settings = settings or ScanSettings()
     info = raster_info(path)
     check_scene_size(info)
     lo, hi = display_levels(path, settings.band, info)
-    detector = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
-    found_pieces: list[np.ndarray] = []
-    found_fill: list[np.ndarray] = []
-    step = settings.tile_px - TILE_OVERLAP_PX
-    for y in range(0, max(info.height - TILE_OVERLAP_PX, 1), step):
-        for x in range(0, max(info.width - TILE_OVERLAP_PX, 1), step):
-            w, h = min(settings.tile_px, info.width - x), min(settings.tile_px, info.height - y)
-            tile = read_raster(path, settings.band, window=(x, y, w, h)).data
-            found = detector.detect(to_8bit(tile, lo, hi))[0]
-            if found is not None:
-                found = found.reshape(-1, 4).astype(float)
-                found_pieces.append(found + np.array([x, y, x, y], float))
-                found_fill.append(_fill_beside(found, fill_mask(tile, info.dtype)))
-    if not found_pieces:
+    tiles = [(path, settings.band, window, lo, hi, info.dtype) for window in tile_windows(info, settings.tile_px)]
+    found = [f for f in run_tasks(tile_segments, tiles, workers=workers, scheduler=scheduler, progress=progress,
+                                  description="detecting segments") if len(f[0])]
+    if not found:
         return np.zeros((0, 4)), np.zeros(0)
-    pieces, beside_fill = np.concatenate(found_pieces), np.concatenate(found_fill)
+    pieces, beside_fill = np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found])
     label = _merge_labels(pieces)
     merged = _joined(pieces, label)
     lengths = _lengths(pieces)
@@ -168,6 +163,28 @@ def detect_segments(path: str, settings: ScanSettings | None = None) -> tuple[np
     merged, fill = merged[order], fill[order]
     keep = _lengths(merged) >= MIN_SEGMENT_PX
     return merged[keep], fill[keep]
+
+
+def tile_windows(info: RasterInfo, tile_px: int) -> list[tuple[int, int, int, int]]:
+    """The windows (x, y, w, h) detection reads: tiles of ``tile_px``
+    overlapping by ``TILE_OVERLAP_PX``, row by row."""
+    step = tile_px - TILE_OVERLAP_PX
+    return [(x, y, min(tile_px, info.width - x), min(tile_px, info.height - y))
+            for y in range(0, max(info.height - TILE_OVERLAP_PX, 1), step)
+            for x in range(0, max(info.width - TILE_OVERLAP_PX, 1), step)]
+
+
+def tile_segments(task) -> tuple[np.ndarray, np.ndarray]:
+    """One tile's LSD pieces (rows x0, y0, x1, y1 in scene pixels) and the
+    fraction of each with fill beside it; ``task`` is (path, band, window,
+    lo, hi, dtype): the tile read and scaled to 8 bits with [lo, hi]."""
+    path, band, (x, y, w, h), lo, hi, dtype = task
+    tile = read_raster(path, band, window=(x, y, w, h)).data
+    found = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD).detect(to_8bit(tile, lo, hi))[0]
+    if found is None:
+        return np.zeros((0, 4)), np.zeros(0)
+    found = found.reshape(-1, 4).astype(float)
+    return found + np.array([x, y, x, y], float), _fill_beside(found, fill_mask(tile, dtype))
 
 
 def _fill_beside(pieces: np.ndarray, fill: np.ndarray) -> np.ndarray:

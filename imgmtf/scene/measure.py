@@ -215,7 +215,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         # a strip or a one-pixel scene holds no chip: refused before any tile is read
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; an edge or bar chip needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
-    segments, fill_fraction = detect_segments(path, settings)
+    segments, fill_fraction = detect_segments(path, settings, workers=workers, scheduler=scheduler, progress=progress)
     junctions, events = find_junctions(segments)
     halves = split_at_junctions(segments, junctions, events, fill_fraction)
     track = track_azimuth(info, settings)
