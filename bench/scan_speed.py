@@ -53,6 +53,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from collections import Counter
@@ -207,7 +208,8 @@ def timed_together(jobs: dict, runs: int, warm: set[str]) -> dict[str, tuple[flo
 
 
 def command(*args: str) -> list[str]:
-    return [shutil.which("imgmtf") or "imgmtf", *args]
+    """The imgmtf command line with ``args``, run by this Python (its venv's imgmtf)."""
+    return [sys.executable, "-m", "imgmtf.cli", *args]
 
 
 def run_quietly(args: list[str]) -> subprocess.CompletedProcess:
