@@ -38,7 +38,8 @@ Timed, in this process, after one warm-up run of each, the best of
    is skipped, saying so, when it is not found), each a new process.
 
 Printed: the load average (the machine is shared: time when it is low),
-the times and their ratios (budgets: ``imgmtf scan`` within 2 x LSD, aim
+the times (wall, and CPU of the process and its children: less hostage to
+the machine's other work) and their ratios (budgets: ``imgmtf scan`` within 2 x LSD, aim
 1.5 x; within 3 x MTF Mapper, aim 2 x), the number of candidates by
 reason, how many of the 14 edges were accepted with their MTF at Nyquist
 against the truth, and how many of the chart's 16 edges each tool measured.
@@ -51,12 +52,14 @@ import argparse
 import json
 import math
 import os
+import resource
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -192,18 +195,40 @@ def mtf_mapper(given: str | None) -> str | None:
     return candidate if candidate and os.path.isfile(candidate) and os.access(candidate, os.X_OK) else None
 
 
-def timed_together(jobs: dict, runs: int, warm: set[str]) -> dict[str, tuple[float, object]]:
-    """Each job's best time (s) and last output over ``runs`` rounds, every
-    round running every job in turn, so that the figures of a ratio share
-    the machine's load; the jobs in ``warm`` are run once before."""
+@dataclass
+class Timing:
+    """A job's best wall time and best CPU time (s, its processes' and
+    threads' together) over the rounds, and its last output."""
+
+    wall_s: float = math.inf
+    cpu_s: float = math.inf
+    out: object = None
+
+    def ratio(self, other: Timing) -> str:
+        """This job against ``other``: wall time, then CPU time (less
+        hostage to the machine's other work)."""
+        return f"{self.wall_s / other.wall_s:5.2f} x (CPU {self.cpu_s / other.cpu_s:5.2f} x)"
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process and of its children waited for (s)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+def timed_together(jobs: dict, runs: int, warm: set[str]) -> dict[str, Timing]:
+    """Each job's best times over ``runs`` rounds, every round running
+    every job in turn, so that the figures of a ratio share the machine's
+    load; the jobs in ``warm`` are run once before."""
     for name in warm:
         jobs[name]()
-    best = {name: (math.inf, None) for name in jobs}
+    best = {name: Timing() for name in jobs}
     for _ in range(runs):
         for name, fn in jobs.items():
-            t = time.perf_counter()
+            wall, cpu = time.perf_counter(), cpu_seconds()
             out = fn()
-            best[name] = (min(best[name][0], time.perf_counter() - t), out)
+            wall, cpu = time.perf_counter() - wall, cpu_seconds() - cpu
+            best[name] = Timing(min(best[name].wall_s, wall), min(best[name].cpu_s, cpu), out)
     return best
 
 
@@ -256,32 +281,36 @@ def main() -> None:
                 jobs["mtf_mapper"] = lambda: (run_quietly([peer, "-q", "-l", str(chart_path), work]),
                                               mtf_mapper_edges(work))
         times = timed_together(jobs, args.runs, warm={"lsd", "scan_scene"})
-    lsd_s, segments = times["lsd"]
-    scan_s, records = times["scan_scene"]
-    print(f"LSD (read + 8 bits + detect, {segments} segments): {lsd_s:6.2f} s")
-    print(f"{f'scan_scene, 1 worker ({len(records)} candidates):':52s} {scan_s:6.2f} s   {scan_s / lsd_s:.2f} x LSD")
+    lsd, scan = times["lsd"], times["scan_scene"]
+    segments, records = lsd.out, scan.out
+
+    def line(label: str, timing: Timing, against: Timing | None = None, what: str = "", more: str = "") -> None:
+        ratio = f"{timing.ratio(against)} {what}" if against is not None else ""
+        print(f"{label + ':':54s} {timing.wall_s:6.2f} s (CPU {timing.cpu_s:6.2f} s)   {ratio}{more}".rstrip())
+    line(f"LSD (read + 8 bits + detect, {segments} segments)", lsd)
+    line(f"scan_scene, 1 worker ({len(records)} candidates)", scan, lsd, "LSD")
     if not args.no_cli:
         for name, label in (("cli", "imgmtf scan SCENE (new process, fits, text table)"),
                             ("cli_nofit", "imgmtf scan SCENE --fit-stages none"),
                             ("cli_workers", "imgmtf scan SCENE --workers 2"),
                             ("cli_out", "imgmtf scan SCENE --out DIR (CSV, GeoJSON, PNG)")):
-            seconds = times[name][0]
-            budget = "   (budget 2 x, aim 1.5 x)" if name == "cli" else ""
-            print(f"{label + ':':52s} {seconds:6.2f} s   {seconds / lsd_s:.2f} x LSD{budget}")
+            line(label, times[name], lsd, "LSD", "   (budget 2 x, aim 1.5 x)" if name == "cli" else "")
         print(f"chart {CHART_SIZE} x {CHART_SIZE}, {len(CHART_ANGLES)} dark squares, "
               f"{4 * len(CHART_ANGLES)} edges:")
-        if peer:
-            peer_s, (_, peer_edges) = times["mtf_mapper"]
-            print(f"  {'mtf_mapper -q -l CHART DIR:':50s} {peer_s:6.2f} s   {peer_edges} edges measured")
+        peer_timing = times.get("mtf_mapper")
+        if peer_timing is not None:
+            line("  mtf_mapper -q -l CHART DIR", peer_timing, more=f"{peer_timing.out[1]} edges measured")
         else:
-            peer_s = None
             print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
         for name, label in (("chart", "imgmtf scan CHART (fits)"),
                             ("chart_nofit", "imgmtf scan CHART --fit-stages none")):
-            seconds, run = times[name]
-            ratio = f"   {seconds / peer_s:.2f} x MTF Mapper" if peer_s else ""
-            budget = " (budget 3 x, aim 2 x)" if peer_s and name == "chart" else ""
-            print(f"  {label + ':':50s} {seconds:6.2f} s   {accepted_edges(run)} edges accepted{ratio}{budget}")
+            timing = times[name]
+            edges = f"{accepted_edges(timing.out)} edges accepted"
+            if peer_timing is None:
+                line("  " + label, timing, more=edges)
+            else:
+                line("  " + label, timing, peer_timing, "MTF Mapper",
+                     f", {edges}" + ("   (budget 3 x, aim 2 x)" if name == "chart" else ""))
     print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     reasons = Counter(r.reason or r.status for r in records)
     print("candidates: " + ", ".join(f"{k} {v}" for k, v in reasons.most_common()))
