@@ -39,7 +39,8 @@ Timed, in this process, after one warm-up run of each, the best of
 
 Printed: the load average (the machine is shared: time when it is low),
 the times (wall, and CPU of the process and its children: less hostage to
-the machine's other work) and their ratios (budgets: ``imgmtf scan`` within 2 x LSD, aim
+the machine's other work; a worker pool's processes are the fork server's
+children, not counted) and their ratios (budgets: ``imgmtf scan`` within 2 x LSD, aim
 1.5 x; within 3 x MTF Mapper, aim 2 x), the number of candidates by
 reason, how many of the 14 edges were accepted with their MTF at Nyquist
 against the truth, and how many of the chart's 16 edges each tool measured.
@@ -292,7 +293,7 @@ def main() -> None:
     if not args.no_cli:
         for name, label in (("cli", "imgmtf scan SCENE (new process, fits, text table)"),
                             ("cli_nofit", "imgmtf scan SCENE --fit-stages none"),
-                            ("cli_workers", "imgmtf scan SCENE --workers 2"),
+                            ("cli_workers", "imgmtf scan SCENE --workers 2 (CPU: not its workers')"),
                             ("cli_out", "imgmtf scan SCENE --out DIR (CSV, GeoJSON, PNG)")):
             line(label, times[name], lsd, "LSD", "   (budget 2 x, aim 1.5 x)" if name == "cli" else "")
         print(f"chart {CHART_SIZE} x {CHART_SIZE}, {len(CHART_ANGLES)} dark squares, "
