@@ -158,35 +158,37 @@ def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] 
     damping = np.full(groups, 1e-3)
     active = np.ones(groups, bool)
     failed = np.zeros(groups, bool)
+    identity = np.eye(4)
     for _ in range(iterations):
-        idx = np.flatnonzero(active)
-        if idx.size == 0:
+        if not active.any():
             break
-        weighted = jac[idx] * w[idx, :, None]
-        normal = np.einsum("gni,gnj->gij", weighted, jac[idx])
-        gradient = np.einsum("gni,gn->gi", weighted, v[idx] - fit[idx])
+        # every group is computed, a stopped one left as it is (the groups
+        # are few: fewer, larger operations cost less than selecting them)
+        weighted = np.swapaxes(jac * w[..., None], 1, 2)
+        normal = weighted @ jac
+        gradient = (weighted @ (v - fit)[..., None])[..., 0]
         diagonal = np.maximum(np.einsum("gii->gi", normal), 1e-12)
-        step, regular = _solve_each(normal + damping[idx, None, None] * (diagonal[:, :, None] * np.eye(4)),
-                                    gradient)
-        failed[idx[~regular]] = True
-        active[idx[~regular]] = False
-        trial = p[idx] + step
+        damped = np.where(active[:, None, None], normal + damping[:, None, None] * (diagonal[:, :, None] * identity),
+                          identity)
+        step, regular = _solve_each(damped, gradient)
+        failed |= active & ~regular
+        active &= regular
+        trial = p + step
         # a zero scale is no model: a longer step's turn
-        zero = regular & (trial[:, 2] == 0)
-        damping[idx[zero]] *= 4.0
-        tried = regular & ~zero
-        idx, step, trial = idx[tried], step[tried], trial[tried]
-        trial_fit, trial_jac = model(s[idx], trial)
-        trial_cost = np.einsum("gn,gn->g", w[idx] * (v[idx] - trial_fit), v[idx] - trial_fit)
-        better = np.isfinite(trial_cost) & (trial_cost < cost[idx])
-        won = idx[better]
-        p[won], fit[won], jac[won], cost[won] = trial[better], trial_fit[better], trial_jac[better], trial_cost[better]
-        damping[won] /= 3.0
+        zero = active & (trial[:, 2] == 0)
+        damping[zero] *= 4.0
+        tried = active & ~zero
+        trial_fit, trial_jac = model(s, np.where(tried[:, None], trial, p))
+        trial_cost = np.einsum("gn,gn->g", w * (v - trial_fit), v - trial_fit)
+        better = tried & np.isfinite(trial_cost) & (trial_cost < cost)
+        p = np.where(better[:, None], trial, p)
+        fit = np.where(better[:, None], trial_fit, fit)
+        jac = np.where(better[:, None, None], trial_jac, jac)
+        cost = np.where(better, trial_cost, cost)
+        lost = tried & ~better
+        damping = np.where(better, damping / 3.0, np.where(lost, damping * 4.0, damping))
         converged = np.abs(step[:, 2]) < 1e-7 * np.maximum(np.abs(trial[:, 2]), 1e-9)
-        active[idx[better & converged]] = False
-        lost = idx[~better]
-        damping[lost] *= 4.0
-        active[lost[damping[lost] > 1e10]] = False
+        active &= ~(better & converged) & ~(lost & (damping > 1e10))
     weighted = jac * w[..., None]
     covariance, regular = _solve_each(np.einsum("gni,gnj->gij", weighted, jac), np.tile(np.eye(4)[2], (groups, 1)))
     variance = covariance[:, 2] * cost / np.maximum(w.sum(axis=1) - 4, 1)
