@@ -60,8 +60,9 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
     cost = _cost(x, y, w, p)
     for _ in range(iterations):
         jac, resid = _jacobian(x, y, w, p)
-        jtj = np.einsum("rki,rkj->rij", jac * w[..., None], jac)
-        jtr = np.einsum("rki,rk->ri", jac * w[..., None], resid)
+        weighted = np.swapaxes(jac * w[..., None], 1, 2)
+        jtj = weighted @ jac
+        jtr = (weighted @ resid[..., None])[..., 0]
         diag = np.einsum("rii->ri", jtj)
         damped = jtj + (lam[:, None] * np.maximum(diag, 1e-12))[:, :, None] * np.eye(4)
         try:
