@@ -47,11 +47,13 @@ def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1) -> np.nda
     if weights.ndim != 1 or weights.size % 2 == 0:
         raise ParameterError(f"correlate1d takes a kernel of odd length, got shape {weights.shape}")
     import cv2  # here, not at import: a batch's parent imports the method registry, never measures
-    moved = np.moveaxis(np.asarray(values, float), axis, -1)
+    values = np.asarray(values, float)
+    last = axis in (-1, values.ndim - 1)
+    moved = values if last else np.moveaxis(values, axis, -1)
     if moved.size == 0:
-        return np.zeros(np.shape(values))
+        return np.zeros(values.shape)
     # every leading index is one row of a 2-D image; the kernel a 1 x k one
     # anchored on its middle, zeros beyond the ends
     rows = np.ascontiguousarray(moved.reshape(-1, moved.shape[-1]))
-    out = cv2.filter2D(rows, cv2.CV_64F, weights[None, :], borderType=cv2.BORDER_CONSTANT)
-    return np.moveaxis(out.reshape(moved.shape), -1, axis)
+    out = cv2.filter2D(rows, cv2.CV_64F, weights[None, :], borderType=cv2.BORDER_CONSTANT).reshape(moved.shape)
+    return out if last else np.moveaxis(out, -1, axis)
