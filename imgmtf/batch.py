@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import os
+from contextlib import ExitStack
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,7 @@ from .atomic import ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .figures import with_figure
 from .inputs import saturation_levels
-from .io import raster_info, read_raster
+from .io import open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
 from .records import Record, utc_now
@@ -106,11 +107,18 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
         raise ParameterError(f"settings must be a MeasureSettings, got {type(settings).__name__}")
     path = os.fspath(path)
     run_utc = run_utc or utc_now()
-    try:
-        info = raster_info(path)
-        bands = info.bands(settings.band)
-    except Exception as exc:               # the safety net: a record, never an abort
-        return [settings.failed(path, settings.band, exc, run_utc)]
+    with ExitStack() as stack:
+        try:
+            file = stack.enter_context(open_raster(path))       # once for the header and every band
+            bands = file.info.bands(settings.band)
+        except Exception as exc:               # the safety net: a record, never an abort
+            return [settings.failed(path, settings.band, exc, run_utc)]
+        return _measure_bands(file, bands, settings, plot_path, run_utc)
+
+
+def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: str) -> list[Record]:
+    """One record per band of an open file (see :func:`measure_file`)."""
+    path, info = file.path, file.info
     skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
     # what the file's reading adds to its first record's warnings (and to its figure's count of them)
     skipped_note = ([f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured"]
@@ -119,7 +127,7 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
     for index, band in enumerate(bands):
         file_notes = skipped_note if index == 0 else []
         try:
-            raster = read_raster(path, band, window=settings.roi)
+            raster = file.read(band, window=settings.roi)
             result = measure_raster(raster, settings)
             summary = result.to_dict(curves=True)
         except Exception as exc:

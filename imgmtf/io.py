@@ -13,6 +13,7 @@ import json
 import os
 import stat
 import warnings
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -273,10 +274,52 @@ class RasterInfo:
 
 def raster_info(path: str | Path) -> RasterInfo:
     """Read a raster file's header (size, bands, type, georeferencing)."""
+    with open_raster(path) as file:
+        return file.info
+
+
+class RasterFile:
+    """An image file held open by :func:`open_raster`: its header
+    (``info``) and its bands, read by :meth:`read` as :func:`read_raster`
+    reads them, without opening the file again for each."""
+
+    def __init__(self, path: str, src):
+        self.path, self._src = path, src
+        self.info = RasterInfo(path, src.width, src.height, src.count, tuple(c.name for c in src.colorinterp),
+                               src.dtypes[0], _gsd_m(src), src.transform,
+                               src.crs.to_wkt() if src.crs else None)
+
+    def read(self, band: int | None = None, window: tuple[int, int, int, int] | None = None,
+             out_shape: tuple[int, int] | None = None) -> Raster:
+        """One band, a window of it, or the luminance: see :func:`read_raster`."""
+        return _read(self._src, self.info, band, window, out_shape)
+
+
+@contextmanager
+def open_raster(path: str | Path) -> Iterator[RasterFile]:
+    """An image file open for its header and any number of reads (the
+    file is opened once: a batch of small chips pays GDAL's open once per
+    file, not once per question).
+
+    Raises
+    ------
+    ImageReadError
+        As :func:`read_raster`: the file cannot be opened, or a GDAL or
+        OS error arises within the block (reported as the file's).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.io import open_raster
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 64)
+    >>> imgmtf.write_geotiff("chip.tif", chip.image, gsd_m=2.0)
+    >>> with open_raster("chip.tif") as file:
+    ...     file.info.count, file.read(1).data.shape
+    (1, (64, 64))
+    """
+    path = _file_name(path)
     with _opened(path) as src:
-        return RasterInfo(str(path), src.width, src.height, src.count,
-                          tuple(c.name for c in src.colorinterp), src.dtypes[0], _gsd_m(src),
-                          src.transform, src.crs.to_wkt() if src.crs else None)
+        yield RasterFile(path, src)
 
 
 def raster_metadata(path: str | Path, band: int | None = None) -> dict[str, dict[str, str]]:
@@ -351,36 +394,37 @@ def read_raster(path: str | Path, band: int | None = None, window: tuple[int, in
     >>> raster.data.shape, raster.origin, raster.gsd_m
     ((64, 64), (100, 60), 2.0)
     """
-    path = _file_name(path)
-    with _opened(path) as src:
-        count = src.count
-        colours = [c.name for c in src.colorinterp]
-        info = RasterInfo(path, src.width, src.height, count, tuple(colours), src.dtypes[0],
-                          _gsd_m(src), src.transform, None)
-        map_projected = src.crs is not None
-        x, y, w, h = info.check_window(window) if window is not None else (0, 0, src.width, src.height)
-        if out_shape is not None:
-            out_shape = _check_shape(path, out_shape)
-        check_read_size(path, (w, h) if out_shape is None else (out_shape[1], out_shape[0]),
-                        windowed=window is not None)
-        region = Window(x, y, w, h)
-        if band is not None:
-            if isinstance(band, (bool, np.bool_)) or not isinstance(band, (int, np.integer)):
-                raise ParameterError(f"{path}: band must be a 1-based integer, got {band!r}")
-            if not 1 <= band <= count:
-                raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
-            chosen: int | str = int(band)
-            data = _band(src, int(band), region, out_shape)
-        elif count == 1 or info.is_grey_alpha:
-            chosen, data = 1, _band(src, 1, region, out_shape)
-        elif info.is_rgb:
-            chosen = "luminance"
-            data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
-        else:
-            raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
-                                 "choose one band, or all", reason="bands")
-        tags = src.tags()
-        codec = lossy_codec(src)
+    with open_raster(path) as file:
+        return file.read(band, window, out_shape)
+
+
+def _read(src, info: RasterInfo, band, window, out_shape) -> Raster:
+    """One band (or the luminance) of an open dataset: see :func:`read_raster`."""
+    path, count = info.path, info.count
+    map_projected = src.crs is not None
+    x, y, w, h = info.check_window(window) if window is not None else (0, 0, info.width, info.height)
+    if out_shape is not None:
+        out_shape = _check_shape(path, out_shape)
+    check_read_size(path, (w, h) if out_shape is None else (out_shape[1], out_shape[0]),
+                    windowed=window is not None)
+    region = Window(x, y, w, h)
+    if band is not None:
+        if isinstance(band, (bool, np.bool_)) or not isinstance(band, (int, np.integer)):
+            raise ParameterError(f"{path}: band must be a 1-based integer, got {band!r}")
+        if not 1 <= band <= count:
+            raise ParameterError(f"{path}: band {band} does not exist (the file has {count})")
+        chosen: int | str = int(band)
+        data = _band(src, int(band), region, out_shape)
+    elif count == 1 or info.is_grey_alpha:
+        chosen, data = 1, _band(src, 1, region, out_shape)
+    elif info.is_rgb:
+        chosen = "luminance"
+        data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
+    else:
+        raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
+                             "choose one band, or all", reason="bands")
+    tags = src.tags()
+    codec = lossy_codec(src)
     if data.size == 0:
         raise ImageContentError(f"{path}: the image is empty")
     return Raster(data, path, chosen, info.gsd_m, tags, info.dtype, (x, y), map_projected, codec)

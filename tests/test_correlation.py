@@ -1,4 +1,4 @@
-"""correlate1d against SciPy's, which it stands in for on the hot path."""
+"""correlate1d against SciPy's, which OpenCV stands in for on the hot path."""
 import numpy as np
 import pytest
 from scipy import ndimage

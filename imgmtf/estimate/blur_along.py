@@ -45,17 +45,19 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     rows = np.unique(ev.rows)
     if rows.size < 2 * MIN_GROUP_ROWS:
         return [], []
+    splits = [np.array_split(rows, parts) for parts in (2, 3) if rows.size >= parts * MIN_GROUP_ROWS]
+    # the five groups' fits run together (one fit's iterations on small
+    # arrays cost mostly the interpreter's time)
+    widths = iter(_group_widths(ev, [(ev.rows >= b[0]) & (ev.rows <= b[-1]) for bounds in splits for b in bounds]))
     worst = None
-    for parts in (2, 3):
-        if rows.size < parts * MIN_GROUP_ROWS:
-            continue
-        bounds = np.array_split(rows, parts)
-        widths = [_group_width(ev, (ev.rows >= b[0]) & (ev.rows <= b[-1])) for b in bounds]
-        if any(w is None for w in widths):
+    for bounds in splits:
+        parts = len(bounds)
+        group = [next(widths) for _ in range(parts)]
+        if any(w is None for w in group):
             continue
         for i in range(parts):
             for j in range(i + 1, parts):
-                (wi, vi), (wj, vj) = widths[i], widths[j]  # type: ignore[misc]
+                (wi, vi), (wj, vj) = group[i], group[j]  # type: ignore[misc]
                 change = abs(wi - wj) / (0.5 * (wi + wj))
                 z = abs(wi - wj) / math.sqrt(vi + vj) if vi + vj > 0 else math.inf
                 if worst is None or (z >= WARN_SIGNIFICANCE, change) > (worst[1] >= WARN_SIGNIFICANCE, worst[0]):
@@ -77,79 +79,118 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     return [check], said
 
 
-def _group_width(ev: Evidence, in_group: np.ndarray) -> tuple[float, float] | None:
-    """The width (px) of one group's profile within the plateau of the
+def _group_widths(ev: Evidence, groups: list[np.ndarray]) -> list[tuple[float, float] | None]:
+    """The width (px) of each group's profile within the plateau of the
     centre, with its variance: the scale c of a Fermi step (an edge) or of
     a Gaussian (a bar) fitted with its own levels and centre, so that
     neither shading nor a slight bend along the target passes for a change
     of blur.  The model need not be the blur's: it is the same for every
     group.  None where the fit fails."""
-    s = ev.distance_px[in_group] - ev.centre_px
-    near = np.abs(s) <= max(ev.plateau_px, MIN_REACH_PX)
-    if np.count_nonzero(near) < MIN_GROUP_SAMPLES:
-        return None
-    s, v = s[near], ev.values[in_group][near]
+    widths: list[tuple[float, float] | None] = [None] * len(groups)
+    reach = max(ev.plateau_px, MIN_REACH_PX)
+    selected = []
+    for g, in_group in enumerate(groups):
+        s = ev.distance_px[in_group] - ev.centre_px
+        near = np.abs(s) <= reach
+        if np.count_nonzero(near) >= MIN_GROUP_SAMPLES:
+            selected.append((g, s[near], ev.values[in_group][near]))
+    if not selected:
+        return widths
+    # the groups side by side, padded to the longest with zero weights
+    longest = max(s.size for _, s, _ in selected)
+    s, v, w = (np.zeros((len(selected), longest)) for _ in range(3))
+    for k, (_, sk, vk) in enumerate(selected):
+        s[k, : sk.size], v[k, : sk.size], w[k, : sk.size] = sk, vk, 1.0
     bar = ev.profile == "bar"
     start = np.array([ev.high - ev.low, 0.0, max(ev.scale_px, 0.2) * (0.5 if bar else 0.25), ev.low])
-    fitted = _fit(_bar if bar else _step, s, v, start)
-    if fitted is None:
-        return None
-    params, variance = fitted
-    if abs(params[2]) < MIN_SCALE_PX:          # a step no blur: no fit to compare (fill, a clip)
-        return None
-    return abs(float(params[2])), variance
+    for (g, _, _), fitted in zip(selected, _fit(_bar if bar else _step, s, v, w, start)):
+        # a step with no blur leaves no fit to compare (fill, a clip)
+        if fitted is not None and abs(fitted[0][2]) >= MIN_SCALE_PX:
+            widths[g] = abs(float(fitted[0][2])), fitted[1]
+    return widths
 
 
 def _step(s, p):
-    """A Fermi step and its Jacobian in (amplitude, centre, scale, base)."""
-    u = np.clip((s - p[1]) / p[2], -50.0, 50.0)
+    """A Fermi step and its Jacobian in (amplitude, centre, scale, base);
+    ``s`` (groups, samples), ``p`` (groups, 4)."""
+    a, b, c, d = (p[:, k, None] for k in range(4))
+    u = np.clip((s - b) / c, -50.0, 50.0)
     f = 1.0 / (1.0 + np.exp(-u))
     slope = f * (1.0 - f)
-    return p[3] + p[0] * f, np.column_stack([f, -p[0] * slope / p[2], -p[0] * slope * u / p[2], np.ones_like(f)])
+    return d + a * f, np.stack([f, -a * slope / c, -a * slope * u / c, np.ones_like(f)], axis=-1)
 
 
 def _bar(s, p):
-    """A Gaussian pulse and its Jacobian in (amplitude, centre, scale, base)."""
-    u = (s - p[1]) / p[2]
+    """A Gaussian pulse and its Jacobian in (amplitude, centre, scale, base);
+    ``s`` (groups, samples), ``p`` (groups, 4)."""
+    a, b, c, d = (p[:, k, None] for k in range(4))
+    u = (s - b) / c
     g = np.exp(-0.5 * u * u)
-    return p[3] + p[0] * g, np.column_stack([g, p[0] * g * u / p[2], p[0] * g * u * u / p[2], np.ones_like(g)])
+    return d + a * g, np.stack([g, a * g * u / c, a * g * u * u / c, np.ones_like(g)], axis=-1)
 
 
-def _fit(model, s, v, start, iterations=60) -> tuple[np.ndarray, float] | None:
-    """Levenberg-Marquardt least squares of ``model`` to (s, v) from
-    ``start``: the parameters and the variance of the third (the scale),
-    scaled by the residual variance.  None where it does not converge to
-    finite numbers."""
-    p = start.astype(float)
-    fit, jac = model(s, p)
-    cost = float(np.sum((v - fit) ** 2))
-    damping = 1e-3
-    for _ in range(iterations):
-        normal = jac.T @ jac
-        gradient = jac.T @ (v - fit)
-        try:
-            step = np.linalg.solve(normal + damping * np.diag(np.maximum(np.diag(normal), 1e-12)), gradient)
-        except np.linalg.LinAlgError:
-            return None
-        trial = p + step
-        if trial[2] == 0:
-            damping *= 4.0
-            continue
-        trial_fit, trial_jac = model(s, trial)
-        trial_cost = float(np.sum((v - trial_fit) ** 2))
-        if np.isfinite(trial_cost) and trial_cost < cost:
-            converged = abs(step[2]) < 1e-7 * max(abs(trial[2]), 1e-9)
-            p, fit, jac, cost, damping = trial, trial_fit, trial_jac, trial_cost, damping / 3.0
-            if converged:
-                break
-        else:
-            damping *= 4.0
-            if damping > 1e10:
-                break
+def _solve_each(matrices: np.ndarray, vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``solve(matrices[k], vectors[k])`` for every k, and which were
+    regular (a singular one's solution is left NaN)."""
     try:
-        covariance = np.linalg.inv(jac.T @ jac) * cost / max(s.size - 4, 1)
+        return np.linalg.solve(matrices, vectors[..., None])[..., 0], np.ones(len(matrices), bool)
     except np.linalg.LinAlgError:
-        return None
-    if not (np.isfinite(p).all() and math.isfinite(covariance[2, 2])):
-        return None
-    return p, max(float(covariance[2, 2]), 0.0)
+        out, ok = np.full(vectors.shape, np.nan), np.ones(len(matrices), bool)
+        for k, (m, b) in enumerate(zip(matrices, vectors)):
+            try:
+                out[k] = np.linalg.solve(m, b)
+            except np.linalg.LinAlgError:
+                ok[k] = False
+        return out, ok
+
+
+def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] | None]:
+    """Levenberg-Marquardt least squares of ``model`` to each group's
+    (s, v) (rows of equal length, weights ``w`` 1 for a sample and 0 for
+    padding) from ``start``, each group with its own damping and its own
+    stop: per group the parameters and the variance of the third (the
+    scale), scaled by the residual variance.  None where it does not
+    converge to finite numbers."""
+    groups = s.shape[0]
+    p = np.tile(start.astype(float), (groups, 1))
+    fit, jac = model(s, p)
+    cost = np.einsum("gn,gn->g", w * (v - fit), v - fit)
+    damping = np.full(groups, 1e-3)
+    active = np.ones(groups, bool)
+    failed = np.zeros(groups, bool)
+    identity = np.eye(4)
+    for _ in range(iterations):
+        if not active.any():
+            break
+        # every group is computed, a stopped one left as it is (the groups
+        # are few: fewer, larger operations cost less than selecting them)
+        weighted = np.swapaxes(jac * w[..., None], 1, 2)
+        normal = weighted @ jac
+        gradient = (weighted @ (v - fit)[..., None])[..., 0]
+        diagonal = np.maximum(np.einsum("gii->gi", normal), 1e-12)
+        damped = np.where(active[:, None, None], normal + damping[:, None, None] * (diagonal[:, :, None] * identity),
+                          identity)
+        step, regular = _solve_each(damped, gradient)
+        failed |= active & ~regular
+        active &= regular
+        trial = p + step
+        # a zero scale is no model: a longer step's turn
+        zero = active & (trial[:, 2] == 0)
+        damping[zero] *= 4.0
+        tried = active & ~zero
+        trial_fit, trial_jac = model(s, np.where(tried[:, None], trial, p))
+        trial_cost = np.einsum("gn,gn->g", w * (v - trial_fit), v - trial_fit)
+        better = tried & np.isfinite(trial_cost) & (trial_cost < cost)
+        p = np.where(better[:, None], trial, p)
+        fit = np.where(better[:, None], trial_fit, fit)
+        jac = np.where(better[:, None, None], trial_jac, jac)
+        cost = np.where(better, trial_cost, cost)
+        lost = tried & ~better
+        damping = np.where(better, damping / 3.0, np.where(lost, damping * 4.0, damping))
+        converged = np.abs(step[:, 2]) < 1e-7 * np.maximum(np.abs(trial[:, 2]), 1e-9)
+        active &= ~(better & converged) & ~(lost & (damping > 1e10))
+    weighted = jac * w[..., None]
+    covariance, regular = _solve_each(np.einsum("gni,gnj->gij", weighted, jac), np.tile(np.eye(4)[2], (groups, 1)))
+    variance = covariance[:, 2] * cost / np.maximum(w.sum(axis=1) - 4, 1)
+    return [(p[k], max(float(variance[k]), 0.0)) if regular[k] and not failed[k] and np.isfinite(p[k]).all()
+            and math.isfinite(variance[k]) else None for k in range(groups)]

@@ -5,8 +5,8 @@ f(x) = a / (1 + exp((x - b) / c)) + d      (Tzannes; paper eq. 7)
 ``b`` is the sub-pixel edge location, ``c`` the transition width, ``a`` the
 step (left level minus right level) and ``d`` the right-hand level.  All
 rows are solved together: each iteration builds every row's 4 x 4 normal
-equations with one ``einsum`` and solves them in one batched call, with a
-damping factor per row.
+equations with one matrix product and solves them in one batched call, with
+a damping factor per row.
 """
 from __future__ import annotations
 
@@ -57,11 +57,11 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
     left, right = _side_levels(y, w)
     p = np.column_stack([left - right, b0, np.full(n, c0), right])
     lam = np.full(n, 1e-2)
-    cost = _cost(x, y, w, p)
+    cost, jac, resid = _evaluate(x, y, w, p)
     for _ in range(iterations):
-        jac, resid = _jacobian(x, y, w, p)
-        jtj = np.einsum("rki,rkj->rij", jac * w[..., None], jac)
-        jtr = np.einsum("rki,rk->ri", jac * w[..., None], resid)
+        weighted = np.swapaxes(jac * w[..., None], 1, 2)
+        jtj = weighted @ jac
+        jtr = (weighted @ resid[..., None])[..., 0]
         diag = np.einsum("rii->ri", jtj)
         damped = jtj + (lam[:, None] * np.maximum(diag, 1e-12))[:, :, None] * np.eye(4)
         try:
@@ -69,10 +69,12 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
         except np.linalg.LinAlgError:
             step = np.stack([np.linalg.lstsq(m, v, rcond=None)[0] for m, v in zip(damped, jtr)])
         trial = p + step
-        trial_cost = _cost(x, y, w, trial)
+        trial_cost, trial_jac, trial_resid = _evaluate(x, y, w, trial)
         better = np.isfinite(trial_cost) & (trial_cost < cost)
         p = np.where(better[:, None], trial, p)
         cost = np.where(better, trial_cost, cost)
+        jac = np.where(better[:, None, None], trial_jac, jac)
+        resid = np.where(better[:, None], trial_resid, resid)
         lam = np.where(better, lam / 3.0, lam * 4.0)
         # converged: no row proposes to move its edge by more than 1e-5 px
         if np.all((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5)):
@@ -102,16 +104,17 @@ def _side_levels(y, w):
     return left, right
 
 
-def _cost(x, y, w, p):
-    r = (y - fermi(x, p)) * w
-    return np.einsum("rk,rk->r", r, r)
-
-
-def _jacobian(x, y, w, p):
+def _evaluate(x, y, w, p):
+    """Each row's cost (weighted sum of squared residuals), Jacobian in
+    (a, b, c, d) and weighted residuals at ``p``, from one exponential:
+    the cost as :func:`fermi` evaluates the model, the residuals with
+    the Jacobian's logistic."""
     a, b, c, d = (p[:, k, None] for k in range(4))
     u = np.clip((x - b) / c, -50.0, 50.0)
-    s = 1.0 / (1.0 + np.exp(u))
+    e = np.exp(u)
+    r = (y - (a / (1.0 + e) + d)) * w
+    s = 1.0 / (1.0 + e)
     ds = s * (1.0 - s)
     jac = np.stack([s, a * ds / c, a * ds * u / c, np.ones_like(s)], axis=-1)
     resid = (y - (a * s + d)) * w
-    return jac, resid
+    return np.einsum("rk,rk->r", r, r), jac, resid

@@ -12,6 +12,7 @@ not straight.
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 OUTLIER_NOISE = 8.0           # beyond every neighbour by this many noise sd...
@@ -41,8 +42,13 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
     margin = max(OUTLIER_NOISE * noise, OUTLIER_CONTRAST * (high - low))
     if not margin > 0:
         return np.zeros(data.shape, bool)
-    above = _around(np.where(finite, data, -np.inf), 2, np.maximum, -np.inf)
-    below = _around(np.where(finite, data, np.inf), 2, np.minimum, np.inf)
+    block = _ring(2)
+    # the largest and smallest of the other pixels of each block (grey
+    # dilation and erosion; beyond the border and at NaN, nothing)
+    above = cv2.dilate(np.where(finite, data, -np.inf), block, borderType=cv2.BORDER_CONSTANT,
+                       borderValue=-np.inf)
+    below = cv2.erode(np.where(finite, data, np.inf), block, borderType=cv2.BORDER_CONSTANT,
+                      borderValue=np.inf)
     # and beyond the block's own range: a thin bar's peak pixel rises above
     # its block by less than the bar's height (the block holds pixels along
     # the bar), a hot pixel on a level stands far out of its block's noise
@@ -51,19 +57,13 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
         beyond = np.maximum(margin, spread)
         outlier = finite & ((data > above + beyond) | (data < below - beyond))
     # isolated: no outlying neighbour (a cluster is a feature, the gate's to judge)
-    clustered = _around(outlier, 1, np.logical_or, False)
-    return outlier & ~clustered
+    clustered = cv2.dilate(outlier.view(np.uint8), _ring(1), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    return outlier & ~clustered.astype(bool)
 
 
-def _around(values: np.ndarray, reach: int, combine, fill) -> np.ndarray:
-    """``combine`` (np.maximum, np.minimum, np.logical_or) over each
-    pixel's block of half-size ``reach``, the pixel itself left out;
-    ``fill`` beyond the border."""
-    rows, cols = values.shape
-    padded = np.pad(values, reach, constant_values=fill)
-    out = np.full(values.shape, fill, dtype=values.dtype)
-    for dy in range(-reach, reach + 1):
-        for dx in range(-reach, reach + 1):
-            if dy or dx:
-                combine(out, padded[reach + dy: reach + dy + rows, reach + dx: reach + dx + cols], out=out)
-    return out
+def _ring(reach: int) -> np.ndarray:
+    """The structuring element of a block of half-size ``reach`` without
+    its centre pixel."""
+    ring = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+    ring[reach, reach] = 0
+    return ring

@@ -103,13 +103,9 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     def window_sums(moments):
         """Sum over each grid point's window of (u + offset)^k for every k,
         from the per-bin sums of u^j: sum_j C(k, j) (offset^(k-j) * S_j),
-        one correlation per power of the offset for all moments at once."""
-        kmax = moments.shape[-2] - 1
-        # offset^p multiplies only the moments j <= kmax - p
-        shifted = [correlate1d(moments[..., : kmax + 1 - p, :], offsets ** p)
-                   for p in range(kmax + 1)]
-        return np.stack([sum(math.comb(k, j) * shifted[k - j][..., j, :] for j in range(k + 1))
-                         for k in range(kmax + 1)], axis=-2)
+        one correlation per power of the offset for all moments at once,
+        combined by one product with the binomials."""
+        return _shifted_powers(moments, offsets, _binomial_shifts(moments.shape[-2], False))
     m = window_sums(s)
     rhs = np.moveaxis(window_sums(t), -1, -2)
     idx = np.arange(order + 1)
@@ -154,10 +150,7 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         # sum over the windows holding a sample's bin of a_k^(j) (u0 + offset)^j,
         # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
         # power p of the offset only meets the coefficients j >= p
-        conv = [correlate1d(a[..., p:, :], (-1.0) ** p * offsets ** p, axis=-1)
-                for p in range(order + 1)]
-        g = np.stack([sum(math.comb(j, m_) * conv[j - m_][..., m_, :] for j in range(m_, order + 1))
-                      for m_ in range(order + 1)], axis=-2)      # (..., order + 1, n_grid)
+        g = _shifted_powers(a, -offsets, _binomial_shifts(order + 1, True))   # (..., order + 1, n_grid)
         kept = np.einsum("...mi,im->...i", g[..., bins], u0) * w
         result = np.zeros((*h.shape[:-1], distance.size))
         result[..., keep] = kept
@@ -166,6 +159,29 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     leverage = np.zeros(distance.size)
     leverage[keep] = np.einsum("ij,ij->i", coef[bins], u0) * w
     return Resampled(out, level[trim: trim + out.size], transfer, params, adjoint, leverage)
+
+
+def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndarray) -> np.ndarray:
+    """``binomials`` applied to the correlations of ``moments`` (..., n, grid)
+    with every power 0..n-1 of ``offsets``: (..., n, grid)."""
+    n = moments.shape[-2]
+    shifted = np.stack([correlate1d(moments, offsets ** p) for p in range(n)], axis=-3)
+    return binomials @ shifted.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
+
+
+@functools.lru_cache(maxsize=32)
+def _binomial_shifts(n: int, adjoint: bool) -> np.ndarray:
+    """The (n, n * n) matrix combining the correlations of moments j with
+    offset^p (column p n + j): row k takes C(k, j) at p = k - j (a
+    window's sums of (u + offset)^k); the adjoint's row m takes C(j, m) at
+    p = j - m (its transpose, with the offsets negated)."""
+    out = np.zeros((n, n * n))
+    for k in range(n):
+        for j in range(n):
+            p = j - k if adjoint else k - j
+            if p >= 0:
+                out[k, p * n + j] = math.comb(j, k) if adjoint else math.comb(k, j)
+    return out
 
 
 def _bins(distance, grid, step):

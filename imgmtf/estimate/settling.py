@@ -95,17 +95,25 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
     if np.ptp(reach) < MIN_SIDE_EXTENT_PX:
         return None
     u = reach ** -float(ev.tail_power)
-    design = np.column_stack([np.ones_like(u), u])
-    normal = design.T @ design
-    if np.linalg.cond(normal) > 1e12:
+    # the straight line in u in closed form about its mean: the normal
+    # matrix [[n, sum u], [sum u, sum u^2]] has determinant n * spread
+    mean_u = float(np.mean(u))
+    centred = u - mean_u
+    spread = float(centred @ centred)
+    n = u.size
+    trace = n + spread + n * mean_u ** 2
+    largest = 0.5 * (trace + math.hypot(n - spread - n * mean_u ** 2, 2.0 * n * mean_u))
+    if not spread > 0 or largest ** 2 > 1e12 * n * spread:      # its condition number, largest^2 / det
         return None
-    coef = np.linalg.solve(normal, design.T @ v)
-    resid = v - design @ coef
+    coef = np.empty(2)
+    coef[1] = float(centred @ v) / spread
+    coef[0] = float(np.mean(v)) - coef[1] * mean_u
+    resid = v - (coef[0] + coef[1] * u)
     sigma2 = max(float(resid @ resid) / max(resid.size - 2, 1), ev.quantum ** 2 / 12.0)
     # the model's own noise: its tail at the side's start, towards the target's other level
     start_u = ev.plateau_px ** -float(ev.tail_power)
     towards = _towards_target(ev, left=bool(s[mask][0] < 0))
-    tail_cov = np.linalg.inv(normal)[1, 1] * sigma2
+    tail_cov = sigma2 / spread                      # the slope's variance, (M^-1)[1, 1] sigma^2
     unsettled = (towards * coef[1] * start_u / ev.contrast, math.sqrt(tail_cov) * start_u / ev.contrast)
 
     band = np.floor((reach - reach.min()) / BAND_PX).astype(int)

@@ -56,15 +56,22 @@ def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> Side
     if x.size < 3:
         return SideFit(np.array([np.nan, 0.0]), np.zeros((2, x.size)), mask, math.nan)
     u = x ** -float(power)
-    if x.size >= MIN_TAIL_SAMPLES and np.std(u) > 1e-3 * np.mean(u):
-        design = np.column_stack([np.ones_like(u), u])
-        operator = np.linalg.solve(design.T @ design, design.T)
+    mean_u = float(np.mean(u))
+    centred = u - mean_u
+    spread = float(centred @ centred)
+    operator = np.empty((2, x.size))
+    if x.size >= MIN_TAIL_SAMPLES and math.sqrt(spread / x.size) > 1e-3 * mean_u:
+        # the straight-line fit in closed form about the mean of u: slope
+        # centred . values / spread, level mean(values) - slope mean(u)
+        operator[1] = centred / spread
+        operator[0] = 1.0 / x.size - mean_u * operator[1]
+        parameters = 2
     else:
-        design = np.ones((x.size, 1))
-        operator = np.vstack([np.full(x.size, 1.0 / x.size), np.zeros(x.size)])
+        operator[0], operator[1] = 1.0 / x.size, 0.0
+        parameters = 1
     coef = operator @ values
-    resid = values - np.column_stack([np.ones_like(u), u]) @ coef
-    dof = max(x.size - design.shape[1], 1)
+    resid = values - (coef[0] + coef[1] * u)
+    dof = max(x.size - parameters, 1)
     return SideFit(coef, operator, mask, float(math.sqrt(resid @ resid / dof)))
 
 
