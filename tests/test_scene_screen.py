@@ -31,8 +31,8 @@ def test_quick_look_rejects_what_the_gate_would(kind, reason):
 
 
 def test_a_half_edge_is_as_long_as_the_longer_of_its_line_and_its_reach_to_the_junctions():
-    from imgmtf.scene.detect import HalfEdge, Segment
     from imgmtf.scene.screen import geometry_screen
+    from imgmtf.scene.segments import HalfEdge, Segment
     from imgmtf.scene.settings import ScanSettings
     # LSD saw 36 px of the line; its ends, moved onto their junctions, span 46 px
     half = HalfEdge(Segment(10.0, 0.0, 16.0, 45.6), line_length_px=36.0, junctions=(1, 2))

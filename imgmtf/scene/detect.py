@@ -1,30 +1,17 @@
-"""Detection: the straight segments of a scene and how they meet.
+"""Detection: the straight segments of a scene.
 
-1. LSD: the scene is read tile by tile (windowed reads: a large scene is
-   never loaded whole), scaled to 8 bits with levels taken from a
-   decimated overview, and OpenCV's line segment detector finds straight
-   segments in each tile.  LSD orients every segment by its gradient (the
-   brighter side always on the same hand), so a line whose polarity flips
-   (a checkerboard's inner line at its centre) comes as two segments.
-2. merge (:func:`merge_segments`): pieces of one line (across tiles too)
-   with the same orientation are joined;
-3. junctions (:func:`find_junctions`): where a segment ends on another or
-   crosses it (the centre of a checkerboard or four-quadrant target, the
-   corners of a rectangle or a cross); segments are split there into
-   half-edges, each knowing the junctions at its ends and the segments it
-   meets, so that its ROI can stop short of them;
-4. bars (:func:`pair_bars`): two parallel segments a few pixels apart are
-   the two sides of one bar.
-
-Contacts between segments are found with a k-d tree over points sampled
-along them (:func:`contacts`), so merging, junctions and pairing cost
-about the number of segments times their neighbours, never their square.
+The scene is read tile by tile (windowed reads: a large scene is never
+loaded whole; one task per tile, on the workers too), scaled to 8 bits with
+levels taken from a decimated overview, and OpenCV's line segment detector
+finds straight segments in each tile.  LSD orients every segment by its
+gradient (the brighter side always on the same hand), so a line whose
+polarity flips (a checkerboard's inner line at its centre) comes as two
+segments.  The pieces of one line, across tiles too, are merged
+(:func:`imgmtf.scene.segments.merge_pieces`); how segments meet is
+:mod:`.segments`' job.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
-from itertools import pairwise
 from pathlib import Path
 
 import cv2
@@ -34,99 +21,16 @@ from ..errors import ImgmtfError
 from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from .fill import FILL_SIDE_PX, fill_mask
+from .segments import merge_pieces, sample_points, unit_vectors
 from .settings import ScanSettings
 
 # Scenes larger than this are refused: detection reads every tile, and 1 Gpx
 # (32768 x 32768) is already minutes of it.  Crop a part to scan it.
 MAX_SCAN_PIXELS = 2 ** 30
 
-MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
-MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line
-MERGE_GAP_PX = 6.0           # ... and leave at most this gap between them
-BAR_MAX_SEPARATION_PX = 8.0  # two parallel sides closer than this are one bar
 TILE_OVERLAP_PX = 32
-SAMPLE_STEP_PX = 2.0         # contacts are sought between points this far apart along segments
-JUNCTION_REACH_PX = 6.0      # a segment ending this close to another meets it (LSD stops short of corners)
-JUNCTION_ANGLE_DEG = 20.0    # segments closer in direction do not make a junction
-JUNCTION_MERGE_PX = 4.0      # meeting points closer than this are one junction
-SPLIT_MARGIN_PX = 8.0        # a junction this far inside a segment splits it
-MIN_SEGMENT_PX = 8.0         # shorter LSD output is noise, never a partner at a junction
 
 
-@dataclass(frozen=True)
-class Segment:
-    """A straight segment from (x0, y0) to (x1, y1), pixel coordinates of
-    the scene (x to the right, y down, pixel centres at integers), in LSD's
-    orientation (its gradient on one hand).  ``width_px`` is 0 for an edge
-    and the separation of its sides for a bar.
-
-    Examples
-    --------
-    >>> s = Segment(10.0, 0.0, 12.0, 80.0)
-    >>> round(s.length_px, 2), round(s.tilt_deg, 2), round(s.normal_angle_deg, 2)
-    (80.02, 1.43, -1.43)
-    """
-
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    width_px: float = 0.0
-
-    @property
-    def length_px(self) -> float:
-        return math.hypot(self.x1 - self.x0, self.y1 - self.y0)
-
-    @property
-    def tilt_deg(self) -> float:
-        """Smallest angle (deg) between the segment and an image axis."""
-        a = abs(math.degrees(math.atan2(self.y1 - self.y0, self.x1 - self.x0))) % 90.0
-        return min(a, 90.0 - a)
-
-    @property
-    def normal_angle_deg(self) -> float:
-        """Angle (deg, in (-90, 90]) of the segment's normal from the x axis
-        towards +y, as the estimators report it (0: a vertical segment)."""
-        angle = math.degrees(math.atan2(self.x1 - self.x0, -(self.y1 - self.y0)))
-        return (angle + 90.0) % 180.0 - 90.0 if (angle + 90.0) % 180.0 != 0.0 else 90.0
-
-    def unit(self) -> np.ndarray:
-        d = np.array([self.x1 - self.x0, self.y1 - self.y0])
-        return d / np.linalg.norm(d)
-
-    def as_array(self) -> np.ndarray:
-        return np.array([self.x0, self.y0, self.x1, self.y1])
-
-
-@dataclass(frozen=True)
-class HalfEdge:
-    """A candidate target: a segment between junctions (or free ends).
-
-    ``segment`` runs from end 0 to end 1, each end moved onto its junction
-    when it has one; ``junctions`` are the junction ids at the two ends
-    (None for a free end); ``partners`` the other segments that meet it
-    there (its ROI keeps clear of them); ``line_length_px`` is the length
-    of the straight line it was split from (for a bar, of its sides);
-    ``fill_fraction`` how much of that line has fill or nodata beside it.
-    """
-
-    segment: Segment
-    line_length_px: float
-    junctions: tuple[int | None, int | None] = (None, None)
-    partners: tuple[Segment, ...] = field(default=(), repr=False)
-    fill_fraction: float = 0.0
-
-
-@dataclass(frozen=True)
-class Junction:
-    """Where segments meet: ``x_px``, ``y_px`` and how many segments meet there."""
-
-    x_px: float
-    y_px: float
-    degree: int
-
-
-# -- LSD ----------------------------------------------------------------------------
 def detect_segments(path: str, settings: ScanSettings | None = None, *, workers: int = 1,
                     scheduler: str | None = None, progress: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every straight piece LSD finds in the scene's tiles, at least
@@ -154,15 +58,7 @@ def detect_segments(path: str, settings: ScanSettings | None = None, *, workers:
                                   description="detecting segments") if len(f[0])]
     if not found:
         return np.zeros((0, 4)), np.zeros(0)
-    pieces, beside_fill = np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found])
-    label = _merge_labels(pieces)
-    merged = _joined(pieces, label)
-    lengths = _lengths(pieces)
-    fill = np.bincount(label, lengths * beside_fill) / np.maximum(np.bincount(label, lengths), 1e-12)
-    order = np.argsort(-_lengths(merged), kind="stable")
-    merged, fill = merged[order], fill[order]
-    keep = _lengths(merged) >= MIN_SEGMENT_PX
-    return merged[keep], fill[keep]
+    return merge_pieces(np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found]))
 
 
 def tile_windows(info: RasterInfo, tile_px: int) -> list[tuple[int, int, int, int]]:
@@ -193,7 +89,7 @@ def _fill_beside(pieces: np.ndarray, fill: np.ndarray) -> np.ndarray:
     if not fill.any() or len(pieces) == 0:
         return np.zeros(len(pieces))
     points, owner = sample_points(pieces, 1.0)
-    units = _units(pieces)[owner]
+    units = unit_vectors(pieces)[owner]
     normal = np.column_stack([-units[:, 1], units[:, 0]])
     rows, cols = fill.shape
     hit = np.zeros(len(points), bool)
@@ -240,352 +136,3 @@ def to_8bit(tile: np.ndarray, lo: float, hi: float) -> np.ndarray:
     finite = np.isfinite(tile)
     filled = tile if finite.all() else np.where(finite, tile, np.median(tile[finite]) if finite.any() else lo)
     return np.clip(np.rint((filled - lo) / (hi - lo) * 255), 0, 255).astype(np.uint8)
-
-
-# -- contacts between segments ------------------------------------------------------
-def _lengths(s: np.ndarray) -> np.ndarray:
-    return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
-
-
-def _units(s: np.ndarray) -> np.ndarray:
-    d = s[:, 2:] - s[:, :2]
-    return d / np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
-
-
-def sample_points(s: np.ndarray, step: float = SAMPLE_STEP_PX) -> tuple[np.ndarray, np.ndarray]:
-    """Points every ``step`` px or closer along each segment (ends
-    included): (points n x 2, the segment of each)."""
-    counts = np.ceil(_lengths(s) / step).astype(int) + 1
-    owner = np.repeat(np.arange(len(s)), counts)
-    first = np.cumsum(counts) - counts
-    fraction = (np.arange(owner.size) - first[owner]) / np.maximum(counts[owner] - 1, 1)
-    points = s[owner, :2] + fraction[:, None] * (s[owner, 2:] - s[owner, :2])
-    return points, owner
-
-
-def contacts(queries: np.ndarray, s: np.ndarray, radius: float,
-             step: float = SAMPLE_STEP_PX) -> tuple[np.ndarray, np.ndarray]:
-    """Which segments pass within about ``radius`` px of which query
-    points: (query index, segment index) pairs, each pair once.  A k-d tree
-    over points sampled along the segments: the cost grows with the number
-    of contacts, not with the square of the number of segments."""
-    from scipy.spatial import cKDTree
-    if len(queries) == 0 or len(s) == 0:
-        return np.zeros(0, int), np.zeros(0, int)
-    points, owner = sample_points(s, step)
-    near = cKDTree(queries).sparse_distance_matrix(cKDTree(points), radius + step / 2, output_type="ndarray")
-    key = np.unique(near["i"].astype(np.int64) * len(s) + owner[near["j"]])
-    return key // len(s), key % len(s)
-
-
-def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int, ordered: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct (a, b) index pairs (indices below ``n``); with ``ordered``
-    false, (a, b) and (b, a) are one pair, given as (min, max)."""
-    a, b = np.asarray(a, np.int64), np.asarray(b, np.int64)
-    if not ordered:
-        a, b = np.minimum(a, b), np.maximum(a, b)
-    key = np.unique(a * n + b)
-    return key // n, key % n
-
-
-def _line_frame(s: np.ndarray, index: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(t, d): positions of ``points`` along segments ``index`` from their
-    start and signed distances from their lines (px)."""
-    u = _units(s)[index]
-    rel = points - s[index, :2]
-    return np.einsum("ij,ij->i", rel, u), rel[:, 0] * -u[:, 1] + rel[:, 1] * u[:, 0]
-
-
-# -- merging ------------------------------------------------------------------------
-def merge_segments(pieces: np.ndarray) -> np.ndarray:
-    """Join pieces (rows x0, y0, x1, y1) that lie on one line with the same
-    orientation (so the same polarity): parallel within
-    ``MERGE_ANGLE_DEG``, the shorter's ends within ``MERGE_OFFSET_PX`` of the
-    longer's line, at most ``MERGE_GAP_PX`` apart along it (or
-    overlapping).  Chains of such pieces become one segment through their
-    length-weighted centre, along their mean direction, spanning all their
-    ends.  Returns the segments (rows), longest first.
-
-    Examples
-    --------
-    >>> merged = merge_segments(np.array([[10, 0, 11, 40], [11.1, 42, 12.2, 80], [30, 0, 30.5, 50]], float))
-    >>> len(merged), round(float(np.hypot(*(merged[0, 2:] - merged[0, :2]))))
-    (2, 80)
-    """
-    pieces = np.asarray(pieces, float).reshape(-1, 4)
-    if len(pieces) < 2:
-        return pieces.copy()
-    merged = _joined(pieces, _merge_labels(pieces))
-    return merged[np.argsort(-_lengths(merged), kind="stable")]
-
-
-def line_lengths(segments: np.ndarray) -> np.ndarray:
-    """For each segment, the length (px) of the straight line it lies on
-    whatever the polarity: collinear segments that meet end to end (the
-    two halves of a checkerboard's inner line, whose polarity flips at its
-    centre) count as one line."""
-    segments = np.asarray(segments, float).reshape(-1, 4)
-    if len(segments) < 2:
-        return _lengths(segments)
-    units = _units(segments)
-    flip = (units[:, 0] < 0) | ((units[:, 0] == 0) & (units[:, 1] < 0))
-    canonical = np.where(flip[:, None], segments[:, [2, 3, 0, 1]], segments)
-    label = _merge_labels(canonical)
-    return _lengths(_joined(canonical, label))[label]
-
-
-def _merge_labels(pieces: np.ndarray) -> np.ndarray:
-    """Which merged line each piece belongs to (connected components of
-    the pairs :func:`merge_segments` joins)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    lengths, units = _lengths(pieces), _units(pieces)
-    q, b = contacts(pieces.reshape(-1, 2), pieces, MERGE_GAP_PX)
-    a = q // 2
-    keep = a != b
-    a, b = a[keep], b[keep]
-    parallel = np.einsum("ij,ij->i", units[a], units[b]) >= math.cos(math.radians(MERGE_ANGLE_DEG))
-    a, b = a[parallel], b[parallel]
-    long_, short = np.where(lengths[a] >= lengths[b], a, b), np.where(lengths[a] >= lengths[b], b, a)
-    t0, d0 = _line_frame(pieces, long_, pieces[short, :2])
-    t1, d1 = _line_frame(pieces, long_, pieces[short, 2:])
-    offset = np.maximum(np.abs(d0), np.abs(d1))
-    gap = np.maximum(np.minimum(t0, t1) - lengths[long_], -np.maximum(t0, t1))
-    join = (offset <= MERGE_OFFSET_PX) & (gap <= MERGE_GAP_PX)
-    n = len(pieces)
-    graph = coo_matrix((np.ones(join.sum()), (a[join], b[join])), shape=(n, n))
-    return connected_components(graph, directed=False)[1]
-
-
-def _joined(pieces: np.ndarray, label: np.ndarray) -> np.ndarray:
-    """One segment per label: through the pieces' length-weighted centre,
-    along their mean direction, spanning all their ends."""
-    groups = int(label.max()) + 1 if label.size else 0
-    lengths, units = _lengths(pieces), _units(pieces)
-    weight = np.bincount(label, lengths, groups)
-    direction = np.column_stack([np.bincount(label, lengths * units[:, k], groups) for k in (0, 1)])
-    direction = direction / np.maximum(np.linalg.norm(direction, axis=1), 1e-12)[:, None]
-    mid = (pieces[:, :2] + pieces[:, 2:]) / 2
-    centre = np.column_stack([np.bincount(label, lengths * mid[:, k], groups)
-                              for k in (0, 1)]) / np.maximum(weight, 1e-12)[:, None]
-    t_ends = np.concatenate([np.einsum("ij,ij->i", pieces[:, :2] - centre[label], direction[label]),
-                             np.einsum("ij,ij->i", pieces[:, 2:] - centre[label], direction[label])])
-    both = np.concatenate([label, label])
-    lo = np.full(groups, np.inf)
-    hi = np.full(groups, -np.inf)
-    np.minimum.at(lo, both, t_ends)
-    np.maximum.at(hi, both, t_ends)
-    return np.column_stack([centre + lo[:, None] * direction, centre + hi[:, None] * direction])
-
-
-# -- junctions ----------------------------------------------------------------------
-def _crossing(s: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Where the lines of segments ``a`` and ``b`` cross (n x 2; not
-    parallel by construction)."""
-    ua, ub = _units(s)[a], _units(s)[b]
-    rel = s[b, :2] - s[a, :2]
-    det = ua[:, 0] * ub[:, 1] - ua[:, 1] * ub[:, 0]
-    t = (rel[:, 0] * ub[:, 1] - rel[:, 1] * ub[:, 0]) / np.where(np.abs(det) > 1e-12, det, 1e-12)
-    return s[a, :2] + t[:, None] * ua
-
-
-def find_junctions(segments: np.ndarray) -> tuple[list[Junction], np.ndarray]:
-    """Where segments meet: an end within ``JUNCTION_REACH_PX`` of another
-    segment, or two segments crossing, at least ``JUNCTION_ANGLE_DEG``
-    apart in direction.  Meeting points closer than ``JUNCTION_MERGE_PX``
-    are one junction.
-
-    Returns the junctions and the events (rows: segment, partner, junction
-    id, t of the junction along the segment in px from its start), one per
-    segment and partner.
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
-    segments = np.asarray(segments, float).reshape(-1, 4)
-    empty = np.zeros((0, 4))
-    if len(segments) < 2:
-        return [], empty
-    lengths, units = _lengths(segments), _units(segments)
-    q, b = contacts(segments.reshape(-1, 2), segments, JUNCTION_REACH_PX)
-    a = q // 2
-    points, owner = sample_points(segments)
-    near = cKDTree(points).query_pairs(SAMPLE_STEP_PX, output_type="ndarray")
-    a, b = _unique_pairs(np.concatenate([a, owner[near[:, 0]]]), np.concatenate([b, owner[near[:, 1]]]),
-                         len(segments), ordered=False)
-    a, b = a[a != b], b[a != b]
-    cos = np.abs(np.einsum("ij,ij->i", units[a], units[b]))
-    a, b = a[cos <= math.cos(math.radians(JUNCTION_ANGLE_DEG))], b[cos <= math.cos(math.radians(JUNCTION_ANGLE_DEG))]
-    x = _crossing(segments, a, b)
-    ta, _ = _line_frame(segments, a, x)
-    tb, _ = _line_frame(segments, b, x)
-    reach = JUNCTION_REACH_PX
-    on_both = ((ta >= -reach) & (ta <= lengths[a] + reach) & (tb >= -reach) & (tb <= lengths[b] + reach))
-    a, b, x, ta, tb = a[on_both], b[on_both], x[on_both], ta[on_both], tb[on_both]
-    if len(a) == 0:
-        return [], empty
-    close = cKDTree(x).query_pairs(JUNCTION_MERGE_PX, output_type="ndarray")
-    graph = coo_matrix((np.ones(len(close)), (close[:, 0], close[:, 1])), shape=(len(x), len(x)))
-    count, label = connected_components(graph, directed=False)
-    members_n = np.bincount(label, None, count)[:, None]
-    centre = np.column_stack([np.bincount(label, x[:, k], count) for k in (0, 1)]) / members_n
-    events = np.vstack([np.column_stack([a, b, label, ta]), np.column_stack([b, a, label, tb])])
-    members = np.unique(events[:, [0, 2]].astype(int), axis=0)
-    degree = np.bincount(members[:, 1], None, count).astype(int)
-    junctions = [Junction(float(cx), float(cy), int(d)) for (cx, cy), d in zip(centre, degree)]
-    # each segment's position of each junction: its own projection of the junction's centre
-    seg, jid = events[:, 0].astype(int), events[:, 2].astype(int)
-    events[:, 3], _ = _line_frame(segments, seg, centre[jid])
-    return junctions, events
-
-
-def split_at_junctions(segments: np.ndarray, junctions: list[Junction], events: np.ndarray,
-                       fill_fraction: np.ndarray | None = None) -> list[HalfEdge]:
-    """Every segment as half-edges: split where a junction lies more than
-    ``SPLIT_MARGIN_PX`` inside it, its ends moved onto the junctions they
-    reach.  Each half-edge carries the junction ids at its ends and the
-    segments met there (its partners), the other halves of its own line
-    included; ``fill_fraction`` (per segment, from :func:`detect_segments`)
-    passes on to its halves."""
-    segments = np.asarray(segments, float).reshape(-1, 4)
-    lengths, lines = _lengths(segments), line_lengths(segments)
-    fill = np.zeros(len(segments)) if fill_fraction is None else np.asarray(fill_fraction, float)
-    out = []
-    by_segment: dict[int, list[np.ndarray]] = {}
-    members: dict[int, set[int]] = {}
-    for row in events:
-        by_segment.setdefault(int(row[0]), []).append(row)
-        members.setdefault(int(row[2]), set()).add(int(row[0]))
-    for i, s in enumerate(segments):
-        line = Segment(*s)
-        rows = by_segment.get(i)
-        if not rows:
-            out.append(HalfEdge(line, float(lines[i]), fill_fraction=float(fill[i])))
-            continue
-        u = (s[2:] - s[:2]) / max(lengths[i], 1e-12)
-        # junctions on this segment, by position (the projection of their centre), and who meets there
-        cuts = {int(jid): float(t) for _, _, jid, t in rows}
-        partners = {jid: sorted(members[jid] - {i}) for jid in cuts}
-        # a junction near an end moves that end onto it (the innermost, if several); one
-        # farther inside splits the segment there
-        near_start = [(t, jid) for jid, t in cuts.items() if t < SPLIT_MARGIN_PX]
-        near_end = [(t, jid) for jid, t in cuts.items() if t > lengths[i] - SPLIT_MARGIN_PX]
-        inside = sorted((t, jid) for jid, t in cuts.items() if SPLIT_MARGIN_PX <= t <= lengths[i] - SPLIT_MARGIN_PX)
-        stops = [(max(near_start)[0], max(near_start)[1], [jid for _, jid in near_start]) if near_start
-                 else (0.0, None, [])]
-        stops += [(t, jid, [jid]) for t, jid in inside]
-        stops.append((min(near_end)[0], min(near_end)[1], [jid for _, jid in near_end]) if near_end
-                     else (float(lengths[i]), None, []))
-        stops = [stop for k, stop in enumerate(stops) if k == 0 or stop[0] > stops[k - 1][0]]
-        halves = [Segment(*(s[:2] + a[0] * u), *(s[:2] + b[0] * u)) for a, b in pairwise(stops)]
-        for k, (a, b) in enumerate(pairwise(stops)):
-            met = [_reaching(segments[p], junctions[j]) for j in a[2] + b[2] for p in partners[j]]
-            met += [halves[m] for m in (k - 1, k + 1) if 0 <= m < len(halves)]
-            out.append(HalfEdge(halves[k], float(lines[i]), (a[1], b[1]), tuple(met), float(fill[i])))
-    return out
-
-
-def _reaching(s: np.ndarray, junction: Junction) -> Segment:
-    """Segment ``s`` with its end nearer ``junction`` moved onto it when the
-    junction lies beyond that end (LSD stops short of where edges meet)."""
-    start, end = s[:2], s[2:]
-    point = np.array([junction.x_px, junction.y_px])
-    u = (end - start) / max(float(np.linalg.norm(end - start)), 1e-12)
-    t = float((point - start) @ u)
-    length = float(np.linalg.norm(end - start))
-    if t < 0:
-        start = start + t * u
-    elif t > length:
-        end = start + t * u
-    return Segment(*start, *end)
-
-
-def parallel_clearance(candidates: list[Segment], segments: np.ndarray, reach_px: float) -> np.ndarray:
-    """For each candidate, the distance (px) from its line to the nearest
-    other segment that runs beside it: parallel within
-    ``JUNCTION_ANGLE_DEG``, alongside it over part of its length, and
-    farther than its own half-width (a bar's own sides do not count);
-    ``inf`` when none lies within ``reach_px``."""
-    c = np.array([seg.as_array() for seg in candidates], float).reshape(-1, 4)
-    out = np.full(len(c), np.inf)
-    segments = np.asarray(segments, float).reshape(-1, 4)
-    if len(c) == 0 or len(segments) == 0:
-        return out
-    widths = np.array([seg.width_px for seg in candidates])
-    points, owner = sample_points(c, reach_px / 2)
-    q, b = contacts(points, segments, reach_px)
-    a, b = _unique_pairs(owner[q], b, max(len(c), len(segments)))
-    parallel = np.abs(np.einsum("ij,ij->i", _units(c)[a], _units(segments)[b])) >= math.cos(
-        math.radians(JUNCTION_ANGLE_DEG))
-    a, b = a[parallel], b[parallel]
-    t0, d0 = _line_frame(c, a, segments[b, :2])
-    t1, d1 = _line_frame(c, a, segments[b, 2:])
-    length = _lengths(c)[a]
-    lo, hi = np.maximum(np.minimum(t0, t1), 0.0), np.minimum(np.maximum(t0, t1), length)
-    beside = hi - lo >= np.minimum(0.25 * length, 10.0)
-    # the neighbour's distance where it runs beside the candidate (its line at the overlap's ends)
-    span = np.where(np.abs(t1 - t0) > 1e-9, t1 - t0, 1e-9)
-    at_lo = d0 + (d1 - d0) * (lo - t0) / span
-    at_hi = d0 + (d1 - d0) * (hi - t0) / span
-    distance = np.minimum(np.abs(at_lo), np.abs(at_hi))
-    keep = beside & (distance > widths[a] / 2 + 1.0)
-    np.minimum.at(out, a[keep], distance[keep])
-    return out
-
-
-# -- bars ---------------------------------------------------------------------------
-def pair_bars(segments: list[Segment]) -> tuple[list[int], list[tuple[int, int, Segment]]]:
-    """Pairs of parallel segments (within ``MERGE_ANGLE_DEG``, either
-    orientation) 0.5 to ``BAR_MAX_SEPARATION_PX`` apart that overlap along
-    half the shorter: the two sides of a bar.  Each segment pairs with its
-    nearest such neighbour when that one's nearest is it too.
-
-    Returns the indices of the lone segments and, per bar, the indices of
-    its two sides and the bar as one segment along its centre line (over
-    their overlap) with ``width_px`` the separation.
-
-    Examples
-    --------
-    >>> lone, bars = pair_bars([Segment(10, 0, 12, 80), Segment(13, 0, 15, 80), Segment(40, 0, 41, 80)])
-    >>> lone, [(i, j, round(bar.width_px, 2)) for i, j, bar in bars]
-    ([2], [(0, 1, 3.0)])
-    """
-    s = np.array([seg.as_array() for seg in segments], float).reshape(-1, 4)
-    n = len(s)
-    if n < 2:
-        return list(range(n)), []
-    lengths, units = _lengths(s), _units(s)
-    points, owner = sample_points(s, BAR_MAX_SEPARATION_PX / 2)
-    q, b = contacts(points, s, BAR_MAX_SEPARATION_PX)
-    a, b = _unique_pairs(owner[q], b, n, ordered=False)
-    keep = (a != b) & (np.abs(np.einsum("ij,ij->i", units[a], units[b]))
-                       >= math.cos(math.radians(MERGE_ANGLE_DEG)))
-    a, b = a[keep], b[keep]
-    t0, d0 = _line_frame(s, a, s[b, :2])
-    t1, d1 = _line_frame(s, a, s[b, 2:])
-    separation = np.abs((d0 + d1) / 2)
-    overlap = np.minimum(np.maximum(t0, t1), lengths[a]) - np.maximum(np.minimum(t0, t1), 0.0)
-    ok = ((separation > 0.5) & (separation <= BAR_MAX_SEPARATION_PX)
-          & (overlap >= 0.5 * np.minimum(lengths[a], lengths[b])))
-    a, b, separation = a[ok], b[ok], separation[ok]
-    t0, t1, d0, d1 = t0[ok], t1[ok], d0[ok], d1[ok]
-    best = np.full(n, np.inf)
-    np.minimum.at(best, a, separation)
-    np.minimum.at(best, b, separation)
-    mutual = (separation == best[a]) & (separation == best[b])
-    taken = np.zeros(n, bool)
-    bars = []
-    for k in np.nonzero(mutual)[0]:
-        i, j = int(a[k]), int(b[k])
-        if taken[i] or taken[j]:
-            continue
-        taken[i] = taken[j] = True
-        u = units[i]
-        normal = np.array([-u[1], u[0]])
-        shift = (d0[k] + d1[k]) / 4
-        start, end = max(min(t0[k], t1[k]), 0.0), min(max(t0[k], t1[k]), lengths[i])
-        c0 = s[i, :2] + start * u + shift * normal
-        c1 = s[i, :2] + end * u + shift * normal
-        bars.append((i, j, Segment(float(c0[0]), float(c0[1]), float(c1[0]), float(c1[1]),
-                                   width_px=float(2 * abs(shift)))))
-    return [i for i in range(n) if not taken[i]], bars

@@ -36,17 +36,10 @@ from ..io import RasterInfo, raster_info, read_raster
 from ..kinds import get_kind
 from ..parallel import run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
-from .detect import (
-    BAR_MAX_SEPARATION_PX,
-    HalfEdge,
-    detect_segments,
-    find_junctions,
-    pair_bars,
-    parallel_clearance,
-    split_at_junctions,
-)
+from .detect import detect_segments
 from .fill import FILL_SIDE_PX, fill_mask, fill_screen, grown
 from .screen import geometry_screen, quick_look
+from .segments import BAR_MAX_SEPARATION_PX, HalfEdge, find_junctions, pair_bars, parallel_clearance, split_at_junctions
 from .settings import ScanSettings
 
 JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its target meets

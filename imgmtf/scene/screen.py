@@ -28,7 +28,7 @@ from ..estimate.geometry import MAX_ANGLE_DEG, MIN_ANGLE_DEG
 from .settings import ScanSettings
 
 if TYPE_CHECKING:
-    from .detect import HalfEdge
+    from .segments import HalfEdge
 
 QUICK_LOOK_SLACK = 1.0          # the quick look rejects what fails the gate's limits this many times over
 SIDE_START_PX = 4.0             # a side's level is read this far from the target at least (px)
