@@ -1,0 +1,135 @@
+"""A candidate's ROI: the tilted rectangle along it that it is measured on,
+and the stretch of it clear of what must not enter the estimate.
+
+The ROI spans ``margin_px`` either side of the candidate's line (plus half
+a bar), stops ``JUNCTION_CLEARANCE_PX`` short of every segment it meets at
+a junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
+short of fill and nodata, and ``END_TRIM_PX`` short of a free end.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..estimate import gate
+from ..io import RasterInfo
+from .fill import FILL_SIDE_PX, fill_screen, grown
+from .segments import HalfEdge
+from .settings import ScanSettings
+
+JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its target meets
+FILL_CLEARANCE_PX = 4           # ... this far from fill and nodata (the target was blurred with the ground beyond it)
+END_TRIM_PX = 3.0               # ... and stops this short of a free end (a corner LSD did not see)
+MIN_HALF_WIDTH_PX = 10.0        # an ROI narrower either side of its target holds too little of the sides
+
+
+@dataclass(frozen=True)
+class Roi:
+    """A tilted rectangle: from (``x``, ``y``) along the unit vector
+    (``ux``, ``uy``) over ``t0_px`` to ``t1_px``, and ``half_width_px``
+    either side of that line (scene pixels)."""
+
+    x: float
+    y: float
+    ux: float
+    uy: float
+    t0_px: float
+    t1_px: float
+    half_width_px: float
+
+    def frame(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(t, d) of points: along the line from (x, y), and across it (px)."""
+        rx, ry = xs - self.x, ys - self.y
+        return rx * self.ux + ry * self.uy, -rx * self.uy + ry * self.ux
+
+    def point(self, t, d) -> tuple[np.ndarray, np.ndarray]:
+        t, d = np.asarray(t, float), np.asarray(d, float)
+        return self.x + t * self.ux - d * self.uy, self.y + t * self.uy + d * self.ux
+
+    def corners(self, t0: float | None = None, t1: float | None = None) -> list[list[float]]:
+        """The rectangle's corners (x, y), optionally over [t0, t1] only."""
+        t0 = self.t0_px if t0 is None else t0
+        t1 = self.t1_px if t1 is None else t1
+        h = self.half_width_px
+        xs, ys = self.point([t0, t1, t1, t0], [-h, -h, h, h])
+        return [[round(float(x), 2), round(float(y), 2)] for x, y in zip(xs, ys)]
+
+    def bbox(self, width: int, height: int) -> tuple[int, int, int, int]:
+        """(x, y, w, h) of the pixels it touches, within a scene of that size."""
+        h = self.half_width_px
+        xs, ys = self.point([self.t0_px, self.t1_px, self.t1_px, self.t0_px], [-h, -h, h, h])
+        x0, y0 = max(math.floor(xs.min()), 0), max(math.floor(ys.min()), 0)
+        x1, y1 = min(math.ceil(xs.max()), width - 1), min(math.ceil(ys.max()), height - 1)
+        return x0, y0, max(x1 - x0 + 1, 1), max(y1 - y0 + 1, 1)
+
+
+def plan_roi(half: HalfEdge, settings: ScanSettings, beside_px: float = math.inf) -> Roi:
+    """The largest ROI a candidate may have: along its segment (a free end
+    trimmed by ``END_TRIM_PX``; a junction end reaching the junction, which
+    the partners' clearance then keeps off), at most ``max_length_px`` of
+    its middle, ``margin_px`` (plus half a bar) either side, or less, to
+    stay ``JUNCTION_CLEARANCE_PX`` clear of a segment running beside it
+    ``beside_px`` away."""
+    s = half.segment
+    length = s.length_px
+    ux, uy = (s.x1 - s.x0) / length, (s.y1 - s.y0) / length
+    t0 = 0.0 if half.junctions[0] is not None else min(END_TRIM_PX, length / 2)
+    t1 = length if half.junctions[1] is not None else max(length - END_TRIM_PX, length / 2)
+    if t1 - t0 > settings.max_length_px:
+        middle = (t0 + t1) / 2
+        t0, t1 = middle - settings.max_length_px / 2, middle + settings.max_length_px / 2
+    half_width = min(settings.margin_px + s.width_px / 2, beside_px - JUNCTION_CLEARANCE_PX)
+    return Roi(s.x0, s.y0, ux, uy, t0, t1, half_width)
+
+
+def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
+    """The longest stretch [t0, t1) of the ROI clear of fill (and
+    ``FILL_CLEARANCE_PX`` around it), of the partners (within
+    ``JUNCTION_CLEARANCE_PX``) and of the scene's border, in whole pixels
+    along the line; or (reason, message) when none is long enough: ``fill``
+    for a boundary of the fill (fill along its sides) or an ROI the fill
+    leaves too short, ``too-short`` otherwise.  ``t``, ``d``, ``xs``, ``ys``
+    describe the ROI's pixels; ``fill`` is the fill of the window they
+    index (its top-left pixel at the smallest ``xs``, ``ys``)."""
+    bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
+    k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
+    bad = np.zeros(bins, bool)
+    by_fill = np.zeros(bins, bool)
+    if fill.any():
+        r, c = ys - ys.min(), xs - xs.min()
+        near_fill = fill[r, c] & (np.abs(d) <= FILL_SIDE_PX)
+        boundary = fill_screen(float(np.mean(np.bincount(k[near_fill], minlength=bins) > 0)))
+        if boundary:
+            return boundary
+        by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
+        bad |= by_fill
+    for p in partners:
+        bad |= np.bincount(k[distance_to_segment(xs, ys, p) <= JUNCTION_CLEARANCE_PX], minlength=bins) > 0
+    # the band's cross-section must lie inside the scene
+    centres = roi.t0_px + np.arange(bins) + 0.5
+    for side in (-1.0, 1.0):
+        px, py = roi.point(centres, side * roi.half_width_px)
+        bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
+    free = np.concatenate([[0], (~bad).astype(int), [0]])
+    step = np.diff(free)
+    starts, ends = np.nonzero(step == 1)[0], np.nonzero(step == -1)[0]
+    longest = int(np.argmax(ends - starts)) if starts.size else None
+    length = float(ends[longest] - starts[longest]) if longest is not None else 0.0
+    rows = int(length * max(abs(roi.ux), abs(roi.uy)))      # rows (or columns) it crosses
+    if rows < gate.MIN_ROWS:
+        if by_fill.mean() >= 0.5:
+            return "fill", (f"fill or nodata leaves only {rows} rows of the target clear (at least "
+                            f"{gate.MIN_ROWS} needed)")
+        return "too-short", (f"only {rows} rows of the target lie clear of its junctions, fill and the "
+                             f"scene's border (at least {gate.MIN_ROWS} needed)")
+    return roi.t0_px + starts[longest], roi.t0_px + ends[longest]
+
+
+def distance_to_segment(xs, ys, s) -> np.ndarray:
+    """Distance (px) of points from the segment s = (x0, y0, x1, y1)."""
+    dx, dy = s[2] - s[0], s[3] - s[1]
+    length2 = max(dx * dx + dy * dy, 1e-12)
+    f = np.clip(((xs - s[0]) * dx + (ys - s[1]) * dy) / length2, 0.0, 1.0)
+    return np.hypot(xs - (s[0] + f * dx), ys - (s[1] + f * dy))
