@@ -106,18 +106,27 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
         return []
     from ..parallel import run_tasks
     targets = sorted({int(r.site["target_id"]) for r in accepted})
-    groups = [([r for r in accepted if r.site["target_id"] == target], {"scope": TARGET_SCOPE, "target_id": target})
-              for target in targets]
-    if len(targets) > 1:        # the scene's fit, the longest, first: the targets' fill the other workers
-        groups.insert(0, (accepted, {"scope": SCENE_SCOPE}))
+    groups = [[r for r in accepted if r.site["target_id"] == target] for target in targets]
     # on workers, each task measures its half-edges again itself (an EdgeResult does not travel between
     # processes); run here, each half-edge is measured again once, for its target's fit and the scene's
     again = dict(zip(map(id, accepted), _measured(accepted))) if workers == 1 and scheduler is None else None
-    tasks = [(members, site, stages, None if again is None else [again[id(r)] for r in members])
-             for members, site in groups]
-    fitted = list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                            description="fitting targets"))
-    return [row for rows in fitted[1:] + fitted[:1] for row in rows] if len(targets) > 1 else fitted[0]
+
+    def task(members: list[Record], site: dict, guess=None) -> tuple:
+        return members, site, stages, None if again is None else [again[id(r)] for r in members], guess
+
+    fitted = list(run_tasks(_fit_task, [task(members, {"scope": TARGET_SCOPE, "target_id": target})
+                                        for members, target in zip(groups, targets)],
+                            workers=workers, scheduler=scheduler, progress=progress, description="fitting targets"))
+    rows = [row for target_rows, _ in fitted for row in target_rows]
+    if len(targets) > 1:
+        # the scene's fit starts where its targets' fits ended: the same optimum in a few iterations
+        ends = {key: end for _, (_, edge_ends) in fitted for key, end in edge_ends.items()}
+        guess = ([coordinates for _, (coordinates, _) in fitted if coordinates],
+                 [ends.get(_edge_key(r)) for r in accepted])
+        (scene_rows, _), = run_tasks(_fit_task, [task(accepted, {"scope": SCENE_SCOPE}, guess)], workers=workers,
+                                     scheduler=scheduler, progress=False)
+        rows += scene_rows
+    return rows
 
 
 def track_of(record: Record) -> float | None:
@@ -179,34 +188,47 @@ def _turned(normal_deg: float, track_deg: float) -> float:
     return angle - 180.0 if angle > 90.0 else angle
 
 
-def _fit_task(task) -> list[Record]:
-    """One fit: (its half-edges' records, its site, the stages, and the
-    half-edges measured again, or None to measure them here)."""
-    records, site, stages, measured = task
-    return _fit_rows(list(zip(records, measured if measured is not None else _measured(records))), site, stages)
+def _fit_task(task) -> tuple[list[Record], tuple[dict, dict]]:
+    """One fit: (its half-edges' records, its site, the stages, the
+    half-edges measured again, or None to measure them here, and where
+    the fit starts, or None).  Its rows, and where it ended (its free
+    parameters' coordinates and variances; each half-edge's levels and
+    offset by its key): a start for the scene's fit."""
+    records, site, stages, measured, guess = task
+    return _fit_rows(list(zip(records, measured if measured is not None else _measured(records))), site, stages,
+                     guess)
 
 
-def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages) -> list[Record]:
-    from ..estimate.fit import fit_edges
+def _edge_key(record: Record) -> tuple:
+    return record.site.get("target_id"), record.site.get("id")
+
+
+def _fit_rows(members: list[tuple[Record, Any]], site: dict, stages, guess=None) -> tuple[list[Record], tuple]:
+    from ..estimate.fit import fit_edges, fitted_coordinates, pooled_guess
     records = [r for r, _ in members]
     first = records[0]
     edges = [e for _, e in members if not isinstance(e, str)]
+    used = [r for r, e in members if not isinstance(e, str)]
     where = _where(records, site)
+    if guess is not None:
+        coordinates, ends = guess
+        guess = pooled_guess(coordinates, [end for end, (_, e) in zip(ends, members) if not isinstance(e, str)])
     try:
         if not edges:
             raise ImgmtfError(f"no half-edge could be measured again: {members[0][1]}", reason="unsuitable")
-        fit = fit_edges(edges, stages=stages, confidence=_confidence(first))
+        fit = fit_edges(edges, stages=stages, confidence=_confidence(first), guess=guess)
     except ImgmtfError as exc:
         what = f"target {site['target_id']}" if site["scope"] == TARGET_SCOPE else "the scene"
         return [Record(first.path, first.band, first.target, first.method, "rejected", exc.reason,
                        f"{first.path}: the sensor model could not be fitted to {what}: {' '.join(str(exc).split())}",
-                       figures={"summary": "fit"}, site=where, params=_params(first, stages), run_utc=first.run_utc)]
-    used = [r for r, e in members if not isinstance(e, str)]
+                       figures={"summary": "fit"}, site=where, params=_params(first, stages),
+                       run_utc=first.run_utc)], ({}, {})
     lost = [f"half-edge {r.site.get('id')} could not be measured again for the fit: {e}"
             for r, e in members if isinstance(e, str)]
+    ended = (fitted_coordinates(fit), {_edge_key(r): (*e.levels_dn, e.offset_px) for r, e in zip(used, fit.edges)})
     # an axis no edge lies nearer to is the model's extrapolation (tied or held parameters): no row
     return [_direction_row(fit, direction, used, where, stages, lost) for direction in ("across", "along")
-            if fit.directions[direction]["constrained"]]
+            if fit.directions[direction]["constrained"]], ended
 
 
 def _direction_row(fit, direction: str, records: list[Record], site: dict, stages, lost: list[str]) -> Record:
