@@ -34,7 +34,8 @@ Identifiability, in three steps:
    and the fit is redone, until every free parameter is determined.  Then,
    best-known first, a parameter is held when freeing it gains less than
    ``LIKELIHOOD_RATIO`` in chi-square, keeping one free parameter on each
-   axis an edge sees.  Optics sigma, electronics cut-off and detector
+   axis an edge sees (one plainly needed, ``WALD_MARGIN`` times that by
+   its Wald statistic, stays free without the trial refit).  Optics sigma, electronics cut-off and detector
    width shape the MTF alike, and such pairs are reported with their
    correlation.
 

@@ -24,6 +24,12 @@ if TYPE_CHECKING:
 #: a parameter stays free only if holding it costs this much chi-square
 #: (in units of the reduced chi-square): p = 0.001 for one degree of freedom
 LIKELIHOOD_RATIO = 10.8
+#: a parameter whose Wald statistic (its distance from its starting value in
+#: standard errors, squared: the chi-square holding it costs, to first order,
+#: the others following) exceeds this many times the likelihood-ratio
+#: threshold stays free without a trial refit: no nonlinearity of the blur
+#: models seen brings that cost back under the threshold
+WALD_MARGIN = 10.0
 
 
 @dataclass(frozen=True)
@@ -61,6 +67,8 @@ def pooled_guess(coordinates: Sequence[Mapping[str, tuple[float, float]]],
     Returns
     -------
     Guess
+        Each parameter some fit freed at its pooled coordinate, and the
+        edges' levels and offsets as given.
 
     Examples
     --------
@@ -193,6 +201,8 @@ def run_fit(model: Model, hold, confidence: float, guess: Guess | None = None) -
         if not model.covers_axes([k for k in model.free if k != key]):
             continue            # the last free parameter of an axis: its uncertainty belongs in the intervals
         index = model.free.index(key)
+        if (z[index] - model.start[key]) ** 2 > WALD_MARGIN * LIKELIHOOD_RATIO * covariance[index, index]:
+            continue            # plainly needed (covariance is scaled, as the cost is)
         trial = model.copy()
         z_held = trial.hold(z, index, covariance)
         try:
