@@ -128,6 +128,7 @@ class Model:
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
+        self._last_esfs: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
 
     # -- which parameters are free ------------------------------------------------
@@ -242,10 +243,13 @@ class Model:
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
         u = z[: self.n_free]
         responses = responses or self.responses(u)
-        out = []
+        out, esfs = [], []
         for e, (d, r) in enumerate(zip(self.data, responses)):
             lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            out.append((d.y - (lo + (hi - lo) * r.esf(d.x - x0))) / d.noise)
+            esfs.append(r.esf(d.x - x0))
+            out.append((d.y - (lo + (hi - lo) * esfs[-1])) / d.noise)
+        # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its columns'
+        self._last_esfs = ((tuple(self.free), z.tobytes()), esfs)
         return np.concatenate(out)
 
     def jacobian(self, z: np.ndarray):
@@ -264,6 +268,7 @@ class Model:
             moved[k] += steps[k]
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
+        known = self._last_esfs[1] if self._last_esfs[0] == (tuple(self.free), z.tobytes()) else None
         stage_columns, blocks, base = [], [], []
         for e, d in enumerate(self.data):
             lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
@@ -272,7 +277,7 @@ class Model:
             base.append(response)
             changes = esf_changes(response, esf_change, lsf_change, d.x - x0)
             stage_columns.append(changes.T * (-(hi - lo) / d.noise / steps))
-            esf = response.esf(d.x - x0)
+            esf = known[e] if known is not None else response.esf(d.x - x0)
             blocks.append(np.column_stack([(esf - 1) / d.noise, -esf / d.noise,
                                            (hi - lo) / d.noise * response.lsf(d.x - x0)]))
         self._last_responses = ((tuple(self.free), u.tobytes()), base)
