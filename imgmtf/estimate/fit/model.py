@@ -290,10 +290,17 @@ class Model:
                 row += len(block)
             return jacobian
         # each edge's levels and offset act on its own samples only: a sparse
-        # Jacobian, whose size grows with the edges, not with their square
+        # Jacobian, whose size grows with the edges, not with their square;
+        # every row holds the stage columns, then its edge's three, so its
+        # compressed rows are written directly
         from scipy import sparse
-        return sparse.hstack([sparse.csr_array(np.concatenate(stage_columns)), sparse.block_diag(blocks)],
-                             format="csr")
+        per_row = self.n_free + 3
+        sizes = [d.x.size for d in self.data]
+        nuisance = np.repeat(self.n_free + 3 * np.arange(len(sizes)), sizes)[:, None] + np.arange(3)
+        indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
+        values = np.hstack([np.concatenate(stage_columns), np.concatenate(blocks)])
+        return sparse.csr_array((values.ravel(), indices.ravel(), np.arange(0, values.size + 1, per_row)),
+                                shape=(values.shape[0], self.n_free + 3 * len(sizes)))
 
     @property
     def sparse(self) -> bool:
