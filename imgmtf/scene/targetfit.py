@@ -7,10 +7,11 @@ and neither is the across- or along-track MTF a specification quotes.
 Here the sensor model (:func:`imgmtf.fit_sensor`: the same stages, the
 same misfit test as ``imgmtf fit``; "optics,detector" by default) is
 fitted jointly to every accepted half-edge of a target, each measured
-again on its masked ROI exactly as the scan measured it (the window
-``roi`` of its site, the pixels whose centres lie inside its
-``roi_polygon_px``), and the model's MTF is read along the track and
-across it: MTF at Nyquist and MTF50 with the fit's delta-method
+again on the masked ROI its record describes (the window ``roi`` of its
+site, the pixels whose centres lie inside its ``roi_polygon_px``, whose
+corners are rounded to 0.01 px: along a tilted ROI's border that can take
+in or leave out 1-3 pixels the scan's own mask did not), and the model's
+MTF is read along the track and across it: MTF at Nyquist and MTF50 with the fit's delta-method
 intervals, FWHM and RER.
 
 The fit is in the sensor's frame: each edge's normal is turned by the
