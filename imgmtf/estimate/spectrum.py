@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -123,7 +124,7 @@ def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
 
 
 def corrected_mtf(profile: np.ndarray, step: float,
-                  divisor: Callable) -> Callable[[np.ndarray], np.ndarray]:
+                  divisor: Callable) -> TabulatedMTF:
     """MTF(f) of a windowed profile (LSF, or pulse response) sampled every
     ``step`` px: |FT| normalised at 0, divided by |divisor(f)|, the transfer
     of everything between the system's LSF and this profile.  NaN where
@@ -141,10 +142,28 @@ def corrected_mtf(profile: np.ndarray, step: float,
     with np.errstate(divide="ignore", invalid="ignore"):
         corrected = np.where(div >= MIN_TRANSFER, modulus[kept] / modulus[0] / div, np.nan)
 
-    def mtf(f):
+    return TabulatedMTF(freqs, corrected)
+
+
+@dataclass(frozen=True, eq=False)
+class TabulatedMTF:
+    """An MTF tabulated on the transform's bins, read between them by
+    linear interpolation; even (MTF(-f) = MTF(f)), NaN beyond the table.
+    A value, not a closure, so that a result holding it can be sent to
+    another process (a scan's worker hands its estimates to the fit).
+
+    Examples
+    --------
+    >>> TabulatedMTF(np.array([0.0, 1.0]), np.array([1.0, 0.5]))(-0.5)
+    array([0.75])
+    """
+
+    frequencies_cy_px: np.ndarray
+    mtf: np.ndarray
+
+    def __call__(self, f: np.ndarray | float) -> np.ndarray:
         f = np.atleast_1d(np.asarray(f, float))
-        return np.interp(np.abs(f), freqs, corrected, right=np.nan)    # even: MTF(-f) = MTF(f)
-    return mtf
+        return np.interp(np.abs(f), self.frequencies_cy_px, self.mtf, right=np.nan)
 
 
 def noise_limited_frequency(mtf: Callable, noise: Callable, f_max: float = 3.0) -> float:
