@@ -91,6 +91,12 @@ class Record:
         Start of the run, UTC, ISO 8601.
     imgmtf_version : str
         The version that made the record.
+    measurement : object or None
+        The estimator's result behind an accepted scan candidate (an
+        :class:`imgmtf.EdgeResult` or :class:`imgmtf.PulseResult`: its
+        samples, profile and MTF), what the target's sensor fit starts
+        from; in memory only: never written, not compared, None once read
+        back from a file or a store.
 
     Raises
     ------
@@ -123,6 +129,7 @@ class Record:
     params: Mapping[str, Any] = field(default_factory=dict)
     run_utc: str = ""
     imgmtf_version: str = __version__
+    measurement: Any = field(default=None, repr=False, compare=False)
 
     @classmethod
     def measured(cls, path: str, band: int | str | None, summary: Mapping[str, Any], *,

@@ -69,6 +69,26 @@ def test_no_fit_without_a_track_nor_for_pulses(scanned):
     assert fit_targets([r.with_(target="pulse") for r in records]) == []
 
 
+def test_the_fit_starts_from_the_scans_own_measurements_and_stored_records_are_measured_again(scanned):
+    """Accepted records carry the estimate scan made (in memory, never
+    written); without it (a record read back from a store) each half-edge
+    is measured again on the ROI its record describes: the same edge, so
+    the same fit to well within its interval (the two masks differ by at
+    most a few border pixels)."""
+    _, records = scanned
+    accepted = [r for r in records if r.ok]
+    assert all(isinstance(r.measurement, im.EdgeResult) for r in accepted)
+    assert all(r.measurement is None for r in records if not r.ok)
+    assert all(r.measurement.mtf_nyquist == pytest.approx(r.figures["mtf_nyquist"], abs=1e-6) for r in accepted)
+    assert "measurement" not in accepted[0].to_dict() and "measurement" not in repr(accepted[0])
+    from_scan = fit_targets(records)
+    again = fit_targets([r.with_(measurement=None) for r in records])
+    for a, b in zip(from_scan, again):
+        low, high = a.figures["mtf_nyquist_ci"]
+        assert abs(a.figures["mtf_nyquist"] - b.figures["mtf_nyquist"]) < 0.05 * (high - low)
+        assert a.figures["n_edges"] == b.figures["n_edges"]
+
+
 def test_roi_mask_holds_the_pixel_centres_inside_a_tilted_rectangle():
     corners = [[2.0, 0.0], [6.0, 4.0], [4.0, 6.0], [0.0, 2.0]]        # a square turned 45 deg
     mask = roi_mask((7, 7), (0, 0), corners)

@@ -108,7 +108,8 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     list of Record
         One per candidate (a half-edge between junctions, or a bar), with
         ``status`` accepted or rejected, the reason of a rejection, the
-        figures of an accepted one, and in its site where it lies
+        figures of an accepted one and its estimate (``measurement``: an
+        EdgeResult or PulseResult, in memory only), and in its site where it lies
         (``x0_px``...), its ROI (``roi``, ``roi_polygon_px``), ``id``,
         ``rank`` and, for the half-edges of a target with an accepted
         one, ``target_id``.  Combine them with
@@ -321,7 +322,7 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
     figures = {**result.to_dict(curves=True), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
                "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
     record = Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
-                             status="accepted", site={**site, "verdict_by": "gate"})
+                             status="accepted", site={**site, "verdict_by": "gate"}, measurement=result)
     if context.figures_dir:
         record = _with_figure(record, result, context, plan)
     return record
@@ -404,7 +405,7 @@ def _measured(candidate: Record, outcome: Record) -> Record:
     return candidate.with_(status=outcome.status, reason=outcome.reason, error=outcome.error,
                            band=outcome.band if outcome.band is not None else candidate.band,
                            figures=outcome.figures, site=outcome.site, plot=outcome.plot,
-                           params={**outcome.params, **candidate.params})
+                           params={**outcome.params, **candidate.params}, measurement=outcome.measurement)
 
 
 def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:

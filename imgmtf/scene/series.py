@@ -193,7 +193,7 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
             partial = getattr(exc, "records", None)
             if partial is None:
                 raise
-            return SceneOutcome(path, tuple(partial), tuple(summarise_scan(partial)), interrupt=exc)
+            return SceneOutcome(path, _reported(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
         if get_kind(settings.target).fits_sensor and stages:
             summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
@@ -201,7 +201,14 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         message = " ".join(str(exc).split())
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
                             reason=exc.reason)
-    return SceneOutcome(path, tuple(records), tuple(summaries), acquisition, figures_dir=figures_dir)
+    return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
+
+
+def _reported(records) -> tuple[Record, ...]:
+    """The records without their measurements: those served the fit; an
+    outcome is what is reported and stored, and it may travel back from a
+    worker and be held for a whole campaign (a measurement is ~0.3 MB)."""
+    return tuple(r.with_(measurement=None) if r.measurement is not None else r for r in records)
 
 
 def _stored(outcome: SceneOutcome, store: str | None) -> Iterator[SceneOutcome]:

@@ -6,13 +6,16 @@ a target tilted like Baotou's (16.8 deg) then has two "oblique" results,
 and neither is the across- or along-track MTF a specification quotes.
 Here the sensor model (:func:`imgmtf.fit_sensor`: the same stages, the
 same misfit test as ``imgmtf fit``; "optics,detector" by default) is
-fitted jointly to every accepted half-edge of a target, each measured
-again on the masked ROI its record describes (the window ``roi`` of its
-site, the pixels whose centres lie inside its ``roi_polygon_px``, whose
-corners are rounded to 0.01 px: along a tilted ROI's border that can take
-in or leave out 1-3 pixels the scan's own mask did not), and the model's
-MTF is read along the track and across it: MTF at Nyquist and MTF50 with the fit's delta-method
-intervals, FWHM and RER.
+fitted jointly to every accepted half-edge of a target, from the samples
+the scan measured it by (the record's ``measurement``), and the model's
+MTF is read along the track and across it: MTF at Nyquist and MTF50 with
+the fit's delta-method intervals, FWHM and RER.
+
+A record without its measurement (read back from a file or a store) is
+measured again on the masked ROI it describes: the window ``roi`` of its
+site, the pixels whose centres lie inside its ``roi_polygon_px``.  Those
+corners are rounded to 0.01 px, so along a tilted ROI's border that mask
+can take in or leave out 1-3 pixels the scan's own did not.
 
 The fit is in the sensor's frame: each edge's normal is turned by the
 track azimuth (``--track-azimuth``; 0, rows along track, for a scene in
@@ -51,8 +54,9 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
     ----------
     records : list of Record
         A scan's records (:func:`imgmtf.scene.measure.scan_scene`) of edge
-        targets; accepted half-edges with a ``target_id`` are fitted, each
-        read again from the scene (``path``) on its ROI.
+        targets; accepted half-edges with a ``target_id`` are fitted, from
+        their ``measurement``, or, without one, read again from the scene
+        (``path``) on their ROI.
     stages : str or list of str
         The stages fitted (:func:`imgmtf.fit_sensor`), default
         "optics,detector".
@@ -108,12 +112,13 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
     from ..parallel import run_tasks
     targets = sorted({int(r.site["target_id"]) for r in accepted})
     groups = [[r for r in accepted if r.site["target_id"] == target] for target in targets]
-    # on workers, each task measures its half-edges again itself (an EdgeResult does not travel between
-    # processes); run here, each half-edge is measured again once, for its target's fit and the scene's
-    again = dict(zip(map(id, accepted), _measured(accepted))) if workers == 1 and scheduler is None else None
+    # a half-edge without its measurement is measured again: by its task on workers, else here, once, for
+    # its target's fit and the scene's
+    here = workers == 1 and scheduler is None
+    known = {id(r): _from_scan(r) if r.measurement is not None or not here else _measured([r])[0] for r in accepted}
 
     def task(members: list[Record], site: dict, guess=None) -> tuple:
-        return members, site, stages, None if again is None else [again[id(r)] for r in members], guess
+        return members, site, stages, [known[id(r)] for r in members], guess
 
     fitted = list(run_tasks(_fit_task, [task(members, {"scope": TARGET_SCOPE, "target_id": target})
                                         for members, target in zip(groups, targets)],
@@ -158,6 +163,15 @@ def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon: ArrayLike
     return inside
 
 
+def _from_scan(record: Record) -> Any:
+    """The scan's own measurement of a half-edge, its normal turned into
+    the sensor's frame; None when the record has none."""
+    if record.measurement is None:
+        return None
+    result = record.measurement
+    return replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0))
+
+
 def _measured(records: list[Record]) -> list[Any]:
     """Each accepted half-edge measured again on its masked ROI (no
     intervals: the fit needs its samples and geometry), its normal turned
@@ -190,14 +204,16 @@ def _turned(normal_deg: float, track_deg: float) -> float:
 
 
 def _fit_task(task) -> tuple[list[Record], tuple[dict, dict]]:
-    """One fit: (its half-edges' records, its site, the stages, the
-    half-edges measured again, or None to measure them here, and where
+    """One fit: (its half-edges' records, its site, the stages, each
+    half-edge's measurement, or None to measure it again here, and where
     the fit starts, or None).  Its rows, and where it ended (its free
     parameters' coordinates and variances; each half-edge's levels and
     offset by its key): a start for the scene's fit."""
     records, site, stages, measured, guess = task
-    return _fit_rows(list(zip(records, measured if measured is not None else _measured(records))), site, stages,
-                     guess)
+    missing = [r for r, m in zip(records, measured) if m is None]
+    again = iter(_measured(missing))
+    measured = [next(again) if m is None else m for m in measured]
+    return _fit_rows(list(zip(records, measured)), site, stages, guess)
 
 
 def _edge_key(record: Record) -> tuple:
