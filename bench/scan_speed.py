@@ -35,7 +35,11 @@ Timed, in this process, after one warm-up run of each, the best of
 4. on the chart, ``imgmtf scan CHART`` against ``mtf_mapper -q -l CHART
    DIR`` (MTF Mapper 0.7.38; ``--mtfmapper PATH`` or the ``MTF_MAPPER``
    environment variable, else ``mtf_mapper`` on the PATH; the comparison
-   is skipped, saying so, when it is not found), each a new process.
+   is skipped, saying so, when it is not found), each a new process;
+5. the start-up every such process pays before its first pixel, the
+   floor of the chart's ratio: a new Python importing the libraries the
+   design names (NumPy, OpenCV, rasterio, SciPy's sparse graphs, spatial
+   trees and optimizer), then also imgmtf's scan and fit modules.
 
 Printed: the load average (the machine is shared: time when it is low),
 the times (wall, and CPU of the process and its children: less hostage to
@@ -248,6 +252,12 @@ def accepted_edges(run: subprocess.CompletedProcess) -> int:
     return sum(r.get("scope") == "edge" and r.get("status") == "accepted" for r in rows)
 
 
+#: what a scan's process must import before its first pixel: the libraries the design names (and,
+#: second, imgmtf's own scan and fit modules): a floor no work done in Python can go below
+LIBRARIES = "import numpy, cv2, rasterio, scipy.sparse.csgraph, scipy.spatial, scipy.optimize"
+MODULES = LIBRARIES + "; import imgmtf.cli.main, imgmtf.scene.series, imgmtf.scene.measure, imgmtf.estimate.fit"
+
+
 def mtf_mapper_edges(out: str) -> int:
     path = Path(out) / "edge_sfr_values.txt"
     return len(path.read_text().splitlines()) if path.exists() else 0
@@ -278,6 +288,8 @@ def main() -> None:
                 "chart_nofit": lambda: run_quietly(command("scan", str(chart_path), "--format", "json",
                                                            "--fit-stages", "none")),
             })
+            jobs["libraries"] = lambda: run_quietly([sys.executable, "-c", LIBRARIES])
+            jobs["modules"] = lambda: run_quietly([sys.executable, "-c", MODULES])
             if peer:
                 jobs["mtf_mapper"] = lambda: (run_quietly([peer, "-q", "-l", str(chart_path), work]),
                                               mtf_mapper_edges(work))
@@ -303,6 +315,10 @@ def main() -> None:
             line("  mtf_mapper -q -l CHART DIR", peer_timing, more=f"{peer_timing.out[1]} edges measured")
         else:
             print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
+        for name, label in (("libraries", "Python importing NumPy, OpenCV, rasterio, SciPy"),
+                            ("modules", "... and imgmtf's scan and fit modules")):
+            line("  " + label, times[name], peer_timing, "MTF Mapper" if peer_timing else "",
+                 "   (start-up: the floor)")
         for name, label in (("chart", "imgmtf scan CHART (fits)"),
                             ("chart_nofit", "imgmtf scan CHART --fit-stages none")):
             timing = times[name]
