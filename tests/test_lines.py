@@ -23,6 +23,40 @@ def test_hermite_is_exact_for_cubics_and_zero_beyond_the_grid():
     assert not out[:, ~inside].any()
 
 
+def test_hermites_second_derivative_is_the_cubics_and_a_bad_order_is_refused():
+    """Exact for a cubic (6x - 2 here); linear between grid samples."""
+    x = np.arange(-3.0, 3.01, 0.5)
+    d = np.array([-2.9, -0.26, 0.0, 1.13, 2.99])
+    out = hermite(-3.0, 0.5, x**3 - x**2, 3 * x**2 - 2 * x, d, derivative=2)
+    np.testing.assert_allclose(out, 6 * d - 2, atol=1e-12)
+    with pytest.raises(ValueError, match="derivative must be 0 or 2"):
+        hermite(-3.0, 0.5, x, x, d, derivative=1)
+
+
+@pytest.mark.parametrize("sensor, gaussian_px", [(im.Sensor(1.0, [st.GaussianOptics(0.6, 0.6)]), 0.6),
+                                                 (im.Sensor(), None),
+                                                 (im.Sensor(1.0, [st.Diffraction(8.0), st.Detector()]), None)],
+                         ids=["gaussian", "paper", "airy"])
+def test_esf_curvature_is_the_second_derivative_of_the_esf(sensor, gaussian_px):
+    """Of the interpolant esf() evaluates: against its central second
+    difference (h = 2e-4 px: exact for the cubic within a grid interval,
+    so the few points within h of a grid sample are left out, and 5e-6 off
+    for the sharpest reference, a Cauchy LSF 0.18 px wide); for a
+    Gaussian, the closed form -x / s^3 phi(x / s) too."""
+    response = sensor.line_response(5.0, reach_px=20.0)
+    d = np.random.default_rng(3).uniform(-6, 6, 2000)
+    h = 2e-4
+    knot = (d - response.start_px) / response.step_px
+    away = np.abs(knot - np.round(knot)) * response.step_px > 1.5 * h
+    second = (response.esf(d + h) - 2 * response.esf(d) + response.esf(d - h)) / h**2
+    curvature = response.esf_curvature(d)
+    np.testing.assert_allclose(curvature[away], second[away], atol=2e-5)
+    if gaussian_px is not None:
+        s = gaussian_px
+        exact = -d / s**3 * np.exp(-0.5 * (d / s) ** 2) / math.sqrt(2 * math.pi)
+        np.testing.assert_allclose(curvature, exact, atol=1e-6)
+
+
 def test_remainders_of_a_gaussian_give_its_closed_form_esf_and_lsf():
     """A Gaussian transfer of width s against a reference of another width:
     the remainders plus the reference's closed form are Phi(x/s) and the

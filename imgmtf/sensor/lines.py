@@ -54,6 +54,20 @@ class LineResponse:
             return value + width / (np.pi * (width**2 + d**2))
         return value + np.exp(-0.5 * (d / width) ** 2) / (width * math.sqrt(2 * math.pi))
 
+    def esf_curvature(self, d_px: ArrayLike) -> np.ndarray:
+        """The edge response's second derivative, the LSF's slope (1/px^2),
+        at signed distances ``d_px``: exactly that of the cubic Hermite
+        interpolant :meth:`esf` evaluates (linear between grid samples),
+        plus the reference's closed form.  What a mean of the ESF over
+        nearby distances needs beyond its value at their mean
+        (:mod:`imgmtf.estimate.fit`'s bins)."""
+        d = np.asarray(d_px, float)
+        value = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d, derivative=2)
+        kind, width = self.reference
+        if kind == "cauchy":
+            return value - 2 * width * d / (np.pi * (width**2 + d**2) ** 2)
+        return value - d * np.exp(-0.5 * (d / width) ** 2) / (width**3 * math.sqrt(2 * math.pi))
+
 
 def reference_transfer(reference: tuple[str, float], f: np.ndarray) -> np.ndarray:
     """Transfer (1 at zero) of a line response's closed-form reference at
@@ -135,9 +149,10 @@ class LineGrid:
 
 
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
-            d_px: np.ndarray) -> np.ndarray:
+            d_px: np.ndarray, derivative: int = 0) -> np.ndarray:
     """Cubic Hermite interpolation of gridded ``values`` with their
-    ``slopes`` (per px) at ``d_px``; zero beyond the grid.
+    ``slopes`` (per px) at ``d_px``, or the interpolant's second
+    derivative (per px^2); zero beyond the grid.
 
     Parameters
     ----------
@@ -147,17 +162,27 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
         Samples on the grid, and their derivatives, one row per function.
     d_px : numpy.ndarray
         Where to interpolate, px.
+    derivative : {0, 2}, optional
+        0 (default): the interpolant; 2: its second derivative (linear
+        between grid samples, the cubic's).
 
     Returns
     -------
     numpy.ndarray, shape (..., len(d_px))
         Each row's values at ``d_px`` (the shared weights computed once).
 
+    Raises
+    ------
+    ValueError
+        A ``derivative`` other than 0 or 2.
+
     Examples
     --------
     >>> grid = np.arange(5.0)
     >>> hermite(0.0, 1.0, grid**2, 2 * grid, np.array([1.5, 9.0])).tolist()   # exact for a cubic
     [2.25, 0.0]
+    >>> hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5, 2.25]), derivative=2).tolist()
+    [9.0, 13.5]
     """
     d = np.asarray(d_px, float)
     t = ((d - start_px) / step_px).ravel()
@@ -166,9 +191,15 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
     k = np.minimum(t[inside].astype(np.intp), n - 2)
     u = t[inside] - k
     h = step_px
+    if derivative == 0:       # the cubic Hermite basis
+        weights = ((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)
+    elif derivative == 2:     # its second derivatives, by d_px
+        weights = ((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h)
+    else:
+        raise ValueError(f"derivative must be 0 or 2, got {derivative!r}")
     out = np.zeros(values.shape[:-1] + t.shape)
-    out[..., inside] = ((1 + 2 * u) * (1 - u) ** 2 * values[..., k] + u * (1 - u) ** 2 * h * slopes[..., k]
-                        + u * u * (3 - 2 * u) * values[..., k + 1] + u * u * (u - 1) * h * slopes[..., k + 1])
+    out[..., inside] = (weights[0] * values[..., k] + weights[1] * slopes[..., k]
+                        + weights[2] * values[..., k + 1] + weights[3] * slopes[..., k + 1])
     return out.reshape(values.shape[:-1] + d.shape)
 
 
