@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
+from ..estimate.fit.report import MISFIT_BIN_PX, residual_means
 from ..estimate.spectrum import NYQUIST
 from ._common import check_truth, expect, figure_axes
 from .sensor import plot_psf
@@ -128,21 +129,15 @@ def plot_fit_residuals(fit: SensorFit, ax: Axes | None = None) -> Figure | SubFi
     expect(fit, "fit")
     fig, ax = figure_axes(ax)
     for i, edge in enumerate(fit.edges):
-        x = edge.samples_x_px - edge.offset_px
-        keep = np.abs(x) <= 6.0
-        bins = np.floor(x[keep] / 0.25).astype(int)
-        bins -= bins.min()
-        count = np.bincount(bins)
-        used = count >= 3
-        mean = np.bincount(bins, weights=edge.residuals_dn[keep])[used] / count[used]
-        centre = (np.nonzero(used)[0] + 0.5) * 0.25 + np.floor(x[keep].min() / 0.25) * 0.25
+        centre, mean, count = residual_means(edge.samples_x_px - edge.offset_px, edge.residuals_dn,
+                                             edge.bin_counts, 6.0)
         scale = 100.0 / abs(edge.step_dn)
         line, = ax.plot(centre, mean * scale, ".-", lw=0.8, ms=3, color=f"C{i % 10}",
                         label=f"{_short(edge.source)}: {100 * edge.misfit_fraction:.2f} %")
-        ax.fill_between(centre, -2 * edge.noise_dn / np.sqrt(count[used]) * scale,
-                        2 * edge.noise_dn / np.sqrt(count[used]) * scale, color=line.get_color(), alpha=0.12, lw=0)
+        ax.fill_between(centre, -2 * edge.noise_dn / np.sqrt(count) * scale,
+                        2 * edge.noise_dn / np.sqrt(count) * scale, color=line.get_color(), alpha=0.12, lw=0)
     ax.axhline(0, color="0.4", lw=0.8)
-    ax.set(title="Residuals along the normal (0.25 px bins)", xlabel="distance from the edge (px)",
+    ax.set(title=f"Residuals along the normal ({MISFIT_BIN_PX:g} px bins)", xlabel="distance from the edge (px)",
            ylabel="data - model (% of the step)")
     ax.legend(fontsize="x-small", title="structure (RMS)", title_fontsize="x-small", loc="upper center",
               bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)       # below the axes, off the data

@@ -184,7 +184,7 @@ def run_fit(model: Model, hold, confidence: float, guess: Guess | None = None) -
     z = model.initial_vector(guess.coordinates if guess else None, guess.nuisance if guess else ())
     while True:
         z, jacobian = model.solve(z)
-        scale = max(model.chi_square(z) / max(model.dof, 1), 1.0)
+        scale = max(model.reduced_chi_square(z), 1.0)
         covariance = parameter_covariance(jacobian, scale)
         undetermined = model.undetermined(z, covariance)
         if not undetermined:
@@ -214,6 +214,6 @@ def run_fit(model: Model, hold, confidence: float, guess: Guess | None = None) -
             notes[key] = ("held", f"the data do not need it (freeing it gains chi-square {max(cost, 0):.1f} "
                                   f"< {LIKELIHOOD_RATIO:g}); held at its starting value")
             model, z = trial, z_held
-            scale = max(model.chi_square(z) / max(model.dof, 1), 1.0)
+            scale = max(model.reduced_chi_square(z), 1.0)
             covariance = parameter_covariance(jacobian_held, scale)
     return fit_report(model, z, covariance, notes, confidence)

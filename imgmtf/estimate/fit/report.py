@@ -26,7 +26,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     start = model.sensor(np.array([model.start[k] for k in model.free]))
     responses = model.responses(u)
     residuals = model.residuals(z, responses)
-    reduced = float(np.sum(residuals**2) / max(model.dof, 1))
+    reduced = model.reduced_chi_square(z)
+    sample_chi_squares = model.sample_chi_squares(z)
     warnings = []
 
     parameters = []
@@ -62,10 +63,11 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     edges, start_row = [], 0
     for e, (d, r) in enumerate(zip(model.data, responses)):
         lo, hi, x0 = z[n + 3 * e: n + 3 * e + 3]
-        res = residuals[start_row: start_row + d.x.size] * d.noise
-        start_row += d.x.size
-        chi = float(np.sum((res / d.noise) ** 2) / max(d.x.size - 3 - n / len(model.data), 1))
-        p, fraction = misfit_test(d.x - x0, res, d.noise, abs(hi - lo), r)
+        bins = d.bins
+        res = residuals[start_row: start_row + bins.x.size] / model.weights[e]   # bin means' data - model, DN
+        start_row += bins.x.size
+        chi = float(sample_chi_squares[e] / max(d.x.size - 3 - n / len(model.data), 1))
+        p, fraction = misfit_test(bins.x - x0, res, bins.count, d.noise, abs(hi - lo), r)
         value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
@@ -74,7 +76,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                        int(measured.rows_used), float(measured.snr), float(value), (float(low), float(high)),
                        first_crossing(f, np.abs(sensor.normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5),
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
-                       (float(lo), float(hi)), float(x0), chi, p, fraction, d.x, res, measured)
+                       (float(lo), float(hi)), float(x0), chi, p, fraction, bins.x, res, bins.count, measured)
         edges.append(edge)
         if p < MISFIT_P and fraction > MISFIT_FRACTION:
             warnings.append(f"{d.source}: the model does not fit this edge: its residuals are structured "
@@ -113,26 +115,59 @@ def value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> f
     return abs(value(u + se_u) - value(u))
 
 
-def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response):
+def residual_means(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, reach_px: float,
+                   width_px: float = MISFIT_BIN_PX) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """An edge's residuals averaged over its samples in bins ``width_px``
+    wide along the normal (from 0 px), within ``reach_px`` of the edge;
+    bins of fewer than 3 samples are left out.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The fit's bins' mean distances from the fitted edge, px.
+    residuals : numpy.ndarray
+        Their mean residuals (data - model), DN.
+    counts : numpy.ndarray
+        Their samples.
+    reach_px : float
+        The farthest distance from the edge taken, px.
+    width_px : float, optional
+        The bins' width, px (default :data:`MISFIT_BIN_PX`).
+
+    Returns
+    -------
+    centres, means, counts : numpy.ndarray
+        Each bin's centre (px), its samples' mean residual (DN) and their count.
+
+    Examples
+    --------
+    >>> residual_means(np.array([0.01, 0.1, 0.3]), np.array([1.0, 4.0, 9.0]), np.array([3, 1, 2]), 3.0)
+    (array([0.125]), array([1.75]), array([4.]))
+    """
+    keep = np.abs(x) <= reach_px
+    index = np.floor(x[keep] / width_px).astype(int)
+    first = int(index.min()) if index.size else 0
+    count = np.bincount(index - first, weights=counts[keep])
+    total = np.bincount(index - first, weights=counts[keep] * residuals[keep])
+    used = count >= 3
+    return (np.flatnonzero(used) + first + 0.5) * width_px, total[used] / count[used], count[used]
+
+
+def misfit_test(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, noise: float, step: float, response):
     """P-value and size (RMS fraction of the step, noise removed) of the
-    residuals' structure: their means in bins along the normal, over the
-    transition (where the model's edge response is between 0.1 % and 99.9 %,
-    and at least +-3 px)."""
+    residuals' structure: their means over the samples in bins along the
+    normal (:func:`residual_means`; from the fit's bins, each by its count),
+    over the transition (where the model's edge response is between 0.1 %
+    and 99.9 %, and at least +-3 px)."""
     grid = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
     esf = response.esf(grid)
     inside = grid[(esf > 1e-3) & (esf < 1 - 1e-3)]
     reach = max(3.0, float(np.abs(inside).max()) if inside.size else 3.0)
-    keep = np.abs(x) <= reach
-    bins = np.floor(x[keep] / MISFIT_BIN_PX).astype(int)
-    bins -= bins.min() if bins.size else 0
-    count = np.bincount(bins)
-    total = np.bincount(bins, weights=residuals[keep])
-    used = count >= 3
-    if not used.any():
+    _, means, count = residual_means(x, residuals, counts, reach)
+    if not count.size:
         return 1.0, 0.0
-    means, count = total[used] / count[used], count[used]
     statistic = float(np.sum(count * means**2) / noise**2)
     from scipy.special import chdtrc  # (scipy.stats, for this one tail, costs most of a second to import)
-    p = float(chdtrc(used.sum(), statistic))
+    p = float(chdtrc(count.size, statistic))
     systematic = max(float(np.mean(means**2 - noise**2 / count)), 0.0)
     return p, math.sqrt(systematic) / step

@@ -89,9 +89,12 @@ class EdgeFit:
     misfit_p, misfit_fraction : float
         P-value of the residuals binned along the normal (small: structure),
         and the size of that structure, RMS as a fraction of the step.
-    samples_x_px, residuals_dn : numpy.ndarray
-        Each profile sample's distance to the edge (px) and its residual
-        against the model (DN).
+    samples_x_px, residuals_dn, bin_counts : numpy.ndarray
+        Per bin of the fit (its profile samples binned along the normal,
+        :data:`imgmtf.estimate.fit.data.FIT_BIN_PX` wide): its samples'
+        mean distance to the edge before the fitted offset (px), their
+        mean residual against the model (DN; its noise is ``noise_dn /
+        sqrt(bin_counts)``) and their count.
     measurement : EdgeResult
         The non-parametric measurement of the edge.
     """
@@ -116,6 +119,7 @@ class EdgeFit:
     misfit_fraction: float
     samples_x_px: np.ndarray = field(repr=False)
     residuals_dn: np.ndarray = field(repr=False)
+    bin_counts: np.ndarray = field(repr=False)
     measurement: EdgeResult = field(repr=False)
 
     def to_dict(self) -> dict:
