@@ -16,11 +16,11 @@ constrain both axes.  The parameters are fitted by bounded least squares
 (``scipy.optimize.least_squares``, :meth:`_Model.solve`), each edge
 weighted by the inverse of its noise, measured without the model (each
 sample against the line through its two neighbours, :func:`profile_noise`).
-The fit's residuals are those of the samples binned 1/16 px along the
+The fit's residuals are those of the samples binned 1/32 px along the
 normal (:func:`.data.bin_profile`), each bin's model its mean over the
 bin's samples (to the third order, far below the noise) weighted by the
-square root of its count: the samples' optimum at a fifth to a twentieth
-of the cost; the reduced chi-square is still the samples'.
+square root of its count: the samples' optimum from a third to a ninth of
+the residuals; the reduced chi-square is still the samples'.
 
 Identifiability, in three steps:
 

@@ -54,16 +54,19 @@ class EdgeImage:
 #: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`.model.bin_esf`);
 #: it leaves out the third and fourth moments' terms, at most f''' w^3 / 48
 #: and f'''' w^4 / 384 for bins w wide.  Measured on noise-free slanted-edge
-#: samples (5 deg, 100 and 300 rows; tests/test_fit_bins.py): at 1/16 px
-#: the bins' model is within 9e-7 of the step of the samples' mean model
-#: for Gaussian optics of 0.3 px + pixel and the paper's sensor, 3.3e-6 for
-#: f/8 diffraction (near its sharp core), where without the m2 term it is
-#: 1.5-2.2e-4 off; in units of a bin mean's noise at the noise floor of
-#: noise-free floats (1e-5 of the step / sqrt(n)) that is 0.045 RMS at
-#: most (0.2 % of the chi-square), against 4-6.5 without the m2 term.
-#: 1/16 px makes a 300-row edge's samples 19 x fewer residuals (6 x for
-#: 100 rows); 1/32 px, 4 x closer still, only 9 x (3 x).
-FIT_BIN_PX = 1 / 16
+#: samples (5 deg, 100 and 300 rows; tests/test_fit_bins.py), for a step of
+#: 1: at 1/32 px the bins' model is within 3.3e-7 of the samples' mean model
+#: for Gaussian optics of 0.3 px + pixel and the paper's sensor, 1.2e-6 for
+#: f/8 diffraction and 4.5e-6 for f/5.6 (their sharp cores), where without
+#: the m2 term it is 5-7e-5 off.  In units of a bin mean's noise at the
+#: noise floor of noise-free floats (1e-5 / sqrt(n)) that is 0.007 RMS
+#: (0.022 at f/5.6), against 0.9-1.9 without the m2 term.  A 300-row edge of
+#: the scan (300 samples per px) gives 9 x fewer residuals, a 100-row chip
+#: 3 x.  1/16 px (19 x, 6 x) made the chart's fits only 10 % faster (what
+#: remains is each edge's line response, not its samples) but lost what
+#: lies within a bin: on a noise-free f/5.6 chip the likelihood-ratio cost
+#: of its detector width fell from 11.2 to 10.6 (11.2 at 1/32 px).
+FIT_BIN_PX = 1 / 32
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,15 +11,15 @@ value ȳ and distances' variance m2 gives
 the mean of the model over its samples to the third order.  Weighted by
 sqrt(n), the sum of r^2 (:meth:`Model.chi_square`, what the fit
 minimises) is the samples' chi-square less their residuals' scatter
-within the bins, which the parameters move by a fraction of a percent of
-what they move the bins' part (the model's slope across a bin, 1/16 px,
-against its slope across the edge): the optimum and the likelihood-ratio
+within the bins, which the parameters move by about a percent or less of
+what they move the bins' part (the model's change across a bin, 1/32 px,
+against its change across the edge): the optimum and the likelihood-ratio
 costs are the samples'.  The reduced chi-square, which scales the
 covariance, is the samples' own (:meth:`Model.sample_chi_squares`, over
 samples - parameters degrees of freedom).  The bins' alone would not do:
 the scatter within a bin is noise, about n - 1 variances, but a misfit's
 structure is in the bins' part whole, so over bins - parameters it would
-read n (the samples per bin, 6-19) times the samples' excess, as much
+read n (the samples per bin, 3-9) times the samples' excess, as much
 larger as the bins are finer."""
 from __future__ import annotations
 
@@ -288,8 +288,8 @@ class Model:
         offset's columns exact.  The stage and offset columns leave out the
         bins' m2 term (:func:`bin_esf`), ESF'' m2 / 2: its changes are about
         m2 / s^2 of the ESF's (s the LSF's width; m2 at most w^2 / 4 for
-        bins w = 1/16 px wide, w^2 / 12 where samples spread evenly), under
-        0.6 % for s over 0.4 px.  The Jacobian is off by that fraction,
+        bins w = 1/32 px wide, w^2 / 12 where samples spread evenly), under
+        0.2 % for s over 0.4 px.  The Jacobian is off by that fraction,
         which costs no iteration, and moves the point where the solver
         stops (where the approximate gradient of the exact residuals
         vanishes) by about that fraction of a standard error."""
