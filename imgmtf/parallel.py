@@ -19,18 +19,23 @@ from __future__ import annotations
 
 import importlib
 import itertools
-import multiprocessing
 import os
 import signal
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from .errors import ParameterError
+
+if TYPE_CHECKING:
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+# multiprocessing and concurrent.futures (about 20 ms to import) are imported where a pool is
+# made: a run in this process (workers=1, a new process's one scene) never needs them
 
 LOCAL_CLUSTER = "local"
 SCHEDULER_TIMEOUT_S = 10        # how long to keep trying a remote Dask scheduler
@@ -178,6 +183,7 @@ def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     and each imports them."""
     if workers < 2 or _prestarted or not 1 <= workers <= MAX_WORKERS:
         return
+    import multiprocessing
     if "forkserver" in multiprocessing.get_all_start_methods() and not _fork_server_running():
         return _start_fork_server(modules)
     # every worker imports the modules as it starts (not as a task: one
@@ -225,6 +231,7 @@ def _take_prestarted(workers: int):
 
 
 def _new_pool(workers: int, modules: tuple[str, ...] = ()) -> ProcessPoolExecutor:
+    from concurrent.futures import ProcessPoolExecutor
     return ProcessPoolExecutor(workers, mp_context=_fresh_processes(), initializer=_init_worker,
                                initargs=(os.getpid(), modules))
 
@@ -287,6 +294,7 @@ def _pool_completed(function, items, workers, on_error):
     ``IN_FLIGHT_PER_WORKER`` tasks per worker are submitted at a time, so
     that each wait (and a stop's cancelling) looks at a few futures however
     long the batch."""
+    from concurrent.futures.process import BrokenProcessPool
     pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
     queue = iter(enumerate(items))
     in_flight: dict = {}
@@ -339,6 +347,7 @@ def _wait_between_signals(waiting: set) -> tuple[set, set]:
     concurrent.futures' wait can leave a future's lock taken, and the
     pool's manager thread then blocks on it for ever, so the interpreter
     hangs at exit.  Short waits keep the signal's handling prompt."""
+    from concurrent.futures import FIRST_COMPLETED, wait
     while True:
         with signals_deferred():
             done, waiting = wait(waiting, timeout=SIGNAL_POLL_S, return_when=FIRST_COMPLETED)
@@ -368,6 +377,7 @@ def _fresh_processes():
     whose OpenCV or BLAS thread pools have run can deadlock in them, and a
     fresh worker loads its libraries after :func:`limit_threads` has set
     their thread counts."""
+    import multiprocessing
     methods = multiprocessing.get_all_start_methods()
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 

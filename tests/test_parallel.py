@@ -63,8 +63,10 @@ def test_measure_and_scan_on_a_local_dask_cluster(tmp_path):
 
 def test_prestarted_workers_are_used_once_and_never_left_behind(monkeypatch):
     # where there is no fork server: a pool of workers started ahead
+    import multiprocessing
+
     from imgmtf import parallel
-    monkeypatch.setattr(parallel.multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     parallel.prestart_workers(2, ["json"])
     assert parallel._prestarted
     assert list(run_tasks(math.sqrt, [9, 4, 1], workers=2)) == [3, 2, 1]
