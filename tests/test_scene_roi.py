@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from affine import Affine
 
+from imgmtf.estimate import gate
 from imgmtf.io import RasterInfo
 from imgmtf.scene.roi import END_TRIM_PX, JUNCTION_CLEARANCE_PX, Roi, clear_extent, plan_roi
 from imgmtf.scene.segments import HalfEdge, Segment
@@ -53,3 +54,50 @@ def test_the_clear_stretch_stops_short_of_a_partner_and_of_fill():
     fill[:, :] = np.abs(xs.min() + np.arange(fill.shape[1]) - 50)[None, :] <= 1
     reason, _ = clear_extent(roi, t, d, xs, ys, fill, [], info)
     assert reason == "fill"
+
+
+
+def _reference_bad_bins(roi, t, xs, ys, partners, info):
+    """The bins of the ROI not clear, computed directly: every pixel's
+    distance from every partner, every bin's cross-section against the border."""
+    bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
+    k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
+    bad = np.zeros(bins, bool)
+    for p in partners:
+        dx, dy = p[2] - p[0], p[3] - p[1]
+        f = np.clip(((xs - p[0]) * dx + (ys - p[1]) * dy) / max(dx * dx + dy * dy, 1e-12), 0.0, 1.0)
+        bad[k[np.hypot(xs - (p[0] + f * dx), ys - (p[1] + f * dy)) <= JUNCTION_CLEARANCE_PX]] = True
+    centres = roi.t0_px + np.arange(bins) + 0.5
+    for side in (-1.0, 1.0):
+        px, py = roi.point(centres, side * roi.half_width_px)
+        bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
+    return bad
+
+
+def test_the_clear_stretch_is_the_longest_run_clear_of_partners_and_border_wherever_they_lie():
+    # partners are sought only near their bounding box, the border only near it: the same stretch
+    info = RasterInfo("scene.tif", 120, 90, 1, ("gray",), "uint16", None, Affine.identity(), None)
+    rng = np.random.default_rng(2)
+    measured = 0
+    for _ in range(80):
+        angle = rng.uniform(0, 2 * math.pi)
+        roi = Roi(rng.uniform(-5, 125), rng.uniform(-5, 95), math.cos(angle), math.sin(angle), 0.0,
+                  rng.uniform(30, 90), rng.uniform(4, 14))
+        t, d, xs, ys = _pixels(roi, 120, 90)
+        if t.size == 0:
+            continue
+        fill = np.zeros((ys.max() - ys.min() + 1, xs.max() - xs.min() + 1), bool)
+        # partners from a point near the ROI (or on it) to anywhere in the scene
+        partners = [np.array([*roi.point(rng.uniform(-10, 90), rng.uniform(-20, 20)),
+                              rng.uniform(0, 120), rng.uniform(0, 90)], float) for _ in range(rng.integers(0, 3))]
+        bad = _reference_bad_bins(roi, t, xs, ys, partners, info)
+        free = np.concatenate([[0], (~bad).astype(int), [0]])
+        starts, ends = np.nonzero(np.diff(free) == 1)[0], np.nonzero(np.diff(free) == -1)[0]
+        got = clear_extent(roi, t, d, xs, ys, fill, partners, info)
+        longest = int(np.argmax(ends - starts)) if starts.size else None
+        if longest is not None and int((ends - starts)[longest] * max(abs(roi.ux), abs(roi.uy))) >= gate.MIN_ROWS:
+            assert got == (roi.t0_px + starts[longest], roi.t0_px + ends[longest])
+            measured += 1
+        else:
+            assert got[0] == "too-short"
+    assert measured >= 10

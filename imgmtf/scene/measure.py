@@ -159,8 +159,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                             settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
     records: list[Record] = []
     plans: list[Plan] = []
+    mapped = not info.transform.is_identity         # (affine's test costs as much as the rest of a record)
     for (half, verdict), clearance in zip(candidates, beside):
-        record = _candidate_record(half, context)
+        record = _candidate_record(half, context, mapped)
         verdict = verdict or _beside_screen(half, clearance)
         if verdict:
             record = record.with_(status="rejected", reason=verdict[0], error=f"{path}: {verdict[1]}",
@@ -373,8 +374,10 @@ def _one_line(exc: BaseException) -> str:
 
 
 # -- records ----------------------------------------------------------------------------
-def _candidate_record(half: HalfEdge, context: Context) -> Record:
-    """A candidate's record before it is screened: where it lies."""
+def _candidate_record(half: HalfEdge, context: Context, mapped: bool) -> Record:
+    """A candidate's record before it is screened: where it lies (and, where
+    the scene's transform is not the identity, ``mapped``, in its map
+    coordinates too)."""
     segment, info, settings = half.segment, context.info, context.settings
     site = {
         "scope": CANDIDATE_SCOPE,
@@ -388,7 +391,7 @@ def _candidate_record(half: HalfEdge, context: Context) -> Record:
     }
     if segment.width_px > 0 or get_kind(settings.target).has_width:
         site["bar_width_px"] = round(segment.width_px, 2)
-    if not info.transform.is_identity:
+    if mapped:
         (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
                                   for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
         site.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)

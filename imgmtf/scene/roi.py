@@ -50,19 +50,23 @@ class Roi:
 
     def corners(self, t0: float | None = None, t1: float | None = None) -> list[list[float]]:
         """The rectangle's corners (x, y), optionally over [t0, t1] only."""
-        t0 = self.t0_px if t0 is None else t0
-        t1 = self.t1_px if t1 is None else t1
-        h = self.half_width_px
-        xs, ys = self.point([t0, t1, t1, t0], [-h, -h, h, h])
-        return [[round(float(x), 2), round(float(y), 2)] for x, y in zip(xs, ys)]
+        return [[round(float(x), 2), round(float(y), 2)] for x, y in self._corners(t0, t1)]
 
     def bbox(self, width: int, height: int) -> tuple[int, int, int, int]:
         """(x, y, w, h) of the pixels it touches, within a scene of that size."""
-        h = self.half_width_px
-        xs, ys = self.point([self.t0_px, self.t1_px, self.t1_px, self.t0_px], [-h, -h, h, h])
-        x0, y0 = max(math.floor(xs.min()), 0), max(math.floor(ys.min()), 0)
-        x1, y1 = min(math.ceil(xs.max()), width - 1), min(math.ceil(ys.max()), height - 1)
+        xs, ys = zip(*self._corners())
+        x0, y0 = max(math.floor(min(xs)), 0), max(math.floor(min(ys)), 0)
+        x1, y1 = min(math.ceil(max(xs)), width - 1), min(math.ceil(max(ys)), height - 1)
         return x0, y0, max(x1 - x0 + 1, 1), max(y1 - y0 + 1, 1)
+
+    def _corners(self, t0: float | None = None, t1: float | None = None) -> list[tuple[float, float]]:
+        """The corners (x, y) over [t0, t1] (default the ROI's), as :meth:`point`
+        computes them, in plain floats: a few of them cost less without NumPy."""
+        t0 = self.t0_px if t0 is None else t0
+        t1 = self.t1_px if t1 is None else t1
+        h = self.half_width_px
+        return [(self.x + t * self.ux - d * self.uy, self.y + t * self.uy + d * self.ux)
+                for t, d in ((t0, -h), (t1, -h), (t1, h), (t0, h))]
 
 
 def plan_roi(half: HalfEdge, settings: ScanSettings, beside_px: float = math.inf) -> Roi:
@@ -106,12 +110,20 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
         by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
         bad |= by_fill
     for p in partners:
-        bad |= np.bincount(k[distance_to_segment(xs, ys, p) <= JUNCTION_CLEARANCE_PX], minlength=bins) > 0
-    # the band's cross-section must lie inside the scene
-    centres = roi.t0_px + np.arange(bins) + 0.5
-    for side in (-1.0, 1.0):
-        px, py = roi.point(centres, side * roi.half_width_px)
-        bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
+        # only the pixels within the clearance of the partner's bounding box can be within it of the partner
+        near = ((xs >= min(p[0], p[2]) - JUNCTION_CLEARANCE_PX) & (xs <= max(p[0], p[2]) + JUNCTION_CLEARANCE_PX)
+                & (ys >= min(p[1], p[3]) - JUNCTION_CLEARANCE_PX) & (ys <= max(p[1], p[3]) + JUNCTION_CLEARANCE_PX))
+        if near.any():
+            close = distance_to_segment(xs[near], ys[near], p) <= JUNCTION_CLEARANCE_PX
+            bad |= np.bincount(k[near][close], minlength=bins) > 0
+    # the band's cross-section must lie inside the scene (checked when the rectangle, a pixel longer
+    # at each end than the bins' centres reach, is not inside it whole)
+    reach = roi._corners(roi.t0_px - 1.0, roi.t0_px + bins + 1.0)
+    if not all(0.0 < x < info.width - 1.0 and 0.0 < y < info.height - 1.0 for x, y in reach):
+        centres = roi.t0_px + np.arange(bins) + 0.5
+        for side in (-1.0, 1.0):
+            px, py = roi.point(centres, side * roi.half_width_px)
+            bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
     free = np.concatenate([[0], (~bad).astype(int), [0]])
     step = np.diff(free)
     starts, ends = np.nonzero(step == 1)[0], np.nonzero(step == -1)[0]

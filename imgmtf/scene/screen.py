@@ -32,6 +32,7 @@ if TYPE_CHECKING:
 
 QUICK_LOOK_SLACK = 1.0          # the quick look rejects what fails the gate's limits this many times over
 SIDE_START_PX = 4.0             # a side's level is read this far from the target at least (px)
+_RIDGE = 1e-9 * np.eye(3)       # keeps a side's normal equations solvable when its pixels lie on a line
 
 
 def geometry_screen(half: HalfEdge, settings: ScanSettings) -> tuple[str, str] | None:
@@ -76,15 +77,23 @@ def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, noise_dn: float
     """
     start = max(SIDE_START_PX, half_width_px / 2) + bar_width_px / 2
     noise = noise_dn
-    sides = []
+    designs, values_of = [], []
     for side in (d <= -start, d >= start):
-        if side.sum() < 12:
-            return None                  # too little to judge: the gate will
         x, y, v = d[side], t[side], values[side]
-        design = np.stack([np.ones_like(x), x - x.mean(), y - y.mean()])
-        coef = np.linalg.solve(design @ design.T + 1e-9 * np.eye(3), design @ v)
+        if v.size < 12:
+            return None                  # too little to judge: the gate will
+        design = np.empty((3, v.size))
+        design[0], design[1], design[2] = 1.0, x - x.mean(), y - y.mean()
+        designs.append((design, x.max() - x.min(), y.max() - y.min()))
+        values_of.append(v)
+    # both sides' planes in one solve
+    normal = np.stack([design @ design.T + _RIDGE for design, _, _ in designs])
+    moments = np.stack([design @ v for (design, _, _), v in zip(designs, values_of)])
+    coefs = np.linalg.solve(normal, moments[:, :, None])[:, :, 0]
+    sides = []
+    for (design, x_span, y_span), v, coef in zip(designs, values_of, coefs):
         resid = v - coef @ design
-        trend = max(abs(coef[1]) * np.ptp(x), abs(coef[2]) * np.ptp(y))
+        trend = max(abs(coef[1]) * x_span, abs(coef[2]) * y_span)
         texture = math.sqrt(max(float(resid @ resid) / max(v.size - 3, 1) - noise ** 2, 0.0))
         sides.append((float(coef[0]), trend, texture))
     if bar_width_px > 0:
