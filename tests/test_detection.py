@@ -41,3 +41,17 @@ def test_a_short_edge_far_from_the_origin_is_one_line_not_a_bend(size, at, angle
     mask[at:at + shape[0], at - 30:at - 30 + shape[1]] = True
     framed, alone = im.measure_edge(frame, mask=mask), im.measure_edge(chip.astype(float))
     assert framed.mtf_nyquist == pytest.approx(alone.mtf_nyquist, abs=0.001)
+
+
+def test_robust_noise_is_the_mad_of_horizontal_differences_exactly():
+    # its medians come from np.partition: exactly np.median's, odd and even counts, NaN pairs skipped
+    from imgmtf.estimate.detection import robust_noise
+    rng = np.random.default_rng(11)
+    for shape in ((7, 8), (8, 9), (30, 31), (2, 2)):
+        image = np.round(rng.normal(1000, 25, shape))
+        image[rng.random(shape) < 0.2] = np.nan
+        diff = np.diff(image, axis=1)
+        diff = diff[np.isfinite(diff)]
+        mad = np.median(np.abs(diff - np.median(diff)))
+        assert robust_noise(image) == max(float(1.4826 * mad / np.sqrt(2.0)), 1e-12)
+    assert robust_noise(np.full((5, 5), 7.0)) == 1e-12
