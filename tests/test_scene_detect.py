@@ -21,3 +21,17 @@ def test_detection_on_workers_finds_the_segments_one_process_finds(tmp_path):
     assert len(here[0]) > 4
     np.testing.assert_array_equal(here[0], there[0])
     np.testing.assert_array_equal(here[1], there[1])
+
+
+def test_to_8bit_maps_lo_hi_onto_0_255_rounded_and_clipped_leaving_the_tile_as_it_was():
+    from imgmtf.scene.detect import to_8bit
+    rng = np.random.default_rng(8)
+    tile = rng.uniform(-500, 5000, (40, 50))
+    tile[3, 4] = np.nan
+    kept = tile.copy()
+    out = to_8bit(tile, 100.0, 4000.0)
+    filled = np.where(np.isfinite(tile), tile, np.median(tile[np.isfinite(tile)]))
+    assert out.dtype == np.uint8 and np.array_equal(out, np.clip(np.rint((filled - 100.0) / 3900.0 * 255), 0, 255))
+    assert np.array_equal(tile, kept, equal_nan=True)
+    assert out.min() == 0 and out.max() == 255
+    assert to_8bit(np.array([[100.0, 4000.0, 2050.0]]), 100.0, 4000.0).tolist() == [[0, 255, 128]]
