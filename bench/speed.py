@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _installed import compile_package
 
 import imgmtf as im
 from imgmtf.estimate.edge import EdgeEstimator
@@ -178,6 +179,7 @@ def main():
     p.add_argument("--runs", type=int, default=50)
     p.add_argument("--only", choices=["chips", "cli", "fit", "startup"])
     a = p.parse_args()
+    compile_package()       # the start-up of an installed imgmtf (see _installed.py)
     print(f"load average (1, 5, 15 min): {', '.join(f'{v:.2f}' for v in os.getloadavg())} "
           f"on {os.cpu_count()} cores")
     if a.only == "startup":
