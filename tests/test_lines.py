@@ -93,3 +93,33 @@ def test_a_grid_response_is_the_sensors_line_response():
     theirs = sensor.line_response(6.0, reach_px=10.0)
     d = np.linspace(-12, 12, 97)
     assert np.array_equal(mine.esf(d), theirs.esf(d)) and np.array_equal(mine.lsf(d), theirs.lsf(d))
+
+
+def shifted_remainders(grid, spectra):
+    """The remainders as the inverse FFTs, shifted and divided after (what
+    :meth:`LineGrid.remainders` computed before it folded both into the
+    spectra)."""
+    f = grid.frequencies_cy_px
+    lsf = np.fft.fftshift(np.fft.irfft(spectra, grid.size), axes=-1) / grid.step_px
+    integral = np.zeros(spectra.shape, complex)
+    integral[..., 1:] = spectra[..., 1:] / (2j * np.pi * f[1:])
+    esf = np.fft.fftshift(np.fft.irfft(integral, grid.size), axes=-1) / grid.step_px
+    return esf - esf[..., :1], lsf
+
+
+@pytest.mark.parametrize("step, size", [(1 / 64, 2048), (0.0123, 4096), (0.25, 9)], ids=["even", "cauchy-step", "odd"])
+def test_remainders_are_the_shifted_inverse_transforms(step, size):
+    """The shift as a phase factor and the scale folded into the spectra:
+    the same remainders as shifting and scaling the inverse FFTs' output,
+    to rounding."""
+    grid = LineGrid(step, size, ("gaussian", 1.0))
+    f = grid.frequencies_cy_px
+    spectra = np.stack([np.exp(-2 * np.pi**2 * w**2 * f**2) * np.sinc(f * w) for w in (0.4, 0.9)])
+    spectra -= reference_transfer(grid.reference, f)
+    esf, lsf = grid.remainders(spectra)
+    expected_esf, expected_lsf = shifted_remainders(grid, spectra)
+    assert esf.shape == lsf.shape == (2, size)
+    np.testing.assert_allclose(lsf, expected_lsf, rtol=0, atol=1e-12 * np.abs(expected_lsf).max())
+    np.testing.assert_allclose(esf, expected_esf, rtol=0, atol=1e-12)
+    one, _ = grid.remainders(spectra[1])
+    np.testing.assert_allclose(one, esf[1], rtol=0, atol=1e-15)

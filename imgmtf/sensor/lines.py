@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Protocol
 
 import numpy as np
@@ -105,8 +105,9 @@ class LineGrid:
 
     @cached_property
     def frequencies_cy_px(self) -> np.ndarray:
-        """The grid's non-negative DFT frequencies, cy/px (``size // 2 + 1``)."""
-        return np.fft.rfftfreq(self.size, d=self.step_px)
+        """The grid's non-negative DFT frequencies, cy/px (``size // 2 + 1``;
+        read-only, shared by every grid of this step and size)."""
+        return _inverse_factors(self.step_px, self.size)[0]
 
     def response(self, transfer: np.ndarray) -> LineResponse:
         """The line response of a sensor whose transfer along the normal at
@@ -140,12 +141,34 @@ class LineGrid:
         esf, lsf : numpy.ndarray, shape (..., size)
             Their edge and line spread functions on the grid.
         """
-        f, n = self.frequencies_cy_px, self.size
-        lsf = np.fft.fftshift(np.fft.irfft(spectra, n), axes=-1) / self.step_px
-        with np.errstate(divide="ignore", invalid="ignore"):
-            integral = np.where(f > 0, spectra / (2j * np.pi * np.where(f > 0, f, 1.0)), 0.0)
-        esf = np.fft.fftshift(np.fft.irfft(integral, n), axes=-1) / self.step_px
+        _, to_lsf, to_esf = _inverse_factors(self.step_px, self.size)
+        spectra = np.asarray(spectra, float)
+        both = np.empty((2, *spectra.shape), complex)
+        np.multiply(spectra, to_lsf, out=both[0])
+        np.multiply(spectra, to_esf, out=both[1])
+        lsf, esf = np.fft.irfft(both, self.size)
         return esf - esf[..., :1], lsf
+
+
+@lru_cache(maxsize=16)
+def _inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A grid's frequencies (cy/px) and what its spectra are multiplied by
+    before the inverse real FFT to give the LSF (1/px) and the ESF
+    centred on the grid: the phase of a shift by ``size // 2`` samples,
+    which moves the origin from the first sample to the middle one (the
+    ``fftshift`` of the output without its copy; (-1)^k, exactly, for an
+    even size), over the step; for the ESF, the LSF's integral, over
+    2 pi i f too (0 at f = 0).  Read-only: every grid of this step and
+    size shares them."""
+    f = np.fft.rfftfreq(size, d=step_px)
+    k = np.arange(f.size)
+    shift = np.where(k % 2 == 0, 1.0, -1.0) if size % 2 == 0 else np.exp(-2j * np.pi * k * (size // 2) / size)
+    to_lsf = shift / step_px
+    to_esf = np.zeros(f.size, complex)
+    to_esf[1:] = to_lsf[1:] / (2j * np.pi * f[1:])
+    for array in (f, to_lsf, to_esf):
+        array.flags.writeable = False
+    return f, to_lsf, to_esf
 
 
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
