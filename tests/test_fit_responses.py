@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.estimate.fit.responses import esf_changes, line_responses
+from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes, line_responses
 from imgmtf.sensor import stages as st
 
 
@@ -41,3 +41,67 @@ def test_the_grid_reaches_the_samples_only_for_a_cauchy_tail():
     assert gaussian.esf(60.0) == pytest.approx(1.0, abs=1e-12)
     airy, _, _ = line_responses([im.Sensor(1.0, [st.Diffraction(8.0)])], 0.0, 1.0, reach_px=60.0)
     assert -airy.start_px >= 60
+
+
+def same_response(a, b):
+    return (a.start_px, a.step_px, a.reference) == (b.start_px, b.step_px, b.reference) and np.array_equal(
+        a.esf_remainder, b.esf_remainder) and np.array_equal(a.lsf_remainder, b.lsf_remainder)
+
+
+def fit_like_sensors():
+    """The sensors a fit asks for, in its order: residuals at a point, the
+    Jacobian's shifts there, a trial point, a point whose grid is twice as
+    long (wider optics), a detector held throughout, diffraction (a Cauchy
+    grid reaching the samples, its step set by the f-number)."""
+    detector = st.Detector(1.0, 1.0)
+    for sigma, f_number in ((0.4, None), (0.45, None), (0.45, None), (3.0, None), (0.5, 8.0), (0.5, 9.0)):
+        base = [st.GaussianOptics(sigma, sigma), detector]
+        if f_number:
+            base.append(st.Diffraction(f_number))
+        shifts = [[st.GaussianOptics(sigma * 1.001, sigma), *base[1:]], [base[0], st.Detector(1.001, 1.0), *base[2:]]]
+        yield im.Sensor(1.0, base), [im.Sensor(1.0, stages) for stages in shifts]
+
+
+def test_kept_responses_are_those_made_afresh_bit_for_bit():
+    """One edge's responses and changes over a fit's evaluations, its grid,
+    transfers and last response kept, equal :func:`line_responses` made
+    afresh for each, bit for bit."""
+    edge = EdgeResponses(6.0, 1.0, 25.0)
+    for sensor, shifted in fit_like_sensors():
+        fresh, fresh_esf, fresh_lsf = line_responses([sensor, *shifted], 6.0, 1.0, 25.0)
+        assert same_response(edge.response(sensor), fresh)
+        response, esf, lsf = edge.changes(sensor, shifted)
+        assert response is edge.response(sensor)
+        assert np.array_equal(esf, fresh_esf) and np.array_equal(lsf, fresh_lsf)
+        alone, _, _ = line_responses([sensor], 6.0, 1.0, 25.0)
+        assert same_response(alone, fresh)
+    assert edge.changes(sensor, [])[1].shape == (0, response.esf_remainder.size)
+
+
+def test_an_edge_keeps_its_base_stages_transfers_not_a_shifts(monkeypatch):
+    """Each stage's transfer on the grid is computed once: the held
+    detector's once for all evaluations on one grid, a shifted copy's own stage once
+    and not kept; at most KEPT_TRANSFERS are kept."""
+    calls = []
+
+    def counted(transfer):
+        def on_grid(stage, fx, fy, gsd):      # the grid's, not line_grid's at one frequency
+            if np.size(fx) > 1:
+                calls.append(stage)
+            return transfer(stage, fx, fy, gsd)
+        return on_grid
+    for cls in (st.GaussianOptics, st.Detector):
+        monkeypatch.setattr(cls, "transfer", counted(cls.transfer))
+    edge = EdgeResponses(6.0, 1.0, 25.0)
+    detector = st.Detector(1.0, 1.0)
+    for sigma in (0.4, 0.41, 0.42):
+        sensor = im.Sensor(1.0, [st.GaussianOptics(sigma, sigma), detector])
+        edge.response(sensor)
+        edge.changes(sensor, [im.Sensor(1.0, [st.GaussianOptics(sigma + 1e-4, sigma), detector])] * 2)
+    assert calls.count(detector) == 1
+    assert calls.count(st.GaussianOptics(0.41, 0.41)) == 1
+    assert calls.count(st.GaussianOptics(0.41 + 1e-4, 0.41)) == 2      # a shift's own stage: not kept
+    for sigma in np.linspace(0.4, 0.45, 3 * KEPT_TRANSFERS):
+        edge.response(im.Sensor(1.0, [st.GaussianOptics(sigma, sigma), detector]))
+    assert len(edge._transfers) == KEPT_TRANSFERS
+    assert (detector, 1.0) in edge._transfers                           # used at every evaluation

@@ -35,7 +35,7 @@ from ...sensor.lines import LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .data import EdgeData, ProfileBins
-from .responses import esf_changes, line_responses
+from .responses import EdgeResponses, esf_changes
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -153,6 +153,8 @@ class Model:
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
+        # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
+        self.edges = [EdgeResponses(d.normal_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         self._last_esfs: tuple = (None, [])
         self._last_samples: tuple = (None, np.zeros(0))
         self._stages_made: dict[tuple, Stage] = {}
@@ -262,8 +264,7 @@ class Model:
         key = (tuple(self.free), u.tobytes())
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
-            self._last_responses = (key, [line_responses([sensor], d.normal_angle_deg, d.gsd_m, self.reach(d))[0]
-                                          for d in self.data])
+            self._last_responses = (key, [edge.response(sensor) for edge in self.edges])
         return self._last_responses[1]
 
     @staticmethod
@@ -287,7 +288,8 @@ class Model:
     def jacobian(self, z: np.ndarray):
         """The residuals' Jacobian at ``z``, sparse: the stage columns by
         forward differences of each edge's response (all shifts in one
-        inverse FFT, :func:`.responses.line_responses`), the levels' and
+        inverse FFT on the grid of the residuals' response,
+        :meth:`.responses.EdgeResponses.changes`), the levels' and
         offset's columns exact.  The stage and offset columns leave out the
         bins' m2 term (:func:`bin_esf`), ESF'' m2 / 2: its changes are about
         m2 / s^2 of the ESF's (s the LSF's width; m2 at most w^2 / 4 for
@@ -311,8 +313,7 @@ class Model:
         stage_columns, blocks, base = [], [], []
         for e, d in enumerate(self.data):
             lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            response, esf_change, lsf_change = line_responses([sensor, *shifted], d.normal_angle_deg, d.gsd_m,
-                                                              self.reach(d))
+            response, esf_change, lsf_change = self.edges[e].changes(sensor, shifted)
             base.append(response)
             weight = self.weights[e]
             changes = esf_changes(response, esf_change, lsf_change, d.bins.x - x0)

@@ -9,6 +9,13 @@ not of two responses on two grids, give the derivatives.  Without a
 diffraction stage the grid covers the PSF's support only: beyond it the
 Gaussian reference is the edge response to below 1e-9, so a sample far
 from the edge needs no grid out to it.
+
+A fit asks for the same edge's responses at every evaluation:
+:class:`EdgeResponses` keeps, per edge, what the next evaluation can use
+again (the last sensor's grid, transfer and response, which the
+Jacobian at the point of the last residuals starts from; the transfers
+of its stages on the grid, which held stages and unshifted ones reuse),
+so an evaluation computes only what its parameters changed.
 """
 from __future__ import annotations
 
@@ -17,16 +24,143 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...sensor.lines import LineResponse, hermite, line_grid, reference_transfer
+from ...sensor.lines import LineGrid, LineResponse, hermite, line_grid
 from ...sensor.model import Sensor
 from ...sensor.stages import Stage
+
+#: how many stage transfers an edge keeps (the longest unused goes first)
+KEPT_TRANSFERS = 8
+
+
+class EdgeResponses:
+    """One edge's line responses for the sensors a fit evaluates, with what
+    depends only on the edge's geometry and on unchanged stages kept from
+    one evaluation to the next (the same responses as
+    :func:`line_responses`, bit for bit).
+
+    Parameters
+    ----------
+    angle_deg : float
+        The edge's tilt from the column axis, deg.
+    gsd_m : float
+        The edge's pixel, m.
+    reach_px : float
+        The farthest sample from the edge, px: the grid reaches it when a
+        Cauchy (diffraction) tail makes the remainder long.
+
+    Notes
+    -----
+    It keeps the last sensor's grid, transfer and response (the solver
+    asks for the Jacobian where it last asked for the residuals) and the
+    transfers of the last sensors' stages (at most :data:`KEPT_TRANSFERS`)
+    on the last grid's frequencies; a shifted copy's own stage is
+    computed and not kept.  A grid of another step or size drops them.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> edge = EdgeResponses(90.0, 1.0, 50.0)
+    >>> round(float(edge.response(Sensor()).esf(0.0)), 6)
+    0.5
+    >>> response, esf, _ = edge.changes(Sensor(), [Sensor(motion_m=0.5)])   # the grid and transfers kept
+    >>> response is edge.response(Sensor()), esf.shape[0]
+    (True, 1)
+    """
+
+    def __init__(self, angle_deg: float, gsd_m: float, reach_px: float):
+        self.angle_deg, self.gsd_m, self.reach_px = angle_deg, gsd_m, reach_px
+        angle = math.radians(angle_deg)
+        self._cos, self._sin = math.cos(angle), math.sin(angle)
+        self._last: tuple | None = None
+        self._on: tuple[float, int] | None = None
+        self._normal: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
+        self._transfers: dict[tuple[Stage, float], np.ndarray] = {}
+
+    def response(self, sensor: Sensor) -> LineResponse:
+        """The line response of ``sensor`` along the edge's normal.
+
+        Parameters
+        ----------
+        sensor : Sensor
+            The sensor.
+
+        Returns
+        -------
+        LineResponse
+            Its edge and line responses (the last one's kept: the same
+            object for the same stages and GSD).
+        """
+        return self._base(sensor)[2]
+
+    def changes(self, sensor: Sensor, shifted: Sequence[Sensor]) -> tuple[LineResponse, np.ndarray, np.ndarray]:
+        """The line response of ``sensor`` and the remainders of the
+        ``shifted`` sensors' minus its own on its grid (what
+        :func:`line_responses` returns for ``[sensor, *shifted]``).
+
+        Parameters
+        ----------
+        sensor : Sensor
+            The sensor.
+        shifted : sequence of Sensor
+            Its shifted copies (same GSD, same chain).
+
+        Returns
+        -------
+        response : LineResponse
+            The sensor's edge and line responses.
+        esf_changes, lsf_changes : numpy.ndarray, shape (len(shifted), grid size)
+            Each shifted sensor's ESF and LSF (1/px) less the first's, on the
+            grid of ``response``: for :func:`esf_changes`.
+        """
+        grid, base, response = self._base(sensor)
+        spectra = np.empty((len(shifted), base.size))
+        for row, other in zip(spectra, shifted):
+            np.subtract(self._transfer(other, grid, keep=False), base, out=row)
+        esf, lsf = grid.remainders(spectra)
+        return response, esf, lsf
+
+    def _base(self, sensor: Sensor) -> tuple[LineGrid, np.ndarray, LineResponse]:
+        """The grid, transfer and response of ``sensor``, the last one's kept."""
+        key = (sensor.gsd_m, sensor.stages)
+        if self._last is None or self._last[0] != key:
+            reach = self.reach_px if sensor.tail_length_m() > 0 else 0.0
+            grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach)
+            transfer = self._transfer(sensor, grid, keep=True)
+            self._last = (key, grid, transfer, grid.response(transfer))
+        return self._last[1:]
+
+    def _transfer(self, sensor: Sensor, grid: LineGrid, keep: bool) -> np.ndarray:
+        """The transfer of ``sensor`` along the normal at the grid's
+        frequencies: the product of its stages' (in their order), each
+        taken from those kept when there; ``keep`` keeps those computed."""
+        if self._on != (grid.step_px, grid.size):
+            self._on = (grid.step_px, grid.size)
+            f = grid.frequencies_cy_px / self.gsd_m
+            self._normal = (f * self._cos, f * self._sin)
+            self._transfers.clear()
+        out = None
+        for stage in sensor.stages:
+            key = (stage, sensor.gsd_m)
+            value = self._transfers.pop(key, None)
+            if value is None:
+                value = stage.transfer(*self._normal, sensor.gsd_m)
+                if not keep:
+                    out = value if out is None else out * value
+                    continue
+                value.flags.writeable = False
+                while len(self._transfers) >= KEPT_TRANSFERS:
+                    del self._transfers[next(iter(self._transfers))]
+            self._transfers[key] = value        # the latest used last: the first to go is the longest unused
+            out = value if out is None else out * value
+        return np.ones(grid.frequencies_cy_px.shape) if out is None else out
 
 
 def line_responses(sensors: Sequence[Sensor], angle_deg: float, gsd_m: float,
                    reach_px: float) -> tuple[LineResponse, np.ndarray, np.ndarray]:
     """The line response of ``sensors[0]`` along the normal of an edge
     tilted ``angle_deg`` (pixels of ``gsd_m``), and the remainders of the
-    others' minus its own on its grid.
+    others' minus its own on its grid (one edge, once: a fit keeps an
+    :class:`EdgeResponses` per edge).
 
     Parameters
     ----------
@@ -55,26 +189,7 @@ def line_responses(sensors: Sequence[Sensor], angle_deg: float, gsd_m: float,
     >>> round(float(response.esf(0.0)), 6), esf.shape[0]
     (0.5, 1)
     """
-    base = sensors[0]
-    grid = line_grid(base, angle_deg, gsd_m, reach_px=reach_px if base.tail_length_m() > 0 else 0.0)
-    angle = math.radians(angle_deg)
-    f = grid.frequencies_cy_px / gsd_m
-    fx, fy = f * math.cos(angle), f * math.sin(angle)
-    known: dict[Stage, np.ndarray] = {}
-
-    def transfer(sensor: Sensor) -> np.ndarray:
-        out = np.ones(f.shape)
-        for stage in sensor.stages:
-            if stage not in known:
-                known[stage] = stage.transfer(fx, fy, base.gsd_m)
-            out = out * known[stage]
-        return out
-
-    spectra = np.stack([transfer(sensor) for sensor in sensors])
-    spectra[1:] -= spectra[0]
-    spectra[0] -= reference_transfer(grid.reference, grid.frequencies_cy_px)
-    esf, lsf = grid.remainders(spectra)
-    return LineResponse(grid.start_px, grid.step_px, esf[0], lsf[0], grid.reference), esf[1:], lsf[1:]
+    return EdgeResponses(angle_deg, gsd_m, reach_px).changes(sensors[0], sensors[1:])
 
 
 def esf_changes(response: LineResponse, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray) -> np.ndarray:
