@@ -8,7 +8,7 @@ from scipy.special import ndtr
 
 import imgmtf as im
 from imgmtf.sensor import stages as st
-from imgmtf.sensor.lines import LineGrid, hermite, line_grid, reference_transfer
+from imgmtf.sensor.lines import PROBE_CY_PX, LineGrid, hermite, line_grid, reference_transfer
 
 
 def test_hermite_is_exact_for_cubics_and_zero_beyond_the_grid():
@@ -123,3 +123,18 @@ def test_remainders_are_the_shifted_inverse_transforms(step, size):
     np.testing.assert_allclose(esf, expected_esf, rtol=0, atol=1e-12)
     one, _ = grid.remainders(spectra[1])
     np.testing.assert_allclose(one, esf[1], rtol=0, atol=1e-15)
+
+
+def test_a_grid_given_the_transfer_at_the_probe_is_the_one_it_computes():
+    """line_grid reads the sensor's transfer at PROBE_CY_PX for its
+    Gaussian reference: given it, the same grid; a Cauchy grid does not
+    read it."""
+    def described(grid):
+        return grid.step_px, grid.size, grid.reference
+    sensor = im.Sensor()
+    probe = float(sensor.normal_transfer(PROBE_CY_PX, 6.0, 1.0))
+    assert described(line_grid(sensor, 6.0, 1.0, transfer_at_probe=probe)) == described(line_grid(sensor, 6.0, 1.0))
+    wider = line_grid(sensor, 6.0, 1.0, transfer_at_probe=1 - 2 * math.pi**2 * 2.0**2 * PROBE_CY_PX**2)
+    assert wider.reference == ("gaussian", pytest.approx(2.0, rel=1e-9))
+    airy = im.Sensor(1.0, [st.Diffraction(8.0)])
+    assert described(line_grid(airy, 6.0, 1.0, transfer_at_probe=0.0)) == described(line_grid(airy, 6.0, 1.0))

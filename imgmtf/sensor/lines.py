@@ -17,6 +17,10 @@ from ..errors import ParameterError
 
 #: largest 1-D line (samples) a sensor may ask for
 MAX_LINE_SAMPLES = 1 << 23
+#: the frequency along the normal (cy/px) at which a sensor's transfer
+#: gives its LSF's variance, 1 - T = 2 pi^2 variance f^2 (the Gaussian
+#: reference's width)
+PROBE_CY_PX = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -237,7 +241,7 @@ class _Blur(Protocol):
 
 
 def line_grid(sensor: _Blur, angle_deg: float, gsd: float, *, reach_px: float = 0.0,
-              step_px: float = 1.0 / 64.0) -> LineGrid:
+              step_px: float = 1.0 / 64.0, transfer_at_probe: float | None = None) -> LineGrid:
     """The grid a sensor's line response along the normal of an edge tilted
     ``angle_deg`` is sampled on: its step, its size (the PSF's support plus
     ``reach_px`` on each side, rounded up to a power of two, at least 256)
@@ -257,6 +261,10 @@ def line_grid(sensor: _Blur, angle_deg: float, gsd: float, *, reach_px: float = 
     step_px : float, optional
         The grid's step, px (default 1/64; finer where a Cauchy tail
         needs it).
+    transfer_at_probe : float, optional
+        The sensor's transfer along the normal at :data:`PROBE_CY_PX`,
+        when the caller has it (default: computed here); read only
+        without a Cauchy tail.
 
     Returns
     -------
@@ -282,8 +290,9 @@ def line_grid(sensor: _Blur, angle_deg: float, gsd: float, *, reach_px: float = 
         reference = ("cauchy", tail_px)
     else:
         # any smooth reference of about the LSF's width keeps the remainder small
-        delta = 1e-3
-        variance = (1.0 - float(sensor.normal_transfer(delta, angle_deg, gsd))) / (2 * math.pi**2 * delta**2)
+        if transfer_at_probe is None:
+            transfer_at_probe = float(sensor.normal_transfer(PROBE_CY_PX, angle_deg, gsd))
+        variance = (1.0 - transfer_at_probe) / (2 * math.pi**2 * PROBE_CY_PX**2)
         reference = ("gaussian", min(max(math.sqrt(max(variance, 0.0)), 0.1), 10.0))
     half = reach_px + sensor.support_radius_m() / gsd + 8 * reference[1] + 4.0
     n = 1 << max(int(math.ceil(math.log2(2 * half / step_px))), 8)

@@ -20,11 +20,13 @@ so an evaluation computes only what its parameters changed.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Sequence
+from functools import reduce
 
 import numpy as np
 
-from ...sensor.lines import LineGrid, LineResponse, hermite, line_grid
+from ...sensor.lines import PROBE_CY_PX, LineGrid, LineResponse, hermite, line_grid
 from ...sensor.model import Sensor
 from ...sensor.stages import Stage
 
@@ -115,7 +117,7 @@ class EdgeResponses:
         grid, base, response = self._base(sensor)
         spectra = np.empty((len(shifted), base.size))
         for row, other in zip(spectra, shifted):
-            np.subtract(self._transfer(other, grid, keep=False), base, out=row)
+            np.subtract(self._transfer(other, keep=False)[1:], base, out=row)
         esf, lsf = grid.remainders(spectra)
         return response, esf, lsf
 
@@ -123,36 +125,48 @@ class EdgeResponses:
         """The grid, transfer and response of ``sensor``, the last one's kept."""
         key = (sensor.gsd_m, sensor.stages)
         if self._last is None or self._last[0] != key:
-            reach = self.reach_px if sensor.tail_length_m() > 0 else 0.0
-            grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach)
-            transfer = self._transfer(sensor, grid, keep=True)
-            self._last = (key, grid, transfer, grid.response(transfer))
+            tailed = sensor.tail_length_m() > 0
+            reach = self.reach_px if tailed else 0.0
+            # without a tail the grid's reference reads the transfer at the probe, which comes with
+            # the transfer on the last grid's frequencies: the next grid's, but when its size changes
+            transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True)
+            grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
+                             transfer_at_probe=None if transfer is None else float(transfer[0]))
+            if self._use(grid) or transfer is None:
+                transfer = self._transfer(sensor, keep=True)
+            self._last = (key, grid, transfer[1:], grid.response(transfer[1:]))
         return self._last[1:]
 
-    def _transfer(self, sensor: Sensor, grid: LineGrid, keep: bool) -> np.ndarray:
-        """The transfer of ``sensor`` along the normal at the grid's
-        frequencies: the product of its stages' (in their order), each
-        taken from those kept when there; ``keep`` keeps those computed."""
-        if self._on != (grid.step_px, grid.size):
-            self._on = (grid.step_px, grid.size)
-            f = grid.frequencies_cy_px / self.gsd_m
-            self._normal = (f * self._cos, f * self._sin)
-            self._transfers.clear()
-        out = None
+    def _use(self, grid: LineGrid) -> bool:
+        """Make ``grid``'s frequencies those transfers are computed at
+        (the probe's first); whether they changed (the kept transfers then
+        dropped)."""
+        if self._on == (grid.step_px, grid.size):
+            return False
+        self._on = (grid.step_px, grid.size)
+        f = np.concatenate([[PROBE_CY_PX], grid.frequencies_cy_px]) / self.gsd_m
+        self._normal = (f * self._cos, f * self._sin)
+        self._transfers.clear()
+        return True
+
+    def _transfer(self, sensor: Sensor, keep: bool) -> np.ndarray:
+        """The transfer of ``sensor`` along the normal at the probe and the
+        current grid's frequencies: the product of its stages' (in their
+        order), each taken from those kept when there; ``keep`` keeps
+        those computed."""
+        values = []
         for stage in sensor.stages:
             key = (stage, sensor.gsd_m)
-            value = self._transfers.pop(key, None)
-            if value is None:
-                value = stage.transfer(*self._normal, sensor.gsd_m)
-                if not keep:
-                    out = value if out is None else out * value
-                    continue
+            kept = self._transfers.pop(key, None)
+            value = stage.transfer(*self._normal, sensor.gsd_m) if kept is None else kept
+            if kept is None and keep:
                 value.flags.writeable = False
                 while len(self._transfers) >= KEPT_TRANSFERS:
                     del self._transfers[next(iter(self._transfers))]
-            self._transfers[key] = value        # the latest used last: the first to go is the longest unused
-            out = value if out is None else out * value
-        return np.ones(grid.frequencies_cy_px.shape) if out is None else out
+            if kept is not None or keep:
+                self._transfers[key] = value        # the latest used last: the first to go is the longest unused
+            values.append(value)
+        return reduce(operator.mul, values)
 
 
 def line_responses(sensors: Sequence[Sensor], angle_deg: float, gsd_m: float,
