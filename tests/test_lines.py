@@ -138,3 +138,33 @@ def test_a_grid_given_the_transfer_at_the_probe_is_the_one_it_computes():
     assert wider.reference == ("gaussian", pytest.approx(2.0, rel=1e-9))
     airy = im.Sensor(1.0, [st.Diffraction(8.0)])
     assert described(line_grid(airy, 6.0, 1.0, transfer_at_probe=0.0)) == described(line_grid(airy, 6.0, 1.0))
+
+
+@pytest.mark.parametrize("sensor", [im.Sensor(), im.Sensor(1.0, [st.Diffraction(8.0), st.Detector()])],
+                         ids=["gaussian", "cauchy"])
+def test_esf_with_curvature_is_esf_and_esf_curvature_bit_for_bit(sensor):
+    """The distances placed on the grid once: the same values as the two
+    methods, within the grid and beyond it (zero remainder there)."""
+    response = sensor.line_response(5.0, reach_px=4.0)
+    d = np.random.default_rng(5).uniform(-40, 40, (30, 20))
+    esf, curvature = response.esf_with_curvature(d)
+    assert esf.shape == curvature.shape == d.shape
+    assert np.array_equal(esf, response.esf(d)) and np.array_equal(curvature, response.esf_curvature(d))
+    near = np.linspace(-2, 2, 7)                       # all within the grid
+    assert [a.tolist() for a in response.esf_with_curvature(near)] == [response.esf(near).tolist(),
+                                                                       response.esf_curvature(near).tolist()]
+
+
+def test_hermite_within_the_grid_and_beyond_alike():
+    """Every distance within the grid (nothing to place back) or some
+    beyond: the same values where both have them, rows and shapes kept."""
+    x = np.arange(-3.0, 3.01, 0.5)
+    values, slopes = np.stack([x**3, x**2]), np.stack([3 * x**2, 2 * x])
+    d = np.array([[-2.9, 0.3], [1.1, 2.99]])
+    within = hermite(-3.0, 0.5, values, slopes, d, derivative=(0, 2))
+    beyond = hermite(-3.0, 0.5, values, slopes, np.append(d, 7.0), derivative=(0, 2))
+    for a, b in zip(within, beyond):
+        assert a.shape == (2, 2, 2) and b.shape == (2, 5)
+        assert np.array_equal(a.reshape(2, 4), b[:, :4]) and not b[:, 4].any()
+    np.testing.assert_allclose(within[0][0], d**3, atol=1e-12)
+    np.testing.assert_allclose(within[1][0], 6 * d, atol=1e-12)

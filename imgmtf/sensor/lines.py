@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from typing import Protocol
+from typing import Protocol, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,12 +41,8 @@ class LineResponse:
         """Edge response at signed distances ``d_px`` (cubic Hermite between
         grid samples, whose slopes are the LSF)."""
         d = np.asarray(d_px, float)
-        value = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d)
-        kind, width = self.reference
-        if kind == "cauchy":
-            return value + 0.5 + np.arctan(d / width) / np.pi
-        from scipy.special import ndtr
-        return value + ndtr(d / width)
+        return self._plus_reference_esf(hermite(self.start_px, self.step_px, self.esf_remainder,
+                                                self.lsf_remainder, d), d)
 
     def lsf(self, d_px: ArrayLike) -> np.ndarray:
         """Line spread function (1/px) at signed distances ``d_px``."""
@@ -67,6 +63,44 @@ class LineResponse:
         (:mod:`imgmtf.estimate.fit`'s bins)."""
         d = np.asarray(d_px, float)
         value = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d, derivative=2)
+        return self._plus_reference_curvature(value, d)
+
+    def esf_with_curvature(self, d_px: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`esf` and :meth:`esf_curvature` at signed distances
+        ``d_px`` (the same values), the distances placed on the grid once.
+
+        Parameters
+        ----------
+        d_px : array_like
+            Signed distances from the edge, px.
+
+        Returns
+        -------
+        esf, curvature : numpy.ndarray
+            The edge response and its second derivative (1/px^2) there.
+
+        Examples
+        --------
+        >>> from imgmtf import Sensor
+        >>> esf, curvature = Sensor().line_response(0.0).esf_with_curvature([0.0, 1.0])
+        >>> esf.round(4).tolist(), bool(curvature[1] < 0)
+        ([0.5, 0.9756], True)
+        """
+        d = np.asarray(d_px, float)
+        value, curvature = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d,
+                                   derivative=(0, 2))
+        return self._plus_reference_esf(value, d), self._plus_reference_curvature(curvature, d)
+
+    def _plus_reference_esf(self, value: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """``value``, the remainder's ESF at ``d``, plus the reference's."""
+        kind, width = self.reference
+        if kind == "cauchy":
+            return value + 0.5 + np.arctan(d / width) / np.pi
+        from scipy.special import ndtr
+        return value + ndtr(d / width)
+
+    def _plus_reference_curvature(self, value: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """``value``, the remainder's ESF curvature at ``d``, plus the reference's."""
         kind, width = self.reference
         if kind == "cauchy":
             return value - 2 * width * d / (np.pi * (width**2 + d**2) ** 2)
@@ -175,8 +209,18 @@ def _inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.ndarray,
     return f, to_lsf, to_esf
 
 
+@overload
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
-            d_px: np.ndarray, derivative: int = 0) -> np.ndarray:
+            d_px: np.ndarray, derivative: int = 0) -> np.ndarray: ...
+
+
+@overload
+def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
+            d_px: np.ndarray, derivative: tuple[int, ...]) -> tuple[np.ndarray, ...]: ...
+
+
+def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
+            d_px: np.ndarray, derivative: int | tuple[int, ...] = 0) -> np.ndarray | tuple[np.ndarray, ...]:
     """Cubic Hermite interpolation of gridded ``values`` with their
     ``slopes`` (per px) at ``d_px``, or the interpolant's second
     derivative (per px^2); zero beyond the grid.
@@ -189,14 +233,16 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
         Samples on the grid, and their derivatives, one row per function.
     d_px : numpy.ndarray
         Where to interpolate, px.
-    derivative : {0, 2}, optional
+    derivative : {0, 2} or tuple of them, optional
         0 (default): the interpolant; 2: its second derivative (linear
-        between grid samples, the cubic's).
+        between grid samples, the cubic's); a tuple: each of them, the
+        distances placed on the grid once.
 
     Returns
     -------
-    numpy.ndarray, shape (..., len(d_px))
-        Each row's values at ``d_px`` (the shared weights computed once).
+    numpy.ndarray, shape (..., len(d_px)), or a tuple of them
+        Each row's values at ``d_px`` (the shared weights computed once),
+        one array per derivative when ``derivative`` is a tuple.
 
     Raises
     ------
@@ -210,24 +256,38 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
     [2.25, 0.0]
     >>> hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5, 2.25]), derivative=2).tolist()
     [9.0, 13.5]
+    >>> [a.tolist() for a in hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5]), derivative=(0, 2))]
+    [[3.375], [9.0]]
     """
+    orders = derivative if isinstance(derivative, tuple) else (derivative,)
+    for order in orders:
+        if order not in (0, 2):
+            raise ValueError(f"derivative must be 0 or 2, got {order!r}")
     d = np.asarray(d_px, float)
     t = ((d - start_px) / step_px).ravel()
     n = values.shape[-1]
-    inside = np.flatnonzero((t >= 0) & (t <= n - 1))      # beyond the grid: zero, nothing to compute
-    k = np.minimum(t[inside].astype(np.intp), n - 2)
-    u = t[inside] - k
+    inside = (t >= 0) & (t <= n - 1)
+    everywhere = bool(inside.all())
+    if not everywhere:        # beyond the grid: zero, nothing to compute
+        inside = np.flatnonzero(inside)
+        t = t[inside]
+    k = np.minimum(t.astype(np.intp), n - 2)
+    u = t - k
     h = step_px
-    if derivative == 0:       # the cubic Hermite basis
-        weights = ((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)
-    elif derivative == 2:     # its second derivatives, by d_px
-        weights = ((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h)
-    else:
-        raise ValueError(f"derivative must be 0 or 2, got {derivative!r}")
-    out = np.zeros(values.shape[:-1] + t.shape)
-    out[..., inside] = (weights[0] * values[..., k] + weights[1] * slopes[..., k]
-                        + weights[2] * values[..., k + 1] + weights[3] * slopes[..., k + 1])
-    return out.reshape(values.shape[:-1] + d.shape)
+    near = (values[..., k], slopes[..., k], values[..., k + 1], slopes[..., k + 1])
+    outputs = []
+    for order in orders:
+        if order == 0:        # the cubic Hermite basis
+            weights = ((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)
+        else:                 # its second derivatives, by d_px
+            weights = ((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h)
+        value = weights[0] * near[0] + weights[1] * near[1] + weights[2] * near[2] + weights[3] * near[3]
+        if not everywhere:
+            placed = np.zeros((*values.shape[:-1], d.size))
+            placed[..., inside] = value
+            value = placed
+        outputs.append(value.reshape(values.shape[:-1] + d.shape))
+    return tuple(outputs) if isinstance(derivative, tuple) else outputs[0]
 
 
 class _Blur(Protocol):

@@ -415,8 +415,8 @@ def bin_esf(response: LineResponse, bins: ProfileBins, x0: float) -> np.ndarray:
     """The mean of the edge response over each bin's samples, for an edge
     at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
     third and higher moments' terms (see :data:`.data.FIT_BIN_PX`)."""
-    d = bins.x - x0
-    return response.esf(d) + 0.5 * bins.m2 * response.esf_curvature(d)
+    value, curvature = response.esf_with_curvature(bins.x - x0)
+    return value + 0.5 * bins.m2 * curvature
 
 
 def other_stages(stages) -> str:
