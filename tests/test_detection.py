@@ -55,3 +55,6 @@ def test_robust_noise_is_the_mad_of_horizontal_differences_exactly():
         mad = np.median(np.abs(diff - np.median(diff)))
         assert robust_noise(image) == max(float(1.4826 * mad / np.sqrt(2.0)), 1e-12)
     assert robust_noise(np.full((5, 5), 7.0)) == 1e-12
+    # integer pixels: their differences taken as floats, never wrapped (int16 32000 - -32000 overflows)
+    wide = np.clip(np.round(rng.normal(0, 20000, (20, 21))), -32768, 32767)
+    assert robust_noise(wide.astype(np.int16)) == robust_noise(wide) > 10000

@@ -276,8 +276,9 @@ def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
 def robust_noise(image: np.ndarray) -> float:
     """Noise standard deviation (DN) from the median absolute difference of
     horizontally adjacent pixels, which an edge barely affects (pairs with a
-    left-out, NaN, pixel skipped)."""
-    diff = np.diff(image, axis=1)
+    left-out, NaN, pixel skipped).  Integer pixels are taken as floats, so
+    that their differences cannot wrap."""
+    diff = np.diff(np.asarray(image, float), axis=1)
     diff = diff[np.isfinite(diff)]
     mad = _median(np.abs(diff - _median(diff)))
     # a noise-free (or coarsely quantised) image has MAD 0: its noise is nil
