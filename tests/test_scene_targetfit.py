@@ -69,7 +69,8 @@ def test_no_fit_without_a_track_nor_for_pulses(scanned):
     assert fit_targets([r.with_(target="pulse") for r in records]) == []
 
 
-def test_the_fit_starts_from_the_scans_own_measurements_and_stored_records_are_measured_again(scanned):
+def test_the_fit_starts_from_the_scans_own_measurements_and_stored_records_are_measured_again(scanned,
+                                                                                              monkeypatch):
     """Accepted records carry the estimate scan made (in memory, never
     written); without it (a record read back from a store) each half-edge
     is measured again on the ROI its record describes: the same edge, so
@@ -81,12 +82,24 @@ def test_the_fit_starts_from_the_scans_own_measurements_and_stored_records_are_m
     assert all(r.measurement is None for r in records if not r.ok)
     assert all(r.measurement.mtf_nyquist == pytest.approx(r.figures["mtf_nyquist"], abs=1e-6) for r in accepted)
     assert "measurement" not in accepted[0].to_dict() and "measurement" not in repr(accepted[0])
+    import imgmtf.scene.targetfit as targetfit
+
+    def measured_again(again):
+        if again:
+            raise AssertionError("a half-edge with its measurement was measured again")
+        return []
+    monkeypatch.setattr(targetfit, "_measured", measured_again)
     from_scan = fit_targets(records)
+    monkeypatch.undo()
     again = fit_targets([r.with_(measurement=None) for r in records])
+    assert len(from_scan) == len(again) == 2
     for a, b in zip(from_scan, again):
         low, high = a.figures["mtf_nyquist_ci"]
         assert abs(a.figures["mtf_nyquist"] - b.figures["mtf_nyquist"]) < 0.05 * (high - low)
         assert a.figures["n_edges"] == b.figures["n_edges"]
+    # on workers, the measurements travel to the fits' processes (pickled): the same rows
+    on_workers = fit_targets(records, workers=2)
+    assert [r.figures["mtf_nyquist"] for r in on_workers] == [r.figures["mtf_nyquist"] for r in from_scan]
 
 
 def test_roi_mask_holds_the_pixel_centres_inside_a_tilted_rectangle():
