@@ -85,7 +85,8 @@ class EdgeFit:
     offset_px : float
         The edge's fitted sub-pixel offset, px.
     reduced_chi_square : float
-        Of this edge's residuals against its noise.
+        Of this edge's samples' residuals against its noise (not its
+        bins'), over its samples less its share of the parameters.
     misfit_p, misfit_fraction : float
         P-value of the residuals binned along the normal (small: structure),
         and the size of that structure, RMS as a fraction of the step.
@@ -151,8 +152,10 @@ class SensorFit:
         Fitted parameter pairs correlated beyond 0.9: the data constrain a
         combination of them better than each.
     reduced_chi_square : float
-        Of the residuals, each edge weighted by its noise (1 for a model
-        that fits to the noise).
+        Of the samples' residuals (each profile sample's value against the
+        fitted model, weighted by its edge's noise), not the fit's bins':
+        their chi-square over samples - parameters degrees of freedom (1
+        for a model that fits to the noise).
     edges : tuple of EdgeFit
         Per input edge: the model's MTF at Nyquist along its normal (cy/px)
         with an interval, the measured one, and the misfit statistics.
