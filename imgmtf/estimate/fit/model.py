@@ -267,6 +267,19 @@ class Model:
             self._last_responses = (key, [edge.response(sensor) for edge in self.edges])
         return self._last_responses[1]
 
+    def release(self) -> None:
+        """Drop what the evaluations keep (each edge's grids, transfers
+        and responses, the last responses, ESFs, samples' chi-squares and
+        stages made), which a finished fit no longer uses: what it still
+        asks (:func:`model_mtf_band`, the sensor's transfer) is made
+        afresh.  The model evaluates as before, computing them again."""
+        for edge in self.edges:
+            edge.release()
+        self._last_responses = (None, [])
+        self._last_esfs = (None, [])
+        self._last_samples = (None, np.zeros(0))
+        self._stages_made.clear()
+
     @staticmethod
     def reach(d: EdgeData) -> float:
         """How far from the edge its line response must be exact, px."""

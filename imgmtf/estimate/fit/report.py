@@ -101,6 +101,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     if not any(d.gsd_known for d in model.data):
         warnings.append(f"no GSD in the inputs: lengths are in units of {model.gsd:g} m per pixel "
                         "(at 1 m, metres are pixels); give the GSD for lengths on the ground")
+    # the fit's caches (each edge's line responses: most of a pickled fit) serve no later question
+    model.release()
     return SensorFit(sensor, start, tuple(parameters), tuple(correlations), reduced, tuple(edges), directions,
                      confidence, tuple(warnings), model, u, covariance)
 

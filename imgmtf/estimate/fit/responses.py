@@ -78,6 +78,13 @@ class EdgeResponses:
         self._normal: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
         self._transfers: dict[tuple[Stage, float], np.ndarray] = {}
 
+    def release(self) -> None:
+        """Drop what is kept (the last grid, transfer and response, the
+        stages' transfers): the next evaluation makes them again."""
+        self._last, self._on = None, None
+        self._normal = (np.zeros(0), np.zeros(0))
+        self._transfers.clear()
+
     def response(self, sensor: Sensor) -> LineResponse:
         """The line response of ``sensor`` along the edge's normal.
 
