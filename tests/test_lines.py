@@ -107,6 +107,28 @@ def shifted_remainders(grid, spectra):
     return esf - esf[..., :1], lsf
 
 
+def test_long_grids_factors_are_made_afresh_and_the_same_as_kept_ones(monkeypatch):
+    """Up to CACHED_LINE_SAMPLES a grid's factors are kept (the same arrays
+    again); beyond, made each time and not kept; either way the same values,
+    bit for bit (one size through both paths), and the same remainders."""
+    from imgmtf.sensor import lines
+    step, size = 1 / 64, lines.CACHED_LINE_SAMPLES
+    kept = lines._inverse_factors(step, size)
+    assert all(a is b for a, b in zip(kept, lines._inverse_factors(step, size)))
+    monkeypatch.setattr(lines, "CACHED_LINE_SAMPLES", size // 2)
+    held = lines._cached_inverse_factors.cache_info().currsize
+    afresh = lines._inverse_factors(step, size)
+    assert lines._cached_inverse_factors.cache_info().currsize == held
+    assert not any(a is b for a, b in zip(kept, afresh))
+    assert all(np.array_equal(a, b) and a.dtype == b.dtype and not b.flags.writeable for a, b in zip(kept, afresh))
+    grid = LineGrid(step, size, ("gaussian", 1.0))
+    spectra = np.exp(-2 * np.pi**2 * 0.5**2 * grid.frequencies_cy_px**2) - reference_transfer(
+        grid.reference, grid.frequencies_cy_px)
+    uncached = grid.remainders(spectra)
+    monkeypatch.setattr(lines, "CACHED_LINE_SAMPLES", size)
+    assert all(np.array_equal(a, b) for a, b in zip(uncached, grid.remainders(spectra)))
+
+
 @pytest.mark.parametrize("step, size", [(1 / 64, 2048), (0.0123, 4096), (0.25, 9)], ids=["even", "cauchy-step", "odd"])
 def test_remainders_are_the_shifted_inverse_transforms(step, size):
     """The shift as a phase factor and the scale folded into the spectra:

@@ -17,6 +17,11 @@ from ..errors import ParameterError
 
 #: largest 1-D line (samples) a sensor may ask for
 MAX_LINE_SAMPLES = 1 << 23
+#: the longest grid (samples) whose inverse-FFT factors are kept (16 grids
+#: at most, about 1 MB each at this size): a fit's grids, up to 2^15 for
+#: 300-row edges of f/5.6-8 diffraction; a render's longer ones, made once,
+#: are not
+CACHED_LINE_SAMPLES = 1 << 16
 #: the frequency along the normal (cy/px) at which a sensor's transfer
 #: gives its LSF's variance, 1 - T = 2 pi^2 variance f^2 (the Gaussian
 #: reference's width)
@@ -188,8 +193,17 @@ class LineGrid:
         return esf - esf[..., :1], lsf
 
 
-@lru_cache(maxsize=16)
 def _inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_make_inverse_factors`, kept for grids of up to
+    :data:`CACHED_LINE_SAMPLES` samples (a fit's, evaluated again and
+    again) and made afresh for longer ones (a render's, once: kept, one
+    2^20-sample grid would hold 16.8 MB for the process)."""
+    if size <= CACHED_LINE_SAMPLES:
+        return _cached_inverse_factors(step_px, size)
+    return _make_inverse_factors(step_px, size)
+
+
+def _make_inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A grid's frequencies (cy/px) and what its spectra are multiplied by
     before the inverse real FFT to give the LSF (1/px) and the ESF
     centred on the grid: the phase of a shift by ``size // 2`` samples,
@@ -207,6 +221,9 @@ def _inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.ndarray,
     for array in (f, to_lsf, to_esf):
         array.flags.writeable = False
     return f, to_lsf, to_esf
+
+
+_cached_inverse_factors = lru_cache(maxsize=16)(_make_inverse_factors)
 
 
 @overload
