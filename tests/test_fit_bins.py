@@ -1,10 +1,13 @@
 """estimate/fit: the edges' samples binned along the normal (data.bin_profile),
 the model of a bin (model.bin_esf) and what the fit reports from bins, against
 the samples themselves."""
+import dataclasses
 import math
+import types
 
 import numpy as np
 import pytest
+from scipy.special import chdtrc
 
 import imgmtf as im
 from imgmtf.estimate.fit import fit_edges
@@ -111,25 +114,55 @@ def test_the_bins_chi_square_is_the_samples_less_their_scatter_within_bins(exact
     assert model.dof == n - model.n_free - 3 and model.rows == bins
 
 
-def test_the_misfit_test_on_bins_is_the_samples(exact_edge):
+def test_residual_means_of_the_bins_are_the_samples_at_zero_offset(exact_edge):
     """Residual means over 0.25 px from the fit's bins, each by its count,
-    are the samples' own means (the bins nest in them at zero offset): the
-    same p-value and size, here of a structure of 0.6 % of the step."""
-    data, model, z, m = exact_edge
-    response = model.responses(z[: model.n_free])[0]
-    bump = 6.0 * np.exp(-0.5 * (data.x / 0.5) ** 2)
-    residual = data.y + bump - m
+    are the samples' own means when the bins nest in them (zero offset):
+    what the residual panel draws."""
+    data, _, _, m = exact_edge
+    residual = data.y - m
     binned = bin_profile(data.x, residual)
-    on_samples = misfit_test(data.x, residual, np.ones(data.x.size), data.noise, 1000.0, response)
-    on_bins = misfit_test(binned.x, binned.y, binned.count, data.noise, 1000.0, response)
-    assert on_samples[0] < 1e-6 and on_samples[1] > 1e-3
-    assert on_bins == pytest.approx(on_samples, rel=1e-9)
     centres, means, counts = residual_means(binned.x, binned.y, binned.count, 3.0)
     near = np.abs(data.x) <= 3.0
     direct = [(v.mean(), v.size) for v, _ in per_bin(data.x[near], residual[near], 0.25)]
     np.testing.assert_allclose(means, [mean for mean, _ in direct], rtol=1e-12)
     np.testing.assert_array_equal(counts, [size for _, size in direct])
     np.testing.assert_allclose(centres, np.arange(-3.0, 3.0, 0.25) + 0.125)
+
+
+@pytest.mark.parametrize("bump_dn", [0.0, 6.0], ids=["exact", "bump"])
+def test_the_reported_misfit_test_is_the_samples_at_an_offset(exact_edge, bump_dn):
+    """The report's misfit p-value and size are those of the samples'
+    residuals against the model, binned 0.25 px from the fitted edge at
+    0.137 px (the samples' own statistic, to 1e-9), with or without a
+    structure of 0.6 % of the step.  The fit's 1/32 px bins, formed on the
+    distances before the offset, straddle those bins: their means binned
+    so give another p-value (0.633 against the samples' 0.368 here, exact
+    model), which the report gave before."""
+    from imgmtf.estimate.fit.model import parameter_covariance
+    from imgmtf.estimate.fit.report import fit_report
+    data, model, z, m = exact_edge
+    x0 = z[model.n_free + 2]
+    assert x0 == 0.137
+    y = data.y + bump_dn * np.exp(-0.5 * ((data.x - x0) / 0.5) ** 2)
+    # what the report reads of the edge's non-parametric measurement, which this edge has not
+    measured = types.SimpleNamespace(rows_used=100, snr=200.0, frequencies_cy_px=np.array([0.0, 1.0]),
+                                     mtf=np.array([1.0, 0.0]))
+    model = Model(1.0, model.stages, [dataclasses.replace(data, y=y, bins=bin_profile(data.x, y),
+                                                          measurement=measured)])
+    response = model.responses(z[: model.n_free])[0]
+    on_samples = misfit_test(data.x - x0, y - m, data.noise, 1000.0, response)
+    covariance = parameter_covariance(model.jacobian(z), 1.0)
+    edge = fit_report(model, z, covariance, {}, 0.95).edges[0]
+    assert (edge.misfit_p, edge.misfit_fraction) == pytest.approx(on_samples, rel=1e-9)
+    # the fit's bins' residual means, 0.25 px binned from the fitted edge: not the samples'
+    grid = np.arange(-50.0, 50.0, 0.25 / 4)
+    reach = max(3.0, float(np.abs(grid[(response.esf(grid) > 1e-3) & (response.esf(grid) < 1 - 1e-3)]).max()))
+    _, means, count = residual_means(edge.samples_x_px - x0, edge.residuals_dn, edge.bin_counts, reach)
+    on_bins = float(chdtrc(count.size, np.sum(count * means**2) / data.noise**2))
+    if bump_dn:
+        assert on_samples[0] < 1e-6 and on_samples[1] > 1e-3
+    else:
+        assert abs(on_bins - on_samples[0]) > 0.2          # measured 0.633 against 0.368
 
 
 def test_a_fits_edges_report_its_bins_and_the_samples_chi_square():

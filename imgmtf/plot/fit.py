@@ -99,7 +99,12 @@ def plot_fit_edge(fit: SensorFit, index: int, ax: Axes | None = None,
 def plot_fit_residuals(fit: SensorFit, ax: Axes | None = None) -> Figure | SubFigure:
     """Each edge's residuals (data - model) averaged in 0.25 px bins along
     its normal, in % of its step, with the noise's 2-sigma band of a bin
-    mean: structure outside it is what the misfit warning reports.
+    mean: structure outside it is what the misfit warning reports.  The
+    means are of the fit's 1/32 px bins (:class:`imgmtf.estimate.fit.EdgeFit`'s
+    ``samples_x_px``, ``residuals_dn``, ``bin_counts``), each by its
+    count in the 0.25 px bin its mean falls in: within a 1/32 px bin's
+    reach of each edge of those bins, samples may count on the other side
+    from where the misfit test, which bins the samples, counts them.
 
     Parameters
     ----------

@@ -156,7 +156,7 @@ class Model:
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.normal_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         self._last_esfs: tuple = (None, [])
-        self._last_samples: tuple = (None, np.zeros(0))
+        self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
 
     # -- which parameters are free ------------------------------------------------
@@ -269,7 +269,7 @@ class Model:
 
     def release(self) -> None:
         """Drop what the evaluations keep (each edge's grids, transfers
-        and responses, the last responses, ESFs, samples' chi-squares and
+        and responses, the last responses, ESFs, samples' residuals and
         stages made), which a finished fit no longer uses: what it still
         asks (:func:`model_mtf_band`, the sensor's transfer) is made
         afresh.  The model evaluates as before, computing them again."""
@@ -277,7 +277,7 @@ class Model:
             edge.release()
         self._last_responses = (None, [])
         self._last_esfs = (None, [])
-        self._last_samples = (None, np.zeros(0))
+        self._last_samples = (None, [])
         self._stages_made.clear()
 
     @staticmethod
@@ -393,18 +393,24 @@ class Model:
         changes are the likelihood-ratio costs."""
         return float(np.sum(self.residuals(z) ** 2))
 
-    def sample_chi_squares(self, z: np.ndarray) -> np.ndarray:
-        """Each edge's chi-square of its samples (not bins) at ``z``: the
-        model evaluated at every sample once (the last ``z``'s kept: the
-        fit's covariance and its report ask at the same point)."""
+    def sample_residuals(self, z: np.ndarray) -> list[np.ndarray]:
+        """Each edge's samples' (not bins') residuals at ``z``, data - model
+        (DN), in the order of its samples: the model evaluated at every
+        sample once (the last ``z``'s kept: the fit's covariance and its
+        report ask at the same point)."""
         key = (tuple(self.free), z.tobytes())
         if self._last_samples[0] != key:
             out = []
             for e, (d, r) in enumerate(zip(self.data, self.responses(z[: self.n_free]))):
                 lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-                out.append(float(np.sum(((d.y - lo - (hi - lo) * r.esf(d.x - x0)) / d.noise) ** 2)))
-            self._last_samples = (key, np.array(out))
+                out.append(d.y - lo - (hi - lo) * r.esf(d.x - x0))
+            self._last_samples = (key, out)
         return self._last_samples[1]
+
+    def sample_chi_squares(self, z: np.ndarray) -> np.ndarray:
+        """Each edge's chi-square of its samples (not bins) at ``z``
+        (:meth:`sample_residuals` over the edge's noise)."""
+        return np.array([float(np.sum((r / d.noise) ** 2)) for d, r in zip(self.data, self.sample_residuals(z))])
 
     def reduced_chi_square(self, z: np.ndarray) -> float:
         """The samples' chi-square at ``z`` per degree of freedom."""

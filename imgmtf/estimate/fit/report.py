@@ -28,6 +28,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     residuals = model.residuals(z, responses)
     reduced = model.reduced_chi_square(z)
     sample_chi_squares = model.sample_chi_squares(z)
+    sample_residuals = model.sample_residuals(z)
     warnings = []
 
     parameters = []
@@ -67,7 +68,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
         res = residuals[start_row: start_row + bins.x.size] / model.weights[e]   # bin means' data - model, DN
         start_row += bins.x.size
         chi = float(sample_chi_squares[e] / max(d.x.size - 3 - n / len(model.data), 1))
-        p, fraction = misfit_test(bins.x - x0, res, bins.count, d.noise, abs(hi - lo), r)
+        # on the samples: the fit's bins, formed before x0 was known, straddle the misfit test's
+        p, fraction = misfit_test(d.x - x0, sample_residuals[e], d.noise, abs(hi - lo), r)
         value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
@@ -121,16 +123,20 @@ def residual_means(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, rea
                    width_px: float = MISFIT_BIN_PX) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """An edge's residuals averaged over its samples in bins ``width_px``
     wide along the normal (from 0 px), within ``reach_px`` of the edge;
-    bins of fewer than 3 samples are left out.
+    bins of fewer than 3 samples are left out.  Given the samples
+    themselves (``counts`` all 1), the bins' means are the samples';
+    given groups of samples (the fit's bins), each group counts wholly in
+    the bin its mean distance falls in.
 
     Parameters
     ----------
     x : numpy.ndarray
-        The fit's bins' mean distances from the fitted edge, px.
+        Distances from the fitted edge, px: of the samples, or of groups'
+        means (the fit's bins').
     residuals : numpy.ndarray
-        Their mean residuals (data - model), DN.
+        Their (mean) residuals, data - model, DN.
     counts : numpy.ndarray
-        Their samples.
+        The samples each stands for (1 for a sample).
     reach_px : float
         The farthest distance from the edge taken, px.
     width_px : float, optional
@@ -155,17 +161,20 @@ def residual_means(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, rea
     return (np.flatnonzero(used) + first + 0.5) * width_px, total[used] / count[used], count[used]
 
 
-def misfit_test(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, noise: float, step: float, response):
+def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response):
     """P-value and size (RMS fraction of the step, noise removed) of the
-    residuals' structure: their means over the samples in bins along the
-    normal (:func:`residual_means`; from the fit's bins, each by its count),
-    over the transition (where the model's edge response is between 0.1 %
-    and 99.9 %, and at least +-3 px)."""
+    structure of an edge's samples' residuals (``residuals``, data - model,
+    DN, at distances ``x`` px from the fitted edge; of one sample's noise
+    ``noise``): their means in bins along the normal
+    (:func:`residual_means`), over the transition (where the model's edge
+    response is between 0.1 % and 99.9 %, and at least +-3 px).  On the
+    samples, not the fit's bins: those are formed on the distances before
+    the fitted offset, so at an offset they straddle these bins' edges."""
     grid = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
     esf = response.esf(grid)
     inside = grid[(esf > 1e-3) & (esf < 1 - 1e-3)]
     reach = max(3.0, float(np.abs(inside).max()) if inside.size else 3.0)
-    _, means, count = residual_means(x, residuals, counts, reach)
+    _, means, count = residual_means(x, residuals, np.ones(x.size), reach)
     if not count.size:
         return 1.0, 0.0
     statistic = float(np.sum(count * means**2) / noise**2)

@@ -88,14 +88,23 @@ class EdgeFit:
         Of this edge's samples' residuals against its noise (not its
         bins'), over its samples less its share of the parameters.
     misfit_p, misfit_fraction : float
-        P-value of the residuals binned along the normal (small: structure),
-        and the size of that structure, RMS as a fraction of the step.
+        P-value of the structure of the samples' residuals (each profile
+        sample's, not the fit's bins') averaged in 0.25 px bins along the
+        normal from the fitted edge (small: structure), and the size of
+        that structure, RMS as a fraction of the step.
     samples_x_px, residuals_dn, bin_counts : numpy.ndarray
-        Per bin of the fit (its profile samples binned along the normal,
-        :data:`imgmtf.estimate.fit.data.FIT_BIN_PX` wide): its samples'
-        mean distance to the edge before the fitted offset (px), their
-        mean residual against the model (DN; its noise is ``noise_dn /
-        sqrt(bin_counts)``) and their count.
+        Per bin of the fit, not per sample (the profile samples binned
+        along the normal, :data:`imgmtf.estimate.fit.data.FIT_BIN_PX` wide
+        on their distances before the fitted offset): its samples' mean
+        distance to the edge before the offset (px; ``samples_x_px -
+        offset_px`` from the fitted edge), their mean value less the
+        model's mean over them (DN; its noise is ``noise_dn /
+        sqrt(bin_counts)``) and their count.  What the residual panel
+        (:func:`imgmtf.plot.plot_fit_residuals`) averages in 0.25 px bins,
+        each fit bin wholly in the one its mean distance falls in: where
+        the offset puts a fit bin across a 0.25 px bin's edge its samples
+        count on one side, so the panel's means are close to, not exactly,
+        those the misfit test takes from the samples.
     measurement : EdgeResult
         The non-parametric measurement of the edge.
     """
