@@ -77,11 +77,11 @@ def exact_edge():
     valued by the paper's sensor's ESF, levels 200 and 1200 DN, offset
     0.137 px, noise 5 DN; and the model at its truth (the fit's own line
     response)."""
-    from imgmtf.estimate.fit.responses import line_responses
+    from imgmtf.estimate.fit.responses import EdgeResponses
     sensor = im.Sensor()
     x = slanted(100)
     levels, x0, noise = (200.0, 1200.0), 0.137, 5.0
-    response = line_responses([sensor], 5.0, 1.0, float(np.abs(x).max()) + 2.0)[0]
+    response = EdgeResponses(5.0, 1.0, float(np.abs(x).max()) + 2.0).response(sensor)
     model_values = levels[0] + (levels[1] - levels[0]) * response.esf(x - x0)
     y = model_values + np.random.default_rng(7).normal(0, noise, x.size)
     data = EdgeData("exact", x, y, bin_profile(x, y), 5.0, 1.0, True, noise, levels, None)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes, line_responses
+from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes
 from imgmtf.sensor import stages as st
 
 
@@ -14,7 +14,7 @@ def test_changes_are_the_difference_of_the_two_edge_responses():
     against each sensor's own line response, to their 1e-7."""
     sensor = im.Sensor()
     wider = im.Sensor(1.0, [st.GaussianOptics(0.41, 0.39), *sensor.stages[1:]])
-    response, esf, lsf = line_responses([sensor, wider], 6.0, 1.0, reach_px=30.0)
+    response, esf, lsf = EdgeResponses(6.0, 1.0, 30.0).changes(sensor, [wider])
     d = np.linspace(-30, 30, 601)
     change = esf_changes(response, esf, lsf, d)[0]
     exact = wider.line_response(6.0, reach_px=30.0).esf(d) - sensor.line_response(6.0, reach_px=30.0).esf(d)
@@ -26,7 +26,7 @@ def test_the_derivative_by_a_gaussian_width_is_its_closed_form():
     """ESF = Phi(x / s): d ESF / d s = -x / s^2 phi(x / s)."""
     s, h = 0.6, 1e-6
     sensors = [im.Sensor(1.0, [st.GaussianOptics(w, w)]) for w in (s, s + h)]
-    response, esf, lsf = line_responses(sensors, 0.0, 1.0, reach_px=40.0)
+    response, esf, lsf = EdgeResponses(0.0, 1.0, 40.0).changes(sensors[0], sensors[1:])
     d = np.linspace(-5, 5, 201)
     derivative = esf_changes(response, esf, lsf, d)[0] / h
     exact = -d / s**2 * np.exp(-0.5 * (d / s) ** 2) / math.sqrt(2 * math.pi)
@@ -36,10 +36,10 @@ def test_the_derivative_by_a_gaussian_width_is_its_closed_form():
 def test_the_grid_reaches_the_samples_only_for_a_cauchy_tail():
     """Without diffraction the grid covers the PSF's support (beyond it the
     reference is the response); with it, the samples' reach."""
-    gaussian, _, _ = line_responses([im.Sensor()], 0.0, 1.0, reach_px=60.0)
+    gaussian = EdgeResponses(0.0, 1.0, 60.0).response(im.Sensor())
     assert -gaussian.start_px < 30
     assert gaussian.esf(60.0) == pytest.approx(1.0, abs=1e-12)
-    airy, _, _ = line_responses([im.Sensor(1.0, [st.Diffraction(8.0)])], 0.0, 1.0, reach_px=60.0)
+    airy = EdgeResponses(0.0, 1.0, 60.0).response(im.Sensor(1.0, [st.Diffraction(8.0)]))
     assert -airy.start_px >= 60
 
 
@@ -64,17 +64,19 @@ def fit_like_sensors():
 
 def test_kept_responses_are_those_made_afresh_bit_for_bit():
     """One edge's responses and changes over a fit's evaluations, its grid,
-    transfers and last response kept, equal :func:`line_responses` made
-    afresh for each, bit for bit."""
+    transfers and last response kept, equal those of a new EdgeResponses
+    for each, bit for bit; and the responses are the sensor's own made
+    independently (Sensor.line_response, its transfer Sensor.normal_transfer;
+    the grid reaching the samples only for a Cauchy tail), bit for bit."""
     edge = EdgeResponses(6.0, 1.0, 25.0)
     for sensor, shifted in fit_like_sensors():
-        fresh, fresh_esf, fresh_lsf = line_responses([sensor, *shifted], 6.0, 1.0, 25.0)
+        fresh, fresh_esf, fresh_lsf = EdgeResponses(6.0, 1.0, 25.0).changes(sensor, shifted)
         assert same_response(edge.response(sensor), fresh)
         response, esf, lsf = edge.changes(sensor, shifted)
         assert response is edge.response(sensor)
         assert np.array_equal(esf, fresh_esf) and np.array_equal(lsf, fresh_lsf)
-        alone, _, _ = line_responses([sensor], 6.0, 1.0, 25.0)
-        assert same_response(alone, fresh)
+        own = sensor.line_response(6.0, 1.0, reach_px=25.0 if sensor.tail_length_m() > 0 else 0.0)
+        assert same_response(response, own)
     assert edge.changes(sensor, [])[1].shape == (0, response.esf_remainder.size)
 
 

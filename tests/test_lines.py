@@ -23,21 +23,21 @@ def test_hermite_is_exact_for_cubics_and_zero_beyond_the_grid():
     assert not out[:, ~inside].any()
 
 
-def test_hermites_second_derivative_is_the_cubics_and_a_bad_order_is_refused():
-    """Exact for a cubic (6x - 2 here); linear between grid samples."""
+def test_hermites_second_derivative_is_the_cubics():
+    """Exact for a cubic (6x - 2 here); linear between grid samples; the
+    values the same as without it, bit for bit."""
     x = np.arange(-3.0, 3.01, 0.5)
     d = np.array([-2.9, -0.26, 0.0, 1.13, 2.99])
-    out = hermite(-3.0, 0.5, x**3 - x**2, 3 * x**2 - 2 * x, d, derivative=2)
+    values, out = hermite(-3.0, 0.5, x**3 - x**2, 3 * x**2 - 2 * x, d, curvature=True)
     np.testing.assert_allclose(out, 6 * d - 2, atol=1e-12)
-    with pytest.raises(ValueError, match="derivative must be 0 or 2"):
-        hermite(-3.0, 0.5, x, x, d, derivative=1)
+    assert np.array_equal(values, hermite(-3.0, 0.5, x**3 - x**2, 3 * x**2 - 2 * x, d))
 
 
 @pytest.mark.parametrize("sensor, gaussian_px", [(im.Sensor(1.0, [st.GaussianOptics(0.6, 0.6)]), 0.6),
                                                  (im.Sensor(), None),
                                                  (im.Sensor(1.0, [st.Diffraction(8.0), st.Detector()]), None)],
                          ids=["gaussian", "paper", "airy"])
-def test_esf_curvature_is_the_second_derivative_of_the_esf(sensor, gaussian_px):
+def test_esf_with_curvature_gives_the_second_derivative_of_the_esf(sensor, gaussian_px):
     """Of the interpolant esf() evaluates: against its central second
     difference (h = 2e-4 px: exact for the cubic within a grid interval,
     so the few points within h of a grid sample are left out, and 5e-6 off
@@ -49,7 +49,7 @@ def test_esf_curvature_is_the_second_derivative_of_the_esf(sensor, gaussian_px):
     knot = (d - response.start_px) / response.step_px
     away = np.abs(knot - np.round(knot)) * response.step_px > 1.5 * h
     second = (response.esf(d + h) - 2 * response.esf(d) + response.esf(d - h)) / h**2
-    curvature = response.esf_curvature(d)
+    _, curvature = response.esf_with_curvature(d)
     np.testing.assert_allclose(curvature[away], second[away], atol=2e-5)
     if gaussian_px is not None:
         s = gaussian_px
@@ -164,17 +164,18 @@ def test_a_grid_given_the_transfer_at_the_probe_is_the_one_it_computes():
 
 @pytest.mark.parametrize("sensor", [im.Sensor(), im.Sensor(1.0, [st.Diffraction(8.0), st.Detector()])],
                          ids=["gaussian", "cauchy"])
-def test_esf_with_curvature_is_esf_and_esf_curvature_bit_for_bit(sensor):
-    """The distances placed on the grid once: the same values as the two
-    methods, within the grid and beyond it (zero remainder there)."""
+def test_esf_with_curvature_is_esf_bit_for_bit(sensor):
+    """The distances placed on the grid once: the same values as esf(),
+    within the grid and beyond it (zero remainder there), and the same
+    curvature at the same distances however they are shaped."""
     response = sensor.line_response(5.0, reach_px=4.0)
     d = np.random.default_rng(5).uniform(-40, 40, (30, 20))
     esf, curvature = response.esf_with_curvature(d)
     assert esf.shape == curvature.shape == d.shape
-    assert np.array_equal(esf, response.esf(d)) and np.array_equal(curvature, response.esf_curvature(d))
+    assert np.array_equal(esf, response.esf(d))
+    assert np.array_equal(curvature.ravel(), response.esf_with_curvature(d.ravel())[1])
     near = np.linspace(-2, 2, 7)                       # all within the grid
-    assert [a.tolist() for a in response.esf_with_curvature(near)] == [response.esf(near).tolist(),
-                                                                       response.esf_curvature(near).tolist()]
+    assert response.esf_with_curvature(near)[0].tolist() == response.esf(near).tolist()
 
 
 def test_hermite_within_the_grid_and_beyond_alike():
@@ -183,8 +184,8 @@ def test_hermite_within_the_grid_and_beyond_alike():
     x = np.arange(-3.0, 3.01, 0.5)
     values, slopes = np.stack([x**3, x**2]), np.stack([3 * x**2, 2 * x])
     d = np.array([[-2.9, 0.3], [1.1, 2.99]])
-    within = hermite(-3.0, 0.5, values, slopes, d, derivative=(0, 2))
-    beyond = hermite(-3.0, 0.5, values, slopes, np.append(d, 7.0), derivative=(0, 2))
+    within = hermite(-3.0, 0.5, values, slopes, d, curvature=True)
+    beyond = hermite(-3.0, 0.5, values, slopes, np.append(d, 7.0), curvature=True)
     for a, b in zip(within, beyond):
         assert a.shape == (2, 2, 2) and b.shape == (2, 5)
         assert np.array_equal(a.reshape(2, 4), b[:, :4]) and not b[:, 4].any()

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from typing import Protocol, overload
+from typing import Literal, Protocol, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -59,20 +59,14 @@ class LineResponse:
             return value + width / (np.pi * (width**2 + d**2))
         return value + np.exp(-0.5 * (d / width) ** 2) / (width * math.sqrt(2 * math.pi))
 
-    def esf_curvature(self, d_px: ArrayLike) -> np.ndarray:
-        """The edge response's second derivative, the LSF's slope (1/px^2),
-        at signed distances ``d_px``: exactly that of the cubic Hermite
-        interpolant :meth:`esf` evaluates (linear between grid samples),
-        plus the reference's closed form.  What a mean of the ESF over
-        nearby distances needs beyond its value at their mean
-        (:mod:`imgmtf.estimate.fit`'s bins)."""
-        d = np.asarray(d_px, float)
-        value = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d, derivative=2)
-        return self._plus_reference_curvature(value, d)
-
     def esf_with_curvature(self, d_px: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`esf` and :meth:`esf_curvature` at signed distances
-        ``d_px`` (the same values), the distances placed on the grid once.
+        """:meth:`esf` (the same values) and its second derivative, the
+        LSF's slope, at signed distances ``d_px``, the distances placed on
+        the grid once.  The curvature is exactly that of the cubic Hermite
+        interpolant :meth:`esf` evaluates (linear between grid samples),
+        plus the reference's closed form: what a mean of the ESF over
+        nearby distances needs beyond its value at their mean
+        (:mod:`imgmtf.estimate.fit`'s bins).
 
         Parameters
         ----------
@@ -93,7 +87,7 @@ class LineResponse:
         """
         d = np.asarray(d_px, float)
         value, curvature = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d,
-                                   derivative=(0, 2))
+                                   curvature=True)
         return self._plus_reference_esf(value, d), self._plus_reference_curvature(curvature, d)
 
     def _plus_reference_esf(self, value: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -228,19 +222,19 @@ _cached_inverse_factors = lru_cache(maxsize=16)(_make_inverse_factors)
 
 @overload
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
-            d_px: np.ndarray, derivative: int = 0) -> np.ndarray: ...
+            d_px: np.ndarray, curvature: Literal[False] = False) -> np.ndarray: ...
 
 
 @overload
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
-            d_px: np.ndarray, derivative: tuple[int, ...]) -> tuple[np.ndarray, ...]: ...
+            d_px: np.ndarray, curvature: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
-            d_px: np.ndarray, derivative: int | tuple[int, ...] = 0) -> np.ndarray | tuple[np.ndarray, ...]:
+            d_px: np.ndarray, curvature: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Cubic Hermite interpolation of gridded ``values`` with their
-    ``slopes`` (per px) at ``d_px``, or the interpolant's second
-    derivative (per px^2); zero beyond the grid.
+    ``slopes`` (per px) at ``d_px``, and with ``curvature`` the
+    interpolant's second derivative (per px^2) too; zero beyond the grid.
 
     Parameters
     ----------
@@ -250,36 +244,25 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
         Samples on the grid, and their derivatives, one row per function.
     d_px : numpy.ndarray
         Where to interpolate, px.
-    derivative : {0, 2} or tuple of them, optional
-        0 (default): the interpolant; 2: its second derivative (linear
-        between grid samples, the cubic's); a tuple: each of them, the
-        distances placed on the grid once.
+    curvature : bool, optional
+        Also the interpolant's second derivative (linear between grid
+        samples, the cubic's), the distances placed on the grid once
+        (default False).
 
     Returns
     -------
-    numpy.ndarray, shape (..., len(d_px)), or a tuple of them
-        Each row's values at ``d_px`` (the shared weights computed once),
-        one array per derivative when ``derivative`` is a tuple.
-
-    Raises
-    ------
-    ValueError
-        A ``derivative`` other than 0 or 2.
+    numpy.ndarray, shape (..., len(d_px)), or a tuple of two
+        Each row's values at ``d_px`` (the shared weights computed once);
+        with ``curvature``, ``(values, second derivatives)``.
 
     Examples
     --------
     >>> grid = np.arange(5.0)
     >>> hermite(0.0, 1.0, grid**2, 2 * grid, np.array([1.5, 9.0])).tolist()   # exact for a cubic
     [2.25, 0.0]
-    >>> hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5, 2.25]), derivative=2).tolist()
-    [9.0, 13.5]
-    >>> [a.tolist() for a in hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5]), derivative=(0, 2))]
-    [[3.375], [9.0]]
+    >>> [a.tolist() for a in hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5, 2.25]), curvature=True)]
+    [[3.375, 11.390625], [9.0, 13.5]]
     """
-    orders = derivative if isinstance(derivative, tuple) else (derivative,)
-    for order in orders:
-        if order not in (0, 2):
-            raise ValueError(f"derivative must be 0 or 2, got {order!r}")
     d = np.asarray(d_px, float)
     t = ((d - start_px) / step_px).ravel()
     n = values.shape[-1]
@@ -292,19 +275,18 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
     u = t - k
     h = step_px
     near = (values[..., k], slopes[..., k], values[..., k + 1], slopes[..., k + 1])
+    bases = [((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)]
+    if curvature:             # the basis's second derivatives, by d_px
+        bases.append(((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h))
     outputs = []
-    for order in orders:
-        if order == 0:        # the cubic Hermite basis
-            weights = ((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)
-        else:                 # its second derivatives, by d_px
-            weights = ((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h)
+    for weights in bases:
         value = weights[0] * near[0] + weights[1] * near[1] + weights[2] * near[2] + weights[3] * near[3]
         if not everywhere:
             placed = np.zeros((*values.shape[:-1], d.size))
             placed[..., inside] = value
             value = placed
         outputs.append(value.reshape(values.shape[:-1] + d.shape))
-    return tuple(outputs) if isinstance(derivative, tuple) else outputs[0]
+    return (outputs[0], outputs[1]) if curvature else outputs[0]
 
 
 class _Blur(Protocol):

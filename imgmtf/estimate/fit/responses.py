@@ -37,8 +37,8 @@ KEPT_TRANSFERS = 8
 class EdgeResponses:
     """One edge's line responses for the sensors a fit evaluates, with what
     depends only on the edge's geometry and on unchanged stages kept from
-    one evaluation to the next (the same responses as
-    :func:`line_responses`, bit for bit).
+    one evaluation to the next (the same responses as a new
+    ``EdgeResponses`` makes, bit for bit).
 
     Parameters
     ----------
@@ -103,8 +103,7 @@ class EdgeResponses:
 
     def changes(self, sensor: Sensor, shifted: Sequence[Sensor]) -> tuple[LineResponse, np.ndarray, np.ndarray]:
         """The line response of ``sensor`` and the remainders of the
-        ``shifted`` sensors' minus its own on its grid (what
-        :func:`line_responses` returns for ``[sensor, *shifted]``).
+        ``shifted`` sensors' minus its own on its grid.
 
         Parameters
         ----------
@@ -176,45 +175,8 @@ class EdgeResponses:
         return reduce(operator.mul, values)
 
 
-def line_responses(sensors: Sequence[Sensor], angle_deg: float, gsd_m: float,
-                   reach_px: float) -> tuple[LineResponse, np.ndarray, np.ndarray]:
-    """The line response of ``sensors[0]`` along the normal of an edge
-    tilted ``angle_deg`` (pixels of ``gsd_m``), and the remainders of the
-    others' minus its own on its grid (one edge, once: a fit keeps an
-    :class:`EdgeResponses` per edge).
-
-    Parameters
-    ----------
-    sensors : sequence of Sensor
-        The sensor, then its shifted copies (same GSD, same chain).
-    angle_deg : float
-        The edge's tilt from the column axis, deg.
-    gsd_m : float
-        The edge's pixel, m.
-    reach_px : float
-        The farthest sample from the edge, px: the grid reaches it when a
-        Cauchy (diffraction) tail makes the remainder long.
-
-    Returns
-    -------
-    response : LineResponse
-        The first sensor's edge and line responses.
-    esf_changes, lsf_changes : numpy.ndarray, shape (len(sensors) - 1, grid size)
-        Each other sensor's ESF and LSF (1/px) less the first's, on the
-        grid of ``response`` (zero beyond it): for :func:`esf_changes`.
-
-    Examples
-    --------
-    >>> from imgmtf import Sensor
-    >>> response, esf, _ = line_responses([Sensor(), Sensor(motion_m=0.5)], 90.0, 1.0, 50.0)
-    >>> round(float(response.esf(0.0)), 6), esf.shape[0]
-    (0.5, 1)
-    """
-    return EdgeResponses(angle_deg, gsd_m, reach_px).changes(sensors[0], sensors[1:])
-
-
 def esf_changes(response: LineResponse, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray) -> np.ndarray:
-    """The changes of the edge response (:func:`line_responses`'
+    """The changes of the edge response (:meth:`EdgeResponses.changes`'
     ``esf_changes``, ``lsf_changes``) at signed distances ``d_px``, one
     row each.
 
@@ -235,7 +197,7 @@ def esf_changes(response: LineResponse, esf: np.ndarray, lsf: np.ndarray, d_px: 
     Examples
     --------
     >>> from imgmtf import Sensor
-    >>> response, esf, lsf = line_responses([Sensor(), Sensor(motion_m=0.5)], 90.0, 1.0, 50.0)
+    >>> response, esf, lsf = EdgeResponses(90.0, 1.0, 50.0).changes(Sensor(), [Sensor(motion_m=0.5)])
     >>> esf_changes(response, esf, lsf, np.array([-1.0, 0.0, 1.0])).round(3).tolist()   # wider: slower rise
     [[0.004, 0.0, -0.004]]
     """
