@@ -114,8 +114,10 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
     groups = [[r for r in accepted if r.site["target_id"] == target] for target in targets]
     # a half-edge without its measurement is measured again: by its task on workers, else here, once, for
     # its target's fit and the scene's
-    here = workers == 1 and scheduler is None
-    known = {id(r): _from_scan(r) if r.measurement is not None or not here else _measured([r])[0] for r in accepted}
+    known = {id(r): _from_scan(r) for r in accepted}
+    if workers == 1 and scheduler is None:
+        missing = [r for r in accepted if r.measurement is None]
+        known.update(zip(map(id, missing), _measured(missing)))
 
     def task(members: list[Record], site: dict, guess=None) -> tuple:
         return members, site, stages, [known[id(r)] for r in members], guess
