@@ -52,9 +52,9 @@ and MTF50, and a misfit warning when the residuals, binned along the
 normal, show structure the noise cannot explain.
 """
 from .data import EdgeImage, profile_noise
-from .fitting import Guess, fit_edges, fitted_coordinates, pooled_guess
+from .fitting import fit_edges
 from .model import check_names
 from .results import EdgeFit, FittedParameter, SensorFit
 
-__all__ = ["EdgeFit", "EdgeImage", "FittedParameter", "Guess", "SensorFit", "check_names", "fit_edges",
-           "fitted_coordinates", "pooled_guess", "profile_noise"]
+__all__ = ["EdgeFit", "EdgeImage", "FittedParameter", "SensorFit", "check_names", "fit_edges",
+           "profile_noise"]

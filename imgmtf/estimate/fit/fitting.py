@@ -3,8 +3,7 @@ stages freed or held by the likelihood ratio."""
 from __future__ import annotations
 
 import importlib
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,69 +31,10 @@ LIKELIHOOD_RATIO = 10.8
 WALD_MARGIN = 10.0
 
 
-@dataclass(frozen=True)
-class Guess:
-    """Where a fit starts, not what it holds: fit coordinates of some
-    stage parameters (each blur length in px raised to its power, keyed
-    "stage.name") and each edge's levels and offset (L, R DN, x0 px; None
-    where unknown).  A fit of edges whose subsets were fitted already
-    starts near its end (:func:`pooled_guess`); its result is the same
-    optimum, found in fewer iterations.
-
-    Examples
-    --------
-    >>> Guess({"optics.sigma_x_m": 0.18}, [(10.0, 200.0, 0.01), None]).nuisance[1] is None
-    True
-    """
-
-    coordinates: Mapping[str, float]
-    nuisance: Sequence[tuple[float, float, float] | None] = ()
-
-
-def pooled_guess(coordinates: Sequence[Mapping[str, tuple[float, float]]],
-                 nuisance: Sequence[tuple[float, float, float] | None] = ()) -> Guess:
-    """A :class:`Guess` from the fits of subsets of the edges: each
-    parameter at the precision-weighted mean of its fitted coordinates.
-
-    Parameters
-    ----------
-    coordinates : sequence of mapping
-        Per fit, its free parameters' (coordinate, variance) by key
-        (:func:`fitted_coordinates`).
-    nuisance : sequence
-        Each edge's levels and offset from its own fit, or None.
-
-    Returns
-    -------
-    Guess
-        Each parameter some fit freed at its pooled coordinate, and the
-        edges' levels and offsets as given.
-
-    Examples
-    --------
-    >>> pooled_guess([{"optics.sigma_x_m": (0.2, 1e-4)}, {"optics.sigma_x_m": (0.3, 4e-4)}]).coordinates
-    {'optics.sigma_x_m': 0.22}
-    """
-    weights: dict[str, float] = {}
-    sums: dict[str, float] = {}
-    for fit in coordinates:
-        for key, (value, variance) in fit.items():
-            if np.isfinite(value) and np.isfinite(variance) and variance > 0:
-                weights[key] = weights.get(key, 0.0) + 1.0 / variance
-                sums[key] = sums.get(key, 0.0) + value / variance
-    return Guess({key: round(sums[key] / weights[key], 15) for key in weights}, tuple(nuisance))
-
-
-def fitted_coordinates(fit: SensorFit) -> dict[str, tuple[float, float]]:
-    """A fit's free parameters' fit coordinates and their variances, by
-    key: what :func:`pooled_guess` pools."""
-    return {key: (float(fit._u[i]), float(fit._covariance[i, i])) for i, key in enumerate(fit._model.free)}
-
-
 def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
               stages: str | Sequence[str] | None = None, start: Sensor | None = None,
               hold: str | Sequence[str] = (), gsd_m: float | None = None,
-              confidence: float = 0.95, guess: Guess | None = None) -> SensorFit:
+              confidence: float = 0.95) -> SensorFit:
     """Fit a sensor's stages to the profiles of one or more edges, given as
     images or measurements (:func:`imgmtf.fit_sensor` reads files and
     takes windows, then calls this).
@@ -119,11 +59,6 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
         it, else 1 (parameters then in pixels).
     confidence : float, optional
         Of the intervals, in (0, 1) (default 0.95).
-    guess : Guess, optional
-        Where the fit starts (parameters' coordinates, each edge's levels
-        and offset, e.g. pooled from fits of subsets of ``edges``,
-        :func:`pooled_guess`); held parameters stay at ``start``'s values.
-
     Returns
     -------
     SensorFit
@@ -155,7 +90,7 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
     importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
     with one_blas_thread():
-        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence, guess)
+        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
 
 
 def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, gsd_m: float | None,
@@ -176,12 +111,12 @@ def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, 
     return stage_names(stages, start), gsd_m
 
 
-def run_fit(model: Model, hold, confidence: float, guess: Guess | None = None) -> SensorFit:
-    """Fit ``model`` from ``guess`` (default its starting values), holding
+def run_fit(model: Model, hold, confidence: float) -> SensorFit:
+    """Fit ``model`` from its starting values, holding
     what the data do not determine or need (see the module's notes), and
     report."""
     notes = model.screen_axes(hold_keys(hold, model.keys))
-    z = model.initial_vector(guess.coordinates if guess else None, guess.nuisance if guess else ())
+    z = model.initial_vector()
     while True:
         z, jacobian = model.solve(z)
         scale = max(model.reduced_chi_square(z), 1.0)

@@ -222,14 +222,10 @@ class Model:
         """Degrees of freedom of the samples' chi-square: samples - parameters."""
         return sum(d.x.size for d in self.data) - self.n_free - 3 * len(self.data)
 
-    def initial_vector(self, coordinates=None, nuisance=()) -> np.ndarray:
-        """The starting vector: the free parameters' starting coordinates
-        (or those ``coordinates`` gives), each edge's measured levels and
-        zero offset (or its entry of ``nuisance``, L, R, x0, when not None)."""
-        given = {**self.start, **(coordinates or {})}
-        guessed = list(nuisance) + [None] * (len(self.data) - len(nuisance))
-        edges = [v for d, g in zip(self.data, guessed) for v in (g if g is not None else (*d.levels, 0.0))]
-        return np.array([given[k] for k in self.free] + edges, float)
+    def initial_vector(self) -> np.ndarray:
+        """The starting vector: the free parameters' starting coordinates,
+        then each edge's measured levels and zero offset."""
+        return np.array([self.start[k] for k in self.free] + [v for d in self.data for v in (*d.levels, 0.0)], float)
 
     def bounds(self):
         upper = [self.specs[k].upper_px ** self.specs[k].power for k in self.free]
