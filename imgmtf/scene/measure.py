@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from ..atomic import ensure_folder
 from ..errors import ImageContentError, ImgmtfError, ParameterError
@@ -416,8 +418,6 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     were accepted) joined through the junctions they share; each target
     with an accepted half-edge gets a ``target_id`` (1, 2... in the order
     of its best rank is assigned after ranking, see :func:`_ranked`)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
     reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
     owners: dict[int, list[int]] = {}
     for i in reached:

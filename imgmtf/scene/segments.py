@@ -22,6 +22,12 @@ from itertools import pairwise
 
 import numpy as np
 
+# SciPy's graphs and trees (0.2-0.25 s to import) at the module's import: a scan imports this
+# while its workers start, not after their tiles when every other step waits for the graph
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
 MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
 MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line
 MERGE_GAP_PX = 6.0           # ... and leave at most this gap between them
@@ -139,7 +145,6 @@ def contacts(queries: np.ndarray, s: np.ndarray, radius: float,
     points: (query index, segment index) pairs, each pair once.  A k-d tree
     over points sampled along the segments: the cost grows with the number
     of contacts, not with the square of the number of segments."""
-    from scipy.spatial import cKDTree
     if len(queries) == 0 or len(s) == 0:
         return np.zeros(0, int), np.zeros(0, int)
     points, owner = sample_points(s, step)
@@ -221,8 +226,6 @@ def line_lengths(segments: np.ndarray) -> np.ndarray:
 def _merge_labels(pieces: np.ndarray) -> np.ndarray:
     """Which merged line each piece belongs to (connected components of
     the pairs :func:`merge_segments` joins)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
     lengths, units = segment_lengths(pieces), unit_vectors(pieces)
     q, b = contacts(pieces.reshape(-1, 2), pieces, MERGE_GAP_PX)
     a = q // 2
@@ -283,9 +286,6 @@ def find_junctions(segments: np.ndarray) -> tuple[list[Junction], np.ndarray]:
     id, t of the junction along the segment in px from its start), one per
     segment and partner.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
     segments = np.asarray(segments, float).reshape(-1, 4)
     empty = np.zeros((0, 4))
     if len(segments) < 2:
