@@ -30,9 +30,10 @@ Timed, in this process, after one warm-up run of each, the best of
    intervals of the accepted, combination) with 1 worker;
 3. the ``imgmtf scan`` command (a new process: its start-up, about 0.5 s
    of imports, and its outputs included), as a user runs it (the targets'
-   sensor fits included), with ``--fit-stages none`` and with
-   ``--workers 2``; the package's modules compiled first, as an installed
-   imgmtf has them (``_installed.py``);
+   sensor fits included), with ``--fit-stages none`` (the scan as it
+   was when its budgets were set, before it fitted targets: like for
+   like), with ``--workers 2``, and with both; the package's modules
+   compiled first, as an installed imgmtf has them (``_installed.py``);
 4. on the chart, ``imgmtf scan CHART`` against ``mtf_mapper -q -l CHART
    DIR`` (MTF Mapper 0.7.38; ``--mtfmapper PATH`` or the ``MTF_MAPPER``
    environment variable, else ``mtf_mapper`` on the PATH; the comparison
@@ -286,6 +287,8 @@ def main() -> None:
                 "cli": lambda: run_quietly(command("scan", str(path))),
                 "cli_nofit": lambda: run_quietly(command("scan", str(path), "--fit-stages", "none")),
                 "cli_workers": lambda: run_quietly(command("scan", str(path), "--workers", "2")),
+                "cli_workers_nofit": lambda: run_quietly(command("scan", str(path), "--workers", "2",
+                                                                 "--fit-stages", "none")),
                 "cli_out": lambda: run_quietly(command("scan", str(path), "--out", work)),
                 "chart": lambda: run_quietly(command("scan", str(chart_path), "--format", "json")),
                 "chart_nofit": lambda: run_quietly(command("scan", str(chart_path), "--format", "json",
@@ -309,6 +312,7 @@ def main() -> None:
         for name, label in (("cli", "imgmtf scan SCENE (new process, fits, text table)"),
                             ("cli_nofit", "imgmtf scan SCENE --fit-stages none"),
                             ("cli_workers", "imgmtf scan SCENE --workers 2 (CPU: not its workers')"),
+                            ("cli_workers_nofit", "imgmtf scan SCENE --workers 2 --fit-stages none"),
                             ("cli_out", "imgmtf scan SCENE --out DIR (CSV, GeoJSON, PNG)")):
             line(label, times[name], lsd, "LSD", "   (budget 2 x, aim 1.5 x)" if name == "cli" else "")
         print(f"chart {CHART_SIZE} x {CHART_SIZE}, {len(CHART_ANGLES)} dark squares, "
