@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 from matplotlib.figure import Figure
 
 import imgmtf as im
@@ -32,8 +33,6 @@ def test_two_measurements_on_one_axes_keep_the_callers_colours_and_one_nyquist_e
 
 
 def test_arguments_of_the_wrong_kind_are_named():
-    import pytest
-
     from imgmtf.plot import plot_fit_edge, plot_sensor
     result = _measured(6.0)
     for call, message in [(lambda: plot_mtf(None), "this figure draws a measurement .*, got NoneType"),
@@ -51,6 +50,30 @@ def test_a_scan_overview_takes_scan_scenes_records_as_they_come():
                                         "roi_polygon_px": [[0, 0], [20, 0], [20, 45], [0, 45]]})
     fig = plot_scan(np.zeros((50, 80)), 1.0, records)
     assert isinstance(fig, Figure)
+
+
+def test_a_scan_overview_keeps_crowded_targets_labels_apart_and_inside_the_image():
+    """Targets a few px apart: each label moves to a free spot (a leader to
+    its target when moved off the first ring), none covers another, all
+    stay inside the image."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    summaries = [{"scope": "target", "target_id": k, "x_px": x, "y_px": y, "summary": "fit",
+                  "direction": "across-track", "mtf_nyquist": 0.25, "mtf50_cy_px": 0.36}
+                 for k, (x, y) in enumerate([(100, 100), (104, 96), (96, 104), (100, 108), (102, 102), (98, 98),
+                                                  (392, 5)], 1)]
+    fig = plot_scan(np.zeros((200, 400)), 1.0, [], summaries)
+    ax = fig.axes[0]
+    labels = [t for t in ax.texts if t.get_text().startswith("T")]
+    assert len(labels) == 7
+    fig.draw_without_rendering()             # each label's text where it is drawn, its leader left out
+    boxes = [Text.get_window_extent(t) for t in labels]
+    frame = ax.get_window_extent()
+    assert all(_overlap(a, b) == 0 for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    assert all(_overlap(b, frame) == pytest.approx(b.width * b.height) for b in boxes)
+    assert any(t.arrow_patch is not None for t in labels)       # the crowded ones point back to their targets
 
 
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():

@@ -1,6 +1,7 @@
 """The overview figure of a scene scan: every candidate coloured by its verdict."""
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -49,8 +50,9 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     summaries : iterable of Record or mapping, optional
         The per-target summaries (``scope`` "target", records or
         dicts, as :func:`imgmtf.summarise_scan` returns them): each
-        target is labelled at its centre with, per direction, MTF at
-        Nyquist and MTF50 (cy/px).
+        target is labelled beside its centre with, per direction, MTF at
+        Nyquist and MTF50 (cy/px); crowded targets' labels move apart,
+        each with a leader to its target, and stay inside the image.
     levels : (float, float), optional
         (black, white) DN of the display; default the 0.5 and 99.5
         percentiles.
@@ -140,18 +142,14 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         for r in accepted:          # each accepted half-edge's id, as in the table and the CSV
             labels.add(r, (0.85, 1.0, 0.85, 0.95), "#004d00", zorder=7, weight="bold")
     targets = [s for s in summary_rows if s.get("scope") == TARGET_SCOPE]
+    target_labels = []
     for target_id in sorted({s["target_id"] for s in targets}):
         rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
         lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"
                                      for s in rows]
-        if len(lines) == 1:
-            continue
-        x, y = rows[0]["x_px"], rows[0]["y_px"]
-        right, low = x > 0.7 * extent_w, y < 0.15 * extent_h       # keep the label inside the image
-        ax.annotate("\n".join(lines), (x, y), xytext=(-6 if right else 6, -6 if low else 6),
-                    textcoords="offset points", fontsize=6.5, color="black", va="top" if low else "bottom",
-                    ha="right" if right else "left", annotation_clip=True, zorder=8,
-                    bbox={"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "#00a000", "lw": 0.8})
+        if len(lines) > 1:
+            target_labels.append(((rows[0]["x_px"], rows[0]["y_px"]), "\n".join(lines)))
+    _place_target_labels(ax, target_labels)
     n_targets = len({s["target_id"] for s in targets})
     ids = "ids as in the table and the CSV" + (f" ({unlabelled} in reasons too common to label)" if unlabelled
                                                  else "")
@@ -162,6 +160,51 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7,
                   title="candidates (ids)", title_fontsize=7, alignment="left", frameon=False)
     return fig
+
+
+#: where a target's label may go: its box's corner this many points from the
+#: target's centre, nearest first, in each quadrant
+LABEL_OFFSETS_PT = (6.0, 20.0, 40.0, 64.0)
+
+
+def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]]) -> None:
+    """Each target's label beside its centre where it overlaps no label
+    placed before it (nor an id) and stays inside the image: the nearest
+    free spot of the four quadrants at :data:`LABEL_OFFSETS_PT`, or the
+    least covered one; a label moved off its first ring gets a leader."""
+    style = {"textcoords": "offset points", "fontsize": 6.5, "color": "black", "annotation_clip": True,
+             "zorder": 8, "bbox": {"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "#00a000",
+                                   "lw": 0.8}}
+    frame = ax.get_window_extent()
+    taken = [t.get_window_extent() for t in ax.texts]           # the ids drawn already
+    pad = 3.0 * ax.figure.dpi / 72.0                             # the label's box around its text
+    for xy, text in labels:
+        probe = ax.annotate(text, xy, xytext=(0.0, 0.0), **style)
+        best: tuple = (math.inf, 0, (LABEL_OFFSETS_PT[0], LABEL_OFFSETS_PT[0]), None)
+        for ring, offset in enumerate(LABEL_OFFSETS_PT):
+            for sx, sy in ((1, 1), (-1, 1), (1, -1), (-1, -1)):
+                probe.xyann = (sx * offset, sy * offset)
+                probe.set_horizontalalignment("left" if sx > 0 else "right")
+                probe.set_verticalalignment("bottom" if sy > 0 else "top")
+                box = probe.get_window_extent().padded(pad)
+                covered = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
+                if covered < best[0]:
+                    best = (covered, ring, probe.xyann, box)
+            if best[0] == 0:
+                break
+        probe.remove()
+        _, ring, (dx, dy), box = best
+        leader = {"arrowprops": {"arrowstyle": "-", "color": "#00a000", "lw": 0.7}} if ring else {}
+        ax.annotate(text, xy, xytext=(dx, dy), ha="left" if dx > 0 else "right", va="bottom" if dy > 0 else "top",
+                    **style, **leader)
+        taken.append(box)
+
+
+def _overlap(a, b) -> float:
+    """The area two display boxes share (0 when apart)."""
+    w = min(a.x1, b.x1) - max(a.x0, b.x0)
+    h = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return w * h if w > 0 and h > 0 else 0.0
 
 
 def _ends(record) -> list[tuple[float, float]]:
