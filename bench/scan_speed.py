@@ -40,8 +40,9 @@ Timed, in this process, after one warm-up run of each, the best of
    is skipped, saying so, when it is not found), each a new process;
 5. the start-up every such process pays before its first pixel, the
    floor of the chart's ratio: a new Python importing the libraries the
-   design names (NumPy, OpenCV, rasterio, SciPy's sparse graphs, spatial
-   trees and optimizer), then also imgmtf's scan and fit modules.
+   design names (NumPy, OpenCV, rasterio, SciPy's sparse graphs and
+   spatial trees: a scan's without fits), then also SciPy's optimizer
+   (the fits' least_squares), then also imgmtf's scan and fit modules.
 
 Printed: the load average (the machine is shared: time when it is low),
 the times (wall, and CPU of the process and its children: less hostage to
@@ -257,7 +258,8 @@ def accepted_edges(run: subprocess.CompletedProcess) -> int:
 
 #: what a scan's process must import before its first pixel: the libraries the design names (and,
 #: second, imgmtf's own scan and fit modules): a floor no work done in Python can go below
-LIBRARIES = "import numpy, cv2, rasterio, scipy.sparse.csgraph, scipy.spatial, scipy.optimize"
+GRAPH_LIBRARIES = "import numpy, cv2, rasterio, scipy.sparse.csgraph, scipy.spatial"
+LIBRARIES = GRAPH_LIBRARIES + ", scipy.optimize"
 MODULES = LIBRARIES + "; import imgmtf.cli.main, imgmtf.scene.series, imgmtf.scene.measure, imgmtf.estimate.fit"
 
 
@@ -294,6 +296,7 @@ def main() -> None:
                 "chart_nofit": lambda: run_quietly(command("scan", str(chart_path), "--format", "json",
                                                            "--fit-stages", "none")),
             })
+            jobs["graph_libraries"] = lambda: run_quietly([sys.executable, "-c", GRAPH_LIBRARIES])
             jobs["libraries"] = lambda: run_quietly([sys.executable, "-c", LIBRARIES])
             jobs["modules"] = lambda: run_quietly([sys.executable, "-c", MODULES])
             if peer:
@@ -322,7 +325,8 @@ def main() -> None:
             line("  mtf_mapper -q -l CHART DIR", peer_timing, more=f"{peer_timing.out[1]} edges measured")
         else:
             print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
-        for name, label in (("libraries", "Python importing NumPy, OpenCV, rasterio, SciPy"),
+        for name, label in (("graph_libraries", "Python importing NumPy, OpenCV, rasterio, SciPy graphs"),
+                            ("libraries", "... and SciPy's optimizer (the fits')"),
                             ("modules", "... and imgmtf's scan and fit modules")):
             line("  " + label, times[name], peer_timing, "MTF Mapper" if peer_timing else "",
                  "   (start-up: the floor)")
