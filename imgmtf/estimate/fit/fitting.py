@@ -59,6 +59,7 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
         it, else 1 (parameters then in pixels).
     confidence : float, optional
         Of the intervals, in (0, 1) (default 0.95).
+
     Returns
     -------
     SensorFit
