@@ -59,7 +59,8 @@ class LineResponse:
             return value + width / (np.pi * (width**2 + d**2))
         return value + np.exp(-0.5 * (d / width) ** 2) / (width * math.sqrt(2 * math.pi))
 
-    def esf_with_curvature(self, d_px: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    def esf_with_curvature(self, d_px: ArrayLike,
+                           placement: HermitePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`esf` (the same values) and its second derivative, the
         LSF's slope, at signed distances ``d_px``, the distances placed on
         the grid once.  The curvature is exactly that of the cubic Hermite
@@ -72,6 +73,10 @@ class LineResponse:
         ----------
         d_px : array_like
             Signed distances from the edge, px.
+        placement : HermitePlacement, optional
+            ``d_px`` placed on this response's grid with the curvature's
+            weights (:meth:`placement`), when the caller keeps it for other
+            functions on the grid (default: placed here).
 
         Returns
         -------
@@ -86,24 +91,55 @@ class LineResponse:
         ([0.5, 0.9756], True)
         """
         d = np.asarray(d_px, float)
-        value, curvature = hermite(self.start_px, self.step_px, self.esf_remainder, self.lsf_remainder, d,
-                                   curvature=True)
+        if placement is None:
+            placement = self.placement(d, curvature=True)
+        value, curvature = placement.interpolate(self.esf_remainder, self.lsf_remainder, curvature=True)
         return self._plus_reference_esf(value, d), self._plus_reference_curvature(curvature, d)
+
+    def placement(self, d_px: ArrayLike, curvature: bool = False) -> HermitePlacement:
+        """Signed distances ``d_px`` placed on this response's grid
+        (:func:`hermite_placement`), for :meth:`esf_with_curvature` and for
+        other functions on the grid (the changes of a fit's Jacobian)."""
+        return hermite_placement(self.start_px, self.step_px, self.esf_remainder.size, d_px, curvature)
 
     def _plus_reference_esf(self, value: np.ndarray, d: np.ndarray) -> np.ndarray:
         """``value``, the remainder's ESF at ``d``, plus the reference's."""
-        kind, width = self.reference
-        if kind == "cauchy":
-            return value + 0.5 + np.arctan(d / width) / np.pi
-        from scipy.special import ndtr
-        return value + ndtr(d / width)
+        return plus_reference_esf(value, self.reference[0], self.reference[1], d)
 
     def _plus_reference_curvature(self, value: np.ndarray, d: np.ndarray) -> np.ndarray:
         """``value``, the remainder's ESF curvature at ``d``, plus the reference's."""
         kind, width = self.reference
-        if kind == "cauchy":
-            return value - 2 * width * d / (np.pi * (width**2 + d**2) ** 2)
-        return value - d * np.exp(-0.5 * (d / width) ** 2) / (width**3 * math.sqrt(2 * math.pi))
+        return plus_reference_curvature(value, kind, width, reference_scale(self.reference), d)
+
+
+def plus_reference_esf(value: np.ndarray, kind: str, width: float | np.ndarray, d: np.ndarray) -> np.ndarray:
+    """``value`` (a remainder's ESF at ``d`` px) plus the ESF of a
+    reference of kind ``kind`` ("cauchy" or "gaussian") and ``width`` px,
+    one for all distances or one per distance (each as its own line
+    response gives it, bit for bit)."""
+    if kind == "cauchy":
+        return value + 0.5 + np.arctan(d / width) / np.pi
+    from scipy.special import ndtr
+    return value + ndtr(d / width)
+
+
+def reference_scale(reference: tuple[str, float]) -> float:
+    """The constant of a reference's ESF curvature
+    (:func:`plus_reference_curvature`): a Gaussian's s^3 sqrt(2 pi), a
+    Cauchy LSF's b^2."""
+    kind, width = reference
+    return width**2 if kind == "cauchy" else width**3 * math.sqrt(2 * math.pi)
+
+
+def plus_reference_curvature(value: np.ndarray, kind: str, width: float | np.ndarray, scale: float | np.ndarray,
+                             d: np.ndarray) -> np.ndarray:
+    """``value`` (a remainder's ESF curvature at ``d`` px, 1/px^2) plus
+    that of a reference of kind ``kind``, ``width`` px and
+    :func:`reference_scale` ``scale``, one for all distances or one per
+    distance."""
+    if kind == "cauchy":
+        return value - 2 * width * d / (np.pi * (scale + d**2) ** 2)
+    return value - d * np.exp(-0.5 * (d / width) ** 2) / scale
 
 
 def reference_transfer(reference: tuple[str, float], f: np.ndarray) -> np.ndarray:
@@ -220,6 +256,133 @@ def _make_inverse_factors(step_px: float, size: int) -> tuple[np.ndarray, np.nda
 _cached_inverse_factors = lru_cache(maxsize=16)(_make_inverse_factors)
 
 
+@dataclass(frozen=True, eq=False)
+class HermitePlacement:
+    """Distances placed on a grid (:func:`hermite_placement`): each one's
+    interval and the cubic Hermite weights of its ends' values and slopes,
+    what every function interpolated on that grid at those distances
+    shares (a fit's residuals and its Jacobian's columns, at one point).
+
+    Attributes
+    ----------
+    shape : tuple of int
+        The distances' shape.
+    inside : numpy.ndarray or None
+        The flat indices of the distances on their grid; None when all are.
+    index : numpy.ndarray
+        The left sample of each one's interval (with its grid's offset).
+    weights : tuple
+        The weights of the interval's left value and slope, right value and
+        slope: for the values, and when placed with ``curvature`` for their
+        second derivatives (per px^2) too.
+    """
+
+    shape: tuple[int, ...]
+    inside: np.ndarray | None
+    index: np.ndarray
+    weights: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+
+    @overload
+    def interpolate(self, values: np.ndarray, slopes: np.ndarray,
+                    curvature: Literal[False] = False) -> np.ndarray: ...
+
+    @overload
+    def interpolate(self, values: np.ndarray, slopes: np.ndarray,
+                    curvature: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+    @overload
+    def interpolate(self, values: np.ndarray, slopes: np.ndarray,
+                    curvature: bool) -> np.ndarray | tuple[np.ndarray, np.ndarray]: ...
+
+    def interpolate(self, values: np.ndarray, slopes: np.ndarray,
+                    curvature: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """:func:`hermite` of ``values`` and ``slopes`` (shape (..., size),
+        or the grids' concatenated) at the placed distances: the values, and
+        with ``curvature`` (when placed with it) their second derivatives
+        too."""
+        if curvature and len(self.weights) < 2:
+            raise ValueError("these distances were placed without the curvature's weights")
+        k = self.index
+        right = k + 1
+        near = (values[..., k], slopes[..., k], values[..., right], slopes[..., right])
+        outputs = []
+        for weights in self.weights[: 2 if curvature else 1]:
+            value = weights[0] * near[0] + weights[1] * near[1] + weights[2] * near[2] + weights[3] * near[3]
+            if self.inside is not None:
+                placed = np.zeros((*values.shape[:-1], math.prod(self.shape)))
+                placed[..., self.inside] = value
+                value = placed
+            outputs.append(value.reshape(values.shape[:-1] + self.shape))
+        return (outputs[0], outputs[1]) if curvature else outputs[0]
+
+
+def hermite_placement(start_px: float | np.ndarray, step_px: float | np.ndarray, size: int | np.ndarray,
+                      d_px: ArrayLike, curvature: bool = False, offset: int | np.ndarray = 0) -> HermitePlacement:
+    """Distances ``d_px`` placed on a grid of ``size`` samples from
+    ``start_px`` every ``step_px`` px, with the weights of cubic Hermite
+    interpolation there (and with ``curvature`` those of its second
+    derivative): for :meth:`HermitePlacement.interpolate`, once for every
+    function on that grid.  Several grids side by side (their samples
+    concatenated) take per-distance ``start_px``, ``step_px``, ``size`` and
+    ``offset`` (where its grid begins among the concatenated samples),
+    each distance then placed as on its grid alone, bit for bit.
+
+    Parameters
+    ----------
+    start_px, step_px : float or numpy.ndarray
+        The grid's first sample and step, px; or each distance's grid's
+        (shaped like ``d_px``).
+    size : int or numpy.ndarray
+        The grid's samples (at least 2); or each distance's grid's.
+    d_px : array_like
+        Where to interpolate, px.
+    curvature : bool, optional
+        Also the weights of the interpolant's second derivative (default
+        False).
+    offset : int or numpy.ndarray, optional
+        Where the (each distance's) grid's first sample is among the
+        values interpolated (default 0).
+
+    Returns
+    -------
+    HermitePlacement
+        The placement.
+
+    Examples
+    --------
+    >>> grid = np.arange(5.0)
+    >>> placement = hermite_placement(0.0, 1.0, 5, [1.5, 9.0])
+    >>> placement.interpolate(grid**2, 2 * grid).tolist(), placement.interpolate(grid**3, 3 * grid**2).tolist()
+    ([2.25, 0.0], [3.375, 0.0])
+    >>> both = np.concatenate([grid**2, grid**3]), np.concatenate([2 * grid, 3 * grid**2])
+    >>> hermite_placement(0.0, 1.0, 5, [1.5, 1.5], offset=np.array([0, 5])).interpolate(*both).tolist()
+    [2.25, 3.375]
+    """
+    d = np.asarray(d_px, float)
+    t = ((d - start_px) / step_px).ravel()
+    inside = (t >= 0) & (t <= size - 1)
+    placed = None
+    if not bool(inside.all()):        # beyond the grid: zero, nothing to compute
+        placed = np.flatnonzero(inside)
+        t = t[placed]
+        if np.ndim(step_px):
+            step_px = np.ravel(step_px)[placed]
+        if np.ndim(size):
+            size = np.ravel(size)[placed]
+        if np.ndim(offset):
+            offset = np.ravel(offset)[placed]
+    k = np.minimum(t.astype(np.intp), size - 2)
+    u = t - k
+    h = step_px
+    falling, squared = (1 - u) ** 2, u * u
+    weights = [((1 + 2 * u) * falling, u * falling * h, squared * (3 - 2 * u), squared * (u - 1) * h)]
+    if curvature:             # the basis's second derivatives, by d_px
+        twelve, six = 12 * u, 6 * u
+        weights.append(((twelve - 6) / h**2, (six - 4) / h, (6 - twelve) / h**2, (six - 2) / h))
+    index = k + offset if np.ndim(offset) or offset else k
+    return HermitePlacement(d.shape, placed, index, tuple(weights))
+
+
 @overload
 def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndarray,
             d_px: np.ndarray, curvature: Literal[False] = False) -> np.ndarray: ...
@@ -252,8 +415,9 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
     Returns
     -------
     numpy.ndarray, shape (..., len(d_px)), or a tuple of two
-        Each row's values at ``d_px`` (the shared weights computed once);
-        with ``curvature``, ``(values, second derivatives)``.
+        Each row's values at ``d_px`` (the shared weights computed once:
+        :func:`hermite_placement`); with ``curvature``, ``(values, second
+        derivatives)``.
 
     Examples
     --------
@@ -263,30 +427,8 @@ def hermite(start_px: float, step_px: float, values: np.ndarray, slopes: np.ndar
     >>> [a.tolist() for a in hermite(0.0, 1.0, grid**3, 3 * grid**2, np.array([1.5, 2.25]), curvature=True)]
     [[3.375, 11.390625], [9.0, 13.5]]
     """
-    d = np.asarray(d_px, float)
-    t = ((d - start_px) / step_px).ravel()
-    n = values.shape[-1]
-    inside = (t >= 0) & (t <= n - 1)
-    everywhere = bool(inside.all())
-    if not everywhere:        # beyond the grid: zero, nothing to compute
-        inside = np.flatnonzero(inside)
-        t = t[inside]
-    k = np.minimum(t.astype(np.intp), n - 2)
-    u = t - k
-    h = step_px
-    near = (values[..., k], slopes[..., k], values[..., k + 1], slopes[..., k + 1])
-    bases = [((1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2 * h, u * u * (3 - 2 * u), u * u * (u - 1) * h)]
-    if curvature:             # the basis's second derivatives, by d_px
-        bases.append(((12 * u - 6) / h**2, (6 * u - 4) / h, (6 - 12 * u) / h**2, (6 * u - 2) / h))
-    outputs = []
-    for weights in bases:
-        value = weights[0] * near[0] + weights[1] * near[1] + weights[2] * near[2] + weights[3] * near[3]
-        if not everywhere:
-            placed = np.zeros((*values.shape[:-1], d.size))
-            placed[..., inside] = value
-            value = placed
-        outputs.append(value.reshape(values.shape[:-1] + d.shape))
-    return (outputs[0], outputs[1]) if curvature else outputs[0]
+    placement = hermite_placement(start_px, step_px, values.shape[-1], d_px, curvature)
+    return placement.interpolate(values, slopes, curvature)
 
 
 class _Blur(Protocol):

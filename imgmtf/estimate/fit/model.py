@@ -31,11 +31,11 @@ import numpy as np
 
 from ...errors import ImgmtfError, ParameterError
 from ...metrics import first_crossing
-from ...sensor.lines import LineResponse
+from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .data import EdgeData, ProfileBins
-from .responses import EdgeResponses, esf_changes
+from .responses import EdgeResponses, StackedResponses, esf_changes
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -149,13 +149,15 @@ class Model:
         self.start = {k: v for s in stages for k, v in stage_coordinates(s, gsd).items()}
         # a bin's residual weight: its mean's noise is noise / sqrt(count)
         self.weights = [np.sqrt(d.bins.count) / d.noise for d in data]
+        self.counts = [d.bins.x.size for d in data]
+        self._stacked_bins: tuple[ProfileBins, np.ndarray] | None = None
         self.values = dict(self.start)           # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.normal_angle_deg, d.gsd_m, self.reach(d)) for d in data]
-        self._last_esfs: tuple = (None, [])
+        self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
 
@@ -266,15 +268,34 @@ class Model:
     def release(self) -> None:
         """Drop what the evaluations keep (each edge's grids, transfers
         and responses, the last responses, ESFs, samples' residuals and
-        stages made), which a finished fit no longer uses: what it still
+        stages made, the edges' bins side by side), which a finished fit no longer uses: what it still
         asks (:func:`model_mtf_band`, the sensor's transfer) is made
         afresh.  The model evaluates as before, computing them again."""
         for edge in self.edges:
             edge.release()
         self._last_responses = (None, [])
-        self._last_esfs = (None, [])
+        self._last_esfs = (None, None, None)
         self._last_samples = (None, [])
         self._stages_made.clear()
+        self._stacked_bins = None
+
+    @property
+    def bins(self) -> ProfileBins:
+        """Every edge's bins in turn (the residuals' order), evaluated in one
+        pass; made when first asked, and again after :meth:`release`."""
+        return self._stack_bins()[0]
+
+    @property
+    def weight(self) -> np.ndarray:
+        """Every edge's bins' residual weights in turn."""
+        return self._stack_bins()[1]
+
+    def _stack_bins(self) -> tuple[ProfileBins, np.ndarray]:
+        if self._stacked_bins is None:
+            self._stacked_bins = (ProfileBins(*(np.concatenate([getattr(d.bins, name) for d in self.data])
+                                                for name in ("count", "x", "y", "m2"))),
+                                  np.concatenate(self.weights))
+        return self._stacked_bins
 
     @staticmethod
     def reach(d: EdgeData) -> float:
@@ -284,15 +305,19 @@ class Model:
     # -- least squares ------------------------------------------------------------
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
         u = z[: self.n_free]
-        responses = responses or self.responses(u)
-        out, esfs = [], []
-        for e, (d, r) in enumerate(zip(self.data, responses)):
-            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            esfs.append(bin_esf(r, d.bins, x0))
-            out.append(self.weights[e] * (d.bins.y - (lo + (hi - lo) * esfs[-1])))
-        # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its columns'
-        self._last_esfs = ((tuple(self.free), z.tobytes()), esfs)
-        return np.concatenate(out)
+        lo, hi, x0 = self.levels(z)
+        stacked = StackedResponses(responses or self.responses(u), self.counts)
+        placement = stacked.placement(self.bins.x - x0, curvature=True)
+        esf = bin_esf(stacked, self.bins, x0, placement)
+        # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its
+        # columns', and their bins' places on the grids those of the changes
+        self._last_esfs = ((tuple(self.free), z.tobytes()), esf, placement)
+        return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
+
+    def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``."""
+        lo, hi, x0 = (np.repeat(z[self.n_free + j::3], self.counts) for j in range(3))
+        return lo, hi, x0
 
     def jacobian(self, z: np.ndarray):
         """The residuals' Jacobian at ``z``, sparse: the stage columns by
@@ -318,39 +343,43 @@ class Model:
             moved[k] += steps[k]
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
-        known = self._last_esfs[1] if self._last_esfs[0] == (tuple(self.free), z.tobytes()) else None
-        stage_columns, blocks, base = [], [], []
-        for e, d in enumerate(self.data):
-            lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-            response, esf_change, lsf_change = self.edges[e].changes(sensor, shifted)
+        base, esf_change, lsf_change = [], [], []
+        for edge in self.edges:
+            response, esf_rows, lsf_rows = edge.changes(sensor, shifted)
             base.append(response)
-            weight = self.weights[e]
-            changes = esf_changes(response, esf_change, lsf_change, d.bins.x - x0)
-            stage_columns.append(changes.T * weight[:, None] * (-(hi - lo) / steps))
-            esf = known[e] if known is not None else bin_esf(response, d.bins, x0)
-            blocks.append(np.column_stack([(esf - 1) * weight, -esf * weight,
-                                           (hi - lo) * weight * response.lsf(d.bins.x - x0)]))
+            esf_change.append(esf_rows)
+            lsf_change.append(lsf_rows)
+        lo, hi, x0 = self.levels(z)
+        d = self.bins.x - x0
+        stacked = StackedResponses(base, self.counts)
+        if self._last_esfs[0] == (tuple(self.free), z.tobytes()):
+            esf, placement = self._last_esfs[1:]
+        else:
+            placement = stacked.placement(d, curvature=True)
+            esf = bin_esf(stacked, self.bins, x0, placement)
+        changes = esf_changes(stacked, np.concatenate(esf_change, axis=-1), np.concatenate(lsf_change, axis=-1),
+                              d, placement)
+        spans = z[self.n_free + 1::3] - z[self.n_free::3]
+        stage_columns = changes.T * self.weight[:, None] * np.repeat(-spans[:, None] / steps, self.counts, axis=0)
+        lsf = np.concatenate([r.lsf(part) for r, part in zip(base, np.split(d, np.cumsum(self.counts)[:-1]))])
+        blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
         self._last_responses = ((tuple(self.free), u.tobytes()), base)
+        # each edge's levels and offset act on its own bins only
+        nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
         if not self.sparse:
             jacobian = np.zeros((self.rows, self.n_free + 3 * len(self.data)))
-            jacobian[:, : self.n_free] = np.concatenate(stage_columns)
-            row = 0
-            for e, block in enumerate(blocks):
-                jacobian[row: row + len(block), self.n_free + 3 * e: self.n_free + 3 * e + 3] = block
-                row += len(block)
+            jacobian[:, : self.n_free] = stage_columns
+            jacobian[np.arange(self.rows)[:, None], nuisance] = blocks
             return jacobian
-        # each edge's levels and offset act on its own samples only: a sparse
-        # Jacobian, whose size grows with the edges, not with their square;
-        # every row holds the stage columns, then its edge's three, so its
-        # compressed rows are written directly
+        # a sparse Jacobian, whose size grows with the edges, not with their
+        # square; every row holds the stage columns, then its edge's three, so
+        # its compressed rows are written directly
         from scipy import sparse
         per_row = self.n_free + 3
-        sizes = [d.bins.x.size for d in self.data]
-        nuisance = np.repeat(self.n_free + 3 * np.arange(len(sizes)), sizes)[:, None] + np.arange(3)
         indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
-        values = np.hstack([np.concatenate(stage_columns), np.concatenate(blocks)])
+        values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), np.arange(0, values.size + 1, per_row)),
-                                shape=(values.shape[0], self.n_free + 3 * len(sizes)))
+                                shape=(values.shape[0], self.n_free + 3 * len(self.counts)))
 
     @property
     def sparse(self) -> bool:
@@ -426,11 +455,15 @@ class Model:
         return out
 
 
-def bin_esf(response: LineResponse, bins: ProfileBins, x0: float) -> np.ndarray:
+def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
+            placement: HermitePlacement | None = None) -> np.ndarray:
     """The mean of the edge response over each bin's samples, for an edge
     at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
-    third and higher moments' terms (see :data:`.data.FIT_BIN_PX`)."""
-    value, curvature = response.esf_with_curvature(bins.x - x0)
+    third and higher moments' terms (see :data:`.data.FIT_BIN_PX`).
+    Several edges' bins in turn take their :class:`.responses.StackedResponses`
+    and each bin's edge's ``x0``; ``placement``, when given, is the bins'
+    distances placed on the response's grid with the curvature's weights."""
+    value, curvature = response.esf_with_curvature(bins.x - x0, placement)
     return value + 0.5 * bins.m2 * curvature
 
 

@@ -23,10 +23,21 @@ import math
 import operator
 from collections.abc import Sequence
 from functools import reduce
+from typing import Any
 
 import numpy as np
 
-from ...sensor.lines import PROBE_CY_PX, LineGrid, LineResponse, hermite, line_grid
+from ...sensor.lines import (
+    PROBE_CY_PX,
+    HermitePlacement,
+    LineGrid,
+    LineResponse,
+    hermite_placement,
+    line_grid,
+    plus_reference_curvature,
+    plus_reference_esf,
+    reference_scale,
+)
 from ...sensor.model import Sensor
 from ...sensor.stages import Stage
 
@@ -175,19 +186,25 @@ class EdgeResponses:
         return reduce(operator.mul, values)
 
 
-def esf_changes(response: LineResponse, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray) -> np.ndarray:
+def esf_changes(response: LineResponse | StackedResponses, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray,
+                placement: HermitePlacement | None = None) -> np.ndarray:
     """The changes of the edge response (:meth:`EdgeResponses.changes`'
     ``esf_changes``, ``lsf_changes``) at signed distances ``d_px``, one
     row each.
 
     Parameters
     ----------
-    response : LineResponse
-        The response whose grid they are on.
+    response : LineResponse or StackedResponses
+        The response whose grid they are on (or several edges' responses,
+        the changes' grids then concatenated, as their remainders are).
     esf, lsf : numpy.ndarray, shape (k, grid size)
         The changes of its ESF and LSF (1/px).
     d_px : numpy.ndarray
         Distances from the edge, px.
+    placement : HermitePlacement, optional
+        ``d_px`` placed on the response's grid (its ``placement``), when the
+        caller has it (the residuals' at the same point); default: placed
+        here.
 
     Returns
     -------
@@ -201,4 +218,69 @@ def esf_changes(response: LineResponse, esf: np.ndarray, lsf: np.ndarray, d_px: 
     >>> esf_changes(response, esf, lsf, np.array([-1.0, 0.0, 1.0])).round(3).tolist()   # wider: slower rise
     [[0.004, 0.0, -0.004]]
     """
-    return hermite(response.start_px, response.step_px, esf, lsf, d_px)
+    if placement is None:
+        placement = response.placement(d_px)
+    return placement.interpolate(esf, lsf)
+
+
+class StackedResponses:
+    """Several edges' line responses side by side, each read at its own
+    distances: their remainders concatenated and, per distance, its
+    edge's grid and reference, so that every edge's distances are placed,
+    interpolated and their references added in one pass over all of them
+    (bit for bit what each response alone gives).
+
+    Parameters
+    ----------
+    responses : sequence of LineResponse
+        The edges' responses (of one sensor: one kind of reference).
+    counts : sequence of int
+        How many distances each edge has, in the order they come.
+
+    Raises
+    ------
+    ValueError
+        Responses with references of different kinds.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> responses = [Sensor().line_response(angle) for angle in (5.0, 80.0)]
+    >>> stacked = StackedResponses(responses, [2, 1])
+    >>> d = np.array([-0.5, 0.5, 0.5])
+    >>> esf, _ = stacked.esf_with_curvature(d, stacked.placement(d, curvature=True))
+    >>> esf.tolist() == [*responses[0].esf(d[:2]), *responses[1].esf(d[2:])]
+    True
+    """
+
+    def __init__(self, responses: Sequence[LineResponse], counts: Sequence[int]):
+        kinds = {r.reference[0] for r in responses}
+        if len(kinds) != 1:
+            raise ValueError(f"the responses' references are of several kinds: {', '.join(sorted(kinds))}")
+        self.kind = kinds.pop()
+        sizes = [r.esf_remainder.size for r in responses]
+
+        def each(values: list) -> Any:
+            """One value per distance, from one per edge (one for all when they agree)."""
+            return values[0] if all(v == values[0] for v in values) else np.repeat(values, counts)
+
+        self.start_px, self.step_px = each([r.start_px for r in responses]), each([r.step_px for r in responses])
+        self.size, self.offset = each(sizes), each(np.cumsum([0, *sizes[:-1]]).tolist())
+        self.width = each([r.reference[1] for r in responses])
+        self.scale = each([reference_scale(r.reference) for r in responses])
+        self.esf_remainder = np.concatenate([r.esf_remainder for r in responses])
+        self.lsf_remainder = np.concatenate([r.lsf_remainder for r in responses])
+
+    def placement(self, d_px: np.ndarray, curvature: bool = False) -> HermitePlacement:
+        """The distances (each edge's, in turn) placed on their edges' grids."""
+        return hermite_placement(self.start_px, self.step_px, self.size, d_px, curvature, self.offset)
+
+    def esf_with_curvature(self, d_px: np.ndarray,
+                           placement: HermitePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Each edge's :meth:`LineResponse.esf_with_curvature` at its distances, in turn."""
+        d = np.asarray(d_px, float)
+        if placement is None:
+            placement = self.placement(d, curvature=True)
+        value, curvature = placement.interpolate(self.esf_remainder, self.lsf_remainder, curvature=True)
+        return (plus_reference_esf(value, self.kind, self.width, d),
+                plus_reference_curvature(curvature, self.kind, self.width, self.scale, d))
