@@ -146,11 +146,14 @@ class Model:
                 self.specs[key] = spec
                 self.keys.append(key)
                 self.units[key] = stage.units()[name]
+        # each stage's parameters: (key, name), in the order the coordinates are
+        self._stage_keys = [[(f"{stage.name}.{name}", name) for name in stage.fit_specs()] for stage in stages]
         self.start = {k: v for s in stages for k, v in stage_coordinates(s, gsd).items()}
         # a bin's residual weight: its mean's noise is noise / sqrt(count)
         self.weights = [np.sqrt(d.bins.count) / d.noise for d in data]
         self.counts = [d.bins.x.size for d in data]
         self._stacked_bins: tuple[ProfileBins, np.ndarray] | None = None
+        self._layout: tuple = (None, None, None)
         self.values = dict(self.start)           # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
@@ -244,7 +247,7 @@ class Model:
         if len(self._stages_made) > 1024:
             self._stages_made.clear()
         for index, stage in enumerate(self.stages):
-            own = {k.split(".", 1)[1]: float(v) for k, v in coords.items() if k.split(".")[0] == stage.name}
+            own = {name: float(coords[key]) for key, name in self._stage_keys[index]}
             if not own:
                 stages.append(stage)
                 continue
@@ -278,6 +281,7 @@ class Model:
         self._last_samples = (None, [])
         self._stages_made.clear()
         self._stacked_bins = None
+        self._layout = (None, None, None)
 
     @property
     def bins(self) -> ProfileBins:
@@ -306,13 +310,17 @@ class Model:
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
         u = z[: self.n_free]
         lo, hi, x0 = self.levels(z)
-        stacked = StackedResponses(responses or self.responses(u), self.counts)
+        stacked = self.stacked(responses or self.responses(u))
         placement = stacked.placement(self.bins.x - x0, curvature=True)
         esf = bin_esf(stacked, self.bins, x0, placement)
         # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its
         # columns', and their bins' places on the grids those of the changes
         self._last_esfs = ((tuple(self.free), z.tobytes()), esf, placement)
         return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
+
+    def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
+        """The edges' responses side by side, for their bins in turn (one edge's alone)."""
+        return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts)
 
     def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``."""
@@ -351,7 +359,7 @@ class Model:
             lsf_change.append(lsf_rows)
         lo, hi, x0 = self.levels(z)
         d = self.bins.x - x0
-        stacked = StackedResponses(base, self.counts)
+        stacked = self.stacked(base)
         if self._last_esfs[0] == (tuple(self.free), z.tobytes()):
             esf, placement = self._last_esfs[1:]
         else:
@@ -364,22 +372,27 @@ class Model:
         lsf = np.concatenate([r.lsf(part) for r, part in zip(base, np.split(d, np.cumsum(self.counts)[:-1]))])
         blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
         self._last_responses = ((tuple(self.free), u.tobytes()), base)
-        # each edge's levels and offset act on its own bins only
-        nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
+        columns = self.n_free + 3 * len(self.counts)
+        indices, starts = self._jacobian_layout()
         if not self.sparse:
-            jacobian = np.zeros((self.rows, self.n_free + 3 * len(self.data)))
-            jacobian[:, : self.n_free] = stage_columns
-            jacobian[np.arange(self.rows)[:, None], nuisance] = blocks
+            jacobian = np.zeros((self.rows, columns))
+            jacobian[np.arange(self.rows)[:, None], indices] = np.hstack([stage_columns, blocks])
             return jacobian
-        # a sparse Jacobian, whose size grows with the edges, not with their
-        # square; every row holds the stage columns, then its edge's three, so
-        # its compressed rows are written directly
         from scipy import sparse
-        per_row = self.n_free + 3
-        indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
         values = np.hstack([stage_columns, blocks])
-        return sparse.csr_array((values.ravel(), indices.ravel(), np.arange(0, values.size + 1, per_row)),
-                                shape=(values.shape[0], self.n_free + 3 * len(self.counts)))
+        return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
+
+    def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each row's columns in the Jacobian, the stage columns then its
+        edge's levels' and offset's (which act on its own bins only), and
+        where each row starts among them (its compressed rows: a sparse
+        Jacobian, whose size grows with the edges, not with their square,
+        is written directly); made once for the free parameters."""
+        if self._layout[0] != self.n_free:
+            nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
+            indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
+            self._layout = (self.n_free, indices, np.arange(0, indices.size + 1, indices.shape[1]))
+        return self._layout[1:]
 
     @property
     def sparse(self) -> bool:
