@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes
+from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes, shared_transfers
 from imgmtf.sensor import stages as st
 
 
@@ -107,3 +107,23 @@ def test_an_edge_keeps_its_base_stages_transfers_not_a_shifts(monkeypatch):
         edge.response(im.Sensor(1.0, [st.GaussianOptics(sigma, sigma), detector]))
     assert len(edge._transfers) == KEPT_TRANSFERS
     assert (detector, 1.0) in edge._transfers                           # used at every evaluation
+
+
+def test_transfers_shared_by_edges_give_each_edge_its_own_responses_bit_for_bit():
+    """Stages' transfers computed for several edges at once (shared_transfers)
+    give each edge the responses and changes it makes alone, bit for bit,
+    over a fit's sensors (a grid twice as long included: what was computed
+    on the old grid is not read on the new)."""
+    angles = (3.0, 40.0, 84.0)
+    shared = [EdgeResponses(a, 1.0, 25.0) for a in angles]
+    alone = [EdgeResponses(a, 1.0, 25.0) for a in angles]
+    for sensor, shifted in fit_like_sensors():
+        given = shared_transfers(shared, sensor.stages, sensor.gsd_m)
+        for edge, own, g in zip(shared, alone, given):
+            assert same_response(edge.response(sensor, g), own.response(sensor))
+        given = shared_transfers(shared, [s for other in shifted for s in other.stages], sensor.gsd_m)
+        assert any(given)
+        for edge, own, g in zip(shared, alone, given):
+            _, esf, lsf = edge.changes(sensor, shifted, g)
+            _, own_esf, own_lsf = own.changes(sensor, shifted)
+            assert np.array_equal(esf, own_esf) and np.array_equal(lsf, own_lsf)

@@ -35,7 +35,7 @@ from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .data import EdgeData, ProfileBins
-from .responses import EdgeResponses, StackedResponses, esf_changes
+from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -265,7 +265,8 @@ class Model:
         key = (tuple(self.free), u.tobytes())
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
-            self._last_responses = (key, [edge.response(sensor) for edge in self.edges])
+            given = shared_transfers(self.edges, sensor.stages, sensor.gsd_m)
+            self._last_responses = (key, [edge.response(sensor, g) for edge, g in zip(self.edges, given)])
         return self._last_responses[1]
 
     def release(self) -> None:
@@ -352,8 +353,9 @@ class Model:
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
         base, esf_change, lsf_change = [], [], []
-        for edge in self.edges:
-            response, esf_rows, lsf_rows = edge.changes(sensor, shifted)
+        given = shared_transfers(self.edges, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
+        for edge, g in zip(self.edges, given):
+            response, esf_rows, lsf_rows = edge.changes(sensor, shifted, g)
             base.append(response)
             esf_change.append(esf_rows)
             lsf_change.append(lsf_rows)

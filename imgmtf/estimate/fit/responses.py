@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from functools import reduce
 from typing import Any
 
@@ -96,13 +96,17 @@ class EdgeResponses:
         self._normal = (np.zeros(0), np.zeros(0))
         self._transfers.clear()
 
-    def response(self, sensor: Sensor) -> LineResponse:
+    def response(self, sensor: Sensor, given: Given | None = None) -> LineResponse:
         """The line response of ``sensor`` along the edge's normal.
 
         Parameters
         ----------
         sensor : Sensor
             The sensor.
+        given : dict, optional
+            Stages' transfers computed for several edges at once
+            (:func:`shared_transfers`), used where on this edge's current
+            frequencies.
 
         Returns
         -------
@@ -110,9 +114,10 @@ class EdgeResponses:
             Its edge and line responses (the last one's kept: the same
             object for the same stages and GSD).
         """
-        return self._base(sensor)[2]
+        return self._base(sensor, given)[2]
 
-    def changes(self, sensor: Sensor, shifted: Sequence[Sensor]) -> tuple[LineResponse, np.ndarray, np.ndarray]:
+    def changes(self, sensor: Sensor, shifted: Sequence[Sensor],
+                given: Given | None = None) -> tuple[LineResponse, np.ndarray, np.ndarray]:
         """The line response of ``sensor`` and the remainders of the
         ``shifted`` sensors' minus its own on its grid.
 
@@ -122,6 +127,8 @@ class EdgeResponses:
             The sensor.
         shifted : sequence of Sensor
             Its shifted copies (same GSD, same chain).
+        given : dict, optional
+            As for :meth:`response` (the shifted stages' transfers).
 
         Returns
         -------
@@ -131,14 +138,14 @@ class EdgeResponses:
             Each shifted sensor's ESF and LSF (1/px) less the first's, on the
             grid of ``response``: for :func:`esf_changes`.
         """
-        grid, base, response = self._base(sensor)
+        grid, base, response = self._base(sensor, given)
         spectra = np.empty((len(shifted), base.size))
         for row, other in zip(spectra, shifted):
-            np.subtract(self._transfer(other, keep=False)[1:], base, out=row)
+            np.subtract(self._transfer(other, keep=False, given=given)[1:], base, out=row)
         esf, lsf = grid.remainders(spectra)
         return response, esf, lsf
 
-    def _base(self, sensor: Sensor) -> tuple[LineGrid, np.ndarray, LineResponse]:
+    def _base(self, sensor: Sensor, given: Given | None = None) -> tuple[LineGrid, np.ndarray, LineResponse]:
         """The grid, transfer and response of ``sensor``, the last one's kept."""
         key = (sensor.gsd_m, sensor.stages)
         if self._last is None or self._last[0] != key:
@@ -146,11 +153,11 @@ class EdgeResponses:
             reach = self.reach_px if tailed else 0.0
             # without a tail the grid's reference reads the transfer at the probe, which comes with
             # the transfer on the last grid's frequencies: the next grid's, but when its size changes
-            transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True)
+            transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
             grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
                              transfer_at_probe=None if transfer is None else float(transfer[0]))
             if self._use(grid) or transfer is None:
-                transfer = self._transfer(sensor, keep=True)
+                transfer = self._transfer(sensor, keep=True, given=given)
             self._last = (key, grid, transfer[1:], grid.response(transfer[1:]))
         return self._last[1:]
 
@@ -166,16 +173,22 @@ class EdgeResponses:
         self._transfers.clear()
         return True
 
-    def _transfer(self, sensor: Sensor, keep: bool) -> np.ndarray:
+    def _transfer(self, sensor: Sensor, keep: bool, given: Given | None = None) -> np.ndarray:
         """The transfer of ``sensor`` along the normal at the probe and the
         current grid's frequencies: the product of its stages' (in their
-        order), each taken from those kept when there; ``keep`` keeps
-        those computed."""
+        order), each taken from those kept when there, else from those
+        ``given`` on these frequencies; ``keep`` keeps those computed."""
         values = []
         for stage in sensor.stages:
             key = (stage, sensor.gsd_m)
             kept = self._transfers.pop(key, None)
-            value = stage.transfer(*self._normal, sensor.gsd_m) if kept is None else kept
+            ready = (given or {}).get(key)
+            if kept is not None:
+                value = kept
+            elif ready is not None and ready[0] == self._on:
+                value = ready[1]
+            else:
+                value = stage.transfer(*self._normal, sensor.gsd_m)
             if kept is None and keep:
                 value.flags.writeable = False
                 while len(self._transfers) >= KEPT_TRANSFERS:
@@ -184,6 +197,65 @@ class EdgeResponses:
                 self._transfers[key] = value        # the latest used last: the first to go is the longest unused
             values.append(value)
         return reduce(operator.mul, values)
+
+
+#: stages' transfers on an edge's frequencies, each with those frequencies'
+#: grid (step, size): {(stage, GSD): ((step, size), transfer)}
+Given = dict[tuple[Stage, float], tuple[tuple[float, int], np.ndarray]]
+
+
+def shared_transfers(edges: Sequence[EdgeResponses], stages: Iterable[Stage], gsd_m: float) -> list[Given]:
+    """The transfers of ``stages`` at ``gsd_m`` that ``edges`` do not keep,
+    on each edge's current frequencies, in one call per stage for all of
+    them (their frequencies concatenated) rather than one per edge: for
+    their :meth:`EdgeResponses.response` and :meth:`EdgeResponses.changes`.
+    A stage's transfer is the same function of each frequency, so each
+    edge's part is what it computes alone, bit for bit.
+
+    Parameters
+    ----------
+    edges : sequence of EdgeResponses
+        The edges (those not evaluated yet have no frequencies: nothing).
+    stages : iterable of Stage
+        The stages (repeats computed once).
+    gsd_m : float
+        The sensor's GSD, m.
+
+    Returns
+    -------
+    list of dict
+        Per edge, {(stage, GSD): ((step, size), transfer)}: with the grid
+        whose frequencies they are on (an edge whose grid changed before
+        it reads them computes its own).
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> edges = [EdgeResponses(angle, 1.0, 20.0) for angle in (5.0, 80.0)]
+    >>> _ = [edge.response(Sensor()) for edge in edges]                     # their grids
+    >>> wider = Sensor(optics_sigma_x_m=0.5)
+    >>> given = shared_transfers(edges, wider.stages, wider.gsd_m)
+    >>> [len(g) for g in given]                                               # the optics: not kept
+    [1, 1]
+    >>> edges[0].response(wider, given[0]).esf(0.3) == EdgeResponses(5.0, 1.0, 20.0).response(wider).esf(0.3)
+    np.True_
+    """
+    out: list[Given] = [{} for _ in edges]
+    for stage in dict.fromkeys(stages):
+        key = (stage, gsd_m)
+        lacking = []
+        for e, edge in enumerate(edges):
+            if edge._on is not None and key not in edge._transfers:
+                lacking.append((e, edge._on, edge._normal))
+        if len(lacking) < 2:
+            continue                # one edge's alone: as it would
+        values = stage.transfer(np.concatenate([fx for _, _, (fx, _) in lacking]),
+                                np.concatenate([fy for _, _, (_, fy) in lacking]), gsd_m)
+        start = 0
+        for e, on, (fx, _) in lacking:
+            out[e][key] = (on, values[start: start + fx.size])
+            start += fx.size
+    return out
 
 
 def esf_changes(response: LineResponse | StackedResponses, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray,
