@@ -272,9 +272,10 @@ class Model:
     def release(self) -> None:
         """Drop what the evaluations keep (each edge's grids, transfers
         and responses, the last responses, ESFs, samples' residuals and
-        stages made, the edges' bins side by side), which a finished fit no longer uses: what it still
-        asks (:func:`model_mtf_band`, the sensor's transfer) is made
-        afresh.  The model evaluates as before, computing them again."""
+        stages made, the edges' bins side by side and the Jacobian's
+        layout), which a finished fit no longer uses: what it still asks
+        (:func:`model_mtf_band`, the sensor's transfer) is made afresh.  The
+        model evaluates as before, computing them again."""
         for edge in self.edges:
             edge.release()
         self._last_responses = (None, [])

@@ -16,6 +16,13 @@ again (the last sensor's grid, transfer and response, which the
 Jacobian at the point of the last residuals starts from; the transfers
 of its stages on the grid, which held stages and unshifted ones reuse),
 so an evaluation computes only what its parameters changed.
+
+A fit's edges are evaluated together where that costs fewer NumPy calls
+and changes no number: a stage's transfer on every edge's frequencies in
+one call (:func:`shared_transfers`), every edge's bins read from their
+responses in one pass (:class:`StackedResponses`).  Each edge's inverse FFT
+stays its own: stacked, the transforms ran slower (19 edges' grids of 2048
+samples: 1.1 ms against 0.8 ms one by one, their arrays out of cache).
 """
 from __future__ import annotations
 
