@@ -379,7 +379,8 @@ class Model:
         indices, starts = self._jacobian_layout()
         if not self.sparse:
             jacobian = np.zeros((self.rows, columns))
-            jacobian[np.arange(self.rows)[:, None], indices] = np.hstack([stage_columns, blocks])
+            jacobian[:, : self.n_free] = stage_columns
+            jacobian[np.arange(self.rows)[:, None], indices[:, self.n_free:]] = blocks
             return jacobian
         from scipy import sparse
         values = np.hstack([stage_columns, blocks])

@@ -337,22 +337,18 @@ class StackedResponses:
         if len(kinds) != 1:
             raise ValueError(f"the responses' references are of several kinds: {', '.join(sorted(kinds))}")
         self.kind = kinds.pop()
-        sizes = [r.esf_remainder.size for r in responses]
+        self.responses, self.counts = list(responses), list(counts)
 
-        def each(values: list) -> Any:
-            """One value per distance, from one per edge (one for all when they agree)."""
-            return values[0] if all(v == values[0] for v in values) else np.repeat(values, counts)
-
-        self.start_px, self.step_px = each([r.start_px for r in responses]), each([r.step_px for r in responses])
-        self.size, self.offset = each(sizes), each(np.cumsum([0, *sizes[:-1]]).tolist())
-        self.width = each([r.reference[1] for r in responses])
-        self.scale = each([reference_scale(r.reference) for r in responses])
-        self.esf_remainder = np.concatenate([r.esf_remainder for r in responses])
-        self.lsf_remainder = np.concatenate([r.lsf_remainder for r in responses])
+    def _each(self, values: list) -> Any:
+        """One value per distance, from one per edge (one for all when they agree)."""
+        return values[0] if all(v == values[0] for v in values) else np.repeat(values, self.counts)
 
     def placement(self, d_px: np.ndarray, curvature: bool = False) -> HermitePlacement:
         """The distances (each edge's, in turn) placed on their edges' grids."""
-        return hermite_placement(self.start_px, self.step_px, self.size, d_px, curvature, self.offset)
+        sizes = [r.esf_remainder.size for r in self.responses]
+        return hermite_placement(self._each([r.start_px for r in self.responses]),
+                                 self._each([r.step_px for r in self.responses]), self._each(sizes), d_px,
+                                 curvature, self._each(np.cumsum([0, *sizes[:-1]]).tolist()))
 
     def esf_with_curvature(self, d_px: np.ndarray,
                            placement: HermitePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -360,6 +356,10 @@ class StackedResponses:
         d = np.asarray(d_px, float)
         if placement is None:
             placement = self.placement(d, curvature=True)
-        value, curvature = placement.interpolate(self.esf_remainder, self.lsf_remainder, curvature=True)
-        return (plus_reference_esf(value, self.kind, self.width, d),
-                plus_reference_curvature(curvature, self.kind, self.width, self.scale, d))
+        value, curvature = placement.interpolate(np.concatenate([r.esf_remainder for r in self.responses]),
+                                                 np.concatenate([r.lsf_remainder for r in self.responses]),
+                                                 curvature=True)
+        width = self._each([r.reference[1] for r in self.responses])
+        scale = self._each([reference_scale(r.reference) for r in self.responses])
+        return (plus_reference_esf(value, self.kind, width, d),
+                plus_reference_curvature(curvature, self.kind, width, scale, d))
