@@ -152,6 +152,7 @@ class Model:
         # a bin's residual weight: its mean's noise is noise / sqrt(count)
         self.weights = [np.sqrt(d.bins.count) / d.noise for d in data]
         self.counts = [d.bins.x.size for d in data]
+        self.starts = np.cumsum([0, *self.counts[:-1]]).tolist()      # each edge's first bin among all
         self._stacked_bins: tuple[ProfileBins, np.ndarray] | None = None
         self._layout: tuple = (None, None, None)
         self.values = dict(self.start)           # coordinates of held parameters live here
@@ -325,9 +326,19 @@ class Model:
         return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts)
 
     def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``."""
-        lo, hi, x0 = (np.repeat(z[self.n_free + j::3], self.counts) for j in range(3))
+        """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``
+        (:meth:`per_bin`)."""
+        lo, hi, x0 = (self.per_bin(z[self.n_free + j::3]) for j in range(3))
         return lo, hi, x0
+
+    def per_bin(self, values: np.ndarray) -> np.ndarray:
+        """One row per bin of ``values``' one per edge: each edge's repeated
+        over its bins; one edge's as it is (broadcast over them)."""
+        return values if len(self.counts) == 1 else np.repeat(values, self.counts, axis=0)
+
+    def side_by_side(self, arrays: list[np.ndarray]) -> np.ndarray:
+        """Each edge's ``arrays`` (by bin or grid sample, on the last axis) joined in turn."""
+        return arrays[0] if len(arrays) == 1 else np.concatenate(arrays, axis=-1)
 
     def jacobian(self, z: np.ndarray):
         """The residuals' Jacobian at ``z``, sparse: the stage columns by
@@ -368,30 +379,32 @@ class Model:
         else:
             placement = stacked.placement(d, curvature=True)
             esf = bin_esf(stacked, self.bins, x0, placement)
-        changes = esf_changes(stacked, np.concatenate(esf_change, axis=-1), np.concatenate(lsf_change, axis=-1),
-                              d, placement)
+        changes = esf_changes(stacked, self.side_by_side(esf_change), self.side_by_side(lsf_change), d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
-        stage_columns = changes.T * self.weight[:, None] * np.repeat(-spans[:, None] / steps, self.counts, axis=0)
-        lsf = np.concatenate([r.lsf(part) for r, part in zip(base, np.split(d, np.cumsum(self.counts)[:-1]))])
+        stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
+        lsf = self.side_by_side([r.lsf(d[start: start + count])
+                                 for r, start, count in zip(base, self.starts, self.counts)])
         blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
         self._last_responses = ((tuple(self.free), u.tobytes()), base)
         columns = self.n_free + 3 * len(self.counts)
-        indices, starts = self._jacobian_layout()
         if not self.sparse:
             jacobian = np.zeros((self.rows, columns))
             jacobian[:, : self.n_free] = stage_columns
-            jacobian[np.arange(self.rows)[:, None], indices[:, self.n_free:]] = blocks
+            for e, (start, count) in enumerate(zip(self.starts, self.counts)):
+                rows, first = slice(start, start + count), self.n_free + 3 * e
+                jacobian[rows, first: first + 3] = blocks[rows]
             return jacobian
         from scipy import sparse
+        indices, starts = self._jacobian_layout()
         values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
-        """Each row's columns in the Jacobian, the stage columns then its
-        edge's levels' and offset's (which act on its own bins only), and
-        where each row starts among them (its compressed rows: a sparse
-        Jacobian, whose size grows with the edges, not with their square,
-        is written directly); made once for the free parameters."""
+        """Each row's columns in a sparse Jacobian, the stage columns then
+        its edge's levels' and offset's (which act on its own bins only),
+        and where each row starts among them: its compressed rows, written
+        directly (its size grows with the edges, not with their square);
+        made once for the free parameters."""
         if self._layout[0] != self.n_free:
             nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
             indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])

@@ -248,6 +248,8 @@ def shared_transfers(edges: Sequence[EdgeResponses], stages: Iterable[Stage], gs
     np.True_
     """
     out: list[Given] = [{} for _ in edges]
+    if len(edges) < 2:
+        return out                  # one edge's alone: as it would
     for stage in dict.fromkeys(stages):
         key = (stage, gsd_m)
         lacking = []
