@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from imgmtf.scene.segments import (
+    SampledSegments,
     Segment,
     find_junctions,
     line_lengths,
@@ -99,6 +100,18 @@ def test_a_segment_beside_another_reports_how_far():
     assert near[0] == pytest.approx(12.0 * 80 / np.hypot(80, 2), abs=0.05)
     # a bar's own sides do not count
     assert parallel_clearance([Segment(10, 0, 12, 80, width_px=24.0)], segments, 20.0)[0] == np.inf
+
+
+def test_sampled_segments_find_what_their_rows_find():
+    # a checkerboard's four half-edges (its line's halves reversed) with a line crossing and one beside
+    segments = np.vstack([checkerboard_segments(), [[20, 70, 90, 75], [61, 10, 69, 48]]])
+    sampled = SampledSegments.of(segments)
+    junctions, events = find_junctions(segments)
+    assert find_junctions(sampled) == (junctions, pytest.approx(events)) and len(junctions) == 2
+    assert split_at_junctions(sampled, junctions, events) == split_at_junctions(segments, junctions, events)
+    assert list(line_lengths(sampled)) == pytest.approx(line_lengths(segments))
+    candidates = [Segment(*row) for row in segments]
+    assert list(parallel_clearance(candidates, sampled, 20.0)) == list(parallel_clearance(candidates, segments, 20.0))
 
 
 def test_segment_angles_follow_the_estimators():

@@ -38,7 +38,15 @@ from .detect import detect_segments
 from .fill import fill_mask, fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, Roi, clear_extent, plan_roi
 from .screen import geometry_screen, quick_look
-from .segments import BAR_MAX_SEPARATION_PX, HalfEdge, find_junctions, pair_bars, parallel_clearance, split_at_junctions
+from .segments import (
+    BAR_MAX_SEPARATION_PX,
+    HalfEdge,
+    SampledSegments,
+    find_junctions,
+    pair_bars,
+    parallel_clearance,
+    split_at_junctions,
+)
 from .settings import ScanSettings
 
 MIN_CONFIDENCE = 0.3            # an accepted target's SNR is at least this fraction of what its length needs
@@ -146,8 +154,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; an edge or bar chip needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
     segments, fill_fraction = detect_segments(path, settings, workers=workers, scheduler=scheduler, progress=progress)
-    junctions, events = find_junctions(segments)
-    halves = split_at_junctions(segments, junctions, events, fill_fraction)
+    sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
+    junctions, events = find_junctions(sampled)
+    halves = split_at_junctions(sampled, junctions, events, fill_fraction)
     track = track_azimuth(info, settings)
     params = {**settings.measure_settings().params(), "track_azimuth_deg": track, "scan": settings.as_dict()}
     if figures_dir is not None:
@@ -157,7 +166,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                   for half, verdict in _candidates(halves, settings)]
     unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
     beside = np.full(len(candidates), np.inf)
-    beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], segments,
+    beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
                                             settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
     records: list[Record] = []
     plans: list[Plan] = []

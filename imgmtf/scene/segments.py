@@ -139,18 +139,49 @@ def sample_points(s: np.ndarray, step: float = SAMPLE_STEP_PX) -> tuple[np.ndarr
     return points, owner
 
 
-def contacts(queries: np.ndarray, s: np.ndarray, radius: float,
+@dataclass(frozen=True, eq=False)
+class SampledSegments:
+    """Segments (rows x0, y0, x1, y1) with points sampled every ``step``
+    px or closer along each (:func:`sample_points`: ``points``, and
+    ``owner``, the segment of each) and a k-d tree over those points: built
+    once, for every search of contacts with the same segments (the scan's
+    junctions, straight lines and neighbours alike)."""
+
+    segments: np.ndarray
+    points: np.ndarray
+    owner: np.ndarray
+    tree: cKDTree
+    step: float
+
+    @classmethod
+    def of(cls, segments: np.ndarray, step: float = SAMPLE_STEP_PX) -> SampledSegments:
+        segments = np.asarray(segments, float).reshape(-1, 4)
+        points, owner = sample_points(segments, step)
+        return cls(segments, points, owner, cKDTree(points), step)
+
+
+def rows_of(segments: np.ndarray | SampledSegments) -> np.ndarray:
+    """The segments' rows (x0, y0, x1, y1), whether sampled or not."""
+    if isinstance(segments, SampledSegments):
+        return segments.segments
+    return np.asarray(segments, float).reshape(-1, 4)
+
+
+def contacts(queries: np.ndarray, s: np.ndarray | SampledSegments, radius: float,
              step: float = SAMPLE_STEP_PX) -> tuple[np.ndarray, np.ndarray]:
     """Which segments pass within about ``radius`` px of which query
     points: (query index, segment index) pairs, each pair once.  A k-d tree
-    over points sampled along the segments: the cost grows with the number
-    of contacts, not with the square of the number of segments."""
-    if len(queries) == 0 or len(s) == 0:
+    over points sampled along the segments (every ``step`` px, or as
+    sampled already when ``s`` is a :class:`SampledSegments`): the cost
+    grows with the number of contacts, not with the square of the number
+    of segments."""
+    n = len(rows_of(s))
+    if len(queries) == 0 or n == 0:
         return np.zeros(0, int), np.zeros(0, int)
-    points, owner = sample_points(s, step)
-    near = cKDTree(queries).sparse_distance_matrix(cKDTree(points), radius + step / 2, output_type="ndarray")
-    key = np.unique(near["i"].astype(np.int64) * len(s) + owner[near["j"]])
-    return key // len(s), key % len(s)
+    sampled = s if isinstance(s, SampledSegments) else SampledSegments.of(s, step)
+    near = cKDTree(queries).sparse_distance_matrix(sampled.tree, radius + sampled.step / 2, output_type="ndarray")
+    key = np.unique(near["i"].astype(np.int64) * n + sampled.owner[near["j"]])
+    return key // n, key % n
 
 
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int, ordered: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -208,26 +239,31 @@ def merge_pieces(pieces: np.ndarray, beside_fill: np.ndarray) -> tuple[np.ndarra
     return merged[keep], fill[keep]
 
 
-def line_lengths(segments: np.ndarray) -> np.ndarray:
+def line_lengths(segments: np.ndarray | SampledSegments) -> np.ndarray:
     """For each segment, the length (px) of the straight line it lies on
     whatever the polarity: collinear segments that meet end to end (the
     two halves of a checkerboard's inner line, whose polarity flips at its
-    centre) count as one line."""
-    segments = np.asarray(segments, float).reshape(-1, 4)
+    centre) count as one line.  ``segments``: rows (x0, y0, x1, y1), or
+    :class:`SampledSegments` of them (whose tree this reuses)."""
+    sampled = segments
+    segments = rows_of(segments)
     if len(segments) < 2:
         return segment_lengths(segments)
     units = unit_vectors(segments)
     flip = (units[:, 0] < 0) | ((units[:, 0] == 0) & (units[:, 1] < 0))
     canonical = np.where(flip[:, None], segments[:, [2, 3, 0, 1]], segments)
-    label = _merge_labels(canonical)
+    # a segment turned round passes by the same points: the contacts of its ends are the same
+    label = _merge_labels(canonical, sampled)
     return segment_lengths(_joined(canonical, label))[label]
 
 
-def _merge_labels(pieces: np.ndarray) -> np.ndarray:
+def _merge_labels(pieces: np.ndarray, near: np.ndarray | SampledSegments | None = None) -> np.ndarray:
     """Which merged line each piece belongs to (connected components of
-    the pairs :func:`merge_segments` joins)."""
+    the pairs :func:`merge_segments` joins); ``near``: where to seek the
+    contacts of the pieces' ends, the pieces themselves (default) or the
+    same segments, sampled, turned round or not."""
     lengths, units = segment_lengths(pieces), unit_vectors(pieces)
-    q, b = contacts(pieces.reshape(-1, 2), pieces, MERGE_GAP_PX)
+    q, b = contacts(pieces.reshape(-1, 2), pieces if near is None else near, MERGE_GAP_PX)
     a = q // 2
     keep = a != b
     a, b = a[keep], b[keep]
@@ -276,25 +312,31 @@ def _crossing(s: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return s[a, :2] + t[:, None] * ua
 
 
-def find_junctions(segments: np.ndarray) -> tuple[list[Junction], np.ndarray]:
+def find_junctions(segments: np.ndarray | SampledSegments) -> tuple[list[Junction], np.ndarray]:
     """Where segments meet: an end within ``JUNCTION_REACH_PX`` of another
     segment, or two segments crossing, at least ``JUNCTION_ANGLE_DEG``
     apart in direction.  Meeting points closer than ``JUNCTION_MERGE_PX``
     are one junction.
 
+    ``segments``: rows (x0, y0, x1, y1), or :class:`SampledSegments` of
+    them (whose tree this reuses).
+
     Returns the junctions and the events (rows: segment, partner, junction
     id, t of the junction along the segment in px from its start), one per
     segment and partner.
     """
-    segments = np.asarray(segments, float).reshape(-1, 4)
     empty = np.zeros((0, 4))
-    if len(segments) < 2:
+    if len(rows_of(segments)) < 2:
         return [], empty
+    sampled = segments
+    if not isinstance(sampled, SampledSegments) or sampled.step != SAMPLE_STEP_PX:
+        sampled = SampledSegments.of(rows_of(segments))
+    segments = sampled.segments
     lengths, units = segment_lengths(segments), unit_vectors(segments)
-    q, b = contacts(segments.reshape(-1, 2), segments, JUNCTION_REACH_PX)
+    q, b = contacts(segments.reshape(-1, 2), sampled, JUNCTION_REACH_PX)
     a = q // 2
-    points, owner = sample_points(segments)
-    near = cKDTree(points).query_pairs(SAMPLE_STEP_PX, output_type="ndarray")
+    owner = sampled.owner
+    near = sampled.tree.query_pairs(SAMPLE_STEP_PX, output_type="ndarray")
     a, b = _unique_pairs(np.concatenate([a, owner[near[:, 0]]]), np.concatenate([b, owner[near[:, 1]]]),
                          len(segments), ordered=False)
     a, b = a[a != b], b[a != b]
@@ -323,16 +365,18 @@ def find_junctions(segments: np.ndarray) -> tuple[list[Junction], np.ndarray]:
     return junctions, events
 
 
-def split_at_junctions(segments: np.ndarray, junctions: list[Junction], events: np.ndarray,
+def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[Junction], events: np.ndarray,
                        fill_fraction: np.ndarray | None = None) -> list[HalfEdge]:
     """Every segment as half-edges: split where a junction lies more than
     ``SPLIT_MARGIN_PX`` inside it, its ends moved onto the junctions they
     reach.  Each half-edge carries the junction ids at its ends and the
     segments met there (its partners), the other halves of its own line
     included; ``fill_fraction`` (per segment, from :func:`detect_segments`)
-    passes on to its halves."""
-    segments = np.asarray(segments, float).reshape(-1, 4)
-    lengths, lines = segment_lengths(segments), line_lengths(segments)
+    passes on to its halves.  ``segments``: rows (x0, y0, x1, y1), or
+    :class:`SampledSegments` of them (whose tree this reuses)."""
+    lines = line_lengths(segments)
+    segments = rows_of(segments)
+    lengths = segment_lengths(segments)
     fill = np.zeros(len(segments)) if fill_fraction is None else np.asarray(fill_fraction, float)
     out = []
     by_segment: dict[int, list[np.ndarray]] = {}
@@ -385,20 +429,24 @@ def _reaching(s: np.ndarray, junction: Junction) -> Segment:
     return Segment(x0, y0, x1, y1)
 
 
-def parallel_clearance(candidates: list[Segment], segments: np.ndarray, reach_px: float) -> np.ndarray:
+def parallel_clearance(candidates: list[Segment], segments: np.ndarray | SampledSegments,
+                       reach_px: float) -> np.ndarray:
     """For each candidate, the distance (px) from its line to the nearest
     other segment that runs beside it: parallel within
     ``JUNCTION_ANGLE_DEG``, alongside it over part of its length, and
     farther than its own half-width (a bar's own sides do not count);
-    ``inf`` when none lies within ``reach_px``."""
+    ``inf`` when none lies within ``reach_px``.  ``segments``: rows (x0,
+    y0, x1, y1), or :class:`SampledSegments` of them (whose tree this
+    reuses)."""
     c = np.array([seg.as_array() for seg in candidates], float).reshape(-1, 4)
     out = np.full(len(c), np.inf)
-    segments = np.asarray(segments, float).reshape(-1, 4)
+    near = segments
+    segments = rows_of(segments)
     if len(c) == 0 or len(segments) == 0:
         return out
     widths = np.array([seg.width_px for seg in candidates])
     points, owner = sample_points(c, reach_px / 2)
-    q, b = contacts(points, segments, reach_px)
+    q, b = contacts(points, near, reach_px)
     a, b = _unique_pairs(owner[q], b, max(len(c), len(segments)))
     parallel = np.abs(np.einsum("ij,ij->i", unit_vectors(c)[a], unit_vectors(segments)[b])) >= math.cos(
         math.radians(JUNCTION_ANGLE_DEG))
