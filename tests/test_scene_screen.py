@@ -40,3 +40,15 @@ def test_a_half_edge_is_as_long_as_the_longer_of_its_line_and_its_reach_to_the_j
     short = HalfEdge(Segment(10.0, 0.0, 14.0, 39.6), line_length_px=36.0)
     reason, message = geometry_screen(short, ScanSettings())
     assert reason == "too-short" and "39.8 px long, shorter than the minimum 40 px" in message
+
+
+def test_quick_looks_at_many_rois_give_each_its_own_verdict():
+    from imgmtf.scene.screen import quick_looks
+    # the last too small to judge
+    kinds = [{}, {"ramp": 0.25}, {"levels": (300.0, 320.0)}, {"texture": 0.12, "seed": 3}, {"length": 1}]
+    bands = [band(**kind) for kind in kinds]
+    which = np.repeat(np.arange(len(bands)), [b[0].size for b in bands])
+    values, d, t = (np.concatenate([b[k] for b in bands]) for k in range(3))
+    got = quick_looks(values, d, t, which, [6.0] * len(bands), [12] * len(bands), [0.0] * len(bands))
+    assert got == [quick_look(*b, noise_dn=6.0, half_width_px=12) for b in bands]
+    assert [None if v is None else v[0] for v in got] == [None, "non-uniform", "snr", "non-uniform", None]

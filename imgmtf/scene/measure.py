@@ -18,7 +18,6 @@ import math
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -37,7 +36,7 @@ from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .detect import detect_segments
 from .fill import fill_mask, fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, Roi, clear_extent, plan_roi
-from .screen import geometry_screen, quick_look
+from .screen import geometry_screen, quick_looks
 from .segments import (
     BAR_MAX_SEPARATION_PX,
     HalfEdge,
@@ -265,27 +264,88 @@ def _batches(plans: list[Plan], info: RasterInfo, tile_px: int) -> list[tuple[tu
 
 
 # -- one batch of candidates (a task) ---------------------------------------------------
+@dataclass(frozen=True)
+class Band:
+    """A candidate's ROI clear of what must not enter its estimate, read:
+    its pixels row by row (``rows``, ``cols`` in ``data``, the window of
+    its bounding box, whose top-left pixel is ``origin`` (x, y) in the
+    scene), their values (DN), their positions along its line (``t``) and
+    across it (``d``, px), its pixel noise (DN) and its site so far."""
+
+    data: np.ndarray
+    origin: tuple[int, int]
+    rows: np.ndarray
+    cols: np.ndarray
+    values: np.ndarray
+    t: np.ndarray
+    d: np.ndarray
+    noise_dn: float
+    site: dict
+
+
 def measure_batch(task) -> list[tuple[int, Record]]:
     """Read one window of the scene and measure every candidate in it: a
     record (accepted or rejected) per candidate, whatever goes wrong with
-    one of them (reason ``internal``)."""
+    one of them (reason ``internal``).  Each candidate's ROI is read and
+    cleared (:func:`read_band`), all of them get their quick look at once
+    (:func:`imgmtf.scene.screen.quick_looks`), and those it passes are
+    estimated (:func:`measure_band`)."""
     context, window, plans = task
     raster = read_raster(context.path, context.settings.band, window=window)
-    out = []
-    for plan in plans:
+
+    def safely(step, plan, *args):
         try:
-            out.append((plan.index, measure_candidate(plan, raster, context)))
+            return step(plan, *args, raster, context)
         except Exception as exc:       # the safety net: one candidate, never the scan
-            out.append((plan.index, Record.failed(context.path, raster.band, context.settings.target,
-                                                  context.settings.method, exc, params=context.params,
-                                                  run_utc=context.run_utc, status="rejected")))
+            return _failed(exc, raster, context)
+    out, read = [], []
+    for plan in plans:
+        band = safely(read_band, plan)
+        if isinstance(band, Band):
+            read.append((plan, band))
+        else:
+            out.append((plan.index, band))
+    try:
+        verdicts = _quick_looks(read)
+    except Exception as exc:           # ... and one batch's quick look, never the scan
+        return out + [(plan.index, _failed(exc, raster, context)) for plan, _ in read]
+    for (plan, band), verdict in zip(read, verdicts):
+        if verdict:
+            out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
+        else:
+            out.append((plan.index, safely(measure_band, plan, band)))
     return out
 
 
-def measure_candidate(plan: Plan, raster, context: Context) -> Record:
-    """One candidate: its ROI within ``raster`` (a window of the scene),
-    the screens, and the gate's verdict on its estimate."""
-    settings, info = context.settings, context.info
+def _quick_looks(read: list[tuple[Plan, Band]]) -> list[tuple[str, str] | None]:
+    """The quick look's verdicts on the candidates read, all in one pass."""
+    if not read:
+        return []
+    values, d, t = (np.concatenate([getattr(band, name) for _, band in read]) for name in ("values", "d", "t"))
+    which = np.repeat(np.arange(len(read)), [band.values.size for _, band in read])
+    return quick_looks(values, d, t, which, [band.noise_dn for _, band in read],
+                       [plan.roi.half_width_px for plan, _ in read], [plan.bar_width_px for plan, _ in read])
+
+
+def _failed(exc: Exception, raster, context: Context) -> Record:
+    """A candidate's record when its measurement failed (reason ``internal``)."""
+    return Record.failed(context.path, raster.band, context.settings.target, context.settings.method, exc,
+                         params=context.params, run_utc=context.run_utc, status="rejected")
+
+
+def _rejected(context: Context, raster, site: dict, reason: str, message: str, **more) -> Record:
+    """A candidate rejected for ``reason``, its site with ``more``."""
+    settings = context.settings
+    return Record(context.path, raster.band, settings.target, settings.method, "rejected", reason,
+                  f"{context.path}: {message}", site={**site, **more}, params=context.params,
+                  run_utc=context.run_utc)
+
+
+def read_band(plan: Plan, raster, context: Context) -> Band | Record:
+    """A candidate's ROI within ``raster`` (a window of the scene): its
+    pixels, the stretch of them clear of fill, partners and border, and
+    their pixel noise; or its record rejected when no stretch is clear."""
+    info = context.info
     roi = plan.roi
     bx, by = raster.origin
     x, y, w, h = roi.bbox(info.width, info.height)
@@ -296,45 +356,51 @@ def measure_candidate(plan: Plan, raster, context: Context) -> Record:
     t, d = t[rows, cols], d[rows, cols]
     fill = fill_mask(data, info.dtype)
     extent = clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
-    site: dict[str, Any] = {"roi_polygon_px": roi.corners()}
-
-    def rejected(reason: str, message: str, **more) -> Record:
-        return Record(context.path, raster.band, settings.target, settings.method, "rejected", reason,
-                      f"{context.path}: {message}", site={**site, **more}, params=context.params,
-                      run_utc=context.run_utc)
     if isinstance(extent[0], str):
-        return rejected(*extent, verdict_by="screen")
+        return _rejected(context, raster, {"roi_polygon_px": roi.corners()}, *extent, verdict_by="screen")
     t0, t1 = extent
     inside = (t >= t0) & (t < t1)
     rows, cols, t, d = rows[inside], cols[inside], t[inside], d[inside]
-    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    chip = data[r0:r1, c0:c1]
+    r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols.min(), cols.max() + 1      # (rows ascend: the band row by row)
+    site = {"roi_polygon_px": roi.corners(t0, t1), "roi": [int(x + c0), int(y + r0), int(c1 - c0), int(r1 - r0)]}
+    values = data[rows, cols]
+    # the noise of the masked chip, from its horizontally adjacent pixels: in the band, row by row,
+    # the pairs of consecutive pixels in one row and neighbouring columns
+    adjacent = (rows[1:] == rows[:-1]) & (cols[1:] == cols[:-1] + 1)
+    noise = robust_noise(np.column_stack([values[:-1][adjacent], values[1:][adjacent]]))
+    return Band(data, (x, y), rows, cols, values, t, d, noise, site)
+
+
+def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
+    """A candidate's record from the gate's verdict on the estimate of its
+    ROI (``band``, which passed the quick look)."""
+    settings = context.settings
+    rows, cols = band.rows, band.cols
+    r0, c0 = rows[0], cols.min()
+    chip = band.data[r0:rows[-1] + 1, c0:cols.max() + 1]
     chip_mask = np.zeros(chip.shape, bool)
     chip_mask[rows - r0, cols - c0] = True
-    roi_box = [int(x + c0), int(y + r0), int(c1 - c0), int(r1 - r0)]
-    site = {"roi_polygon_px": roi.corners(t0, t1), "roi": roi_box}
-    noise = robust_noise(np.where(chip_mask, chip, np.nan))
-    verdict = quick_look(data[rows, cols], d, t, noise, roi.half_width_px, plan.bar_width_px)
-    if verdict:
-        return rejected(*verdict, verdict_by="screen")
     try:
         # the quality gate refuses a chip before its intervals are computed
         # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
         result = _estimate(chip, chip_mask, raster, context, plan)
     except ImgmtfError as exc:
-        return rejected(exc.reason, _one_line(exc), verdict_by="gate", **_gate_figures(getattr(exc, "checks", ())))
+        return _rejected(context, raster, band.site, exc.reason, _one_line(exc), verdict_by="gate",
+                         **_gate_figures(getattr(exc, "checks", ())))
     needed = _confident_snr(settings.target, result.rows_used)
     if result.snr < MIN_CONFIDENCE * needed:
         # measure would report it with a warning; a scan chooses its targets, and at a small fraction
         # of the SNR its length needs, ground texture beside a target biases it beyond its interval
-        return rejected("snr", f"SNR {result.snr:.0f} is below {MIN_CONFIDENCE:g} x the {needed:.0f} a "
-                        f"{result.rows_used}-row {result.target} needs for 95 % of estimates within 5 %: "
-                        "too noisy for its length to calibrate with", verdict_by="gate", snr=result.snr)
+        return _rejected(context, raster, band.site, "snr",
+                         f"SNR {result.snr:.0f} is below {MIN_CONFIDENCE:g} x the {needed:.0f} a "
+                         f"{result.rows_used}-row {result.target} needs for 95 % of estimates within 5 %: "
+                         "too noisy for its length to calibrate with", verdict_by="gate", snr=result.snr)
     x_, y_, w_, h_ = result.roi
+    roi_box = band.site["roi"]
     figures = {**result.to_dict(curves=True), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
                "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
     record = Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
-                             status="accepted", site={**site, "verdict_by": "gate"}, measurement=result)
+                             status="accepted", site={**band.site, "verdict_by": "gate"}, measurement=result)
     if context.figures_dir:
         record = _with_figure(record, result, context, plan)
     return record

@@ -96,7 +96,8 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
     for a boundary of the fill (fill along its sides) or an ROI the fill
     leaves too short, ``too-short`` otherwise.  ``t``, ``d``, ``xs``, ``ys``
     describe the ROI's pixels; ``fill`` is the fill of the window they
-    index (its top-left pixel at the smallest ``xs``, ``ys``)."""
+    index (its top-left pixel at the smallest ``xs``, ``ys``).  The pixels
+    come row by row (``ys`` ascending), as :func:`numpy.nonzero` gives them."""
     bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
     k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
     bad = np.zeros(bins, bool)
@@ -110,12 +111,18 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
         by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
         bad |= by_fill
     for p in partners:
-        # only the pixels within the clearance of the partner's bounding box can be within it of the partner
-        near = ((xs >= min(p[0], p[2]) - JUNCTION_CLEARANCE_PX) & (xs <= max(p[0], p[2]) + JUNCTION_CLEARANCE_PX)
-                & (ys >= min(p[1], p[3]) - JUNCTION_CLEARANCE_PX) & (ys <= max(p[1], p[3]) + JUNCTION_CLEARANCE_PX))
-        if near.any():
+        # only the pixels within the clearance of the partner's bounding box can be within it of the
+        # partner: those of its rows (a slice: the pixels come row by row), then of its columns
+        first = np.searchsorted(ys, min(p[1], p[3]) - JUNCTION_CLEARANCE_PX, "left")
+        last = np.searchsorted(ys, max(p[1], p[3]) + JUNCTION_CLEARANCE_PX, "right")
+        if first == last:
+            continue
+        row_xs = xs[first:last]
+        near = first + np.flatnonzero((row_xs >= min(p[0], p[2]) - JUNCTION_CLEARANCE_PX)
+                                      & (row_xs <= max(p[0], p[2]) + JUNCTION_CLEARANCE_PX))
+        if near.size:
             close = distance_to_segment(xs[near], ys[near], p) <= JUNCTION_CLEARANCE_PX
-            bad |= np.bincount(k[near][close], minlength=bins) > 0
+            bad |= np.bincount(k[near[close]], minlength=bins) > 0
     # the band's cross-section must lie inside the scene (checked when the rectangle, a pixel longer
     # at each end than the bins' centres reach, is not inside it whole)
     reach = roi._corners(roi.t0_px - 1.0, roi.t0_px + bins + 1.0)

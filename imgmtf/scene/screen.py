@@ -74,32 +74,73 @@ def quick_look(values: np.ndarray, d: np.ndarray, t: np.ndarray, noise_dn: float
       ``QUICK_LOOK_SLACK * MAX_SIDE_TREND`` of the contrast, or its texture
       (scatter beyond the pixel noise) ``QUICK_LOOK_SLACK *
       MAX_SIDE_TEXTURE``.
+
+    :func:`quick_looks` glances at many ROIs at once.
     """
-    start = max(SIDE_START_PX, half_width_px / 2) + bar_width_px / 2
-    noise = noise_dn
-    designs, values_of = [], []
-    for side in (d <= -start, d >= start):
-        x, y, v = d[side], t[side], values[side]
-        if v.size < 12:
-            return None                  # too little to judge: the gate will
-        design = np.empty((3, v.size))
-        design[0], design[1], design[2] = 1.0, x - x.mean(), y - y.mean()
-        designs.append((design, x.max() - x.min(), y.max() - y.min()))
-        values_of.append(v)
-    # both sides' planes in one solve
-    normal = np.stack([design @ design.T + _RIDGE for design, _, _ in designs])
-    moments = np.stack([design @ v for (design, _, _), v in zip(designs, values_of)])
-    coefs = np.linalg.solve(normal, moments[:, :, None])[:, :, 0]
-    sides = []
-    for (design, x_span, y_span), v, coef in zip(designs, values_of, coefs):
-        resid = v - coef @ design
-        trend = max(abs(coef[1]) * x_span, abs(coef[2]) * y_span)
-        texture = math.sqrt(max(float(resid @ resid) / max(v.size - 3, 1) - noise ** 2, 0.0))
-        sides.append((float(coef[0]), trend, texture))
-    if bar_width_px > 0:
-        core = np.abs(d) <= max(bar_width_px / 2, 0.5)
+    return quick_looks(values, d, t, np.zeros(np.size(values), int), [noise_dn], [half_width_px], [bar_width_px])[0]
+
+
+def quick_looks(values: np.ndarray, d: np.ndarray, t: np.ndarray, roi: np.ndarray, noise_dn, half_width_px,
+                bar_width_px) -> list[tuple[str, str] | None]:
+    """:func:`quick_look` of many ROIs in one pass (a scan's batch of
+    candidates: a few dozen NumPy calls for them all, not for each): the
+    pixels of all of them, ``roi`` numbering the ROI of each (0 to n - 1,
+    each ROI's pixels together), and per ROI its noise (DN), half-width
+    and bar width (px).  One verdict per ROI."""
+    values, d, t = (np.asarray(a, float).ravel() for a in (values, d, t))
+    roi = np.asarray(roi, int).ravel()
+    noise = np.asarray(noise_dn, float).ravel()
+    n = noise.size
+    bar = np.broadcast_to(np.asarray(bar_width_px, float), (n,))
+    start = (np.maximum(SIDE_START_PX, np.asarray(half_width_px, float) / 2) + bar / 2)[roi]
+    # each side of each ROI a group: 2 x ROI (left) and 2 x ROI + 1 (right)
+    left, right = d <= -start, d >= start
+    on = left | right
+    group = 2 * roi[on] + right[on]
+    x, y, v = d[on], t[on], values[on]
+    m = 2 * n
+    count = np.bincount(group, minlength=m)
+
+    def total(w: np.ndarray) -> np.ndarray:
+        return np.bincount(group, w, minlength=m)
+    x = x - (total(x) / np.maximum(count, 1))[group]          # each side's across and along, about its centre
+    y = y - (total(y) / np.maximum(count, 1))[group]
+    sx, sy, sxy = total(x), total(y), total(x * y)
+    normal = np.stack([np.stack([count, sx, sy], 1), np.stack([sx, total(x * x), sxy], 1),
+                       np.stack([sy, sxy, total(y * y)], 1)], 1) + _RIDGE
+    moments = np.stack([total(v), total(x * v), total(y * v)], 1)
+    coef = np.linalg.solve(normal, moments[:, :, None])[:, :, 0]      # each side's level and trends
+    resid = v - (coef[group, 0] + coef[group, 1] * x + coef[group, 2] * y)
+    square = total(resid * resid)
+    spans = []
+    for w in (x, y):
+        high, low = np.full(m, -np.inf), np.full(m, np.inf)
+        np.maximum.at(high, group, w)
+        np.minimum.at(low, group, w)
+        spans.append(high - low)
+    trend = np.maximum(np.abs(coef[:, 1]) * spans[0], np.abs(coef[:, 2]) * spans[1])
+    first = np.searchsorted(roi, np.arange(n + 1)) if np.any(bar > 0) else None
+    out: list[tuple[str, str] | None] = []
+    for i in range(n):
+        if count[2 * i] < 12 or count[2 * i + 1] < 12:
+            out.append(None)                    # too little to judge: the gate will
+            continue
+        sides = [(float(coef[k, 0]), float(trend[k]),
+                  math.sqrt(max(float(square[k]) / max(int(count[k]) - 3, 1) - float(noise[i]) ** 2, 0.0)))
+                 for k in (2 * i, 2 * i + 1)]
+        out.append(_verdict(sides, float(noise[i]), float(bar[i]),
+                            None if first is None else slice(first[i], first[i + 1]), values, d))
+    return out
+
+
+def _verdict(sides, noise: float, bar_width_px: float, pixels: slice | None, values: np.ndarray,
+             d: np.ndarray) -> tuple[str, str] | None:
+    """A ROI's quick look from its sides' (level, trend, texture): for a
+    bar, its contrast is its core's (its ``pixels`` of ``values`` and ``d``)."""
+    if bar_width_px > 0 and pixels is not None:
+        core = np.abs(d[pixels]) <= max(bar_width_px / 2, 0.5)
         background = 0.5 * (sides[0][0] + sides[1][0])
-        contrast = abs(float(np.median(values[core])) - background) if core.any() else 0.0
+        contrast = abs(float(np.median(values[pixels][core])) - background) if core.any() else 0.0
     else:
         contrast = abs(sides[1][0] - sides[0][0])
     if contrast < gate.MIN_SNR / QUICK_LOOK_SLACK * noise:
