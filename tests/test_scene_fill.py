@@ -28,3 +28,19 @@ def test_nodata_and_a_negative_sentinel_are_fill_a_saturated_side_is_not():
 
 def test_a_segment_with_fill_along_half_its_length_is_a_fill_boundary():
     assert fill_screen(0.5)[0] == "fill" and fill_screen(0.3) is None
+
+
+def test_a_window_may_hold_fill_wherever_any_part_of_it_is_fill():
+    from imgmtf.scene.fill import may_hold_fill
+    rng = np.random.default_rng(1)
+    ground = 900.0 + rng.normal(0, 5, (40, 40))
+    assert not may_hold_fill(ground, "uint16") and not may_hold_fill(ground, "float32")
+    for value, dtype in [(0.0, "uint16"), (np.nan, "float32"), (-9999.0, "float32"), (65535.0, "uint16")]:
+        window = ground.copy()
+        window[30:, 30:] = value                 # a corner of fill: part of the window is fill
+        assert fill_mask(window[20:, 20:], dtype)[10:, 10:].all()
+        assert may_hold_fill(window, dtype)
+    # an integer type's greatest value is fill only in an integer scene
+    window = ground.copy()
+    window[30:, 30:] = 65535.0
+    assert not may_hold_fill(window, "float32")

@@ -58,6 +58,28 @@ def fill_mask(window: np.ndarray, dtype: DTypeLike) -> np.ndarray:
     return fill
 
 
+def may_hold_fill(window: np.ndarray, dtype: DTypeLike) -> bool:
+    """False when no part of ``window`` can hold fill or nodata
+    (:func:`fill_mask` of any part of it is empty): it has no NaN, and
+    every value lies above 0 (the least fill value, negative sentinels
+    included) and, for an integer type, below its greatest value.  Two
+    reductions of a batch's window spare each of its candidates its own
+    :func:`fill_mask`.
+
+    Examples
+    --------
+    >>> w = np.full((20, 20), 900.0)
+    >>> may_hold_fill(w, "uint16"), may_hold_fill(np.where(w > 0, w, 0) * (np.arange(20) < 12), "uint16")
+    (False, True)
+    """
+    if window.size == 0:
+        return False
+    low, high = float(window.min()), float(window.max())
+    if not low > 0:                     # a NaN, 0, or a negative value
+        return True
+    return bool(np.issubdtype(np.dtype(dtype), np.integer) and high >= np.iinfo(np.dtype(dtype)).max)
+
+
 def grown(mask: np.ndarray, px: int) -> np.ndarray:
     """``mask`` dilated by a square of ``px`` pixels each way."""
     if px <= 0 or not mask.any():

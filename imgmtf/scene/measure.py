@@ -34,7 +34,7 @@ from ..kinds import get_kind
 from ..parallel import run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .detect import detect_segments
-from .fill import fill_mask, fill_screen
+from .fill import fill_mask, fill_screen, may_hold_fill
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, Roi, clear_extent, plan_roi
 from .screen import geometry_screen, quick_looks
 from .segments import (
@@ -295,12 +295,13 @@ def measure_batch(task) -> list[tuple[int, Record]]:
 
     def safely(step, plan, *args):
         try:
-            return step(plan, *args, raster, context)
+            return step(plan, *args)
         except Exception as exc:       # the safety net: one candidate, never the scan
             return _failed(exc, raster, context)
     out, read = [], []
+    fill_possible = may_hold_fill(raster.data, context.info.dtype)
     for plan in plans:
-        band = safely(read_band, plan)
+        band = safely(read_band, plan, raster, context, fill_possible)
         if isinstance(band, Band):
             read.append((plan, band))
         else:
@@ -313,7 +314,7 @@ def measure_batch(task) -> list[tuple[int, Record]]:
         if verdict:
             out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
         else:
-            out.append((plan.index, safely(measure_band, plan, band)))
+            out.append((plan.index, safely(measure_band, plan, band, raster, context)))
     return out
 
 
@@ -341,10 +342,11 @@ def _rejected(context: Context, raster, site: dict, reason: str, message: str, *
                   run_utc=context.run_utc)
 
 
-def read_band(plan: Plan, raster, context: Context) -> Band | Record:
+def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) -> Band | Record:
     """A candidate's ROI within ``raster`` (a window of the scene): its
     pixels, the stretch of them clear of fill, partners and border, and
-    their pixel noise; or its record rejected when no stretch is clear."""
+    their pixel noise; or its record rejected when no stretch is clear.
+    ``fill_possible`` false: the window holds no fill (:func:`.fill.may_hold_fill`)."""
     info = context.info
     roi = plan.roi
     bx, by = raster.origin
@@ -354,7 +356,7 @@ def read_band(plan: Plan, raster, context: Context) -> Band | Record:
     band = (np.abs(d) <= roi.half_width_px) & (t >= roi.t0_px) & (t <= roi.t1_px)
     rows, cols = np.nonzero(band)
     t, d = t[rows, cols], d[rows, cols]
-    fill = fill_mask(data, info.dtype)
+    fill = fill_mask(data, info.dtype) if fill_possible else np.zeros(data.shape, bool)
     extent = clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
     if isinstance(extent[0], str):
         return _rejected(context, raster, {"roi_polygon_px": roi.corners()}, *extent, verdict_by="screen")
