@@ -374,25 +374,34 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
     included; ``fill_fraction`` (per segment, from :func:`detect_segments`)
     passes on to its halves.  ``segments``: rows (x0, y0, x1, y1), or
     :class:`SampledSegments` of them (whose tree this reuses)."""
-    lines = line_lengths(segments)
+    lines = line_lengths(segments).tolist()
     segments = rows_of(segments)
-    lengths = segment_lengths(segments)
+    lengths = segment_lengths(segments).tolist()
     fill = np.zeros(len(segments)) if fill_fraction is None else np.asarray(fill_fraction, float)
+    fill = fill.tolist()
+    rows_of_segments = segments.tolist()
     out = []
-    by_segment: dict[int, list[np.ndarray]] = {}
+    by_segment: dict[int, list[tuple[int, float]]] = {}
     members: dict[int, set[int]] = {}
-    for row in events:
-        by_segment.setdefault(int(row[0]), []).append(row)
-        members.setdefault(int(row[2]), set()).add(int(row[0]))
+    for i, _, jid, t in events.tolist():        # (plain numbers: thousands of rows cost less out of NumPy)
+        by_segment.setdefault(int(i), []).append((int(jid), t))
+        members.setdefault(int(jid), set()).add(int(i))
+    reached: dict[tuple[int, int], Segment] = {}
+
+    def reaching(p: int, jid: int) -> Segment:
+        """Partner ``p`` reaching junction ``jid`` (:func:`_reaching`), once for all who meet it there."""
+        if (p, jid) not in reached:
+            reached[p, jid] = _reaching(rows_of_segments[p], junctions[jid])
+        return reached[p, jid]
     for i, s in enumerate(segments):
         line = Segment(*s)
         rows = by_segment.get(i)
         if not rows:
-            out.append(HalfEdge(line, float(lines[i]), fill_fraction=float(fill[i])))
+            out.append(HalfEdge(line, lines[i], fill_fraction=fill[i]))
             continue
         u = (s[2:] - s[:2]) / max(lengths[i], 1e-12)
         # junctions on this segment, by position (the projection of their centre), and who meets there
-        cuts = {int(jid): float(t) for _, _, jid, t in rows}
+        cuts = dict(rows)
         partners = {jid: sorted(members[jid] - {i}) for jid in cuts}
         # a junction near an end moves that end onto it (the innermost, if several); one
         # farther inside splits the segment there
@@ -403,17 +412,17 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
                  else (0.0, None, [])]
         stops += [(t, jid, [jid]) for t, jid in inside]
         stops.append((min(near_end)[0], min(near_end)[1], [jid for _, jid in near_end]) if near_end
-                     else (float(lengths[i]), None, []))
+                     else (lengths[i], None, []))
         stops = [stop for k, stop in enumerate(stops) if k == 0 or stop[0] > stops[k - 1][0]]
         halves = [Segment(*(s[:2] + a[0] * u), *(s[:2] + b[0] * u)) for a, b in pairwise(stops)]
         for k, (a, b) in enumerate(pairwise(stops)):
-            met = [_reaching(segments[p], junctions[j]) for j in a[2] + b[2] for p in partners[j]]
+            met = [reaching(p, j) for j in a[2] + b[2] for p in partners[j]]
             met += [halves[m] for m in (k - 1, k + 1) if 0 <= m < len(halves)]
-            out.append(HalfEdge(halves[k], float(lines[i]), (a[1], b[1]), tuple(met), float(fill[i])))
+            out.append(HalfEdge(halves[k], lines[i], (a[1], b[1]), tuple(met), fill[i]))
     return out
 
 
-def _reaching(s: np.ndarray, junction: Junction) -> Segment:
+def _reaching(s, junction: Junction) -> Segment:
     """Segment ``s`` with its end nearer ``junction`` moved onto it when the
     junction lies beyond that end (LSD stops short of where edges meet).
     (Plain floats: thousands of calls on two-element arrays cost more in
