@@ -169,17 +169,14 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                             settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
     records: list[Record] = []
     plans: list[Plan] = []
-    mapped = not info.transform.is_identity         # (affine's test costs as much as the rest of a record)
-    for (half, verdict), clearance in zip(candidates, beside):
-        record = _candidate_record(half, context, mapped)
+    rounded = _rounded_ends([half.segment for half, _ in candidates])
+    mapped = _map_ends([half.segment for half, _ in candidates], info)
+    for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
         verdict = verdict or _beside_screen(half, clearance)
-        if verdict:
-            record = record.with_(status="rejected", reason=verdict[0], error=f"{path}: {verdict[1]}",
-                                  site={"verdict_by": "screen"})
-        else:
+        if not verdict:
             partners = np.array([p.as_array() for p in half.partners]).reshape(-1, 4)
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
-        records.append(record)
+        records.append(_candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict))
     batches = _batches(plans, info, settings.tile_px)
     halves = [half for half, _ in candidates]
 
@@ -453,15 +450,16 @@ def _one_line(exc: BaseException) -> str:
 
 
 # -- records ----------------------------------------------------------------------------
-def _candidate_record(half: HalfEdge, context: Context, mapped: bool) -> Record:
-    """A candidate's record before it is screened: where it lies (and, where
-    the scene's transform is not the identity, ``mapped``, in its map
-    coordinates too)."""
+def _candidate_record(half: HalfEdge, context: Context, ends: list[float], map_ends: list[float] | None,
+                      verdict: tuple[str, str] | None) -> Record:
+    """A candidate's record before it is measured: where it lies (its
+    ``ends`` x0, y0, x1, y1, rounded, and in map coordinates
+    ``map_ends`` when the scene has them), ``candidate``, or rejected by a
+    screen's ``verdict``."""
     segment, info, settings = half.segment, context.info, context.settings
     site = {
         "scope": CANDIDATE_SCOPE,
-        "x0_px": round(segment.x0, 2), "y0_px": round(segment.y0, 2),
-        "x1_px": round(segment.x1, 2), "y1_px": round(segment.y1, 2),
+        **dict(zip(("x0_px", "y0_px", "x1_px", "y1_px"), ends)),
         "length_px": round(segment.length_px, 1), "line_length_px": round(half.line_length_px, 1),
         "tilt_deg": round(segment.tilt_deg, 2), "normal_angle_deg": round(segment.normal_angle_deg, 2),
         "direction": direction_label(segment.normal_angle_deg, context.track_azimuth_deg),
@@ -470,12 +468,38 @@ def _candidate_record(half: HalfEdge, context: Context, mapped: bool) -> Record:
     }
     if segment.width_px > 0 or get_kind(settings.target).has_width:
         site["bar_width_px"] = round(segment.width_px, 2)
-    if mapped:
-        (mx0, my0), (mx1, my1) = (info.transform @ (x + 0.5, y + 0.5)
-                                  for x, y in ((segment.x0, segment.y0), (segment.x1, segment.y1)))
-        site.update(map_x0=mx0, map_y0=my0, map_x1=mx1, map_y1=my1)
+    if map_ends is not None:
+        site.update(zip(("map_x0", "map_y0", "map_x1", "map_y1"), map_ends))
+    if verdict:
+        site["verdict_by"] = "screen"
+        return Record(context.path, settings.band, settings.target, settings.method, "rejected", verdict[0],
+                      f"{context.path}: {verdict[1]}", site=site, params=context.params, run_utc=context.run_utc)
     return Record(context.path, settings.band, settings.target, settings.method, "candidate", site=site,
                   params=context.params, run_utc=context.run_utc)
+
+
+def _rounded_ends(segments: list) -> list[list[float]]:
+    """The segments' ends (x0, y0, x1, y1) rounded to 0.01 px as ``round``
+    rounds each: NumPy's scalars (the segments split from LSD's lines)
+    all in one pass, as NumPy rounds them (a scalar at a time, NumPy's
+    round costs some 3 us); plain floats (a bar's centre line) as Python
+    does (the two differ where a value lies within rounding of a
+    half-step)."""
+    ends = [(s.x0, s.y0, s.x1, s.y1) for s in segments]
+    by_numpy = np.round(np.array(ends, float).reshape(-1, 4), 2).tolist()
+    return [by_numpy[k] if isinstance(e[0], np.floating) else [round(v, 2) for v in e] for k, e in enumerate(ends)]
+
+
+def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:
+    """The segments' ends (x0, y0, x1, y1 of their pixel centres) in the
+    scene's map coordinates, all in one pass; None where its transform is
+    the identity (pixel coordinates are all it has)."""
+    if info.transform.is_identity or not segments:
+        return None
+    ends = np.array([(s.x0, s.y0, s.x1, s.y1) for s in segments], float).reshape(-1, 4) + 0.5
+    x0, y0 = info.transform @ (ends[:, 0], ends[:, 1])
+    x1, y1 = info.transform @ (ends[:, 2], ends[:, 3])
+    return np.column_stack([x0, y0, x1, y1]).tolist()
 
 
 def _end(junction: int | None) -> str:
