@@ -351,8 +351,9 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
     data = raster.data[y - by: y - by + h, x - bx: x - bx + w]
     t, d = roi.frame(np.arange(x, x + w, dtype=float)[None, :], np.arange(y, y + h, dtype=float)[:, None])
     band = (np.abs(d) <= roi.half_width_px) & (t >= roi.t0_px) & (t <= roi.t1_px)
-    rows, cols = np.nonzero(band)
-    t, d = t[rows, cols], d[rows, cols]
+    inside = np.flatnonzero(band)            # (flat: faster than nonzero's pair of indices, the same order)
+    rows, cols = np.divmod(inside, w)
+    t, d = t.ravel()[inside], d.ravel()[inside]
     fill = fill_mask(data, info.dtype) if fill_possible else np.zeros(data.shape, bool)
     extent = clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
     if isinstance(extent[0], str):
