@@ -168,19 +168,21 @@ def rows_of(segments: np.ndarray | SampledSegments) -> np.ndarray:
 
 
 def contacts(queries: np.ndarray, s: np.ndarray | SampledSegments, radius: float,
-             step: float = SAMPLE_STEP_PX) -> tuple[np.ndarray, np.ndarray]:
+             step: float = SAMPLE_STEP_PX, by: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Which segments pass within about ``radius`` px of which query
-    points: (query index, segment index) pairs, each pair once.  A k-d tree
-    over points sampled along the segments (every ``step`` px, or as
-    sampled already when ``s`` is a :class:`SampledSegments`): the cost
-    grows with the number of contacts, not with the square of the number
-    of segments."""
+    points: (query index, segment index) pairs, each pair once; with
+    ``by`` (one index per query: the segment it was sampled from), (that
+    index, segment index) pairs, each once.  A k-d tree over points
+    sampled along the segments (every ``step`` px, or as sampled already
+    when ``s`` is a :class:`SampledSegments`): the cost grows with the
+    number of contacts, not with the square of the number of segments."""
     n = len(rows_of(s))
     if len(queries) == 0 or n == 0:
         return np.zeros(0, int), np.zeros(0, int)
     sampled = s if isinstance(s, SampledSegments) else SampledSegments.of(s, step)
     near = cKDTree(queries).sparse_distance_matrix(sampled.tree, radius + sampled.step / 2, output_type="ndarray")
-    key = np.unique(near["i"].astype(np.int64) * n + sampled.owner[near["j"]])
+    first = near["i"] if by is None else np.asarray(by)[near["i"]]
+    key = np.unique(first.astype(np.int64) * n + sampled.owner[near["j"]])
     return key // n, key % n
 
 
@@ -455,8 +457,7 @@ def parallel_clearance(candidates: list[Segment], segments: np.ndarray | Sampled
         return out
     widths = np.array([seg.width_px for seg in candidates])
     points, owner = sample_points(c, reach_px / 2)
-    q, b = contacts(points, near, reach_px)
-    a, b = _unique_pairs(owner[q], b, max(len(c), len(segments)))
+    a, b = contacts(points, near, reach_px, by=owner)
     parallel = np.abs(np.einsum("ij,ij->i", unit_vectors(c)[a], unit_vectors(segments)[b])) >= math.cos(
         math.radians(JUNCTION_ANGLE_DEG))
     a, b = a[parallel], b[parallel]
@@ -498,8 +499,7 @@ def pair_bars(segments: list[Segment]) -> tuple[list[int], list[tuple[int, int, 
         return list(range(n)), []
     lengths, units = segment_lengths(s), unit_vectors(s)
     points, owner = sample_points(s, BAR_MAX_SEPARATION_PX / 2)
-    q, b = contacts(points, s, BAR_MAX_SEPARATION_PX)
-    a, b = _unique_pairs(owner[q], b, n, ordered=False)
+    a, b = _unique_pairs(*contacts(points, s, BAR_MAX_SEPARATION_PX, by=owner), n, ordered=False)
     keep = (a != b) & (np.abs(np.einsum("ij,ij->i", units[a], units[b]))
                        >= math.cos(math.radians(MERGE_ANGLE_DEG)))
     a, b = a[keep], b[keep]
