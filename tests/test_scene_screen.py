@@ -52,3 +52,14 @@ def test_quick_looks_at_many_rois_give_each_its_own_verdict():
     got = quick_looks(values, d, t, which, [6.0] * len(bands), [12] * len(bands), [0.0] * len(bands))
     assert got == [quick_look(*b, noise_dn=6.0, half_width_px=12) for b in bands]
     assert [None if v is None else v[0] for v in got] == [None, "non-uniform", "snr", "non-uniform", None]
+
+
+def test_quick_looks_at_bars_take_the_contrast_of_their_core():
+    from imgmtf.scene.screen import quick_looks
+    values, d, t = band(levels=(300.0, 300.0))
+    strong, faint = values + 1200.0 * (np.abs(d) <= 1.5), values + 20.0 * (np.abs(d) <= 1.5)
+    which = np.repeat([0, 1, 2], values.size)
+    got = quick_looks(np.concatenate([strong, faint, values]), np.tile(d, 3), np.tile(t, 3), which,
+                      [6.0] * 3, [12] * 3, [3.0, 3.0, 0.0])
+    # the faint bar's 20 DN and the edge of no contrast are under MIN_SNR x 6 DN of noise
+    assert got[0] is None and got[1][0] == "snr" and got[2][0] == "snr"

@@ -85,7 +85,7 @@ def quick_looks(values: np.ndarray, d: np.ndarray, t: np.ndarray, roi: np.ndarra
     """:func:`quick_look` of many ROIs in one pass (a scan's batch of
     candidates: a few dozen NumPy calls for them all, not for each): the
     pixels of all of them, ``roi`` numbering the ROI of each (0 to n - 1,
-    each ROI's pixels together), and per ROI its noise (DN), half-width
+    ascending: each ROI's pixels together), and per ROI its noise (DN), half-width
     and bar width (px).  One verdict per ROI."""
     values, d, t = (np.asarray(a, float).ravel() for a in (values, d, t))
     roi = np.asarray(roi, int).ravel()
@@ -93,16 +93,24 @@ def quick_looks(values: np.ndarray, d: np.ndarray, t: np.ndarray, roi: np.ndarra
     n = noise.size
     bar = np.broadcast_to(np.asarray(bar_width_px, float), (n,))
     start = (np.maximum(SIDE_START_PX, np.asarray(half_width_px, float) / 2) + bar / 2)[roi]
-    # each side of each ROI a group: 2 x ROI (left) and 2 x ROI + 1 (right)
-    left, right = d <= -start, d >= start
-    on = left | right
-    group = 2 * roi[on] + right[on]
+    # each side of each ROI a group, 2 x ROI (left) and 2 x ROI + 1 (right), its pixels gathered
+    # together: sums over contiguous runs (reduceat) cost a tenth of bincount's
+    on = np.flatnonzero((d <= -start) | (d >= start))
+    group = 2 * roi[on] + (d[on] >= start[on])
+    by_group = np.argsort(group, kind="stable")
+    on, group = on[by_group], group[by_group]
     x, y, v = d[on], t[on], values[on]
     m = 2 * n
     count = np.bincount(group, minlength=m)
+    filled = count > 0
+    first_of = (np.cumsum(count) - count)[filled]
 
-    def total(w: np.ndarray) -> np.ndarray:
-        return np.bincount(group, w, minlength=m)
+    def total(w: np.ndarray, ufunc=np.add) -> np.ndarray:
+        """Per group, ``w`` reduced by ``ufunc`` (0 for an empty group)."""
+        out = np.zeros(m)
+        if first_of.size:
+            out[filled] = ufunc.reduceat(w, first_of)
+        return out
     x = x - (total(x) / np.maximum(count, 1))[group]          # each side's across and along, about its centre
     y = y - (total(y) / np.maximum(count, 1))[group]
     sx, sy, sxy = total(x), total(y), total(x * y)
@@ -112,12 +120,7 @@ def quick_looks(values: np.ndarray, d: np.ndarray, t: np.ndarray, roi: np.ndarra
     coef = np.linalg.solve(normal, moments[:, :, None])[:, :, 0]      # each side's level and trends
     resid = v - (coef[group, 0] + coef[group, 1] * x + coef[group, 2] * y)
     square = total(resid * resid)
-    spans = []
-    for w in (x, y):
-        high, low = np.full(m, -np.inf), np.full(m, np.inf)
-        np.maximum.at(high, group, w)
-        np.minimum.at(low, group, w)
-        spans.append(high - low)
+    spans = [total(w, np.maximum) - total(w, np.minimum) for w in (x, y)]
     trend = np.maximum(np.abs(coef[:, 1]) * spans[0], np.abs(coef[:, 2]) * spans[1])
     first = np.searchsorted(roi, np.arange(n + 1)) if np.any(bar > 0) else None
     out: list[tuple[str, str] | None] = []
