@@ -99,7 +99,8 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
     index (its top-left pixel at the smallest ``xs``, ``ys``).  The pixels
     come row by row (``ys`` ascending), as :func:`numpy.nonzero` gives them."""
     bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
-    k = np.clip(np.floor(t - roi.t0_px).astype(int), 0, bins - 1)
+    # (np.minimum and np.maximum: np.clip's own overhead is most of a small array's cost)
+    k = np.minimum(np.maximum(np.floor(t - roi.t0_px).astype(int), 0), bins - 1)
     bad = np.zeros(bins, bool)
     by_fill = np.zeros(bins, bool)
     if fill.any():
@@ -110,7 +111,7 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
             return boundary
         by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
         bad |= by_fill
-    for p in partners:
+    for p in np.asarray(partners, float).reshape(-1, 4).tolist():
         # only the pixels within the clearance of the partner's bounding box can be within it of the
         # partner: those of its rows (a slice: the pixels come row by row), then of its columns
         first = np.searchsorted(ys, min(p[1], p[3]) - JUNCTION_CLEARANCE_PX, "left")
@@ -122,7 +123,7 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
                                       & (row_xs <= max(p[0], p[2]) + JUNCTION_CLEARANCE_PX))
         if near.size:
             close = distance_to_segment(xs[near], ys[near], p) <= JUNCTION_CLEARANCE_PX
-            bad |= np.bincount(k[near[close]], minlength=bins) > 0
+            bad[k[near[close]]] = True
     # the band's cross-section must lie inside the scene (checked when the rectangle, a pixel longer
     # at each end than the bins' centres reach, is not inside it whole)
     reach = roi._corners(roi.t0_px - 1.0, roi.t0_px + bins + 1.0)
@@ -131,9 +132,10 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
         for side in (-1.0, 1.0):
             px, py = roi.point(centres, side * roi.half_width_px)
             bad |= (px < -0.5) | (py < -0.5) | (px > info.width - 0.5) | (py > info.height - 0.5)
-    free = np.concatenate([[0], (~bad).astype(int), [0]])
+    free = np.zeros(bins + 2, np.int8)
+    free[1:-1] = ~bad
     step = np.diff(free)
-    starts, ends = np.nonzero(step == 1)[0], np.nonzero(step == -1)[0]
+    starts, ends = np.flatnonzero(step == 1), np.flatnonzero(step == -1)
     longest = int(np.argmax(ends - starts)) if starts.size else None
     length = float(ends[longest] - starts[longest]) if longest is not None else 0.0
     rows = int(length * max(abs(roi.ux), abs(roi.uy)))      # rows (or columns) it crosses
@@ -150,5 +152,5 @@ def distance_to_segment(xs, ys, s) -> np.ndarray:
     """Distance (px) of points from the segment s = (x0, y0, x1, y1)."""
     dx, dy = s[2] - s[0], s[3] - s[1]
     length2 = max(dx * dx + dy * dy, 1e-12)
-    f = np.clip(((xs - s[0]) * dx + (ys - s[1]) * dy) / length2, 0.0, 1.0)
+    f = np.minimum(np.maximum(((xs - s[0]) * dx + (ys - s[1]) * dy) / length2, 0.0), 1.0)
     return np.hypot(xs - (s[0] + f * dx), ys - (s[1] + f * dy))
