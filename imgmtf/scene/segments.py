@@ -152,12 +152,24 @@ class SampledSegments:
     owner: np.ndarray
     tree: cKDTree
     step: float
+    found: dict = field(default_factory=dict, init=False, repr=False)     # end_contacts, by radius
 
     @classmethod
     def of(cls, segments: np.ndarray, step: float = SAMPLE_STEP_PX) -> SampledSegments:
         segments = np.asarray(segments, float).reshape(-1, 4)
         points, owner = sample_points(segments, step)
         return cls(segments, points, owner, cKDTree(points), step)
+
+    def end_contacts(self, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """Which segments pass within about ``radius`` px of an end of
+        which (:func:`contacts`): (segment, segment) pairs, each once, a
+        segment with itself included; found once for each radius, for
+        every step that asks (the junctions' reach and the straight
+        lines' merging gap are one).  Read only: the arrays are shared."""
+        if radius not in self.found:
+            ends = self.segments.reshape(-1, 2)
+            self.found[radius] = contacts(ends, self, radius, by=np.arange(len(ends)) // 2)
+        return self.found[radius]
 
 
 def rows_of(segments: np.ndarray | SampledSegments) -> np.ndarray:
@@ -247,7 +259,7 @@ def line_lengths(segments: np.ndarray | SampledSegments) -> np.ndarray:
     two halves of a checkerboard's inner line, whose polarity flips at its
     centre) count as one line.  ``segments``: rows (x0, y0, x1, y1), or
     :class:`SampledSegments` of them (whose tree this reuses)."""
-    sampled = segments
+    sampled = segments if isinstance(segments, SampledSegments) else None
     segments = rows_of(segments)
     if len(segments) < 2:
         return segment_lengths(segments)
@@ -259,14 +271,13 @@ def line_lengths(segments: np.ndarray | SampledSegments) -> np.ndarray:
     return segment_lengths(_joined(canonical, label))[label]
 
 
-def _merge_labels(pieces: np.ndarray, near: np.ndarray | SampledSegments | None = None) -> np.ndarray:
+def _merge_labels(pieces: np.ndarray, sampled: SampledSegments | None = None) -> np.ndarray:
     """Which merged line each piece belongs to (connected components of
-    the pairs :func:`merge_segments` joins); ``near``: where to seek the
-    contacts of the pieces' ends, the pieces themselves (default) or the
-    same segments, sampled, turned round or not."""
+    the pairs :func:`merge_segments` joins); ``sampled``: the same
+    segments sampled (turned round or not: their ends are the same points),
+    whose contacts this reuses."""
     lengths, units = segment_lengths(pieces), unit_vectors(pieces)
-    q, b = contacts(pieces.reshape(-1, 2), pieces if near is None else near, MERGE_GAP_PX)
-    a = q // 2
+    a, b = (sampled or SampledSegments.of(pieces)).end_contacts(MERGE_GAP_PX)
     keep = a != b
     a, b = a[keep], b[keep]
     parallel = np.einsum("ij,ij->i", units[a], units[b]) >= math.cos(math.radians(MERGE_ANGLE_DEG))
@@ -335,8 +346,7 @@ def find_junctions(segments: np.ndarray | SampledSegments) -> tuple[list[Junctio
         sampled = SampledSegments.of(rows_of(segments))
     segments = sampled.segments
     lengths, units = segment_lengths(segments), unit_vectors(segments)
-    q, b = contacts(segments.reshape(-1, 2), sampled, JUNCTION_REACH_PX)
-    a = q // 2
+    a, b = sampled.end_contacts(JUNCTION_REACH_PX)
     owner = sampled.owner
     near = sampled.tree.query_pairs(SAMPLE_STEP_PX, output_type="ndarray")
     a, b = _unique_pairs(np.concatenate([a, owner[near[:, 0]]]), np.concatenate([b, owner[near[:, 1]]]),
