@@ -172,13 +172,13 @@ def test_a_low_contrast_boundary_on_a_textured_field_is_not_accepted(tmp_path):
     assert any(r.reason == "snr" and "too noisy for its length" in r.error for r in records)
 
 
-def test_candidates_ends_are_rounded_as_before_numpy_scalars_as_numpy_rounds_them():
+def test_candidates_ends_are_rounded_as_before_a_half_edges_as_numpy_rounds_them():
     from imgmtf.scene.measure import _rounded_ends
     from imgmtf.scene.segments import Segment
     # the two roundings of 3846.965 differ: Python rounds its exact binary value, NumPy its product by 100
     value = 3846.965
-    split = Segment(*np.array([value, 1.0, value, 80.0]))         # a half-edge's ends: NumPy scalars
-    bar = Segment(value, 1.0, value, 80.0, width_px=3.0)           # a bar's centre line: plain floats
+    split = Segment(value, 1.0, value, 80.0)                        # a half-edge
+    bar = Segment(value, 1.0, value, 80.0, width_px=3.0)           # a bar's centre line
     assert _rounded_ends([split, bar]) == [[round(np.float64(value), 2), 1.0, round(np.float64(value), 2), 80.0],
                                            [round(value, 2), 1.0, round(value, 2), 80.0]]
     assert round(np.float64(value), 2) != round(value, 2)

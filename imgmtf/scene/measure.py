@@ -41,6 +41,7 @@ from .segments import (
     BAR_MAX_SEPARATION_PX,
     HalfEdge,
     SampledSegments,
+    Segment,
     find_junctions,
     pair_bars,
     parallel_clearance,
@@ -479,16 +480,16 @@ def _candidate_record(half: HalfEdge, context: Context, ends: list[float], map_e
                   params=context.params, run_utc=context.run_utc)
 
 
-def _rounded_ends(segments: list) -> list[list[float]]:
-    """The segments' ends (x0, y0, x1, y1) rounded to 0.01 px as ``round``
-    rounds each: NumPy's scalars (the segments split from LSD's lines)
-    all in one pass, as NumPy rounds them (a scalar at a time, NumPy's
-    round costs some 3 us); plain floats (a bar's centre line) as Python
-    does (the two differ where a value lies within rounding of a
-    half-step)."""
+def _rounded_ends(segments: list[Segment]) -> list[list[float]]:
+    """The segments' ends (x0, y0, x1, y1) rounded to 0.01 px: a
+    half-edge's as NumPy rounds (x 100, to the nearest integer), all in one
+    pass; a bar's centre line's as Python's ``round`` does (the nearest of
+    the exact value), as the records always had them (the two differ where
+    a value lies within rounding of a half-step)."""
     ends = [(s.x0, s.y0, s.x1, s.y1) for s in segments]
     by_numpy = np.round(np.array(ends, float).reshape(-1, 4), 2).tolist()
-    return [by_numpy[k] if isinstance(e[0], np.floating) else [round(v, 2) for v in e] for k, e in enumerate(ends)]
+    return [[round(v, 2) for v in e] if s.width_px > 0 else by_numpy[k]
+            for k, (s, e) in enumerate(zip(segments, ends))]
 
 
 def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:

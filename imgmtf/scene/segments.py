@@ -391,7 +391,7 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
     lengths = segment_lengths(segments).tolist()
     fill = np.zeros(len(segments)) if fill_fraction is None else np.asarray(fill_fraction, float)
     fill = fill.tolist()
-    rows_of_segments = segments.tolist()
+    rows_of_segments = segments.tolist()         # (plain floats: the half-edges' arithmetic is per segment)
     out = []
     by_segment: dict[int, list[tuple[int, float]]] = {}
     members: dict[int, set[int]] = {}
@@ -405,15 +405,16 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
         if (p, jid) not in reached:
             reached[p, jid] = _reaching(rows_of_segments[p], junctions[jid])
         return reached[p, jid]
-    for i, s in enumerate(segments):
-        line = Segment(*s)
-        rows = by_segment.get(i)
-        if not rows:
+    for i, row in enumerate(rows_of_segments):
+        line = Segment(*row)
+        cut_at = by_segment.get(i)
+        if not cut_at:
             out.append(HalfEdge(line, lines[i], fill_fraction=fill[i]))
             continue
-        u = (s[2:] - s[:2]) / max(lengths[i], 1e-12)
+        x0, y0, x1, y1 = row
+        ux, uy = (x1 - x0) / max(lengths[i], 1e-12), (y1 - y0) / max(lengths[i], 1e-12)
         # junctions on this segment, by position (the projection of their centre), and who meets there
-        cuts = dict(rows)
+        cuts = dict(cut_at)
         partners = {jid: sorted(members[jid] - {i}) for jid in cuts}
         # a junction near an end moves that end onto it (the innermost, if several); one
         # farther inside splits the segment there
@@ -426,7 +427,7 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
         stops.append((min(near_end)[0], min(near_end)[1], [jid for _, jid in near_end]) if near_end
                      else (lengths[i], None, []))
         stops = [stop for k, stop in enumerate(stops) if k == 0 or stop[0] > stops[k - 1][0]]
-        halves = [Segment(*(s[:2] + a[0] * u), *(s[:2] + b[0] * u)) for a, b in pairwise(stops)]
+        halves = [Segment(x0 + a[0] * ux, y0 + a[0] * uy, x0 + b[0] * ux, y0 + b[0] * uy) for a, b in pairwise(stops)]
         for k, (a, b) in enumerate(pairwise(stops)):
             met = [reaching(p, j) for j in a[2] + b[2] for p in partners[j]]
             met += [halves[m] for m in (k - 1, k + 1) if 0 <= m < len(halves)]
