@@ -6,9 +6,10 @@ its free ends).  The estimators see it as a mask (:func:`imgmtf.measure_edge`'s 
 nothing outside it enters the estimate.
 
 Order of work, cheapest first: fill and the geometric screens (unread);
-then, per batch of candidates sharing a tile (one windowed read): the
-ROI's extent clear of junctions and fill, a quick look at its pixels
-(:mod:`.screen`), and the estimate, whose quality gate gives the verdict
+then, per batch of candidates sharing a tile (one windowed read): each
+ROI's extent clear of junctions and fill, a quick look at the pixels of
+all of them at once (:mod:`.screen`), and the estimate of each it
+passes, whose quality gate gives the verdict
 (:mod:`imgmtf.estimate.gate`).  The gate runs before the estimate's
 intervals are computed, so only the accepted candidates pay for them.
 """
@@ -45,6 +46,7 @@ from .segments import (
     find_junctions,
     pair_bars,
     parallel_clearance,
+    segment_rows,
     split_at_junctions,
 )
 from .settings import ScanSettings
@@ -175,7 +177,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
         verdict = verdict or _beside_screen(half, clearance)
         if not verdict:
-            partners = np.array([p.as_array() for p in half.partners]).reshape(-1, 4)
+            partners = segment_rows(half.partners)
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
         records.append(_candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict))
     batches = _batches(plans, info, settings.tile_px)
@@ -486,10 +488,9 @@ def _rounded_ends(segments: list[Segment]) -> list[list[float]]:
     pass; a bar's centre line's as Python's ``round`` does (the nearest of
     the exact value), as the records always had them (the two differ where
     a value lies within rounding of a half-step)."""
-    ends = [(s.x0, s.y0, s.x1, s.y1) for s in segments]
-    by_numpy = np.round(np.array(ends, float).reshape(-1, 4), 2).tolist()
-    return [[round(v, 2) for v in e] if s.width_px > 0 else by_numpy[k]
-            for k, (s, e) in enumerate(zip(segments, ends))]
+    by_numpy = np.round(segment_rows(segments), 2).tolist()
+    return [[round(v, 2) for v in (s.x0, s.y0, s.x1, s.y1)] if s.width_px > 0 else by_numpy[k]
+            for k, s in enumerate(segments)]
 
 
 def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:
@@ -498,7 +499,7 @@ def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:
     the identity (pixel coordinates are all it has)."""
     if info.transform.is_identity or not segments:
         return None
-    ends = np.array([(s.x0, s.y0, s.x1, s.y1) for s in segments], float).reshape(-1, 4) + 0.5
+    ends = segment_rows(segments) + 0.5
     x0, y0 = info.transform @ (ends[:, 0], ends[:, 1])
     x1, y1 = info.transform @ (ends[:, 2], ends[:, 3])
     return np.column_stack([x0, y0, x1, y1]).tolist()

@@ -81,9 +81,6 @@ class Segment:
         d = np.array([self.x1 - self.x0, self.y1 - self.y0])
         return d / np.linalg.norm(d)
 
-    def as_array(self) -> np.ndarray:
-        return np.array([self.x0, self.y0, self.x1, self.y1])
-
 
 @dataclass(frozen=True)
 class HalfEdge:
@@ -117,6 +114,12 @@ class Junction:
 
 
 # -- contacts between segments ------------------------------------------------------
+def segment_rows(segments: list[Segment] | tuple[Segment, ...]) -> np.ndarray:
+    """Segments as rows (x0, y0, x1, y1), n x 4 (without a NumPy array
+    for each on the way)."""
+    return np.array([(s.x0, s.y0, s.x1, s.y1) for s in segments], float).reshape(-1, 4)
+
+
 def segment_lengths(s: np.ndarray) -> np.ndarray:
     """Lengths (px) of segments (rows x0, y0, x1, y1)."""
     return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
@@ -460,7 +463,7 @@ def parallel_clearance(candidates: list[Segment], segments: np.ndarray | Sampled
     ``inf`` when none lies within ``reach_px``.  ``segments``: rows (x0,
     y0, x1, y1), or :class:`SampledSegments` of them (whose tree this
     reuses)."""
-    c = np.array([seg.as_array() for seg in candidates], float).reshape(-1, 4)
+    c = segment_rows(candidates)
     out = np.full(len(c), np.inf)
     near = segments
     segments = rows_of(segments)
@@ -504,7 +507,7 @@ def pair_bars(segments: list[Segment]) -> tuple[list[int], list[tuple[int, int, 
     >>> lone, [(i, j, round(bar.width_px, 2)) for i, j, bar in bars]
     ([2], [(0, 1, 3.0)])
     """
-    s = np.array([seg.as_array() for seg in segments], float).reshape(-1, 4)
+    s = segment_rows(segments)
     n = len(s)
     if n < 2:
         return list(range(n)), []
