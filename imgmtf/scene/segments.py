@@ -80,10 +80,6 @@ class Segment:
         angle = math.degrees(math.atan2(self.x1 - self.x0, -(self.y1 - self.y0)))
         return (angle + 90.0) % 180.0 - 90.0 if (angle + 90.0) % 180.0 != 0.0 else 90.0
 
-    def unit(self) -> np.ndarray:
-        d = np.array([self.x1 - self.x0, self.y1 - self.y0])
-        return d / np.linalg.norm(d)
-
 
 @dataclass(frozen=True)
 class HalfEdge:
