@@ -170,7 +170,7 @@ def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
 
 
 def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
-    import imgmtf.scene.measure as scan_module
+    import imgmtf.scene.candidates as scan_module
     calls = []
 
     def breaks_once(*args):
