@@ -21,7 +21,8 @@ from ..errors import ImgmtfError
 from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from .fill import FILL_SIDE_PX, fill_mask
-from .segments import merge_pieces, sample_points, unit_vectors
+from .geometry import sample_points, unit_vectors
+from .segments import merge_pieces
 from .settings import ScanSettings
 
 # Scenes larger than this are refused: detection reads every tile, and 1 Gpx

@@ -28,11 +28,12 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from .geometry import SAMPLE_STEP_PX, sample_points, segment_lengths, unit_vectors
+
 MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
 MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line
 MERGE_GAP_PX = 6.0           # ... and leave at most this gap between them
 BAR_MAX_SEPARATION_PX = 8.0  # two parallel sides closer than this are one bar
-SAMPLE_STEP_PX = 2.0         # contacts are sought between points this far apart along segments
 JUNCTION_REACH_PX = 6.0      # a segment ending this close to another meets it (LSD stops short of corners)
 JUNCTION_ANGLE_DEG = 20.0    # segments closer in direction do not make a junction
 JUNCTION_MERGE_PX = 4.0      # meeting points closer than this are one junction
@@ -117,28 +118,6 @@ def segment_rows(segments: list[Segment] | tuple[Segment, ...]) -> np.ndarray:
     """Segments as rows (x0, y0, x1, y1), n x 4 (without a NumPy array
     for each on the way)."""
     return np.array([(s.x0, s.y0, s.x1, s.y1) for s in segments], float).reshape(-1, 4)
-
-
-def segment_lengths(s: np.ndarray) -> np.ndarray:
-    """Lengths (px) of segments (rows x0, y0, x1, y1)."""
-    return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
-
-
-def unit_vectors(s: np.ndarray) -> np.ndarray:
-    """Unit vectors along segments (rows x0, y0, x1, y1), from start to end."""
-    d = s[:, 2:] - s[:, :2]
-    return d / np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
-
-
-def sample_points(s: np.ndarray, step: float = SAMPLE_STEP_PX) -> tuple[np.ndarray, np.ndarray]:
-    """Points every ``step`` px or closer along each segment (ends
-    included): (points n x 2, the segment of each)."""
-    counts = np.ceil(segment_lengths(s) / step).astype(int) + 1
-    owner = np.repeat(np.arange(len(s)), counts)
-    first = np.cumsum(counts) - counts
-    fraction = (np.arange(owner.size) - first[owner]) / np.maximum(counts[owner] - 1, 1)
-    points = s[owner, :2] + fraction[:, None] * (s[owner, 2:] - s[owner, :2])
-    return points, owner
 
 
 @dataclass(frozen=True, eq=False)
