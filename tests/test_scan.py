@@ -169,6 +169,21 @@ def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
     assert header[:3] == ["id", "rank", "path"] and "bar_width_px" in header and "run_utc" in header
 
 
+def test_the_scans_workers_load_no_scipy():
+    """What the workers run (tile search, a batch of candidates, a target's
+    fit) and what their fork server preloads (imgmtf.cli.scan's lists,
+    without the fits') load no SciPy: only the segment graph, in the
+    calling process, needs it."""
+    import subprocess
+    import sys
+
+    from imgmtf.cli.scan import SCANNING_MODULES
+    code = f"import sys; import {', '.join(SCANNING_MODULES)}; print(sorted(m for m in sys.modules if m == 'scipy'))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+
+
 def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
     import imgmtf.scene.candidates as scan_module
     calls = []

@@ -22,7 +22,6 @@ from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from .fill import FILL_SIDE_PX, fill_mask
 from .geometry import sample_points, unit_vectors
-from .segments import merge_pieces
 from .settings import ScanSettings
 
 # Scenes larger than this are refused: detection reads every tile, and 1 Gpx
@@ -59,6 +58,7 @@ def detect_segments(path: str, settings: ScanSettings | None = None, *, workers:
                                   description="detecting segments") if len(f[0])]
     if not found:
         return np.zeros((0, 4)), np.zeros(0)
+    from .segments import merge_pieces  # (the graph's module loads SciPy; the tiles' workers need not)
     return merge_pieces(np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found]))
 
 

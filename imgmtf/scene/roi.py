@@ -10,14 +10,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..estimate import gate
 from ..io import RasterInfo
 from .fill import FILL_SIDE_PX, fill_screen, grown
-from .segments import HalfEdge
 from .settings import ScanSettings
+
+if TYPE_CHECKING:
+    from .segments import HalfEdge
 
 JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its target meets
 FILL_CLEARANCE_PX = 4           # ... this far from fill and nodata (the target was blurred with the ground beyond it)
