@@ -25,8 +25,8 @@ from .tables import print_scan
 DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without importing it for --help
 # what a scan's workers load, NumPy's lazily loaded parts included: imported once by the workers'
 # fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
-# of the fits only when the targets are fitted (SciPy's optimizer alone is 0.35 s).  Not the segment
-# graph's SciPy (0.2 s), which only this process needs: the workers start that much sooner
+# of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
+# Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
 SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit", "numpy.fft",
                     "numpy.ma", "numpy.polynomial")
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
@@ -125,7 +125,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             raise click.UsageError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
                                    "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
-            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if stages else ()))
+            fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
+            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ()))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
