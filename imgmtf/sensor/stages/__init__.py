@@ -3,7 +3,7 @@
 A stage is a frozen dataclass whose fields are its physical parameters.
 Every stage gives
 
-* ``transfer(fx, fy, gsd_m)``: its real 2-D transfer function at spatial
+* ``transfer(fx, fy, gsd_m)``: its 2-D transfer function at spatial
   frequencies in cycles per metre on the ground (``fx`` across track, image
   columns; ``fy`` along track, image rows), 1 at zero frequency.  ``gsd_m``
   is the sensor's ground sample distance, which maps focal-plane lengths
@@ -20,9 +20,15 @@ Every stage gives
 * ``to_dict()`` / :func:`stage_from_dict`: the TOML form, ``{"stage": name,
   parameter: value, ...}``.
 
-Every PSF here is non-negative and symmetric about both axes, so every
-transfer function is real and even in ``fx`` and in ``fy``.  A new stage is
-one class in this file with the :func:`register` decorator; the fit
+Every PSF here is non-negative.  Most are symmetric about both axes, so
+their transfer functions are real and even in ``fx`` and in ``fy``; the
+one-sided :class:`Lag` is not: its transfer is complex (Hermitian,
+T(-f) = conj T(f)), the sensor gains a phase transfer function and an
+asymmetric PSF, and its MTF is the transfer's modulus.  The stages real
+L0R blur needs beside the paper's: :class:`Diffusion` (exponential wings
+per axis), :class:`Halo` (a share of the energy scattered into a broad
+kernel) and :class:`Lag`.  A new stage is one module of this package
+with the :func:`register` decorator and its import below; the fit
 (:mod:`imgmtf.estimate.fit`) reads what it needs to fit it from the fields'
 ``FitSpec`` metadata.
 
@@ -49,6 +55,9 @@ from .diffraction import Diffraction
 from .defocus import Defocus
 from .olpf import OLPF
 from .jitter import Jitter
+from .diffusion import Diffusion
+from .halo import Halo
+from .lag import Lag
 # isort: on
 
 __all__ = [
@@ -58,10 +67,13 @@ __all__ = [
            "Defocus",
            "Detector",
            "Diffraction",
+           "Diffusion",
            "Electronics",
            "FitSpec",
            "GaussianOptics",
+           "Halo",
            "Jitter",
+           "Lag",
            "Motion",
            "Stage",
            "register",

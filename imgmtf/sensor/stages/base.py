@@ -37,7 +37,11 @@ class FitSpec:
     blur length in pixels (a width, ``kind="length"``, or 1 / (cut-off x
     GSD), ``kind="frequency"``) raised to ``power`` (2 for the widths, whose
     effect grows as their square; 1 for diffraction, whose MTF falls
-    linearly).  ``upper_px`` bounds the blur length; ``axis`` is the image axis it acts on ("x"
+    linearly), or a share of the energy as it is (``kind="fraction"``,
+    ``power`` 1).  ``upper_px`` bounds the blur length (a fraction's
+    largest share); ``signed`` lets the coordinate take either sign, within
+    +-``upper_px`` (a one-sided response pointing either way along its
+    axis); ``axis`` is the image axis it acts on ("x"
     across track, "y" along track, "xy" both); ``pair`` names the parameter
     of the other axis it is tied to when the edges see only one axis;
     ``rank`` orders what to hold when the data cannot constrain everything
@@ -50,6 +54,12 @@ class FitSpec:
     axis: str = "xy"
     pair: str | None = None
     rank: int = 1
+    signed: bool = False
+
+    @property
+    def lower(self) -> float:
+        """The coordinate's lower bound: -upper for a signed one, else 0."""
+        return -(self.upper_px**self.power) if self.signed else 0.0
 
 
 def param(default: float, unit: str, fit: FitSpec | None = None, **flags) -> Any:
@@ -69,14 +79,17 @@ class Stage:
         for f in fields(self):
             value = check_number(f"{self.name} {f.name}", getattr(self, f.name),
                                  positive=f.metadata.get("positive", False),
-                                 allow_inf=f.metadata.get("allow_inf", False))
+                                 allow_inf=f.metadata.get("allow_inf", False),
+                                 signed=f.metadata.get("signed", False), high=f.metadata.get("high"))
             if math.isfinite(value) and value > MAX_PARAMETER:
                 raise ParameterError(f"{self.name} {f.name} must be at most {MAX_PARAMETER:g} "
                                      f"{f.metadata['unit']}, got {value:g}".rstrip())
             object.__setattr__(self, f.name, value)
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
-        """The stage's transfer function, real and 1 at zero frequency.
+        """The stage's transfer function, 1 at zero frequency: real for a
+        PSF symmetric about both axes, complex (Hermitian, T(-f) = conj T(f))
+        for a one-sided one; its modulus is the MTF, its argument the PTF.
 
         Parameters
         ----------
@@ -126,8 +139,11 @@ class Stage:
         out = {}
         for name, spec in self.fit_specs().items():
             value = getattr(self, name)
+            if spec.kind == "fraction":
+                out[name] = value
+                continue
             length = value / gsd_m if spec.kind == "length" else 1.0 / (value * gsd_m)
-            out[name] = length**spec.power
+            out[name] = math.copysign(abs(length) ** spec.power, length) if spec.signed else length**spec.power
         return out
 
     def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> Stage:
@@ -135,6 +151,12 @@ class Stage:
         values = {}
         for name, u in coordinates.items():
             spec = self.fit_specs()[name]
+            if spec.kind == "fraction":
+                values[name] = max(u, 0.0)
+                continue
+            if spec.signed:
+                values[name] = math.copysign(abs(u) ** (1.0 / spec.power), u) * gsd_m
+                continue
             length = max(u, 0.0) ** (1.0 / spec.power)
             values[name] = length * gsd_m if spec.kind == "length" else (
                 1.0 / (length * gsd_m) if length > 0 else math.inf)
