@@ -93,7 +93,8 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     Parameters
     ----------
     stages : str or sequence of str, optional
-        Stage names to fit, as :func:`imgmtf.fit_sensor` takes them.
+        Stage names to fit, as :func:`imgmtf.fit_sensor` takes them
+        (``"auto"`` included).
     hold : str or sequence of str, optional
         Parameters held: "stage" or "stage.name".
     start : Sensor, optional
@@ -102,7 +103,7 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     Returns
     -------
     list of str
-        The stages' names.
+        The stages' names (``["auto"]`` for the model the data choose).
 
     Raises
     ------
@@ -115,6 +116,10 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     >>> check_names("optics,detector", "detector.width_x_m")
     ['optics', 'detector']
     """
+    from .fitting import check_auto_hold, is_auto
+    if is_auto(stages):
+        check_auto_hold(hold)
+        return ["auto"]
     names = stage_names(stages, start)
     hold_keys(hold, [f"{name}.{parameter}" for name in names for parameter in STAGES[name].fit_specs()])
     return names
@@ -160,7 +165,7 @@ class Model:
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
-        self.edges = [EdgeResponses(d.normal_angle_deg, d.gsd_m, self.reach(d)) for d in data]
+        self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
@@ -236,7 +241,7 @@ class Model:
     def bounds(self):
         upper = [self.specs[k].upper_px ** self.specs[k].power for k in self.free]
         big = np.inf
-        lower = [0.0] * self.n_free + [-big] * (3 * len(self.data))
+        lower = [self.specs[k].lower for k in self.free] + [-big] * (3 * len(self.data))
         return np.array(lower), np.array(upper + [big] * (3 * len(self.data)))
 
     def sensor(self, u: np.ndarray) -> Sensor:
@@ -478,8 +483,11 @@ class Model:
         for i, key in enumerate(self.free):
             power = self.specs[key].power
             u, se = z[i], math.sqrt(max(covariance[i, i], 0.0))
-            length = u ** (1 / power)
-            width = ((u + se) ** (1 / power) - max(u - se, 0.0) ** (1 / power)) / 2
+            if power == 1:              # a length or share taken as it is (a signed one included)
+                length, width = abs(u), se
+            else:
+                length = u ** (1 / power)
+                width = ((u + se) ** (1 / power) - max(u - se, 0.0) ** (1 / power)) / 2
             if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
                 out[i] = width if np.isfinite(width) else math.inf
         return out

@@ -112,9 +112,10 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
 def value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> float:
     """Standard error of a parameter in its own unit, from that of its fit
     coordinate (linearised; one-sided at the coordinate's zero)."""
+    lower = stage.fit_specs()[name].lower
     def value(coordinate):
-        return getattr(stage.with_fit_coordinates({name: max(coordinate, 0.0)}, gsd), name)
-    if u > se_u:
+        return getattr(stage.with_fit_coordinates({name: max(coordinate, lower)}, gsd), name)
+    if u - se_u > lower:
         return abs(value(u + se_u) - value(u - se_u)) / 2
     return abs(value(u + se_u) - value(u))
 

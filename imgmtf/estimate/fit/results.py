@@ -13,6 +13,7 @@ from .model import Model, model_mtf_band
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
+    from .choice import ModelChoice
 
 #: misfit warning: binned residuals significant at this level ...
 MISFIT_P = 1e-3
@@ -176,6 +177,9 @@ class SensorFit:
     warnings : tuple of str
         Where the model does not fit an edge, and which direction no edge
         constrains.
+    choice : ModelChoice or None
+        With ``stages="auto"``: the candidate stage sets fitted, their
+        information criterion and verdicts, and why this one was kept.
 
     Examples
     --------
@@ -197,6 +201,7 @@ class SensorFit:
     _model: Model = field(repr=False)
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
+    choice: ModelChoice | None = None
 
     @property
     def misfit(self) -> bool:
@@ -243,6 +248,7 @@ class SensorFit:
                                    else [json_value(x) for x in vv] for kk, vv in v.items()}
                                for k, v in self.directions.items()},
                 "warnings": list(self.warnings), "sensor": self.sensor.to_dict(),
+                "model_choice": self.choice.to_dict() if self.choice is not None else None,
                 "edges": [e.to_dict() for e in self.edges]}
 
 
