@@ -19,6 +19,7 @@ from .data import EdgeImage, edge_data
 from .model import Model, hold_keys, initial_stages, listed, parameter_covariance, stage_names
 from .report import fit_report
 from .results import SensorFit
+from .seeds import seeded
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
@@ -100,10 +101,11 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
     with one_blas_thread():
         if not auto:
-            return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
+            return run_fit(Model(gsd, seeded(initial_stages(names, start, gsd), data, gsd, start), data), hold,
+                           confidence)
         fits = []
         for candidate in AUTO_CANDIDATES:
-            model = Model(gsd, initial_stages(list(candidate), start, gsd), data)
+            model = Model(gsd, seeded(initial_stages(list(candidate), start, gsd), data, gsd, start), data)
             fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence))
             if not fits[-1].misfit:
                 break               # the simplest that fits

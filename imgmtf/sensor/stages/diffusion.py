@@ -34,8 +34,9 @@ class Diffusion(Stage):
     ----------
     length_x_m, length_y_m : float
         The e-folding lengths Lx (across track) and Ly (along track) of the
-        LSF's wings, metres on the ground, >= 0 (default 0.3); the LSF's
-        standard deviation is sqrt(2) L.
+        LSF's wings, metres on the ground, >= 0; the LSF's
+        standard deviation is sqrt(2) L (default 0: no wings, where a fit
+        starts, so that a length the data do not need is held at none).
 
     Raises
     ------
@@ -54,8 +55,8 @@ class Diffusion(Stage):
 
     name: ClassVar[str] = "diffusion"
     title: ClassVar[str] = "diffusion (exponential wings)"
-    length_x_m: float = param(0.3, "m", FitSpec(axis="x", upper_px=6.0, rank=3))
-    length_y_m: float = param(0.3, "m", FitSpec(axis="y", upper_px=6.0, pair="length_x_m", rank=3))
+    length_x_m: float = param(0.0, "m", FitSpec(axis="x", upper_px=6.0, rank=3))
+    length_y_m: float = param(0.0, "m", FitSpec(axis="y", upper_px=6.0, pair="length_x_m", rank=3))
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         fx, fy = np.asarray(fx, float), np.asarray(fy, float)

@@ -27,7 +27,9 @@ class Halo(Stage):
     Parameters
     ----------
     fraction : float
-        The share eta of the energy in the halo, in [0, 1] (default 0.05).
+        The share eta of the energy in the halo, in [0, 1] (default 0: no
+        halo, where a fit starts, so that a halo the data do not need is
+        held at none).
     radius_m : float
         The kernel's e-folding radius R, metres on the ground, >= 0 (default
         3); its LSF has standard deviation sqrt(3) R.
@@ -50,7 +52,7 @@ class Halo(Stage):
 
     name: ClassVar[str] = "halo"
     title: ClassVar[str] = "scatter halo"
-    fraction: float = param(0.05, "", FitSpec(kind="fraction", power=1, upper_px=0.5, rank=2), high=1.0)
+    fraction: float = param(0.0, "", FitSpec(kind="fraction", power=1, upper_px=0.5, rank=2), high=1.0)
     radius_m: float = param(3.0, "m", FitSpec(upper_px=12.0, rank=4))
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
