@@ -128,7 +128,7 @@ class SyntheticCampaign:
         for name, ok in checks.items():
             if not (math.isfinite(getattr(self, name)) and ok):
                 raise ParameterError(f"{name} out of range: {getattr(self, name)!r}")
-        if not (len(self.optics_sigma_px) == 2 and all(0 <= s <= 5 for s in self.optics_sigma_px)):  # type: ignore[arg-type]
+        if not (len(self.optics_sigma_px) == 2 and all(0 <= s <= 5 for s in self.optics_sigma_px)):
             raise ParameterError(f"optics_sigma_px must be two widths of 0 to 5 px, got {self.optics_sigma_px!r}")
         if not (isinstance(self.size_px, int) and 96 <= self.size_px <= 4096):
             raise ParameterError(f"scenes are 96 to 4096 px a side, got {self.size_px!r}")
@@ -211,7 +211,7 @@ class SyntheticCampaign:
 
     def as_dict(self) -> dict:
         return {"acquisitions": self.acquisitions, "start_utc": self.start_utc, "interval_days": self.interval_days,
-                "degradation_per_year": self.degradation, "optics_sigma_px": list(self.optics_sigma_px),
+                "degradation_per_year": self.degradation, "optics_sigma_px": list(self.optics_sigma_px or ()),
                 "snr": self.snr, "size_px": self.size_px, "bits": self.bits, "seed": self.seed,
                 "gsd_m": self.gsd_m, "fill": self.fill, "blur": self.blur}
 

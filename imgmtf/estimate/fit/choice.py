@@ -81,15 +81,20 @@ class ModelChoice:
         The kept candidate's stages.
     reason : str
         Why, in a phrase ("the simplest that fits, 2 of 5 tried").
+    failed : tuple of (tuple of str, str)
+        Candidates whose fit did not converge, with why (the next one was
+        tried).
     """
 
     candidates: tuple[CandidateFit, ...]
     kept: tuple[str, ...]
     reason: str
+    failed: tuple[tuple[tuple[str, ...], str], ...] = ()
 
     def to_dict(self) -> dict:
         return {"kept": list(self.kept), "reason": self.reason,
-                "candidates": [c.to_dict() for c in self.candidates]}
+                "candidates": [c.to_dict() for c in self.candidates],
+                "failed": [{"stages": list(c), "error": message} for c, message in self.failed]}
 
 
 def candidate_summary(fit) -> CandidateFit:
@@ -101,13 +106,15 @@ def candidate_summary(fit) -> CandidateFit:
                         chi_square + model.n_free * math.log(max(samples, 2)), bool(fit.misfit))
 
 
-def choose(fits) -> tuple[int, str]:
-    """Index of the fit to keep among candidates fitted in order, and why:
+def choose(fits, tried: int | None = None) -> tuple[int, str]:
+    """Index of the fit to keep among candidates fitted in order (``tried``
+    of :data:`AUTO_CANDIDATES` tried, those that failed included), and why:
     the first that fits, else the lowest information criterion."""
     summaries = [candidate_summary(f) for f in fits]
+    tried = len(fits) if tried is None else tried
     for index, summary in enumerate(summaries):
         if not summary.misfit:
-            return index, f"the simplest that fits ({index + 1} of {len(AUTO_CANDIDATES)} tried)"
+            return index, f"the simplest that fits ({tried} of {len(AUTO_CANDIDATES)} tried)"
     best = min(range(len(summaries)), key=lambda i: summaries[i].bic)
-    return best, (f"none of the {len(summaries)} candidates fits: the lowest information criterion "
+    return best, (f"none of the {tried} candidates fits: the lowest information criterion "
                   f"(BIC {summaries[best].bic:.0f})")

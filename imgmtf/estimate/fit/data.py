@@ -205,10 +205,18 @@ def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | 
     noise = max(profile_noise(x, y), floor)           # of one sample, from the samples themselves
     gsd = result.gsd_m if result.gsd_m else (gsd_m or 1.0)
     normal = float(result.normal_angle_deg)
-    # the vertical frame's distances grow toward +x; a transposed (horizontal) frame's toward +y
-    toward_decreasing_row = result.orientation == "horizontal" and normal < 0
     return EdgeData(source, x, y, bin_profile(x, y), normal, float(gsd), bool(result.gsd_m),
-                    noise, levels, result, toward_decreasing_row)
+                    noise, levels, result, profile_angle_deg(result) != normal)
+
+
+def profile_angle_deg(result: EdgeResult) -> float:
+    """The direction (deg from the x axis) an edge measurement's sample
+    distances (and its LSF's) grow along: its normal, or for a
+    near-horizontal edge whose normal points toward decreasing row the
+    opposite one (the vertical frame's distances grow toward +x, a
+    transposed frame's toward +y)."""
+    normal = float(result.normal_angle_deg)
+    return normal + 180.0 if result.orientation == "horizontal" and normal < 0 else normal
 
 
 def profile_noise(x: np.ndarray, y: np.ndarray) -> float:

@@ -101,17 +101,35 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
     with one_blas_thread():
         if not auto:
-            return run_fit(Model(gsd, seeded(initial_stages(names, start, gsd), data, gsd, start), data), hold,
-                           confidence)
-        fits = []
+            return run_fit(new_model(gsd, initial_stages(names, start, gsd), data, start), hold, confidence)
+        fits, failed = [], []
         for candidate in AUTO_CANDIDATES:
-            model = Model(gsd, seeded(initial_stages(list(candidate), start, gsd), data, gsd, start), data)
-            fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence))
+            model = new_model(gsd, initial_stages(list(candidate), start, gsd), data, start)
+            try:
+                fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence))
+            except ImgmtfError as exc:          # one that does not converge: the next is tried
+                failed.append((candidate, str(exc)))
+                continue
             if not fits[-1].misfit:
                 break               # the simplest that fits
-    index, reason = choose(fits)
-    choice = ModelChoice(tuple(candidate_summary(f) for f in fits), AUTO_CANDIDATES[index], reason)
+    if not fits:
+        raise ImgmtfError("no candidate sensor model could be fitted: "
+                          + "; ".join(f"{'+'.join(c)}: {message}" for c, message in failed), reason="fit")
+    index, reason = choose(fits, tried=len(fits) + len(failed))
+    kept = tuple(s.name for s in fits[index].sensor.stages)
+    choice = ModelChoice(tuple(candidate_summary(f) for f in fits), kept, reason, tuple(failed))
     return replace(fits[index], choice=choice)
+
+
+def new_model(gsd: float, stages: list, data: list, start: Sensor | None) -> Model:
+    """The model of ``stages``, a lag started where the edges lean
+    (:func:`.seeds.seeded`) but held, if held, at none."""
+    return Model(gsd, seeded(stages, data, gsd, start), data, held_at=stages)
+
+
+def held_where(model: Model, key: str) -> str:
+    """Where a held parameter is held, in words."""
+    return "its starting value" if model.held_at[key] == model.start[key] else "none (0)"
 
 
 def is_auto(stages) -> bool:
@@ -167,7 +185,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         worst = max(undetermined, key=lambda i: (model.specs[model.free[i]].rank, undetermined[i]))
         notes[model.free[worst]] = ("held", f"not determined by the data (within one standard error its blur "
                                             f"length spans {undetermined[worst]:.2g} px); "
-                                            "held at its starting value")
+                                            f"held at {held_where(model, model.free[worst])}")
         z = model.hold(z, worst, covariance)
     # hold, best-known first, each parameter the data do not need (holding it
     # at its starting value costs less than the likelihood-ratio threshold),
@@ -187,7 +205,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         cost = (trial.chi_square(z_held) - model.chi_square(z)) / scale
         if cost < LIKELIHOOD_RATIO:
             notes[key] = ("held", f"the data do not need it (freeing it gains chi-square {max(cost, 0):.1f} "
-                                  f"< {LIKELIHOOD_RATIO:g}); held at its starting value")
+                                  f"< {LIKELIHOOD_RATIO:g}); held at {held_where(model, key)}")
             model, z = trial, z_held
             scale = max(model.reduced_chi_square(z), 1.0)
             covariance = parameter_covariance(jacobian_held, scale)

@@ -142,7 +142,7 @@ class Model:
     """The shared stage parameters and each edge's nuisance parameters as
     one vector z = [free stage coordinates, then L, R, x0 per edge]."""
 
-    def __init__(self, gsd: float, stages: list[Stage], data: list[EdgeData]):
+    def __init__(self, gsd: float, stages: list[Stage], data: list[EdgeData], held_at: list[Stage] | None = None):
         self.gsd, self.stages, self.data = gsd, stages, data
         self.specs, self.keys, self.units = {}, [], {}
         for stage in stages:
@@ -154,13 +154,17 @@ class Model:
         # each stage's parameters: (key, name), in the order the coordinates are
         self._stage_keys = [[(f"{stage.name}.{name}", name) for name in stage.fit_specs()] for stage in stages]
         self.start = {k: v for s in stages for k, v in stage_coordinates(s, gsd).items()}
+        # where a held parameter is held: its start, but for a stage started from the data (a lag's
+        # lean, :mod:`.seeds`), the value it had before (none): a guess is no value to hold
+        self.held_at = dict(self.start) if held_at is None else {
+            k: v for s in held_at for k, v in stage_coordinates(s, gsd).items()}
         # a bin's residual weight: its mean's noise is noise / sqrt(count)
         self.weights = [np.sqrt(d.bins.count) / d.noise for d in data]
         self.counts = [d.bins.x.size for d in data]
         self.starts = np.cumsum([0, *self.counts[:-1]]).tolist()      # each edge's first bin among all
         self._stacked_bins: tuple[ProfileBins, np.ndarray] | None = None
         self._layout: tuple = (None, None, None)
-        self.values = dict(self.start)           # coordinates of held parameters live here
+        self.values = dict(self.held_at)         # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
@@ -215,8 +219,8 @@ class Model:
         the held one), the refit's starting point: a few steps from its end."""
         key = self.free.pop(index)
         if covariance is not None and covariance[index, index] > 0:
-            z = z + covariance[:, index] / covariance[index, index] * (self.start[key] - z[index])
-        self.values[key] = self.start[key]
+            z = z + covariance[:, index] / covariance[index, index] * (self.held_at[key] - z[index])
+        self.values[key] = self.held_at[key]
         return np.delete(z, index)
 
     @property
