@@ -67,7 +67,13 @@ class Check:
     ``reason`` is the machine-readable code, ``message`` one line saying
     what was measured against what limit; ``value`` and ``limit`` are the
     numbers (units in the message); ``share`` the fraction of the chip a
-    failure covers, where that is known (fill).
+    failure covers, where that is known (fill).  ``ran`` is False for a
+    check that could not run on this chip (too few samples, no side left
+    to judge): it is no pass (``passed`` False), and no refusal either
+    (``failed`` False); its message says why it could not run
+    (:func:`not_run`).  Where being unable to judge is itself a fault
+    (a side whose plateau never arrives within the chip), the check
+    fails instead.
     """
 
     reason: str
@@ -76,6 +82,38 @@ class Check:
     value: float | None = None
     limit: float | None = None
     share: float | None = None
+    ran: bool = True
+
+    @property
+    def failed(self) -> bool:
+        """Did the check run and refuse the chip?"""
+        return self.ran and not self.passed
+
+    @property
+    def outcome(self) -> str:
+        """"passed", "failed" or "not-run"."""
+        return "not-run" if not self.ran else "passed" if self.passed else "failed"
+
+    def to_dict(self) -> dict:
+        """JSON-ready: reason, outcome, passed, message, value and limit
+        (None where not known)."""
+        def number(x):
+            return round(float(x), 6) if x is not None and math.isfinite(float(x)) else None
+        return {"reason": self.reason, "outcome": self.outcome, "passed": bool(self.passed and self.ran),
+                "message": self.message, "value": number(self.value), "limit": number(self.limit)}
+
+
+def not_run(reason: str, why: str) -> Check:
+    """The record of a check that could not run on a chip, and ``why``
+    (one line): neither a pass nor a refusal.
+
+    Examples
+    --------
+    >>> check = not_run("compression", "too few rows to see an 8-row block grid")
+    >>> check.outcome, check.passed, check.failed
+    ('not-run', False, False)
+    """
+    return Check(reason, False, f"not run: {why}", ran=False)
 
 
 class QualityError(UnsuitableTargetError):
@@ -143,7 +181,7 @@ def untrusted_when_forced(checks) -> Check | None:
     cannot be read off (not an MTF), or fill that is most of the chip or
     comes with a second target (whose edge is then the fill's boundary).
     A caller reports such a number as a failure, printed with its reason."""
-    failed = {c.reason: c for c in checks if not c.passed}
+    failed = {c.reason: c for c in checks if c.failed}
     for check in checks:
         if check.reason == "mtf-above-one" and check.value is not None and check.value > 0:
             return Check("mtf-above-one", False, check.message, check.value, 0.0)
@@ -158,7 +196,7 @@ def untrusted_when_forced(checks) -> Check | None:
 def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
     """Raise :class:`QualityError` for failed checks, unless ``force``:
     then return them as warnings."""
-    failed = [c for c in checks if not c.passed]
+    failed = [c for c in checks if c.failed]
     if failed and not force:
         raise (TwoTargetsError if failed[0].reason == "two-targets" else QualityError)(failed)
     return tuple(f"{c.reason}: {c.message} (measured anyway: forced)" for c in failed)
@@ -265,6 +303,9 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
         checks.append(Check("not-straight", not bowed,
                             f"the {name} bows by {sagitta:.2f} px over its length (at most "
                             f"{MAX_SAGITTA_PX} px): a curved {name}", sagitta, MAX_SAGITTA_PX))
+    else:
+        checks.append(not_run("not-straight", f"only {int(kept.sum())} rows on the line: too few (10) to see "
+                              f"the {name} bow"))
     return checks
 
 
@@ -326,6 +367,9 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
     s = distance - centre
     for name, mask in (("left", s <= -start_px), ("right", s >= start_px)):
         if mask.sum() < 20:
+            # the sides' settling check (:mod:`.settling`) refuses a side without a plateau
+            checks.append(not_run("non-uniform", f"the {name} side holds {int(mask.sum())} samples beyond "
+                                  f"{start_px:.1f} px (20 needed): its trend and texture not measured"))
             continue
         ss, v, t = np.abs(s[mask]), values[mask], along[mask]
         design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
@@ -377,7 +421,8 @@ def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
     wrong profile does.  Checked up to the noise limit (and 1 cy/px)."""
     f = np.arange(0.01, min(limit_cy_px, 1.0) + 1e-9, 0.01)
     if f.size == 0:
-        return Check("mtf-above-one", True, "MTF not checked")
+        return not_run("mtf-above-one", f"the MTF falls into its noise below 0.01 cy/px ({limit_cy_px:.3f}): "
+                       "nothing to compare with 1")
     excess = mtf(f) - 1.0 - 3.0 * noise_sd(f)
     worst = int(np.nanargmax(excess)) if np.isfinite(excess).any() else 0
     over = float(excess[worst]) if np.isfinite(excess).any() else -1.0

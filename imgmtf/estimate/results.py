@@ -78,7 +78,8 @@ class MTFResult:
         The LSF window's flat core, and the share of the LSF's area the
         tail model supplies beyond it.
     checks : tuple of imgmtf.estimate.gate.Check
-        Every quality check and its outcome.
+        Every quality check and its outcome (passed, failed, or not run
+        and why), in the JSON form too.
     warnings : tuple of str
         What the user should know (low SNR, forced checks...).
     mtf_function : callable or None
@@ -181,8 +182,7 @@ class MTFResult:
             "lsf_half_width_px": finite(self.lsf_half_width_px), "tail_fraction": finite(self.tail_fraction),
             **self._specific(),
             "roi": list(self.roi), "warnings": list(self.warnings),
-            "checks": [{"reason": c.reason, "passed": bool(c.passed), "message": c.message}
-                       for c in self.checks if not c.passed],
+            "checks": [c.to_dict() for c in self.checks],
             "params": self.params, "imgmtf_version": __version__,
         }
         if curves:
