@@ -73,7 +73,8 @@ class Check:
     (``failed`` False); its message says why it could not run
     (:func:`not_run`).  Where being unable to judge is itself a fault
     (a side whose plateau never arrives within the chip), the check
-    fails instead.
+    fails instead.  ``explained_by`` names a known cause that makes what
+    would fail the check pass (a sharpening kernel's MTF above 1).
     """
 
     reason: str
@@ -83,6 +84,7 @@ class Check:
     limit: float | None = None
     share: float | None = None
     ran: bool = True
+    explained_by: str | None = None
 
     @property
     def failed(self) -> bool:
@@ -99,8 +101,9 @@ class Check:
         (None where not known)."""
         def number(x):
             return round(float(x), 6) if x is not None and math.isfinite(float(x)) else None
-        return {"reason": self.reason, "outcome": self.outcome, "passed": bool(self.passed and self.ran),
-                "message": self.message, "value": number(self.value), "limit": number(self.limit)}
+        out = {"reason": self.reason, "outcome": self.outcome, "passed": bool(self.passed and self.ran),
+               "message": self.message, "value": number(self.value), "limit": number(self.limit)}
+        return {**out, "explained_by": self.explained_by} if self.explained_by else out
 
 
 def not_run(reason: str, why: str) -> Check:
@@ -177,13 +180,15 @@ MOSTLY_FILL = 0.5               # a forced chip more than this much fill measure
 
 def untrusted_when_forced(checks) -> Check | None:
     """The check that makes a forced number unusable, or None: an MTF above
-    1 beyond its noise (even within the gate's allowance), figures that
+    1 beyond its noise (even within the gate's allowance) that no
+    sharpening kernel explains, figures that
     cannot be read off (not an MTF), or fill that is most of the chip or
     comes with a second target (whose edge is then the fill's boundary).
     A caller reports such a number as a failure, printed with its reason."""
     failed = {c.reason: c for c in checks if c.failed}
     for check in checks:
-        if check.reason == "mtf-above-one" and check.value is not None and check.value > 0:
+        if (check.reason == "mtf-above-one" and check.value is not None and check.value > 0
+                and check.explained_by is None):
             return Check("mtf-above-one", False, check.message, check.value, 0.0)
     if "mtf-undefined" in failed:
         return failed["mtf-undefined"]
