@@ -362,15 +362,20 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Chec
     return Check(reason, False, message)
 
 
-def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power) -> list[Check]:
+def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power,
+                names: tuple[str, str] = ("left", "right")) -> list[Check]:
     """Uniform sides: each side's samples beyond ``start_px`` from the
     centre fitted with its level, its tail (a / |s|^p), a trend across and
     a trend along the target; a trend over the side larger than
     ``MAX_SIDE_TREND`` of the contrast, texture beyond the pixel noise, or
-    a 1-px band far off the model (another edge or bar) fail."""
+    a 1-px band far off the model (another edge or bar) fail.
+    ``pixel_noise`` (DN): one for both sides, or (left, right) where it
+    differs (linearised values: the stored noise scaled at each level);
+    ``names`` what the left and right sides are called ("dark", "bright")."""
     checks = []
     s = distance - centre
-    for name, mask in (("left", s <= -start_px), ("right", s >= start_px)):
+    noises = tuple(pixel_noise) if np.ndim(pixel_noise) else (pixel_noise, pixel_noise)
+    for (name, mask), pixel_noise in zip(((names[0], s <= -start_px), (names[1], s >= start_px)), noises):
         if mask.sum() < 20:
             # the sides' settling check (:mod:`.settling`) refuses a side without a plateau
             checks.append(not_run("non-uniform", f"the {name} side holds {int(mask.sum())} samples beyond "
@@ -380,7 +385,8 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
         design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
         coef, *_ = np.linalg.lstsq(design, v, rcond=None)
         resid = v - design @ coef
-        trend = max(abs(coef[2]) * np.ptp(ss), abs(coef[3]) * np.ptp(t)) / contrast
+        across, along_target = abs(coef[2]) * np.ptp(ss) / contrast, abs(coef[3]) * np.ptp(t) / contrast
+        trend, way = max((across, "across"), (along_target, "along"))
         texture = math.sqrt(max(np.var(resid) - pixel_noise ** 2, 0.0)) / contrast
         bands = np.floor(ss).astype(int)
         counts = np.bincount(bands)
@@ -393,8 +399,8 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
                   if full.any() and band_means[worst] > 5 * band_noise[worst] else 0.0)
         checks += [
             Check("non-uniform", trend <= MAX_SIDE_TREND,
-                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast (at most "
-                  f"{100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
+                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast {way} the target (at "
+                  f"most {100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
             Check("non-uniform", texture <= MAX_SIDE_TEXTURE,
                   f"the {name} side carries texture of {100 * texture:.0f} % of the contrast beyond the "
                   f"pixel noise (at most {100 * MAX_SIDE_TEXTURE:g} %): not a uniform field",

@@ -417,12 +417,14 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
                                 noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
                                 bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone,
                                 contrast=contrast, bar_edge_px=kind.known_half_width_px(shape))
+    # each side's texture against its own pixel noise (linearisation scales it with the level)
+    side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     checks += gate.side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
-                               chip.noise_dn, kind.tail_power)
+                               side_noise, kind.tail_power, (side_names[0], side_names[1]))
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     evidence = Evidence(distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
                         noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile,
                         (side_names[0], side_names[1]), located.geometry)

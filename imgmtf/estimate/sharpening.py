@@ -17,8 +17,9 @@ read:
 - the same along the target: the edge's overshoot and undershoot (a bar's
   lobes) are alike in the two halves of its rows.
 
-A rise at the highest frequencies only, a halo or ringing on one side, or
-lobes that change along the target stay refused (``mtf-above-one``).
+A rise at the highest frequencies only or at the lowest (a side's
+shading), a halo or ringing on one side, or lobes that change along the
+target stay refused (``mtf-above-one``).
 """
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ STEP_CY_PX = 0.005
 MIN_RISE = 0.01                 # a peak this far above 1 (and beyond 3 noise sd) is a rise to report
 MAX_PEAK = 1.5                  # MTF compensation stays below this; a stronger rise is not a product's
 MAX_PEAK_CY_PX = 0.45           # the bump's peak below Nyquist: a rise at the highest frequencies is noise
+MIN_PEAK_CY_PX = 0.06           # a 3 x 3 or 5 x 5 kernel barely acts below this: a rise there is a side's shading
 MIN_LOBE = 0.02                 # each negative lobe at least this share of the LSF's peak...
 MIN_LOBE_RATIO = 0.5            # ...the shallower at least this share of the deeper...
 MIN_LOBE_PLACE_RATIO = 0.5      # ...at distances from the peak alike to this ratio
@@ -107,6 +109,9 @@ def _not_a_kernel(spectrum, ev: Evidence, peak: Peak) -> str | None:
     """What a sharpening kernel would not have done here, or None."""
     if peak.mtf > MAX_PEAK:
         return f"a peak of {peak.mtf:.2f}, more than the {MAX_PEAK:g} MTF compensation gives"
+    if peak.cy_px < MIN_PEAK_CY_PX:
+        return (f"the rise peaks at {peak.cy_px:.3f} cy/px, the lowest frequencies, where a small kernel does "
+                "nothing: a side's level that changes across it (a shading, a slope, flare)")
     if peak.cy_px > MAX_PEAK_CY_PX:
         return f"the rise peaks at {peak.cy_px:.2f} cy/px, at the highest frequencies"
     f = np.arange(STEP_CY_PX, min(spectrum.noise_limit_cy_px, 1.0) + 1e-9, STEP_CY_PX)
