@@ -49,6 +49,30 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
     return out
 
 
+def once_each(files: list[str]) -> tuple[list[str], dict[str, int]]:
+    """The files in their order with each file once (the same file named
+    twice, or by two paths, as ``a.tif ./a.tif``, or inside a folder also
+    named), and how many times each repeated one was named (by its first
+    name): a batch measures a file once and says so.
+
+    Examples
+    --------
+    >>> once_each(["a.tif", "b.tif", "./a.tif", "a.tif"])
+    (['a.tif', 'b.tif'], {'a.tif': 3})
+    """
+    first: dict[str, str] = {}
+    counts: dict[str, int] = {}
+    kept = []
+    for name in files:
+        key = os.path.normcase(os.path.realpath(name)) if name else name
+        if key in first:
+            counts[first[key]] = counts.get(first[key], 1) + 1
+            continue
+        first[key] = name
+        kept.append(name)
+    return kept, counts
+
+
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
                  *, run_utc: str | None = None, **options: Any) -> list[Record]:
     """Measure one image file as ``imgmtf measure FILE`` does: every
