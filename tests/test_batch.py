@@ -199,7 +199,11 @@ def test_an_unexpected_failure_is_an_internal_error_record_for_that_file_only(tm
 
 def test_mixed_batch_keeps_every_row_in_input_order_with_workers(tmp_path, good):
     cases = bad_inputs(tmp_path)
-    paths = [str(p) for p, _ in cases.values()] * 2 + [str(good)] * 3
+    # distinct files (a file named twice is measured once): the good one copied under three names
+    copies = [tmp_path / f"good{i}.tif" for i in range(3)]
+    for copy in copies:
+        copy.write_bytes(good.read_bytes())
+    paths = [str(p) for p, _ in cases.values()] + [str(c) for c in copies]
     out_csv = tmp_path / "rows.csv"
     result = CliRunner().invoke(main, ["measure", "--format", "json", "--workers", "2", "--bootstrap", "0",
                                        "--csv", str(out_csv), *paths])
