@@ -53,8 +53,8 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
     warnings: list[str] = []
     for name, fit in zip(ev.side_names, fits):
         if isinstance(fit, Check):
-            checks.append(Check(fit.reason, fit.passed, fit.message.format(name=name), fit.value, fit.limit,
-                                ran=fit.ran))
+            # (no value: the gate's figures of a side's variation are shares of the contrast)
+            checks.append(Check(fit.reason, fit.passed, fit.message.format(name=name), ran=fit.ran))
             continue
         if fit["departure"] is None:
             checks.append(not_run("non-uniform", f"the {name} side spans too little beyond its plateau's start "
@@ -114,8 +114,7 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
                      f"the {{name}} side holds no plateau within the chip: {count} samples over {extent:.1f} px lie "
                      f"beyond {ev.plateau_px:.1f} px from the {ev.name} (at least {MIN_SIDE_SAMPLES} over "
                      f"{MIN_PLATEAU_PX:g} px needed to see it settle): its level may still be changing "
-                     "(illumination, a slope) and would read as blur; crop wider or choose a flatter side",
-                     float(count), float(MIN_SIDE_SAMPLES))
+                     "(illumination, a slope) and would read as blur; crop wider or choose a flatter side")
     reach, v = np.abs(s[mask]), ev.values[mask]
     u = reach ** -float(ev.tail_power)
     # the straight line in u in closed form about its mean: the normal
