@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
+from .phase import without_phase_bias
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
 MIN_SNR = 8.0                   # below this an edge's MTF at Nyquist is mostly noise (about +-0.1)
@@ -314,40 +315,6 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
         checks.append(not_run("not-straight", f"only {int(kept.sum())} rows on the line: too few (10) to see "
                               f"the {name} bow"))
     return checks
-
-
-PHASE_HARMONICS = 2             # the row locator's bias as a function of sub-pixel phase: this many harmonics
-MIN_PHASE_ROWS = 20
-
-
-def without_phase_bias(resid: np.ndarray, line: np.ndarray) -> np.ndarray:
-    """The per-row locations' residuals ``resid`` (px) about the line less
-    what the rows' sub-pixel phase explains (the fractional part of the
-    line's position ``line``, px): a row locator's bias depends on where
-    the target falls within a pixel, most for a sharp or sharpened target
-    (aliasing; up to 0.3 px on a sharpened edge of MTF 0.6 at Nyquist), and
-    repeats with the phase, where texture or a bend does not.
-
-    Examples
-    --------
-    >>> line = 0.1 * np.arange(100.0)
-    >>> bias = 0.3 * np.sin(2 * np.pi * line)
-    >>> float(np.abs(without_phase_bias(bias, line)).max()) < 1e-9
-    True
-    """
-    if resid.size < MIN_PHASE_ROWS:
-        return resid
-    phase = 2 * np.pi * np.mod(line, 1.0)
-    design = np.column_stack([np.ones_like(phase)] + [f(k * phase) for k in range(1, PHASE_HARMONICS + 1)
-                                                      for f in (np.cos, np.sin)])
-    # a robust fit: a few wild rows (a hot pixel, a scratch) must not take the phase's model
-    weights = np.ones_like(resid)
-    for _ in range(3):
-        coef, *_ = np.linalg.lstsq(design * weights[:, None], resid * weights, rcond=None)
-        out = resid - design @ coef
-        scale = max(1.4826 * float(np.median(np.abs(out))), 1e-9)
-        weights = 1.0 / np.sqrt(np.maximum(1.0, np.abs(out) / (1.5 * scale)))
-    return out
 
 
 def rows_check(rows_used: int, name: str) -> Check:
