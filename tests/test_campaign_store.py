@@ -188,7 +188,7 @@ def test_bad_stores_and_rows_are_clear_errors(tmp_path, acquisition):
         read_layer(tmp_path / "missing.gpkg", "edges")
     with pytest.raises(ParameterError, match="layer must be one of"):
         read_layer(tmp_path / "notes.gpkg", "bridges")
-    with pytest.raises(ParameterError, match="summary must be one of combined, fit"):
+    with pytest.raises(ParameterError, match="summary must be one of combined, sections, fit"):
         write_acquisition(tmp_path / "s.gpkg", acquisition, [], [summary("scene", "across-track", "mean")])
     with pytest.raises(ParameterError, match="must be Records"):
         write_acquisition(tmp_path / "s.gpkg", acquisition, [{"mtf_nyquist": 0.2}], [])
