@@ -36,7 +36,8 @@ def report(tmp_path):
         row = Record("scene.tif", 1, "edge", "", "fitted", site={"scope": "scene"},
                      figures={"summary": "fit", "direction": "across-track", "mtf_nyquist": value,
                               "mtf_nyquist_ci": [value - 0.005, value + 0.005], "fwhm_px": 1.2 + 0.05 * k})
-        write_acquisition(store, Acquisition(f"a{k}", f"scene{k}.tif", "0" * 64, f"{2020 + k}-06-01"), [], [row])
+        write_acquisition(store, Acquisition(f"a{k}", f"scene{k}.tif", "0" * 64, f"{2020 + k}-06-01", "Simsat-1"),
+                          [], [row])
     return write_report(store, tmp_path / "report", requirement=0.2).report_html
 
 
@@ -62,6 +63,12 @@ def test_the_report_loads_without_console_errors_and_every_figure_renders(report
     complete = browser.execute_script(
         "return Array.from(document.images).map(i => [i.complete, i.naturalWidth, i.naturalHeight])")
     assert all(done and width > 0 and height > 0 for done, width, height in complete), complete
+    # the figure opens at full resolution: a link to its PNG beside the page, larger than the page's copy
+    link = browser.execute_script("return document.images[0].parentElement.href")
+    browser.get(link)
+    full = browser.execute_script("return [document.images[0].naturalWidth, document.images[0].complete]")
+    assert full[1] and full[0] > complete[0][1]
+    browser.back()
     errors = [entry for entry in browser.get_log("browser") if entry["level"] in ("SEVERE", "ERROR")]
     assert not errors, errors
     external = browser.execute_script(

@@ -47,7 +47,7 @@ FIGURES = {
 GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recommended", "misfit")
 ACROSS_ALONG = ("across-track", "along-track")
 TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
-                 "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest", "latest_ci_low",
+                 "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest", "latest_ci_low",
                  "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence",
                  "weights", "consistency", "drift", "requirement", "meets_requirement", "note")
 NOTE_MISFIT = "misfit: not trended (the sensor model does not fit; its values may be biased)"
@@ -87,6 +87,7 @@ class Trend:
     assumption: str | None
     recommended: bool
     misfit: bool
+    recommended_because: str
     figure: str
     n_acquisitions: int
     n_points: int
@@ -272,7 +273,8 @@ def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
             times = [p["acquired_utc"] for p in usable]
             first, last = usable[0], usable[-1]
             low, high = (last.get(b) for b in bounds) if bounds else (None, None)
-            common = dict(**group, platform=platform, figure=figure,
+            common = dict(**group, platform=platform, recommended_because=last.get("recommended_because") or "",
+                          figure=figure,
                           n_acquisitions=len({p["acquisition_id"] for p in usable}), n_points=len(usable),
                           first_utc=times[0], last_utc=times[-1], latest=float(last[figure]),
                           latest_ci_low=math.nan if low is None else float(low),
