@@ -122,6 +122,14 @@ def test_the_report_command(tmp_path):
     assert missing.exit_code == 1 and "none.gpkg: no such campaign store" in missing.output
     bad = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "o"), "--requirement", "nan"])
     assert bad.exit_code == 2
+    per = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "per"),
+                                    "--requirement", "across=0.25,along=0.1"])
+    assert per.exit_code == 0, per.output
+    page = (tmp_path / "per" / "report.html").read_text(encoding="utf-8")
+    assert "at least across-track 0.25, along-track 0.1." in page
+    assert '<span class="pass">pass</span> (&ge; 0.25)' in page      # the latest, 0.26 +- 0.004
+    wrong = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "o"), "--requirement", "across"])
+    assert wrong.exit_code == 2 and "DIRECTION=MTF" in wrong.output
 
 
 def chip(path, angle, when=None, sigma=0.4):

@@ -166,3 +166,18 @@ def test_the_requirement_is_judged_on_the_latest_acquisitions_interval():
     assert requirement_verdict(fwhm, 1.3) == "pass" and requirement_verdict(fwhm, 1.5) == "fail"  # value alone
     misfit = [t for t in trends([row(0, "2020-01-01", 0.3, misfit=1)]) if t.figure == "mtf_nyquist"]
     assert requirement_verdict(misfit[0], 0.1) == ""
+
+
+def test_a_requirement_per_direction_is_read_and_applied():
+    from imgmtf.campaign.trend import Requirement, requirement_verdict
+    need = Requirement.parse("0.1, along=0.3, oblique (normal 17 deg)=0.05")
+    assert (need.for_direction("across-track"), need.for_direction("along-track"),
+            need.for_direction("oblique (normal 17 deg)")) == (0.1, 0.3, 0.05)
+    assert Requirement.parse("across-track=0.2").for_direction("along-track") is None
+    assert Requirement.of(0.25) == Requirement(0.25) and Requirement.of(None) is None
+    rows = [row(0, "2020-01-01", 0.2, half=0.01), row(0, "2020-01-01", 0.2, direction="along-track", half=0.01)]
+    verdicts = {t.direction: requirement_verdict(t, need) for t in trends(rows) if t.figure == "mtf_nyquist"}
+    assert verdicts == {"across-track": "pass", "along-track": "fail"}
+    for bad in ("1.5", "across=", "=0.1", "across=0.1,across=0.2", "0.1,0.2", "nan", "fast"):
+        with pytest.raises(ParameterError, match="requirement"):
+            Requirement.parse(bad)

@@ -24,12 +24,21 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..atomic import atomic_output, ensure_folder
-from ..errors import FileWriteError, ParameterError
+from ..errors import FileWriteError
 from ..records import utc_now
 from ..version import __version__
 from .report_figures import Figures
 from .store import read_layer
-from .trend import GROUP_KEYS, Trend, campaign_rows, requirement_verdict, trend_points, trends, write_trend_csv
+from .trend import (
+    GROUP_KEYS,
+    Requirement,
+    Trend,
+    campaign_rows,
+    requirement_verdict,
+    trend_points,
+    trends,
+    write_trend_csv,
+)
 
 MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are counted)
 MAX_ACQUISITIONS_WITH_FIGURES = 12   # the latest acquisitions whose figures the page embeds (a page, not an archive)
@@ -75,7 +84,7 @@ def baseline_values(sensor_path: str | Path | None) -> dict[str, float]:
     return {"across-track": sensor.mtf_nyquist("across"), "along-track": sensor.mtf_nyquist("along")}
 
 
-def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: float | None = None,
+def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: float | str | Requirement | None = None,
                  baseline: str | Path | None = None, confidence: float = 0.95) -> ReportFiles:
     """Write ``trend.csv``, ``report.html`` and its figures (``figures/``)
     of a campaign store into ``out_dir``.
@@ -92,10 +101,12 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
         The campaign store (:mod:`imgmtf.campaign.store`).
     out_dir : str or pathlib.Path
         The folder (created if missing).
-    requirement : float, optional
-        The lowest acceptable MTF at Nyquist: drawn as a line, and each
-        trend's latest acquisition judged against it (pass, fail, or
-        undecided when its interval straddles it).
+    requirement : float, str or Requirement, optional
+        The lowest acceptable MTF at Nyquist, for every direction or per
+        direction (:meth:`~imgmtf.campaign.trend.Requirement.parse`:
+        ``across=0.12,along=0.10``): drawn as a line, and each trend's
+        latest acquisition judged against it (pass, fail, or undecided
+        when its interval straddles it).
     baseline : str or pathlib.Path, optional
         A sensor TOML whose across- and along-track MTF at Nyquist are the
         pre-launch values drawn against those directions.
@@ -117,10 +128,9 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     FileWriteError
         An output cannot be written.
     ParameterError
-        A requirement that is not a finite number.
+        A requirement that is not an MTF from 0 to 1 (per direction).
     """
-    if requirement is not None and not math.isfinite(requirement):
-        raise ParameterError(f"the requirement must be a finite MTF, got {requirement!r}")
+    need = Requirement.of(requirement)
     acquisitions = read_layer(store_path, "acquisitions")
     targets = read_layer(store_path, "targets")
     edges = read_layer(store_path, "edges")
@@ -129,9 +139,9 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     prelaunch = baseline_values(baseline)
     folder = ensure_folder(out_dir)
     trend_csv, report_html = str(folder / "trend.csv"), str(folder / "report.html")
-    write_trend_csv(found, trend_csv, requirement)
+    write_trend_csv(found, trend_csv, need)
     figures = Figures(Path(folder), Path(store_path))
-    page = _page(str(store_path), acquisitions, points, edges, found, requirement, prelaunch,
+    page = _page(str(store_path), acquisitions, points, edges, found, need, prelaunch,
                  str(baseline) if baseline else None, figures)
     with atomic_output(report_html) as partial:
         try:
@@ -174,7 +184,7 @@ def _sensor_note(points: Sequence[Mapping]) -> str:
 
 
 def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: list[dict], found: Sequence[Trend],
-          requirement: float | None, prelaunch: Mapping[str, float], baseline: str | None,
+          requirement: Requirement | None, prelaunch: Mapping[str, float], baseline: str | None,
           figures: Figures) -> str:
     from ..plot.campaign import plot_campaign
     from .recommended import mark_recommended
@@ -186,7 +196,8 @@ def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: li
              + (f"; {len(acquisitions) - len(timed)} without an acquisition time, left out of the trends"
                 if len(timed) < len(acquisitions) else "")
              + f". Report by imgmtf {html.escape(__version__)}, {utc_now()}."
-             + (f" Requirement: MTF at Nyquist at least {requirement:g}." if requirement is not None else "")
+             + (f" Requirement: MTF at Nyquist at least {html.escape(str(requirement))}."
+                if requirement is not None else "")
              + (f" Pre-launch values from <code>{html.escape(baseline)}</code>: across-track "
                 f"{prelaunch['across-track']:.4f}, along-track {prelaunch['along-track']:.4f}." if baseline else "")
              + "</p>", _sensor_note(points)]
@@ -205,7 +216,8 @@ def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: li
     for key, group in groups.items():
         direction = key[2]
         shown = by_group.get(key, [])
-        fig = plot_campaign(group, shown, requirement=requirement, baseline=prelaunch.get(direction))
+        fig = plot_campaign(group, shown, requirement=requirement.for_direction(shown[0].direction if shown else None)
+                            if requirement else None, baseline=prelaunch.get(direction))
         title = html.escape(_group_title(shown[0])) if shown else html.escape(str(key))
         src, link = figures.render(fig, "trend")
         parts.append(f'<div class="figure"><h3>{title}</h3><a href="{html.escape(link)}"><img src="{src}" '
@@ -260,7 +272,7 @@ def _quoted(trend: Trend, only_misfit: bool) -> str:
     return f'<span title="{because}">other</span>'
 
 
-def _drift_table(found: Sequence[Trend], requirement: float | None) -> list[str]:
+def _drift_table(found: Sequence[Trend], requirement: Requirement | None) -> list[str]:
     """The MTF at Nyquist of every group: the recommended one per direction first, the others marked."""
     chosen = _order([t for t in found if t.figure == "mtf_nyquist"])
     out = ["<h2>Drift of the MTF at Nyquist</h2>"]
@@ -275,7 +287,7 @@ def _drift_table(found: Sequence[Trend], requirement: float | None) -> list[str]
                + "All in <code>trend.csv</code>.</p>")
     judged = requirement is not None
     head = ("sensor, band", "direction", "method", "quoted", "acquisitions (UTC)", "latest [interval]",
-            *((f"&ge; {requirement:g}",) if judged else ()), "slope per year", "interval", "drift")
+            *(("requirement",) if judged else ()), "slope per year", "interval", "drift")
     out.append('<table class="trend"><tr>' + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
     directions: dict[tuple, list[Trend]] = {}
     for t in chosen:
@@ -289,7 +301,8 @@ def _drift_table(found: Sequence[Trend], requirement: float | None) -> list[str]
         numbers = [latest]
         if judged:
             verdict = requirement_verdict(t, requirement)
-            numbers.append(f'<span class="{verdict}">{verdict}</span>' if verdict else "")
+            need = requirement.for_direction(t.direction) if requirement else None
+            numbers.append(f'<span class="{verdict}">{verdict}</span> (&ge; {need:g})' if verdict else "")
         if t.has_slope:
             interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
                         else "too few points")
@@ -356,7 +369,7 @@ def _result_line(row: Mapping) -> str:
             f"{_mtf(row.get('mtf_nyquist'))}{interval}{misfit}</span>")
 
 
-def _acquisition_table(acquisitions: list[dict], points: list[Mapping], edges: list[dict],
+def _acquisition_table(acquisitions: list[dict], points: Sequence[Mapping], edges: list[dict],
                        store_figures: Figures) -> list[str]:
     out = ["<h2>Acquisitions</h2>"]
     if not acquisitions:
@@ -406,7 +419,7 @@ def _acquisition_figures(acquisition: dict, edges: list[dict], targets: list[Map
         shown.append(f'<a href="{html.escape(link)}"><img src="{src}" style="max-width: 760px" alt="overview of '
                      f'{html.escape(str(acquisition.get("path")))}"></a>')
     paths = list(dict.fromkeys(p for p in (r.get("plot") for r in (*targets, *edges)) if p))
-    present = []
+    present: list[tuple[str, str, str]] = []
     examined = 0
     for path in paths:
         if len(present) == MAX_EDGE_FIGURES:

@@ -94,7 +94,8 @@ _EDGE_COLUMNS = {
 _TARGET_COLUMNS = {
     **_REPEATED, "scope": "str", "target_id": "int", "method": "str", "status": "str", "reason": "str",
     **_FIGURES, "n_edges": "int", "consistency": "float", "constrained": "int", "misfit": "int",
-    "recommended": "int", "recommended_because": "str", "assumption": "str", "snr_min": "float", "edge_ids": "str", "x_px": "float", "y_px": "float", "plot": "str", "record": "str",
+    "recommended": "int", "recommended_because": "str", "assumption": "str", "snr_min": "float", "edge_ids": "str",
+    "x_px": "float", "y_px": "float", "plot": "str", "record": "str",
 }
 SCHEMA: dict[str, dict[str, str]] = {"acquisitions": _ACQUISITION_COLUMNS, "edges": _EDGE_COLUMNS,
                                      "targets": _TARGET_COLUMNS}

@@ -47,8 +47,8 @@ FIGURES = {
 GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recommended", "misfit")
 ACROSS_ALONG = ("across-track", "along-track")
 TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
-                 "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest", "latest_ci_low",
-                 "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence",
+                 "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest",
+                 "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence",
                  "weights", "consistency", "drift", "requirement", "meets_requirement", "note")
 NOTE_MISFIT = "misfit: not trended (the sensor model does not fit; its values may be biased)"
 NOTE_ONE = "one acquisition: no slope"
@@ -211,7 +211,7 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
     return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
 
 
-def _by_normal(rows: list[Mapping]) -> list[Mapping]:
+def _by_normal(rows: Sequence[Mapping]) -> list[Mapping]:
     """``rows`` with each oblique or unknown direction labelled by its
     family of normals, so that a target's two oblique directions make two
     trends, not one."""
@@ -295,13 +295,84 @@ def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
     return out
 
 
-def requirement_verdict(trend: Trend, requirement: float | None) -> str:
+_DIRECTION_NAMES = {"across": "across-track", "along": "along-track"}
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """The lowest acceptable MTF at Nyquist: one ``default`` for every
+    direction, and values ``per_direction`` (direction label -> value)
+    that override it for theirs.
+
+    Examples
+    --------
+    >>> need = Requirement.parse("across=0.12,along=0.10")
+    >>> need.for_direction("across-track"), need.for_direction("oblique (normal 17 deg)"), str(need)
+    (0.12, None, 'across-track 0.12, along-track 0.1')
+    >>> str(Requirement.parse("0.1,along=0.08"))
+    'along-track 0.08, 0.1 in any other direction'
+    """
+
+    default: float | None = None
+    per_direction: tuple[tuple[str, float], ...] = ()
+
+    def for_direction(self, direction: str | None) -> float | None:
+        """The value a trend of ``direction`` is judged against (None: none applies)."""
+        return dict(self.per_direction).get(str(direction), self.default)
+
+    def __str__(self) -> str:
+        parts = [f"{d} {v:g}" for d, v in self.per_direction]
+        if self.default is not None:
+            parts.append(f"{self.default:g} in any other direction" if parts else f"{self.default:g}")
+        return ", ".join(parts)
+
+    @classmethod
+    def of(cls, value: float | str | Requirement | None) -> Requirement | None:
+        """A requirement from a number (every direction), its text (:meth:`parse`) or itself."""
+        if value is None or isinstance(value, Requirement):
+            return value
+        return cls.parse(value) if isinstance(value, str) else cls.parse(repr(float(value)))
+
+    @classmethod
+    def parse(cls, text: str) -> Requirement:
+        """``0.1`` (every direction), ``across=0.12,along=0.10`` (``across``
+        and ``along`` stand for ``across-track`` and ``along-track``; any
+        direction label of the store may be named), or both
+        (``0.1,along=0.08``: the value for the directions not named).
+
+        Raises
+        ------
+        ParameterError
+            An item that is not ``MTF`` or ``DIRECTION=MTF`` with MTF a
+            number from 0 to 1, or a direction named twice.
+        """
+        default, named = None, {}
+        for item in (part.strip() for part in str(text).split(",")):
+            direction, equals, value = item.rpartition("=")
+            direction = _DIRECTION_NAMES.get(direction.strip(), direction.strip())
+            try:
+                number = float(value)
+            except ValueError:
+                number = math.nan
+            if not (0.0 <= number <= 1.0) or (equals and not direction):
+                raise ParameterError(f"requirement {item!r} is not an MTF from 0 to 1 or DIRECTION=MTF "
+                                     "(e.g. 0.1 or across=0.12,along=0.10)")
+            if direction in named or (not direction and default is not None):
+                raise ParameterError(f"requirement {text!r} gives {direction or 'the default'} twice")
+            if direction:
+                named[direction] = number
+            else:
+                default = number
+        return cls(default, tuple(named.items()))
+
+
+def requirement_verdict(trend: Trend, requirement: float | Requirement | None) -> str:
     """Whether a trend's latest acquisition meets ``requirement`` (a
     lowest acceptable value of its figure): ``pass`` when its interval
     lies at or above it, ``fail`` when below, ``undecided`` when the
     interval straddles it; without an interval the value alone decides.
-    Empty without a requirement, and for a misfit trend (its value is
-    not one to judge).
+    Empty without a requirement (or none for the trend's direction), and
+    for a misfit trend (its value is not one to judge).
 
     Examples
     --------
@@ -310,6 +381,8 @@ def requirement_verdict(trend: Trend, requirement: float | None) -> str:
     >>> requirement_verdict(t, 0.08), requirement_verdict(t, 0.10), requirement_verdict(t, 0.14)
     ('pass', 'undecided', 'fail')
     """
+    if isinstance(requirement, Requirement):
+        requirement = requirement.for_direction(trend.direction)
     if requirement is None or trend.misfit:
         return ""
     low, high = trend.latest_ci_low, trend.latest_ci_high
@@ -327,7 +400,7 @@ def _half_width(row: Mapping, bounds: tuple[str, str]) -> float:
     return (high - low) / 2.0
 
 
-def write_trend_csv(found: Sequence[Trend], path: str, requirement: float | None = None) -> None:
+def write_trend_csv(found: Sequence[Trend], path: str, requirement: float | Requirement | None = None) -> None:
     """``found`` as ``trend.csv`` (columns :data:`TREND_COLUMNS`; slopes in
     the figure's units per year; NaN as empty), written atomically; with a
     ``requirement`` on the MTF at Nyquist, its rows say whether their
@@ -344,7 +417,8 @@ def write_trend_csv(found: Sequence[Trend], path: str, requirement: float | None
                 writer = csv.DictWriter(fh, fieldnames=list(TREND_COLUMNS))
                 writer.writeheader()
                 for trend in found:
-                    judged = requirement if trend.figure == "mtf_nyquist" else None
+                    need = Requirement.of(requirement)
+                    judged = need.for_direction(trend.direction) if need and trend.figure == "mtf_nyquist" else None
                     writer.writerow({**{k: _cell(v) for k, v in asdict(trend).items()},
                                      "requirement": _cell(judged), "meets_requirement": requirement_verdict(trend,
                                                                                                           judged)})

@@ -4,16 +4,18 @@ from __future__ import annotations
 import click
 
 from .errors import reported_errors
-from .options import FiniteFloat
+from .options import FiniteFloat, RequirementType
 
 
 @click.command(short_help="Trend a campaign store's results and write its HTML report.")
 @click.argument("store", type=click.Path(dir_okay=False))
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
               help="folder for trend.csv and report.html (created if missing)")
-@click.option("--requirement", type=FiniteFloat(0, 1), metavar="MTF",
-              help="the lowest acceptable MTF at Nyquist: drawn as a line on its figures, and each trend's "
-                   "latest acquisition judged pass, fail or undecided (its interval straddles it)")
+@click.option("--requirement", type=RequirementType(), metavar="MTF|DIR=MTF,...",
+              help="the lowest acceptable MTF at Nyquist, for every direction (0.1) or per direction "
+                   "(across=0.12,along=0.10; a plain value covers the directions not named): drawn as a line "
+                   "on its figures, and each trend's latest acquisition judged pass, fail or undecided "
+                   "(its interval straddles it)")
 @click.option("--baseline", type=click.Path(dir_okay=False), metavar="SENSOR.toml",
               help="sensor TOML whose across- and along-track MTF at Nyquist are the pre-launch values")
 @click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
