@@ -48,8 +48,9 @@ GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recom
 ACROSS_ALONG = ("across-track", "along-track")
 TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
                  "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest",
-                 "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence",
-                 "weights", "consistency", "drift", "requirement", "meets_requirement", "note")
+                 "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low",
+                 "slope_ci_high", "confidence", "weights", "consistency", "drift", "requirement", "meets_requirement",
+                 "note")
 NOTE_MISFIT = "misfit: not trended (the sensor model does not fit; its values may be biased)"
 NOTE_ONE = "one acquisition: no slope"
 NOTE_TWO = "two acquisitions: a slope without interval"
