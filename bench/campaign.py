@@ -111,7 +111,8 @@ def synthetic(work: Path, seed: int) -> bool:
         true_slope = truth["true_slope_per_year"][f"mtf_nyquist_{axis}"]
         for method in ("fit", "combined"):
             rows = [r for r in trend if r["figure"] == "mtf_nyquist" and r["method"] == method
-                    and r["direction"] == f"{axis}-track"]
+                    and r["direction"] == f"{axis}-track" and r.get("misfit") != "True"]
+            rows.sort(key=lambda r: r.get("recommended") != "True")      # the recommended series first
             if method == "combined":        # its rows are oblique: shown for comparison only
                 continue
             if not rows:
@@ -126,7 +127,7 @@ def synthetic(work: Path, seed: int) -> bool:
             print(f"trend, fit {axis}-track MTF at Nyquist: {slope:+.5f} per year "
                   f"[{float(row['slope_ci_low']):+.5f}, {float(row['slope_ci_high']):+.5f}], true {true_slope:+.5f}: "
                   f"ratio {ratio:.3f} (done when 0.6-1.4 and flagged), drift {drift}: {'PASS' if ok else 'FAIL'}")
-    oblique = [r for r in trend if r["figure"] == "mtf_nyquist" and r["method"] == "combined"]
+    oblique = [r for r in trend if r["figure"] == "mtf_nyquist" and r["method"] == "combined" and r["slope_per_year"]]
     for row in oblique:
         print(f"trend, combined ({row['direction']}) MTF at Nyquist: {float(row['slope_per_year']):+.5f} per year")
     print(f"report: {report / 'report.html'}")
@@ -139,8 +140,8 @@ def real(work: Path) -> None:
         return
     store, report = work / "real.gpkg", work / "real-report"
     for name, acquired in REAL_CHIPS.items():
-        imgmtf("scan", str(REAL / name), "--campaign", str(store), "--acquired", acquired, "--platform",
-               "unnamed", "--no-progress")
+        # no --platform: the report keys each unnamed chip by its file (two sensors, never one trend)
+        imgmtf("scan", str(REAL / name), "--campaign", str(store), "--acquired", acquired, "--no-progress")
     run = imgmtf("report", str(store), "--out", str(report))
     print(f"\nreal chips through scan --campaign and report (exit {run.returncode}; {report / 'report.html'}):")
     print(f"{'chip':<28} {'method':<8} {'dir':<13} {'normal':>7} {'MTF@Nyq':>7} {'interval':>17} {'MTF50':>7} "

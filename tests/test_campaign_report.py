@@ -2,6 +2,7 @@
 a self-contained page, the figures; measure and fit with --campaign."""
 import csv
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -248,6 +249,15 @@ def test_the_drift_table_quotes_the_recommended_rows_and_marks_the_others(real_l
     # one figure: the recommended series of Sat-A across track, and Sat-B's single point; nothing misfit drawn
     drawn = re.findall(r'<div class="figure"><h3>([^<]*)</h3>', page)
     assert drawn == ["Sat-A: across-track, sections (bracket)", "Sat-B: across-track, combined"]
+
+
+def test_the_command_says_which_directions_have_only_misfit_rows(real_like, tmp_path):
+    store = str(Path(real_like.report_html).parent.parent / "site.gpkg")
+    result = CliRunner().invoke(main, ["report", store, "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    assert "note: Sat-A, along-track: only misfit rows, nothing to quote or trend" in result.output
+    assert result.output.count("note:") == 1
+    assert "drift: Sat-A, across-track, sections: MTF at Nyquist -0.0200/year" in result.output
 
 
 def test_trend_csv_holds_every_group_with_method_assumption_recommended_and_misfit(real_like):

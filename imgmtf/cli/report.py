@@ -39,8 +39,20 @@ def report(store, out_dir, requirement, baseline, confidence):
         click.echo(f"warning: {warning}", err=True)
     drifting = [t for t in written.trends if t.drift and t.figure == "mtf_nyquist" and t.recommended]
     for t in drifting:
-        click.echo(f"drift: {t.sensor}, band {t.band_name or '?'}, {t.direction}, "
+        click.echo(f"drift: {_named(t.sensor, t.band_name)}, {t.direction}, "
                    f"{t.method}: MTF at Nyquist {t.slope_per_year:+.4f}/year "
                    f"[{t.slope_ci_low:+.4f}, {t.slope_ci_high:+.4f}]")
+    directions: dict[tuple, list] = {}
+    for t in written.trends:
+        if t.figure == "mtf_nyquist":
+            directions.setdefault((t.sensor, t.band_name, t.direction), []).append(t)
+    for (sensor, band, direction), found in directions.items():
+        if all(t.misfit for t in found):
+            click.echo(f"note: {_named(sensor, band)}, {direction}: only misfit rows, nothing to quote or trend")
     click.echo(f"wrote {written.trend_csv}")
     click.echo(f"wrote {written.report_html}")
+
+
+def _named(sensor: str, band: str | None) -> str:
+    """A sensor and its band as a line names them (no band when none is known)."""
+    return f"{sensor}, band {band}" if band else sensor
