@@ -304,3 +304,13 @@ def test_every_figure_opens_at_full_resolution_and_a_missing_one_is_reported(tmp
     assert "1 figure(s) the store names are missing" in page and "<code title=" in page
     result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "again")])
     assert result.exit_code == 0 and "warning: " in result.output and "edge2.png is missing" in result.output
+
+
+def test_the_page_escapes_what_the_store_holds(tmp_path):
+    # the template autoescapes: a platform or file name is text, never markup
+    store = tmp_path / "site.gpkg"
+    for k in range(2):
+        write_acquisition(store, Acquisition(f"a{k}", f"<b>s{k}.tif", "0" * 64, f"{2020 + k}-01-01",
+                                             "<script>alert(1)</script>"), [], [fit_row("across-track", 0.3)])
+    page = open(write_report(store, tmp_path / "out").report_html, encoding="utf-8").read()
+    assert "<script" not in page and "&lt;script&gt;alert(1)&lt;/script&gt;" in page and "&lt;b&gt;s1.tif" in page

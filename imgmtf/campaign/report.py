@@ -1,7 +1,9 @@
 """The campaign report: ``trend.csv`` and one self-contained ``report.html``
 from a campaign store.
 
-The page holds the table of drifts of the MTF at Nyquist (per sensor,
+The page is rendered from a Jinja2 template
+(``imgmtf/campaign/templates/report.html``, autoescaping on: every value
+from the store is text, never markup).  It holds the table of drifts of the MTF at Nyquist (per sensor,
 band and direction the recommended rows first, the others marked, the
 requirement judged); per sensor, band and direction the recommended
 rows' four figures of merit against time
@@ -16,7 +18,6 @@ keeps them), and a figure the store names that is missing is listed.
 """
 from __future__ import annotations
 
-import html
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -42,24 +43,6 @@ from .trend import (
 
 MAX_EDGE_FIGURES = 8            # edge figures shown per acquisition (the rest are counted)
 MAX_ACQUISITIONS_WITH_FIGURES = 12   # the latest acquisitions whose figures the page embeds (a page, not an archive)
-
-_STYLE = """
-body { font: 15px/1.45 system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0 auto; max-width: 1240px;
-       padding: 0 16px 40px; color: #1b1b1b; }
-h1 { font-size: 1.5em; margin-top: 0.8em; } h2 { font-size: 1.2em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
-table { border-collapse: collapse; margin: 8px 0; font-size: 0.92em; }
-th, td { border: 1px solid #d0d0d0; padding: 3px 7px; text-align: left; vertical-align: top; }
-th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-tr.drift td { background: #fff0ee; } table.trend td, .time { white-space: nowrap; }
-table.trend td.note { white-space: normal; max-width: 16em; }
-table.trend td .wrap { white-space: normal; display: inline-block; min-width: 12em; max-width: 18em; }
-tr.other td, tr.misfit td { color: #666; } tr.misfit td { background: #f6f6f6; }
-.note { color: #555; font-size: 0.92em; } .warning { color: #8a1c00; }
-.pass { color: #1a6d1a; font-weight: 600; } .fail { color: #b00000; font-weight: 600; } .undecided { color: #8a5a00; }
-img { max-width: 100%; height: auto; } img.thumb { width: 360px; margin: 2px; border: 1px solid #ddd; }
-.figure { margin: 10px 0 24px; } code { font-size: 0.95em; }
-"""
-
 
 @dataclass(frozen=True)
 class ReportFiles:
@@ -141,8 +124,9 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     trend_csv, report_html = str(folder / "trend.csv"), str(folder / "report.html")
     write_trend_csv(found, trend_csv, need)
     figures = Figures(Path(folder), Path(store_path))
-    page = _page(str(store_path), acquisitions, points, edges, found, need, prelaunch,
-                 str(baseline) if baseline else None, figures)
+    context = _context(str(store_path), acquisitions, points, edges, found, need, prelaunch,
+                       str(baseline) if baseline else None, figures)
+    page = _environment().get_template("report.html").render(**context)
     with atomic_output(report_html) as partial:
         try:
             Path(partial).write_text(page, encoding="utf-8")
@@ -153,12 +137,31 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     return ReportFiles(trend_csv, report_html, found, warnings)
 
 
+def _environment():
+    """The Jinja2 environment of the report's template, autoescaping HTML."""
+    from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
+    return Environment(loader=PackageLoader("imgmtf.campaign", "templates"), undefined=StrictUndefined,
+                       autoescape=select_autoescape(("html",), default=True), keep_trailing_newline=True)
+
+
 def _text(value, digits: int = 4) -> str:
+    """A value as a table shows it (text; the template escapes it)."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return ""
     if isinstance(value, float):
         return f"{value:.{digits}g}" if abs(value) >= 1e-3 or value == 0 else f"{value:.2e}"
-    return html.escape(str(value))
+    return str(value)
+
+
+def _mtf(value) -> str:
+    return "" if value is None or not math.isfinite(value) else f"{value:.4f}"
+
+
+def _when(text) -> str:
+    """An ISO 8601 UTC time as a table shows it: to the minute, no T or Z."""
+    if not text:
+        return ""
+    return text[:16].replace("T", " ") if "T" in text else text
 
 
 def _group_title(trend: Trend) -> str:
@@ -169,77 +172,53 @@ def _group_title(trend: Trend) -> str:
     return f"{trend.sensor}{band}: {trend.direction or 'unknown direction'}, {how}"
 
 
-def _sensor_note(points: Sequence[Mapping]) -> str:
-    """What the page says of acquisitions that name no platform."""
+def _unnamed(points: Sequence[Mapping]) -> dict | None:
+    """How many sensors name no platform, and how many acquisitions stand alone."""
     from .recommended import sensor_of
     unnamed = sorted({sensor_of(p) for p in points if not p.get("platform")})
     if not unnamed:
-        return ""
-    alone = [s for s in unnamed if s.endswith(" alone")]
-    return (f'<p class="note">{len(unnamed)} sensor(s) without a platform name: each is keyed by what '
-            "identifies its files (the camera's make, model and serial when tagged, else the image's size, data "
-            "type, bands, GSD and software) and never trended with another"
-            + (f"; {len(alone)} acquisition(s) of a store older than schema 2 stand alone" if alone else "")
-            + ". Give <code>--platform</code> with <code>--campaign</code> to name them.</p>")
+        return None
+    return {"count": len(unnamed), "alone": sum(s.endswith(" alone") for s in unnamed)}
 
 
-def _page(store: str, acquisitions: list[dict], points: list[Mapping], edges: list[dict], found: Sequence[Trend],
-          requirement: Requirement | None, prelaunch: Mapping[str, float], baseline: str | None,
-          figures: Figures) -> str:
-    from ..plot.campaign import plot_campaign
+def _context(store: str, acquisitions: list[dict], points: list[Mapping], edges: list[dict],
+             found: Sequence[Trend], requirement: Requirement | None, prelaunch: Mapping[str, float],
+             baseline: str | None, figures: Figures) -> dict:
+    """What the template shows (values as text; the template adds the markup and escapes them)."""
     from .recommended import mark_recommended
-    timed = [a for a in acquisitions if a.get("acquired_utc")]
-    span = sorted(a["acquired_utc"] for a in timed)
-    parts = [f"<h1>MTF calibration campaign: {html.escape(Path(store).name)}</h1>",
-             f'<p class="note">Store <code>{html.escape(store)}</code>: {len(acquisitions)} acquisition(s)'
-             + (f", {html.escape(span[0])} to {html.escape(span[-1])}" if span else "")
-             + (f"; {len(acquisitions) - len(timed)} without an acquisition time, left out of the trends"
-                if len(timed) < len(acquisitions) else "")
-             + f". Report by imgmtf {html.escape(__version__)}, {utc_now()}."
-             + (f" Requirement: MTF at Nyquist at least {html.escape(str(requirement))}."
-                if requirement is not None else "")
-             + (f" Pre-launch values from <code>{html.escape(baseline)}</code>: across-track "
-                f"{prelaunch['across-track']:.4f}, along-track {prelaunch['along-track']:.4f}." if baseline else "")
-             + "</p>", _sensor_note(points)]
-    parts += _drift_table(found, requirement)
+    timed = sorted(a["acquired_utc"] for a in acquisitions if a.get("acquired_utc"))
+    context = {"store": store, "store_name": Path(store).name, "n_acquisitions": len(acquisitions),
+               "span": (timed[0], timed[-1]) if timed else None, "untimed": len(acquisitions) - len(timed),
+               "version": __version__, "now": utc_now(),
+               "requirement": str(requirement) if requirement is not None else None,
+               "baseline": {"path": baseline, "across": f"{prelaunch['across-track']:.4f}",
+                            "along": f"{prelaunch['along-track']:.4f}"} if baseline else None,
+               "unnamed": _unnamed(points), "drift": _drift_rows(found, requirement),
+               "groups": _trend_figures(points, found, requirement, prelaunch, figures),
+               "others": [_trend_row(t) for t in _order(found)
+                          if t.figure in ("mtf50_cy_px", "fwhm_px", "rer") and t.recommended and not t.misfit]}
+    context.update(_acquisition_rows(acquisitions, mark_recommended(points), edges, figures))
+    context["missing"] = len(figures.missing)
+    return context
+
+
+def _trend_figures(points: list[Mapping], found: Sequence[Trend], requirement: Requirement | None,
+                   prelaunch: Mapping[str, float], figures: Figures) -> list[dict]:
+    """The recommended series' figures: title, embedded source, link to the full-resolution file."""
+    from ..plot.campaign import plot_campaign
     by_group: dict[tuple, list[Trend]] = {}
     for trend in found:
         by_group.setdefault(tuple(getattr(trend, k) for k in GROUP_KEYS), []).append(trend)
-    parts.append("<h2>Figures of merit against time</h2>")
-    groups = {key: group for key, group in trend_points(points).items() if key[-2] and not key[-1]}
-    if not groups:
-        parts.append('<p class="note">No acquisition with a time and a recommended result: nothing to draw.</p>')
-    else:
-        parts.append('<p class="note">The recommended rows of each sensor, band and direction (the other '
-                     "methods' trends are in the table above and in <code>trend.csv</code>). Click a figure to "
-                     "open it at full resolution.</p>")
-    for key, group in groups.items():
-        direction = key[2]
+    out = []
+    for key, group in trend_points(points).items():
         shown = by_group.get(key, [])
-        fig = plot_campaign(group, shown, requirement=requirement.for_direction(shown[0].direction if shown else None)
-                            if requirement else None, baseline=prelaunch.get(direction))
-        title = html.escape(_group_title(shown[0])) if shown else html.escape(str(key))
+        if not (key[-2] and not key[-1] and shown):          # recommended, not misfit
+            continue
+        need = requirement.for_direction(shown[0].direction) if requirement else None
+        fig = plot_campaign(group, shown, requirement=need, baseline=prelaunch.get(key[2]))
         src, link = figures.render(fig, "trend")
-        parts.append(f'<div class="figure"><h3>{title}</h3><a href="{html.escape(link)}"><img src="{src}" '
-                     f'width="1215" height="594" alt="MTF at Nyquist, MTF50, FWHM and RER against time: {title}">'
-                     "</a></div>")
-    parts += _trend_table(found, "Drift of MTF50, FWHM and RER (recommended rows)", ("mtf50_cy_px", "fwhm_px", "rer"))
-    parts += _acquisition_table(acquisitions, mark_recommended(points), edges, figures)
-    if figures.missing:
-        parts.insert(2, f'<p class="warning">{len(figures.missing)} figure(s) the store names are missing '
-                     "(moved or deleted): listed under their acquisitions below.</p>")
-    body = "\n".join(p for p in parts if p)
-    return (f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-            f"<title>MTF campaign: {html.escape(Path(store).name)}</title>\n<style>{_STYLE}</style>\n"
-            f"</head>\n<body>\n{body}\n</body>\n</html>\n")
-
-
-def _when(text) -> str:
-    """An ISO 8601 UTC time as a table shows it: to the minute, no T or Z."""
-    if not text:
-        return ""
-    return html.escape(text[:16].replace("T", " ") if "T" in text else text)
+        out.append({"title": _group_title(shown[0]), "src": src, "link": link})
+    return out
 
 
 def _order(found: Sequence[Trend]) -> list[Trend]:
@@ -248,99 +227,44 @@ def _order(found: Sequence[Trend]) -> list[Trend]:
                                         t.misfit, str(t.method), str(t.assumption)))
 
 
-def _sensor_band(trend: Trend) -> str:
-    """The sensor and band cell (wraps: an unnamed sensor's key is long)."""
-    band = f", band {_text(trend.band_name)}" if trend.band_name else ""
-    return f'<span class="wrap">{_text(trend.sensor)}{band}</span>'
+def _trend_row(t: Trend) -> dict:
+    """A trend as a table row: who, what, when, the latest value and the slope (or why there is none)."""
+    band = f", band {t.band_name}" if t.band_name else ""
+    span = f"{t.n_acquisitions}: {_when(t.first_utc)}"
+    if t.first_utc != t.last_utc:
+        span += f" to {_when(t.last_utc)}"
+    interval = ""
+    if t.has_slope:
+        interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
+                    else "too few points")
+    return {"sensor": f"{t.sensor}{band}", "direction": _text(t.direction), "figure": t.figure,
+            "method": _text(t.method) + (f" ({t.assumption})" if t.assumption else ""), "span": span,
+            "latest": _text(t.latest), "slope": f"{t.slope_per_year:+.4g}" if t.has_slope else None,
+            "interval": interval, "drift": t.drift, "note": t.note, "because": t.recommended_because,
+            "kind": "drift" if t.drift else ("misfit" if t.misfit else ("other" if not t.recommended else ""))}
 
 
-def _span(trend: Trend) -> str:
-    """How many acquisitions, from when to when."""
-    if trend.first_utc == trend.last_utc:
-        return f"{trend.n_acquisitions}: {_when(trend.first_utc)}"
-    return f"{trend.n_acquisitions}: {_when(trend.first_utc)} to {_when(trend.last_utc)}"
-
-
-def _quoted(trend: Trend, only_misfit: bool) -> str:
-    """The drift table's cell saying whether a trend's rows are the ones to quote."""
-    because = html.escape(trend.recommended_because)
-    if trend.misfit:
-        text = "<strong>only misfit rows</strong>:<br>nothing to quote" if only_misfit else "misfit"
-        return f'<span title="{because}">{text}</span>'
-    if trend.recommended:
-        return f'<strong title="{because}">recommended</strong>'
-    return f'<span title="{because}">other</span>'
-
-
-def _drift_table(found: Sequence[Trend], requirement: Requirement | None) -> list[str]:
+def _drift_rows(found: Sequence[Trend], requirement: Requirement | None) -> dict:
     """The MTF at Nyquist of every group: the recommended one per direction first, the others marked."""
     chosen = _order([t for t in found if t.figure == "mtf_nyquist"])
-    out = ["<h2>Drift of the MTF at Nyquist</h2>"]
-    if not chosen:
-        return [*out, '<p class="note">No acquisition with a time and a result yet.</p>']
-    out.append('<p class="note">Per sensor, band and direction, the recommended rows (the ones to quote) first; '
-               "misfit rows are never recommended and never trended. Slope of a weighted least-squares line per "
-               f"year (365.25 days), with its {100 * chosen[0].confidence:g} % interval; a drift when the interval "
-               "excludes 0; one acquisition gives no slope. "
-               + ("The requirement is judged on the latest acquisition: pass when its interval lies above it, "
-                  "undecided when it straddles it. " if requirement is not None else "")
-               + "All in <code>trend.csv</code>.</p>")
-    judged = requirement is not None
-    head = ("sensor, band", "direction", "method", "quoted", "acquisitions (UTC)", "latest [interval]",
-            *(("requirement",) if judged else ()), "slope per year", "interval", "drift")
-    out.append('<table class="trend"><tr>' + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
     directions: dict[tuple, list[Trend]] = {}
     for t in chosen:
         directions.setdefault((t.sensor, t.band_name, t.direction), []).append(t)
+    rows = []
     for t in chosen:
-        only_misfit = all(o.misfit for o in directions[t.sensor, t.band_name, t.direction])
-        method = _text(t.method) + (f" ({_text(t.assumption)})" if t.assumption else "")
-        cells = [_sensor_band(t), _text(t.direction), method, _quoted(t, only_misfit), _span(t)]
-        latest = _text(t.latest) + (f" [{_mtf(t.latest_ci_low)}, {_mtf(t.latest_ci_high)}]"
-                                    if math.isfinite(t.latest_ci_low) else "")
-        numbers = [latest]
-        if judged:
-            verdict = requirement_verdict(t, requirement)
-            need = requirement.for_direction(t.direction) if requirement else None
-            numbers.append(f'<span class="{verdict}">{verdict}</span> (&ge; {need:g})' if verdict else "")
-        if t.has_slope:
-            interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
-                        else "too few points")
-            tail = "".join(f'<td class="num">{c}</td>' for c in (f"{t.slope_per_year:+.4g}", interval,
-                                                                 "yes" if t.drift else "no"))
+        row = _trend_row(t)
+        if math.isfinite(t.latest_ci_low):
+            row["latest"] += f" [{_mtf(t.latest_ci_low)}, {_mtf(t.latest_ci_high)}]"
+        if t.misfit:
+            only = all(o.misfit for o in directions[t.sensor, t.band_name, t.direction])
+            row["quoted"] = "only misfit" if only else "misfit"
         else:
-            tail = f'<td colspan="3" class="note">{html.escape(t.note)}</td>'
-        row = ("".join(f"<td>{c}</td>" for c in cells) + "".join(f'<td class="num">{c}</td>' for c in numbers)
-               + tail)
-        kind = "drift" if t.drift else ("misfit" if t.misfit else ("other" if not t.recommended else ""))
-        out.append(f'<tr class="{kind}">{row}</tr>')
-    out.append("</table>")
-    return out
-
-
-def _trend_table(found: Sequence[Trend], title: str, figures: Sequence[str]) -> list[str]:
-    """The recommended rows' drifts of ``figures`` as a table headed ``title``."""
-    chosen = _order([t for t in found if t.figure in figures and t.recommended and not t.misfit])
-    out = [f"<h2>{html.escape(title)}</h2>"]
-    if not chosen:
-        return [*out, '<p class="note">No recommended result with a time yet.</p>']
-    head = ("sensor, band", "direction", "method", "figure", "acquisitions (UTC)", "latest", "slope per year",
-            "interval", "drift")
-    out.append('<table class="trend"><tr>' + "".join(f"<th>{h}</th>" for h in head) + "</tr>")
-    for t in chosen:
-        method = _text(t.method) + (f" ({_text(t.assumption)})" if t.assumption else "")
-        cells = [_sensor_band(t), _text(t.direction), method, t.figure, _span(t)]
-        if t.has_slope:
-            interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
-                        else "too few points")
-            tail = "".join(f'<td class="num">{c}</td>' for c in (f"{t.slope_per_year:+.4g}", interval,
-                                                                 "yes" if t.drift else "no"))
-        else:
-            tail = f'<td colspan="3" class="note">{html.escape(t.note)}</td>'
-        row = "".join(f"<td>{c}</td>" for c in cells) + f'<td class="num">{_text(t.latest)}</td>' + tail
-        out.append(f'<tr class="{"drift" if t.drift else ""}">{row}</tr>')
-    out.append("</table>")
-    return out
+            row["quoted"] = "recommended" if t.recommended else "other"
+        need = requirement.for_direction(t.direction) if requirement else None
+        row.update(verdict=requirement_verdict(t, requirement), need=f"{need:g}" if need is not None else "")
+        rows.append(row)
+    confidence = f"{100 * chosen[0].confidence:g}" if chosen else ""
+    return {"rows": rows, "confidence": confidence, "judged": requirement is not None}
 
 
 # the acquisitions table's columns: heading, and the acquisition's key (None: built apart)
@@ -350,95 +274,59 @@ _ACQUISITION_COLUMNS = (("acquired (UTC)", None), ("platform", "platform"), ("in
                         ("MTF at Nyquist [95 % interval]", None))
 
 
-def _mtf(value) -> str:
-    return "" if value is None else f"{value:.4f}"
-
-
-def _result_line(row: Mapping) -> str:
-    """One result of an acquisition: where, which direction, how, its MTF at Nyquist."""
+def _result(row: Mapping) -> dict:
+    """One result of an acquisition: where, which direction, how, its MTF at Nyquist; misfit, recommended."""
     where = f"target {row['target_id']}" if row.get("target_id") is not None else _text(row.get("scope"))
     interval = (f" [{_mtf(row.get('mtf_nyquist_ci_low'))}, {_mtf(row.get('mtf_nyquist_ci_high'))}]"
                 if row.get("mtf_nyquist_ci_low") is not None else "")
-    misfit = " <strong>misfit</strong>" if row.get("misfit") else ""
-    if row.get("recommended"):
-        misfit += " <em>recommended</em>"
     direction = _text(row.get("direction"))
     if row.get("direction") not in ("across-track", "along-track") and row.get("normal_angle_deg") is not None:
         direction += f" {row['normal_angle_deg']:.1f} deg"
-    return (f'<span class="time">{where}, {direction}, {_text(row.get("method"))}: '
-            f"{_mtf(row.get('mtf_nyquist'))}{interval}{misfit}</span>")
+    how = _text(row.get("method")) + (f" ({row['assumption']})" if row.get("assumption") else "")
+    return {"text": f"{where}, {direction}, {how}: {_mtf(row.get('mtf_nyquist'))}{interval}",
+            "misfit": bool(row.get("misfit")), "recommended": bool(row.get("recommended"))}
 
 
-def _acquisition_table(acquisitions: list[dict], points: Sequence[Mapping], edges: list[dict],
-                       store_figures: Figures) -> list[str]:
-    out = ["<h2>Acquisitions</h2>"]
-    if not acquisitions:
-        return [*out, '<p class="note">The store holds no acquisition.</p>']
-    # a fact no acquisition knows gets no column
-    columns = [(h, k) for h, k in _ACQUISITION_COLUMNS if k is None or any(a.get(k) is not None for a in acquisitions)]
-    out.append("<table><tr>" + "".join(f"<th>{h}</th>" for h, _ in columns) + "</tr>")
-    ordered = sorted(acquisitions, key=lambda a: (a.get("acquired_utc") or "~", a.get("path") or ""))
-    figures = []
-    for a in ordered:
+def _acquisition_rows(acquisitions: list[dict], points: Sequence[Mapping], edges: list[dict],
+                      figures: Figures) -> dict:
+    """The acquisitions table (a fact no acquisition knows gets no column) and the latest acquisitions' figures."""
+    columns = [h for h, k in _ACQUISITION_COLUMNS if k is None or any(a.get(k) is not None for a in acquisitions)]
+    facts = {h: k for h, k in _ACQUISITION_COLUMNS if k}
+    rows, blocks = [], []
+    for a in sorted(acquisitions, key=lambda a: (a.get("acquired_utc") or "~", a.get("path") or "")):
         ident = a["acquisition_id"]
         mine = [t for t in points if t.get("acquisition_id") == ident]
-        when = _when(a.get("acquired_utc")) or "<em>no time</em>"
-        source = json.loads(a["sources"]).get("acquired_utc") if a.get("sources") else None
-        if source and a.get("acquired_utc"):
-            when += f'<br><span class="note">from {html.escape(source)}</span>'
+        own_edges = [e for e in edges if e.get("acquisition_id") == ident]
         path = str(a.get("path") or "")
-        built = {"acquired (UTC)": f'<td class="time">{when}</td>',
-                 "file": f'<td title="{html.escape(path)}"><code>{html.escape(Path(path).name)}</code></td>',
-                 "SHA-256": f"<td><code>{_text((a.get('sha256') or '')[:12])}</code></td>",
-                 "edges": f'<td class="num">{sum(e.get("acquisition_id") == ident for e in edges)}</td>',
-                 "MTF at Nyquist [95 % interval]": "<td>" + "<br>".join(_result_line(t) for t in mine) + "</td>"}
-        out.append("<tr>" + "".join(built[h] if k is None else f"<td>{_text(a.get(k))}</td>" for h, k in columns)
-                   + "</tr>")
-        figures.append(_acquisition_figures(a, [e for e in edges if e.get("acquisition_id") == ident], mine,
-                                            store_figures))
-    out.append("</table>")
-    shown = [f for f in figures[::-1] if f][:MAX_ACQUISITIONS_WITH_FIGURES][::-1]     # the latest
-    if shown:
-        left = sum(bool(f) for f in figures) - len(shown)
-        out += ["<h2>Figures of each acquisition</h2>",
-                *((f'<p class="note">The latest {len(shown)} acquisitions\' figures; {left} earlier ones have '
-                   "theirs beside their files.</p>",) if left else ()),
-                *(part for f in shown for part in f)]
-    return out
+        rows.append({"when": _when(a.get("acquired_utc")), "path": path, "file": Path(path).name,
+                     "source": json.loads(a["sources"]).get("acquired_utc") if a.get("sources") else None,
+                     "sha": (a.get("sha256") or "")[:12], "edges": len(own_edges),
+                     "facts": {h: _text(a.get(k)) for h, k in facts.items()}, "results": [_result(t) for t in mine]})
+        blocks.append(_acquisition_figures(a, own_edges, mine, figures))
+    shown = [b for b in blocks[::-1] if b][:MAX_ACQUISITIONS_WITH_FIGURES][::-1]      # the latest
+    return {"columns": columns, "acquisitions": rows, "shown": shown,
+            "earlier": sum(bool(b) for b in blocks) - len(shown)}
 
 
-def _acquisition_figures(acquisition: dict, edges: list[dict], targets: list[Mapping], figures: Figures) -> list[str]:
+def _acquisition_figures(acquisition: dict, edges: list[dict], targets: list[Mapping], figures: Figures) -> dict:
     """The acquisition's overview and first edge figures, embedded and each
     a link to its file at full resolution; those the store names that are
-    missing, listed."""
-    shown = []
+    missing, listed.  Empty when it has none."""
     before = len(figures.missing)
     overview = figures.stored(acquisition.get("overview"))
-    if overview:
-        src, link = overview
-        shown.append(f'<a href="{html.escape(link)}"><img src="{src}" style="max-width: 760px" alt="overview of '
-                     f'{html.escape(str(acquisition.get("path")))}"></a>')
     paths = list(dict.fromkeys(p for p in (r.get("plot") for r in (*targets, *edges)) if p))
-    present: list[tuple[str, str, str]] = []
+    thumbs: list[dict] = []
     examined = 0
     for path in paths:
-        if len(present) == MAX_EDGE_FIGURES:
+        if len(thumbs) == MAX_EDGE_FIGURES:
             break
         examined += 1
         found = figures.stored(path)
         if found:
-            present.append((path, *found))
-    for path, src, link in present:
-        shown.append(f'<a href="{html.escape(link)}"><img class="thumb" src="{src}" '
-                     f'alt="{html.escape(Path(path).name)}" title="{html.escape(path)}"></a>')
-    more = len(paths) - examined
+            thumbs.append({"src": found[0], "link": found[1], "name": Path(path).name, "stored": path})
     lost = figures.missing[before:]
-    if not shown and not lost:
-        return []
-    name = html.escape(f"{acquisition.get('acquired_utc') or 'no time'}: {acquisition.get('path')}")
-    note = f'<p class="note">and {more} more edge figure(s) beside the scan\'s outputs</p>' if more > 0 else ""
-    if lost:
-        note += ('<p class="warning">Missing (moved or deleted): '
-                 + ", ".join(f'<code title="looked for {html.escape(where)}">{html.escape(stored)}</code>'
-                             for stored, where in lost) + "</p>")
-    return [f'<div class="figure"><h3>{name}</h3>' + "".join(shown) + note + "</div>"]
+    if not (overview or thumbs or lost):
+        return {}
+    return {"name": f"{acquisition.get('acquired_utc') or 'no time'}: {acquisition.get('path')}",
+            "path": str(acquisition.get("path")), "more": len(paths) - examined, "lost": lost, "thumbs": thumbs,
+            "overview": {"src": overview[0], "link": overview[1]} if overview else None}
