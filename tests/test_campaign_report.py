@@ -302,6 +302,9 @@ def test_every_figure_opens_at_full_resolution_and_a_missing_one_is_reported(tmp
     assert written.warnings == (f"{store}: figure scan/edge2.png is missing (looked for {out / 'edge2.png'}): "
                                 "moved or deleted",)
     assert "1 figure(s) the store names are missing" in page and "<code title=" in page
+    (tmp_path / "report" / "figures" / "07-trend.png").write_bytes(b"an earlier report's")
+    write_report(store, tmp_path / "report")
+    assert sorted(p.name for p in (tmp_path / "report" / "figures").iterdir()) == ["01-trend.png"]
     result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "again")])
     assert result.exit_code == 0 and "warning: " in result.output and "edge2.png is missing" in result.output
 

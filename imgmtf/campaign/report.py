@@ -124,6 +124,7 @@ def write_report(store_path: str | Path, out_dir: str | Path, *, requirement: fl
     trend_csv, report_html = str(folder / "trend.csv"), str(folder / "report.html")
     write_trend_csv(found, trend_csv, need)
     figures = Figures(Path(folder), Path(store_path))
+    figures.clear()
     context = _context(str(store_path), acquisitions, points, edges, found, need, prelaunch,
                        str(baseline) if baseline else None, figures)
     page = _environment().get_template("report.html").render(**context)

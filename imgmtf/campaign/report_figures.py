@@ -34,6 +34,15 @@ class Figures:
     missing: list[tuple[str, str]] = field(default_factory=list)
     _count: int = 0
 
+    def clear(self) -> None:
+        """Remove the figures an earlier report wrote into ``figures/``
+        (a campaign with fewer series leaves none of them behind)."""
+        for old in (self.out_dir / "figures").glob("[0-9][0-9]-*.png"):
+            try:
+                old.unlink()
+            except OSError:
+                pass            # held open elsewhere: overwritten or left, never fatal
+
     def render(self, fig, name: str) -> tuple[str, str]:
         """A matplotlib figure written to ``figures/<name>.png`` at
         :data:`FILE_DPI`: its embedded ``src`` (at :data:`EMBED_DPI`) and
