@@ -231,9 +231,9 @@ def _order(found: Sequence[Trend]) -> list[Trend]:
 def _trend_row(t: Trend) -> dict:
     """A trend as a table row: who, what, when, the latest value and the slope (or why there is none)."""
     band = f", band {t.band_name}" if t.band_name else ""
-    span = f"{t.n_acquisitions}: {_when(t.first_utc)}"
-    if t.first_utc != t.last_utc:
-        span += f" to {_when(t.last_utc)}"
+    span = f"{t.n_acquisitions}: {_when(t.first_utc)[:10]}"          # dates: the times are in the acquisitions
+    if t.first_utc[:10] != t.last_utc[:10]:
+        span += f" to {_when(t.last_utc)[:10]}"
     interval = ""
     if t.has_slope:
         interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
