@@ -148,3 +148,11 @@ def test_the_sensor_key_tells_sensors_apart_by_camera_tags_or_image_signature(tm
     assert sensor_key(info, camera) == "camera Canon EOS 5D 0421"
     assert sensor_key(replace(info, count=3, width=20), raster_metadata(tmp_path / "a.tif")) == (
         "20 x 16 px uint16, 3 bands, GSD 2 m")
+
+
+def test_the_real_baotou_and_pan_chips_are_two_sensors():
+    # neither names a platform: a store of both must not trend them together (issue #31)
+    from conftest import real_scene
+    keys = {read_acquisition(real_scene(name), band=1).sensor_key
+            for name in ("baotou_l0r_checkerboard.tif", "pan_l0r_checkerboard.tif")}
+    assert keys == {"101 x 101 px uint16", "80 x 80 px uint16, SSTL Terra v1.1.4.0"}
