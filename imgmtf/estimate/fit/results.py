@@ -241,6 +241,29 @@ class SensorFit:
         return model_mtf_band(self._model, self._u, self._covariance, np.asarray(f_cy_px, float),
                          angle_deg, gsd, self.confidence)
 
+    def to_toml(self, path, comment: str = "", sources: list[str] | None = None) -> None:
+        """Write the fitted sensor as TOML with a ``[fit]`` table saying
+        whether the model fits (:mod:`imgmtf.estimate.fit.record`):
+        :meth:`imgmtf.Sensor.from_toml` reads the sensor, ``imgmtf
+        restore`` refuses a misfit one.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file (replaced if it exists).
+        comment : str, optional
+            Lines written as TOML comments on top.
+        sources : list of str, optional
+            What the edges were (default the edges' names).
+
+        Raises
+        ------
+        FileWriteError
+            The file cannot be written.
+        """
+        from .record import write_fitted_sensor
+        write_fitted_sensor(path, self, comment=comment, sources=sources)
+
     def to_dict(self) -> dict:
         """JSON-ready: one object holding the sensor, parameters, fit
         quality, directions and a record per input edge (``edges``)."""
