@@ -43,7 +43,9 @@ def test_no_library_message_names_a_command_line_option():
 ])
 def test_the_cli_answers_a_reason_with_its_option(reason, option):
     answers = option_hints(CHIP, reason)
-    assert option in refusal_hint(reason, "a message") and len(answers) == 1 and option in answers[0]
+    # one answer per refusal, per command ("--band all" only where --band takes it)
+    assert option in refusal_hint(reason, "a message") and option in answers[0]
+    assert len(answers) == len({h.only for h in HINTS if h.command == CHIP and h.reason == reason})
 
 
 def test_a_reason_no_option_answers_gets_no_option():
@@ -68,4 +70,4 @@ def test_a_scan_names_no_option_where_none_moves_the_limit():
 def test_every_hint_is_for_a_command_that_shows_it_and_names_an_option():
     assert {h.command for h in HINTS} == {CHIP, SCAN}
     assert all(FLAG.search(h.text) for h in HINTS)
-    assert len({(h.command, h.reason, h.words) for h in HINTS}) == len(HINTS)   # one answer per refusal
+    assert len({(h.command, h.reason, h.words, h.only) for h in HINTS}) == len(HINTS)   # one answer per refusal

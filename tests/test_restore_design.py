@@ -120,3 +120,59 @@ def test_kernel_files_round_trip(gaussian_pixel, tmp_path):
         filt.save(tmp_path / "k.csv")
     with pytest.raises(im.FileWriteError, match="cannot write"):
         filt.save(tmp_path / "missing" / "k.npy")
+
+
+#: the one-sided lag of the stand-in sensor below, m (0.4 px at its 1 m pixel)
+LAG_M = 0.4
+
+
+class LaggedSensor(im.Sensor):
+    """A stand-in for a sensor with a one-sided stage along track: its
+    transfer is the base sensor's times 1 / (1 + 2 pi i tau fy), complex
+    (its MTF the modulus), so that the design's handling of a phase is
+    tested without the stage itself."""
+
+    def transfer(self, fx, fy):
+        return super().transfer(fx, fy) / (1 + 2j * np.pi * LAG_M * np.asarray(fy, float))
+
+
+# the stand-in's line response (the edge figures of the report) is its stages', read from its transfer
+# by imgmtf.sensor.lines, which takes the real part: the figures tested here are the transfer's
+@pytest.mark.filterwarnings("ignore::numpy.exceptions.ComplexWarning")
+def test_a_complex_transfer_gets_real_taps_that_undo_its_phase():
+    sensor = LaggedSensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0)])
+    filt = im.design_filter(sensor, 0.3, noise_std_dn=1.0, signal_std_dn=500.0)
+    k = (1.0 / 500.0) ** 2
+    # real taps summing to 1, not point-symmetric: the filter's own transfer is complex
+    assert filt.taps.dtype == np.float64 and filt.taps.sum() == pytest.approx(1.0, abs=1e-12)
+    assert not filt.point_symmetric and np.iscomplexobj(filt.axis_transfer(0.3, "along"))
+    # the taps' transfer is T conj(H) (1 + K) / (|H|^2 + K) on the design grid; between its nodes it rings
+    # about it, since a real filter's transfer is real at Nyquist (W(0.5) = W(-0.5) = conj(W(0.5))) where
+    # the lag's phase is not: within 0.015 inside 0.35 cy/px (measured up to 0.012), 0.06 beyond
+    fx, fy = np.meshgrid(np.linspace(-0.35, 0.35, 15), np.linspace(-0.35, 0.35, 15))
+    h = sensor.transfer(fx, fy)
+    closed = target_transfer(fx, 0.3) * target_transfer(fy, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
+    assert np.abs(filt.transfer(fx, fy) - closed).max() < 0.015
+    n = np.fft.fftfreq(filt.taps.shape[0])[:4]              # on the design grid's nodes: exact
+    h = sensor.transfer(0.0, n)
+    closed = target_transfer(n, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
+    assert np.abs(filt.axis_transfer(n, "along") - closed).max() < 1e-9
+    # the restored system H W is real and positive (the phase undone) and follows the target
+    restored = h * filt.axis_transfer(n, "along")
+    assert np.abs(restored.imag).max() < 1e-9 and restored.real.min() > 0
+    f = np.linspace(0.0, 0.45, 10)
+    restored = sensor.transfer(0.0, f) * filt.axis_transfer(f, "along")
+    assert np.abs(restored - target_transfer(f, 0.3)).max() < 0.02 and np.abs(restored.imag).max() < 0.02
+    # across track the lag does nothing: that axis's design is the real sensor's (to the ringing)
+    real = im.design_filter(im.Sensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0)]), 0.3,
+                            noise_std_dn=1.0, signal_std_dn=500.0)
+    assert abs(filt.axis_transfer(0.5, "across") - real.axis_transfer(0.5, "across")) < 0.01
+    # the report reads the MTF, |H|: 1 / sqrt(1 + (2 pi tau f)^2) of the real sensor's along track
+    report = im.restoration_report(filt)
+    lag = 1 / math.sqrt(1 + (2 * math.pi * LAG_M * 0.5) ** 2)
+    assert report.axes["along"].system_mtf_nyquist == pytest.approx(
+        im.restoration_report(real).axes["along"].system_mtf_nyquist * lag, rel=1e-9)
+    along = report.axes["along"]
+    assert along.achieved_mtf_nyquist == pytest.approx(
+        abs(sensor.transfer(0.0, 0.5) * filt.axis_transfer(0.5, "along")), rel=1e-12)
+    assert np.isrealobj(filt(np.full((20, 20), 500.0)))

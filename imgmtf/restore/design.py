@@ -2,16 +2,20 @@
 
 The filter is the normalised Wiener (regularised inverse) filter
 
-    W(fx, fy) = T(fx, fy) H(fx, fy) (1 + K) / (H(fx, fy)^2 + K)
+    W(fx, fy) = T(fx, fy) conj(H(fx, fy)) (1 + K) / (|H(fx, fy)|^2 + K)
 
-where ``H`` is the sensor's real 2-D transfer at the image's pixel
-(:meth:`imgmtf.Sensor.transfer`), ``T`` the target transfer and ``K`` the
+where ``H`` is the sensor's 2-D transfer at the image's pixel
+(:meth:`imgmtf.Sensor.transfer`; complex for a sensor with a one-sided
+stage, whose MTF is ``|H|``), ``T`` the target transfer and ``K`` the
 regulariser, the noise-to-signal power ratio ``(noise_std / signal_std)^2``
-of a scene with a white spectrum.  The restored system ``H W`` follows the
-target where the sensor passes signal well above the noise (``H^2 >> K``)
-and falls to zero where it does not, so an exact zero of ``H`` (motion, an
-OLPF) is never divided by: ``|W| <= T (1 + K) / (2 sqrt K)``.  The factor
-``1 + K`` keeps the DC gain at exactly 1 (the image's radiometry).
+of a scene with a white spectrum.  The restored system ``H W = T |H|^2 (1 +
+K) / (|H|^2 + K)`` is real: the filter undoes the sensor's phase with its
+blur.  It follows the target where the sensor passes signal well above the
+noise (``|H|^2 >> K``) and falls to zero where it does not, so an exact zero
+of ``H`` (motion, an OLPF) is never divided by: ``|W| <= T (1 + K) / (2 sqrt
+K)``.  The factor ``1 + K`` keeps the DC gain at exactly 1 (the image's
+radiometry).  ``H`` is the transfer of a real PSF, Hermitian (``H(-f) =
+conj(H(f))``), and so is ``W``: its taps are real.
 
 The target is smooth, separable and never above 1: ``T(fx, fy) = g(fx)
 g(fy)`` with ``g(f) = V ** ((f / 0.5) ** 2)``, a Gaussian whose value at
@@ -138,7 +142,9 @@ class RestorationFilter:
         return "fft" if self.kernel_size is None else "spatial"
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
-        """The filter's (real, periodic) transfer at (``fx``, ``fy``) cy/px.
+        """The filter's (periodic) transfer at (``fx``, ``fy``) cy/px: real
+        for point-symmetric taps (a sensor whose transfer is real), complex
+        otherwise (its modulus is the filter's gain).
 
         Parameters
         ----------
@@ -153,10 +159,20 @@ class RestorationFilter:
         """
         fx, fy = np.broadcast_arrays(np.asarray(fx, float), np.asarray(fy, float))
         offsets = np.arange(self.taps.shape[0]) - self.radius_px
-        # taps are even in x and in y: the transfer is a sum of cosines, separable per term
-        cx = np.cos(2 * np.pi * fx[..., None] * offsets)
-        cy = np.cos(2 * np.pi * fy[..., None] * offsets)
-        return np.einsum("...i,ij,...j->...", cy, self.taps, cx)
+        # the taps' DFT, tap (j, k) at (y, x) = (j, k) - radius: W = sum t e^(-2 pi i (fy y + fx x)),
+        # the sign of a convolution's (and of a PSF's) transfer
+        ex = np.exp(-2j * np.pi * fx[..., None] * offsets)
+        ey = np.exp(-2j * np.pi * fy[..., None] * offsets)
+        w = np.einsum("...i,ij,...j->...", ey, self.taps, ex)
+        # point-symmetric taps (t(-y, -x) = t(y, x), to rounding): a sum of cosines, real
+        return w.real if self.point_symmetric else w
+
+    @property
+    def point_symmetric(self) -> bool:
+        """True when the taps are point-symmetric (to 1e-12 of the largest):
+        the filter's transfer is real (a sensor whose transfer is real)."""
+        return bool(np.allclose(self.taps, self.taps[::-1, ::-1], rtol=0.0,
+                                atol=1e-12 * float(np.abs(self.taps).max())))
 
     def axis_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """The filter's transfer along one axis: across track (fx, fy = 0) or
@@ -351,7 +367,9 @@ class _DesignGrid:
                 break
 
     def _full_taps(self, regulariser: float) -> np.ndarray:
-        w = self.t * self.h * (1 + regulariser) / (self.h ** 2 + regulariser)
+        # conj(H) / (|H|^2 + K): on the odd grid every frequency has its negative, W is Hermitian and
+        # its inverse DFT real to rounding (the imaginary part dropped is that rounding)
+        w = self.t * np.conj(self.h) * (1 + regulariser) / (np.abs(self.h) ** 2 + regulariser)
         return np.fft.fftshift(np.fft.ifft2(w).real)
 
     def taps(self, regulariser: float) -> np.ndarray:
