@@ -288,8 +288,8 @@ def noise_domination(restoration: RestorationFilter) -> str:
 def blurring_note(report: RestorationReport) -> list[str]:
     """A note for each axis whose target lies below the sensor's own MTF at
     Nyquist: the filter blurs it."""
-    return [f"the target MTF at Nyquist {a.designed_mtf_nyquist:g} is below the sensor's own {direction} "
-            f"({a.system_mtf_nyquist:.4f}): the filter blurs the image {direction} track"
+    return [f"the target MTF at Nyquist, {a.designed_mtf_nyquist:g}, is below the sensor's own {direction} track, "
+            f"{a.system_mtf_nyquist:.4f}: the filter blurs {direction} track rather than sharpening"
             for direction, a in report.axes.items() if a.designed_mtf_nyquist < a.system_mtf_nyquist]
 
 
