@@ -10,7 +10,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -170,7 +170,7 @@ def _distinct(items: list, rois: list) -> tuple[list, list, list[str]]:
 
 
 def _read(item, k: int, band: int | None, roi: Roi | None, gsd_m: float | None, force: bool, transfer: str,
-          saturation: tuple[float, float] | None) -> tuple[object, list[str]]:
+          saturation: tuple[float, float] | None) -> tuple[Any, list[str]]:
     """Edge ``k`` (0-based) as the fit takes it, and the warnings its
     measurement gave: a file read and measured as ``imgmtf measure`` does
     (its window ``roi``), an array's window; measurements (and what is no
@@ -199,11 +199,12 @@ def _measured_file(path: str, band: int | None, roi: Roi | None, gsd_m: float | 
     from .batch import measure_raster
     from .errors import ImgmtfError
     from .estimate.gate import untrusted_when_forced
+    from .estimate.intervals import Intervals
     from .io import open_raster
     from .measure_settings import MeasureSettings
     source = edge_sources([path], [roi])[0]
-    settings = MeasureSettings("edge", band=band, roi=roi, intervals="none", force=force, saturation=saturation,
-                               transfer=transfer)
+    settings = MeasureSettings("edge", band=band, roi=roi, intervals=Intervals("none"), force=force,
+                               saturation=saturation, transfer=transfer)
     try:
         with open_raster(path) as file:
             raster = file.read(band, window=roi)

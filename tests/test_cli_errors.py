@@ -107,7 +107,8 @@ def test_every_hint_reaches_some_command_and_only_measure_takes_band_all():
     assert refusal_hint("fit", "", running=fit) == " (--stages fits fewer, --hold holds some)"
     assert "--force" in refusal_hint("fill", "", running=fit)
     restore = Command.of(next(c for c in COMMANDS if c.name == "restore"))
-    assert refusal_hint("fill", "", "a.tif", running=restore) == " (imgmtf scan a.tif finds and measures each edge in it)"
+    assert refusal_hint("fill", "", "a.tif", running=restore) == \
+        " (imgmtf scan a.tif finds and measures each edge in it)"
     assert refusal_hint("misfit", "", running=restore) == " (--allow-misfit restores with it anyway)"
     assert refusal_hint("misfit", "", running=fit) == ""
 

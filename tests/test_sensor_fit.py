@@ -67,7 +67,8 @@ def test_files_are_measured_as_measure_measures_them(chips, tmp_path):
     for transfer in ("linear", "srgb"):
         fit = im.fit_sensor([path], stages=STAGES, transfer=transfer)
         measured = im.measure_file(path, transfer=transfer, intervals="none")[0]
-        assert fit.edges[0].measured_mtf_nyquist == pytest.approx(measured.get("mtf_nyquist"), abs=5e-7)  # (its 6 digits)
+        # (to the record's 6 digits)
+        assert fit.edges[0].measured_mtf_nyquist == pytest.approx(measured.get("mtf_nyquist"), abs=5e-7)
     assert im.fit_sensor([path], stages=STAGES, transfer="srgb").edges[0].measured_mtf_nyquist != \
         im.fit_sensor([path], stages=STAGES).edges[0].measured_mtf_nyquist
     # nodata declared by the file: measured around, as measure does

@@ -241,12 +241,15 @@ def check_model_fits(fit: FitRecord | None, source: str = "the sensor", *,
 
     Examples
     --------
+    >>> from imgmtf import ImgmtfError
     >>> from imgmtf.estimate.fit.record import FitRecord
     >>> from imgmtf.restore.restoration import check_model_fits
     >>> record = FitRecord(True, 3.8, 0.0, 0.025, ("optics", "detector"), ("chip.tif",))
-    >>> check_model_fits(record, "s.toml")
-    Traceback (most recent call last):
-    imgmtf.errors.ImgmtfError: s.toml: the model (optics, detector) does not fit the 1 edge(s) it was fitted to (reduced chi-square 3.8, misfit p 0, structure 2.50 % of the step): a filter designed from it inverts a blur the sensor does not have
+    >>> try:
+    ...     check_model_fits(record, "s.toml")
+    ... except ImgmtfError as refusal:
+    ...     print(refusal.reason, "|", str(refusal)[:60])
+    misfit | s.toml: the model (optics, detector) does not fit the 1 edge
     >>> check_model_fits(record, "s.toml", allow_misfit=True)[0][:40]
     'MISFIT SENSOR, restored with anyway: the'
     """

@@ -17,7 +17,7 @@ import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ...errors import ConfigError, FileWriteError
 
@@ -163,18 +163,19 @@ def read_fit_record(path: str | Path) -> FitRecord | None:
         return None
     if not isinstance(table, dict):
         raise ConfigError(f"{path}: [fit] must be a table")
-    values = {}
+    values: dict[str, Any] = {}
     for key, kind in _FIELDS.items():
         if key not in table:
             if key == "imgmtf_version":
                 continue
             raise ConfigError(f"{path}: [fit] has no {key}")
-        value = table[key]
+        value: Any = table[key]
         if kind is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
-        if not isinstance(value, kind) or (kind is list and not all(isinstance(v, str) for v in value)):
+        strings = isinstance(value, list) and all(isinstance(v, str) for v in value)
+        if not (strings if kind is list else isinstance(value, kind)):
             raise ConfigError(f"{path}: [fit] {key} must be {_KIND_NAMES[kind]}, got {value!r}")
-        values[key] = tuple(value) if kind is list else value
+        values[key] = tuple(value) if strings else value
     return FitRecord(**values)
 
 
