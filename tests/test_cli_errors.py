@@ -105,7 +105,9 @@ def test_every_hint_reaches_some_command_and_only_measure_takes_band_all():
     fit = Command.of(next(c for c in COMMANDS if c.name == "fit"))
     assert refusal_hint("bands", "", running=fit) == " (--band N chooses one)"
     assert refusal_hint("fit", "", running=fit) == " (--stages fits fewer, --hold holds some)"
-    assert "--force" in refusal_hint("fill", "", running=fit)
+    assert refusal_hint("fill", "", "a.tif", running=fit) == (
+        " (--roi X,Y,W,H once per file fits the edges imgmtf scan finds; imgmtf scan a.tif finds and measures "
+        "each edge in it; --force measures it anyway)")
     restore = Command.of(next(c for c in COMMANDS if c.name == "restore"))
     assert refusal_hint("fill", "", "a.tif", running=restore) == \
         " (imgmtf scan a.tif finds and measures each edge in it)"

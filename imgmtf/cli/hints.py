@@ -44,6 +44,8 @@ HINTS = (
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
     Hint(CHIP, "fit", "--stages fits fewer, --hold holds some"),
+    # a scene's half-edges: fit takes the ROIs scan prints, one per file named
+    Hint(CHIP, "fill", "--roi X,Y,W,H once per file fits the edges imgmtf scan finds", only=frozenset({"fit"})),
     Hint(CHIP, "no-signal", "--signal-std gives it"),
     Hint(CHIP, "misfit", "--allow-misfit restores with it anyway"),
     Hint(CHIP, "noise-dominated", "--max-noise-gain G sets the noise budget, the target then met only within it; "

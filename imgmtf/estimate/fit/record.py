@@ -17,12 +17,9 @@ import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ...errors import ConfigError, FileWriteError
-
-if TYPE_CHECKING:
-    from .results import SensorFit
 
 #: the keys of the ``[fit]`` table and the type each holds
 _FIELDS = {"misfit": bool, "reduced_chi_square": float, "misfit_p": float, "misfit_fraction": float,
@@ -72,8 +69,10 @@ class FitRecord:
     imgmtf_version: str = ""
 
     @classmethod
-    def of(cls, fit: SensorFit, sources: list[str] | None = None) -> FitRecord:
-        """The record of ``fit``; ``sources`` default to its edges' names."""
+    def of(cls, fit: Any, sources: list[str] | None = None) -> FitRecord:
+        """The record of ``fit`` (a :class:`imgmtf.SensorFit`; this module sits
+        below :mod:`.results`, which writes with it); ``sources`` default to
+        its edges' names."""
         from ...version import __version__
         edges = fit.edges
         return cls(bool(fit.misfit), float(fit.reduced_chi_square),
@@ -104,7 +103,7 @@ class FitRecord:
                 f"imgmtf_version = {json.dumps(self.imgmtf_version)}"]
 
 
-def write_fitted_sensor(path: str | Path, fit: SensorFit, *, comment: str = "",
+def write_fitted_sensor(path: str | Path, fit: Any, *, comment: str = "",
                         sources: list[str] | None = None) -> None:
     """Write ``fit``'s sensor as TOML with its ``[fit]`` record: the
     sensor in a ``[sensor]`` table (``gsd_m`` and ``[[sensor.stages]]``),

@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike
 
 from ...sensor.model import Sensor
 from .model import Model, model_mtf_band
+from .record import write_fitted_sensor
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
@@ -261,7 +262,6 @@ class SensorFit:
         FileWriteError
             The file cannot be written.
         """
-        from .record import write_fitted_sensor
         write_fitted_sensor(path, self, comment=comment, sources=sources)
 
     def to_dict(self) -> dict:
