@@ -27,7 +27,7 @@ from .tables import print_fit
 @click.option("--gsd", type=FiniteFloat(0, min_open=True),
               help="GSD in metres (default: the files', else 1: parameters in px)")
 @click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
-@click.option("--roi", multiple=True, callback=parse_rois,
+@click.option("--roi", multiple=True, callback=parse_rois, metavar="X,Y,W,H",
               help="X,Y,W,H window in pixels: once for every file, or once per file in their order (a file "
                    "named again with another window gives another edge; default: the whole image)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
