@@ -186,6 +186,11 @@ def test_a_restoration_whose_noise_dominates_is_refused_unless_a_noise_budget_is
     assert result.exit_code == 0 and "warning: NOISE DOMINATES: the filter multiplies the noise by 5.3" in result.output
     result = run("restore", chip, "--sensor", true, "--target-nyquist", 0.4, "--out", tmp_path / "r.tif")
     assert result.exit_code == 0 and "NOISE" not in result.output
+    # a batch reports each refusal with its hint and goes on
+    result = run("restore", chip, tmp_path / "r.tif", "--sensor", true, "--target-nyquist", 0.6,
+                 "--out", tmp_path / "b")
+    assert result.exit_code == 1 and result.output.count("(--max-noise-gain G sets the noise budget") == 2
+    assert "0 restored, 2 failed" in result.output
 
 
 def test_a_target_below_the_sensor_s_own_mtf_is_noted_as_blurring(chip, tmp_path):

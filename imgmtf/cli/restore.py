@@ -159,7 +159,8 @@ def _print_failure(path: str, exc: BaseException, fmt: str) -> None:
     if fmt == "json":
         click.echo(json.dumps({"input": path, "status": "error", "reason": reason, "error": message}))
     else:
-        click.echo(f"imgmtf: error: {message}", err=True)
+        from .hints import refusal_hint
+        click.echo(f"imgmtf: error: {message}{refusal_hint(reason, message, path)}", err=True)
 
 
 def _print_text(done, written: list[str]) -> None:
