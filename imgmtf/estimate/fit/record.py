@@ -70,9 +70,21 @@ class FitRecord:
 
     @classmethod
     def of(cls, fit: Any, sources: list[str] | None = None) -> FitRecord:
-        """The record of ``fit`` (a :class:`imgmtf.SensorFit`; this module sits
-        below :mod:`.results`, which writes with it); ``sources`` default to
-        its edges' names."""
+        """The record of a fit.
+
+        Parameters
+        ----------
+        fit : SensorFit
+            The fit (:func:`imgmtf.fit_sensor`; untyped here: this module
+            sits below :mod:`.results`, which writes with it).
+        sources : list of str, optional
+            What the edges were (default the fit's edge names).
+
+        Returns
+        -------
+        FitRecord
+            Its verdict and figures.
+        """
         from ...version import __version__
         edges = fit.edges
         return cls(bool(fit.misfit), float(fit.reduced_chi_square),
@@ -142,13 +154,30 @@ def write_fitted_sensor(path: str | Path, fit: Any, *, comment: str = "",
 
 
 def read_fit_record(path: str | Path) -> FitRecord | None:
-    """The ``[fit]`` record of a sensor file, None when it has none (a
-    sensor written by hand or by ``imgmtf sensor --save``).
+    """The ``[fit]`` record of a sensor file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The sensor TOML.
+
+    Returns
+    -------
+    FitRecord or None
+        Its record; None when it has none (a sensor written by hand or by
+        ``imgmtf sensor --save`` makes no claim).
 
     Raises
     ------
     ConfigError
         The file cannot be read as TOML, or its ``[fit]`` table is malformed.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> imgmtf.Sensor().to_toml("plain.toml")
+    >>> print(imgmtf.read_fit_record("plain.toml"))
+    None
     """
     try:
         with open(path, "rb") as fh:

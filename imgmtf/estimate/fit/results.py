@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -242,7 +243,7 @@ class SensorFit:
         return model_mtf_band(self._model, self._u, self._covariance, np.asarray(f_cy_px, float),
                          angle_deg, gsd, self.confidence)
 
-    def to_toml(self, path, comment: str = "", sources: list[str] | None = None) -> None:
+    def to_toml(self, path: str | os.PathLike, comment: str = "", sources: list[str] | None = None) -> None:
         """Write the fitted sensor as TOML with a ``[fit]`` table saying
         whether the model fits (:mod:`imgmtf.estimate.fit.record`):
         :meth:`imgmtf.Sensor.from_toml` reads the sensor, ``imgmtf
