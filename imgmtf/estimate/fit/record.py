@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -115,7 +116,7 @@ class FitRecord:
                 f"imgmtf_version = {json.dumps(self.imgmtf_version)}"]
 
 
-def write_fitted_sensor(path: str | Path, fit: Any, *, comment: str = "",
+def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
                         sources: list[str] | None = None) -> None:
     """Write ``fit``'s sensor as TOML with its ``[fit]`` record: the
     sensor in a ``[sensor]`` table (``gsd_m`` and ``[[sensor.stages]]``),
