@@ -146,27 +146,24 @@ def test_a_complex_transfer_gets_real_taps_that_undo_its_phase():
     # real taps summing to 1, not point-symmetric: the filter's own transfer is complex
     assert filt.taps.dtype == np.float64 and filt.taps.sum() == pytest.approx(1.0, abs=1e-12)
     assert not filt.point_symmetric and np.iscomplexobj(filt.axis_transfer(0.3, "along"))
-    # the taps' transfer is T conj(H) (1 + K) / (|H|^2 + K) on the design grid; between its nodes it rings
-    # about it, since a real filter's transfer is real at Nyquist (W(0.5) = W(-0.5) = conj(W(0.5))) where
-    # the lag's phase is not: within 0.015 inside 0.35 cy/px (measured up to 0.012), 0.06 beyond
-    fx, fy = np.meshgrid(np.linspace(-0.35, 0.35, 15), np.linspace(-0.35, 0.35, 15))
-    h = sensor.transfer(fx, fy)
-    closed = target_transfer(fx, 0.3) * target_transfer(fy, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
-    assert np.abs(filt.transfer(fx, fy) - closed).max() < 0.015
-    n = np.fft.fftfreq(filt.taps.shape[0])[:4]              # on the design grid's nodes: exact
-    h = sensor.transfer(0.0, n)
-    closed = target_transfer(n, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
-    assert np.abs(filt.axis_transfer(n, "along") - closed).max() < 1e-9
-    # the restored system H W is real and positive (the phase undone) and follows the target
-    restored = h * filt.axis_transfer(n, "along")
-    assert np.abs(restored.imag).max() < 1e-9 and restored.real.min() > 0
+    # the taps' transfer is T conj(H) (1 + K) / (|H|^2 + K), except about Nyquist: a real filter's
+    # transfer is real there (W(0.5) = W(-0.5) = conj(W(0.5))) where the lag's phase is not, and the taps,
+    # which then never decay, are tapered (measured: within 4e-4 inside 0.35 cy/px, 2e-3 inside 0.45)
+    for reach, tolerance in ((0.35, 1e-3), (0.45, 4e-3)):
+        fx, fy = np.meshgrid(np.linspace(-reach, reach, 15), np.linspace(-reach, reach, 15))
+        h = sensor.transfer(fx, fy)
+        closed = target_transfer(fx, 0.3) * target_transfer(fy, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
+        assert np.abs(filt.transfer(fx, fy) - closed).max() < tolerance
+    # the restored system H W is real and positive (the phase undone) and follows the target to 0.45 cy/px
+    # (measured within 3e-4); at Nyquist itself the phase cannot be undone, and the report says so
     f = np.linspace(0.0, 0.45, 10)
     restored = sensor.transfer(0.0, f) * filt.axis_transfer(f, "along")
-    assert np.abs(restored - target_transfer(f, 0.3)).max() < 0.02 and np.abs(restored.imag).max() < 0.02
+    assert np.abs(restored - target_transfer(f, 0.3)).max() < 1e-3 and np.abs(restored.imag).max() < 1e-3
     # across track the lag does nothing: that axis's design is the real sensor's (to the ringing)
     real = im.design_filter(im.Sensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0)]), 0.3,
                             noise_std_dn=1.0, signal_std_dn=500.0)
     assert abs(filt.axis_transfer(0.5, "across") - real.axis_transfer(0.5, "across")) < 0.01
+    assert real.taps.shape[0] < filt.taps.shape[0]          # (the real design's taps decay: not tapered)
     # the report reads the MTF, |H|: 1 / sqrt(1 + (2 pi tau f)^2) of the real sensor's along track
     report = im.restoration_report(filt)
     lag = 1 / math.sqrt(1 + (2 * math.pi * LAG_M * 0.5) ** 2)

@@ -22,7 +22,11 @@ g(fy)`` with ``g(f) = V ** ((f / 0.5) ** 2)``, a Gaussian whose value at
 Nyquist (0.5 cy/px) is ``V`` in both axes.
 
 The filter's taps are the inverse DFT of ``W`` on a grid fine enough that
-they have decayed at its border (the FFT form), or those taps cut to a small
+they have decayed at its border (the FFT form; taps that have not decayed
+on the largest grid, those of a transfer with a phase at Nyquist, where a
+real filter's transfer is real, are tapered by a Tukey window over the
+outer half of their reach rather than ringing about the design at every
+frequency), or those taps cut to a small
 ``N x N`` kernel as operational MTFC applies (the spatial form; the cut
 is the least-squares fit of ``W`` with the DC gain held at 1).  Its
 white-noise gain is the root of the sum of its squared taps.  A noise-gain
@@ -365,6 +369,10 @@ class _DesignGrid:
             taps = self._full_taps(MIN_REGULARISER)
             if _border_fraction(taps) < CROP_TOLERANCE:
                 break
+        # taps that have not decayed even on the largest grid come from a transfer that jumps at
+        # Nyquist (a phase there, which a real filter's transfer cannot have): cut bare, they ring
+        # about the design at every frequency; tapered, they follow it to Nyquist's neighbourhood
+        self.window = None if _border_fraction(taps) < CROP_TOLERANCE else _tukey(taps.shape[0])
 
     def _full_taps(self, regulariser: float) -> np.ndarray:
         # conj(H) / (|H|^2 + K): on the odd grid every frequency has its negative, W is Hermitian and
@@ -376,6 +384,8 @@ class _DesignGrid:
         taps = self._full_taps(regulariser)
         centre = taps.shape[0] // 2
         if self.kernel_size is None:
+            if self.window is not None:
+                taps = taps * self.window
             half = _crop_half_width(taps)
         else:
             half = self.kernel_size // 2
@@ -401,6 +411,14 @@ class _DesignGrid:
             if high - low < 1e-4:          # K to 0.01 %: the gain to about 1e-5
                 break
         return math.exp(high)
+
+
+def _tukey(n: int, flat: float = 0.5) -> np.ndarray:
+    """A separable n x n Tukey window: 1 over the inner ``flat`` of the
+    half-width, a raised cosine to 0 beyond the outermost tap."""
+    x = np.abs(np.arange(n) - n // 2) / (n // 2 + 1)
+    w = np.where(x <= flat, 1.0, 0.5 * (1 + np.cos(np.pi * (x - flat) / (1 - flat))))
+    return w[:, None] * w[None, :]
 
 
 def _gain(taps: np.ndarray) -> float:
