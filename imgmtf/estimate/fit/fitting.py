@@ -32,6 +32,10 @@ from .seeds import seeded
 if TYPE_CHECKING:
     from ..edge import EdgeResult
 
+#: Jacobians a candidate of ``auto`` may take: its larger models (ten
+#: parameters, a dozen edges solved by LSMR) took 200-1000 on an L0R
+#: campaign's scenes where the paper's four take under 50
+AUTO_MAX_ITERATIONS = 1500
 #: a parameter stays free only if holding it costs this much chi-square
 #: (in units of the reduced chi-square): p = 0.001 for one degree of freedom
 LIKELIHOOD_RATIO = 10.8
@@ -114,7 +118,10 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
         for candidate in AUTO_CANDIDATES:
             model = new_model(gsd, initial_stages(list(candidate), start, gsd), data, start)
             try:
-                fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence))
+                # parsimony is the candidates' order here: within one, a parameter held at a starting value
+                # that is no knowledge (the paper's optics) would bias the rest and narrow the intervals
+                fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence, hold_unneeded=False,
+                                    max_iterations=AUTO_MAX_ITERATIONS))
             except ImgmtfError as exc:          # one that does not converge: the next is tried
                 failed.append((candidate, str(exc)))
                 continue
@@ -165,14 +172,16 @@ def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, 
     return (["auto"] if is_auto(stages) else stage_names(stages, start)), gsd_m
 
 
-def run_fit(model: Model, hold, confidence: float) -> SensorFit:
+def run_fit(model: Model, hold, confidence: float, hold_unneeded: bool = True,
+            max_iterations: int = 200) -> SensorFit:
     """Fit ``model`` from its starting values, holding
-    what the data do not determine or need (see the module's notes), and
+    what the data do not determine or (``hold_unneeded``) need (see the
+    module's notes), each solve within ``max_iterations`` Jacobians, and
     report."""
     notes = model.screen_axes(hold_keys(hold, model.keys))
     z = model.initial_vector()
     while True:
-        z, jacobian = model.solve(z)
+        z, jacobian = model.solve(z, max_iterations)
         scale = max(model.reduced_chi_square(z), 1.0)
         covariance = parameter_covariance(jacobian, scale)
         undetermined = model.undetermined(z, covariance)
@@ -186,7 +195,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
     # hold, best-known first, each parameter the data do not need (holding it
     # at its starting value costs less than the likelihood-ratio threshold),
     # but keep one free parameter on each axis an edge sees
-    for key in sorted(model.free, key=lambda k: -model.specs[k].rank):
+    for key in sorted(model.free, key=lambda k: -model.specs[k].rank) if hold_unneeded else ():
         if not model.covers_axes([k for k in model.free if k != key]):
             continue            # the last free parameter of an axis: its uncertainty belongs in the intervals
         index = model.free.index(key)
@@ -195,7 +204,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         trial = model.copy()
         z_held = trial.hold(z, index, covariance)
         try:
-            z_held, jacobian_held = trial.solve(z_held)
+            z_held, jacobian_held = trial.solve(z_held, max_iterations)
         except ImgmtfError:
             continue
         cost = (trial.chi_square(z_held) - model.chi_square(z)) / scale
