@@ -1,0 +1,573 @@
+"""The 2-D MTF's across- and along-track sections from MTFs measured
+along two or more normals, without a sensor model.
+
+An edge whose normal makes the angle theta with the across-track axis
+measures the central section of the 2-D MTF along that normal (the Fourier
+slice theorem): m(f) = M(f cos theta, f sin theta), f in cy/px along the
+normal.  Two sections do not fix a 2-D function; each named assumption
+does:
+
+- **separable**: M(u, v) = Mx(u) My(v).  In logs every measured point is
+  a sum, log m(f) = log Mx(f |cos|) + log My(f |sin|): one linear least
+  squares for both curves on a node grid (:func:`separable_model`).
+- **elliptical**: M(u, v) = sinc(u) sinc(v) g(sqrt(u^2 + v^2 / a^2)), the
+  square pixel times an elliptical remainder.  With the pixel divided out
+  every section is g stretched: r(f) = g(f sqrt(cos^2 + sin^2 / a^2)); the
+  aspect ``a`` is the one that lays the sections onto one curve
+  (:func:`elliptical_model`).
+
+Across track is u (theta = 0), along track v (theta = 90 deg); with rows
+along track those are the image's x and y.  Two (near-)perpendicular
+sections fit either assumption exactly, so the data cannot tell them
+apart: :func:`mtf2d_from_sections` then gives both and the ``bracket``
+spanning them.  A third orientation is predicted from the two nearest the
+axes under each assumption and compared with its measurement; the
+assumption it does not reject is chosen.
+
+Intervals: each section's uncertainty (one standard deviation per
+frequency) is drawn as a whole-curve shift (the noise of one edge's MTF is
+correlated across frequency), every draw inverted, and the percentiles
+taken.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import optimize, stats
+
+from ...errors import ParameterError
+
+SEPARABLE, ELLIPTICAL, BRACKET = "separable", "elliptical", "bracket"
+ASSUMPTIONS = (SEPARABLE, ELLIPTICAL)
+NODE_STEP_CY_PX = 0.025     # the curves' node spacing
+REACH_CY_PX = 0.8           # the sections are inverted up to this frequency on each axis
+MIN_MTF = 0.02              # below it a measured MTF is noise in logs: not used
+SD_FLOOR = 0.005            # what a measured MTF cannot be trusted to better (edge estimator bias)
+MIN_SEPARATION_DEG = 30.0   # two normals closer than this hardly tell the axes apart
+SMOOTHING = 3.0             # weight of the curves' second differences (per node, log units)
+ASPECT_BOUNDS = (0.25, 4.0)  # the elliptical remainder's along/across width ratio searched
+TEST_ALPHA = 0.05           # a prediction whose p-value falls below is rejected
+TEST_DRAWS = 30             # draws for a prediction's own spread
+_GRID = np.round(np.arange(0.0, REACH_CY_PX + 1e-9, 0.01), 2)
+
+
+@dataclass(frozen=True)
+class TrackSection:
+    """One section of a 2-D MTF (across- or along-track) and its interval.
+
+    Attributes
+    ----------
+    direction : str
+        "across-track" (u) or "along-track" (v).
+    frequencies_cy_px, mtf, low, high : numpy.ndarray
+        The section (MTF 1 at zero frequency) and its pointwise interval;
+        NaN beyond what the measured sections reach.
+    mtf_nyquist, mtf50_cy_px, fwhm_px : float
+        MTF at 0.5 cy/px, where it falls to 0.5, the LSF's full width at
+        half maximum (px).
+    mtf_nyquist_ci, mtf50_ci_cy_px : (float, float)
+        Their intervals (NaN without uncertainties).
+    """
+
+    direction: str
+    frequencies_cy_px: np.ndarray = field(repr=False)
+    mtf: np.ndarray = field(repr=False)
+    low: np.ndarray = field(repr=False)
+    high: np.ndarray = field(repr=False)
+    mtf_nyquist: float
+    mtf_nyquist_ci: tuple[float, float]
+    mtf50_cy_px: float
+    mtf50_ci_cy_px: tuple[float, float]
+    fwhm_px: float
+
+
+@dataclass(frozen=True)
+class SeparableModel:
+    """log Mx and log My on ``nodes`` (cy/px), NaN beyond the data."""
+
+    nodes: np.ndarray
+    log_x: np.ndarray
+    log_y: np.ndarray
+
+    def transfer(self, u: ArrayLike, v: ArrayLike) -> np.ndarray:
+        return np.exp(_interp(np.abs(u), self.nodes, self.log_x) + _interp(np.abs(v), self.nodes, self.log_y))
+
+
+@dataclass(frozen=True)
+class EllipticalModel:
+    """log g on ``nodes`` (cy/px of the across-track axis) and the aspect."""
+
+    nodes: np.ndarray
+    log_g: np.ndarray
+    aspect: float
+
+    def transfer(self, u: ArrayLike, v: ArrayLike) -> np.ndarray:
+        u, v = np.asarray(u, float), np.asarray(v, float)
+        w = np.hypot(u, v / self.aspect)
+        return np.sinc(u) * np.sinc(v) * np.exp(_interp(w, self.nodes, self.log_g))
+
+
+@dataclass(frozen=True)
+class MTF2D:
+    """The 2-D MTF from measured sections, under a named assumption.
+
+    Attributes
+    ----------
+    assumption : str
+        "separable", "elliptical" or "bracket" (the data cannot tell the
+        two apart: the interval spans both).
+    because : str
+        Why that assumption (a short phrase).
+    across, along : TrackSection
+        The chosen assumption's across-track (u, cy/px) and along-track
+        (v) sections.
+    alternatives : dict
+        Every assumption's (``across``, ``along``) sections, the bracket's
+        among them.
+    models : dict
+        Each assumption's fitted model (:class:`SeparableModel`,
+        :class:`EllipticalModel`).
+    aspect : float
+        The elliptical remainder's aspect a (along/across widths).
+    normals_deg : tuple of float
+        The sections' normals from the across-track axis, deg.
+    tests : dict
+        For each assumption, the p-value of its prediction of the
+        orientations it was not fitted to (absent with two orientations).
+    """
+
+    assumption: str
+    because: str
+    across: TrackSection
+    along: TrackSection
+    alternatives: dict = field(repr=False)
+    models: dict = field(repr=False)
+    aspect: float
+    normals_deg: tuple
+    tests: dict
+
+    def transfer(self, fx_cy_px: ArrayLike, fy_cy_px: ArrayLike) -> np.ndarray:
+        """The 2-D MTF at (across, along) frequencies, cy/px; the bracket's
+        is the mean of the two assumptions'.  NaN beyond the data's reach."""
+        if self.assumption == BRACKET:
+            return 0.5 * sum(self.models[a].transfer(fx_cy_px, fy_cy_px) for a in ASSUMPTIONS)
+        return self.models[self.assumption].transfer(fx_cy_px, fy_cy_px)
+
+
+def sd_from_nyquist(sd_nyquist: ArrayLike, frequencies_cy_px: ArrayLike) -> np.ndarray:
+    """Per-frequency standard deviations of sections from theirs at Nyquist
+    (n,), growing in proportion to frequency (0 at 0, where an MTF is 1 by
+    construction): (n, len(frequencies)).
+
+    Examples
+    --------
+    >>> sd_from_nyquist([0.01], [0.0, 0.25, 0.5]).tolist()
+    [[0.0, 0.005, 0.01]]
+    """
+    return np.outer(np.asarray(sd_nyquist, float), np.asarray(frequencies_cy_px, float) / 0.5)
+
+
+def separable_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
+                    sd: ArrayLike | None = None) -> SeparableModel:
+    """Mx(u) My(v) from sections along ``normals_deg`` (from the across-track
+    axis): a weighted least-squares fit of log Mx + log My on nodes every
+    ``NODE_STEP_CY_PX`` to ``REACH_CY_PX``, lightly smoothed.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> truth = lambda u, v: np.exp(-2 * u ** 2 - 5 * v ** 2)
+    >>> t = np.radians([16.8, -73.2])
+    >>> m = [truth(f * np.cos(a), f * np.sin(a)) for a in t]
+    >>> model = separable_model([16.8, -73.2], f, m)
+    >>> round(float(model.transfer(0.5, 0.0)), 3), round(float(truth(0.5, 0.0)), 3)
+    (0.607, 0.607)
+    """
+    theta, f, m, weight = _prepared(normals_deg, frequencies_cy_px, mtfs, sd)
+    nodes = _nodes(REACH_CY_PX)
+    u, v = np.abs(np.cos(theta))[:, None] * f, np.abs(np.sin(theta))[:, None] * f
+    use = (m >= MIN_MTF) & (u <= nodes[-1]) & (v <= nodes[-1])
+    design = np.hstack([_hat(u[use], nodes), _hat(v[use], nodes)])
+    solution, reach = _solve(design, np.log(m[use]), weight[use], 2, nodes.size)
+    log_x, log_y = np.split(solution, 2)
+    return SeparableModel(nodes, np.where(reach[0], log_x, np.nan), np.where(reach[1], log_y, np.nan))
+
+
+def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
+                     sd: ArrayLike | None = None, aspect: float | None = None) -> EllipticalModel:
+    """sinc(u) sinc(v) g(sqrt(u^2 + v^2 / a^2)) from sections along
+    ``normals_deg``: the pixel divided out, the aspect a (searched in
+    ``ASPECT_BOUNDS`` unless given) that lays the remainders onto one
+    curve g, and g on its nodes.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> truth = lambda u, v: np.sinc(u) * np.sinc(v) / (1 + 9 * (u ** 2 + v ** 2 / 0.7 ** 2))
+    >>> t = np.radians([16.8, -73.2])
+    >>> model = elliptical_model([16.8, -73.2], f, [truth(f * np.cos(a), f * np.sin(a)) for a in t])
+    >>> round(model.aspect, 2), round(float(model.transfer(0.0, 0.5)), 3), round(float(truth(0.0, 0.5)), 3)
+    (0.7, 0.114, 0.114)
+    """
+    if aspect is not None:
+        return _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, (math.log(aspect),) * 2, 1)
+    return _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, tuple(np.log(ASPECT_BOUNDS)), 25)
+
+
+def _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, log_bounds: tuple[float, float],
+                coarse: int) -> EllipticalModel:
+    """The elliptical model whose log aspect, within ``log_bounds``, best
+    lays the remainders onto one curve: ``coarse`` trial values, then a
+    bounded search about the best."""
+    theta, f, m, weight = _prepared(normals_deg, frequencies_cy_px, mtfs, sd)
+    c, s = np.abs(np.cos(theta))[:, None], np.abs(np.sin(theta))[:, None]
+    pixel = np.sinc(f * c) * np.sinc(f * s)
+    use = (m >= MIN_MTF) & (np.maximum(f * c, f * s) <= REACH_CY_PX) & (pixel > 0.05)
+    log_r = np.log(m[use] / pixel[use])
+    weight = weight[use]
+
+    def fitted(log_aspect: float) -> tuple[float, EllipticalModel]:
+        a = math.exp(log_aspect)
+        w = (f * np.sqrt(c ** 2 + s ** 2 / a ** 2))[use]
+        nodes = _nodes(max(float(w.max(initial=0.0)), NODE_STEP_CY_PX), count=33)
+        design = _hat(w, nodes)
+        solution, reach = _solve(design, log_r, weight, 1, nodes.size)
+        residual = float(np.sum((weight * (design @ solution[1:] - log_r)) ** 2))
+        return residual, EllipticalModel(nodes, np.where(reach[0], solution, np.nan), a)
+
+    lo, hi = log_bounds
+    if coarse > 1:
+        trials = np.linspace(lo, hi, coarse)
+        best = int(np.argmin([fitted(x)[0] for x in trials]))
+        lo, hi = trials[max(best - 1, 0)], trials[min(best + 1, coarse - 1)]
+    if hi > lo:
+        return fitted(float(optimize.minimize_scalar(lambda x: fitted(x)[0], bounds=(lo, hi), method="bounded",
+                                                     options={"xatol": 1e-4}).x))[1]
+    return fitted(lo)[1]
+
+
+def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
+                        sd: ArrayLike | None = None, *, assumption: str = "auto", draws: int = 100,
+                        confidence: float = 0.95, seed: int = 0) -> MTF2D:
+    """The across- and along-track sections of the 2-D MTF from MTFs
+    measured along two or more normals.
+
+    Parameters
+    ----------
+    normals_deg : sequence of float
+        Each section's normal from the across-track axis (deg; 180 apart
+        is the same section), at least two of them ``MIN_SEPARATION_DEG``
+        apart.
+    frequencies_cy_px : array_like
+        The sections' common frequencies along their normals, cy/px.
+    mtfs : array_like
+        (n, len(frequencies)): the measured MTFs (1 at zero frequency).
+    sd : array_like, optional
+        (n, len(frequencies)): their standard deviations
+        (:func:`sd_from_nyquist`); without, no intervals and the tests
+        assume ``SD_FLOOR``.
+    assumption : str, optional
+        "auto" (default: chosen as the module says), "separable",
+        "elliptical" or "bracket".
+    draws : int, optional
+        Draws of the sections within their uncertainty for the intervals.
+    confidence : float, optional
+        Of the intervals (default 0.95).
+    seed : int, optional
+        Of the draws: the same inputs give the same intervals.
+
+    Returns
+    -------
+    MTF2D
+
+    Raises
+    ------
+    ParameterError
+        Shapes that do not agree, fewer than two distinct normals, or an
+        unknown assumption.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> truth = lambda u, v: np.sinc(u) * np.sinc(v) * np.exp(-2 * u ** 2 - 4 * v ** 2)
+    >>> t = np.radians([16.8, -73.2])
+    >>> result = mtf2d_from_sections([16.8, -73.2], f, [truth(f * np.cos(a), f * np.sin(a)) for a in t])
+    >>> result.assumption, round(result.across.mtf_nyquist, 3), round(float(truth(0.5, 0)), 3)
+    ('bracket', 0.386, 0.386)
+    """
+    if assumption not in ("auto", BRACKET, *ASSUMPTIONS):
+        raise ParameterError(f"assumption must be auto, separable, elliptical or bracket, got {assumption!r}")
+    theta, f, m, _ = _prepared(normals_deg, frequencies_cy_px, mtfs, sd)
+    normals = np.degrees(theta)
+    spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
+    base = _base_pair(normals)
+    inputs = (normals, f, m, spread)
+    models = {a: _model(a, normals, f, m, spread) for a in ASSUMPTIONS}
+    tests: dict[str, float] = {}
+    if assumption == "auto":
+        others = [k for k in range(normals.size) if k not in base]
+        if others:
+            tests = _tests(inputs, base, others, draws, seed)
+        assumption, because = _decision(tests, normals[list(others)] if others else None)
+    else:
+        because = "asked for"
+    rng = np.random.default_rng(seed)
+    shifts = rng.standard_normal((draws, normals.size)) if sd is not None and draws > 0 else None
+    alternatives = {a: _sections(a, models[a], inputs, shifts, confidence) for a in ASSUMPTIONS}
+    alternatives[BRACKET] = tuple(_bracket(alternatives[SEPARABLE][k], alternatives[ELLIPTICAL][k]) for k in (0, 1))
+    across, along = alternatives[assumption]
+    return MTF2D(assumption, because, across, along, alternatives, models, models[ELLIPTICAL].aspect,
+                 tuple(float(n) for n in normals), tests)
+
+
+def _model(assumption: str, normals, f, m, sd):
+    if assumption == SEPARABLE:
+        return separable_model(normals, f, m, sd)
+    return elliptical_model(normals, f, m, sd)
+
+
+def _prepared(normals_deg, frequencies_cy_px, mtfs, sd):
+    """Normals (rad), frequencies, MTFs and the least squares' weights
+    (1 / the standard deviation of log m, with ``SD_FLOOR``), validated."""
+    normals = np.atleast_1d(np.asarray(normals_deg, float))
+    f = np.asarray(frequencies_cy_px, float)
+    m = np.atleast_2d(np.asarray(mtfs, float))
+    if f.ndim != 1 or m.shape != (normals.size, f.size):
+        raise ParameterError(f"mtfs must be (n normals, n frequencies) = ({normals.size}, {f.size}), "
+                             f"got {m.shape}")
+    if not (np.isfinite(normals).all() and np.isfinite(f).all()):
+        raise ParameterError("normals and frequencies must be finite")
+    doubled = np.radians(2 * normals)
+    apart = np.degrees(np.arccos(np.clip(np.cos(doubled[:, None] - doubled[None, :]), -1, 1))) / 2
+    if normals.size < 2 or apart.max() < MIN_SEPARATION_DEG:
+        raise ParameterError(f"need sections along at least two normals {MIN_SEPARATION_DEG:g} deg apart, "
+                             f"got {', '.join(f'{n:g}' for n in normals)} deg")
+    spread = 0.0 if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
+    m = np.where(np.isfinite(m), m, 0.0)
+    weight = np.clip(m, MIN_MTF, None) / np.hypot(np.nan_to_num(spread, nan=1.0), SD_FLOOR)
+    return np.radians(normals), f, m, weight
+
+
+def _nodes(reach: float, count: int | None = None) -> np.ndarray:
+    if count is None:
+        return np.arange(0.0, reach + 1e-9, NODE_STEP_CY_PX)
+    return np.linspace(0.0, reach, count)
+
+
+def _hat(x: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """Linear interpolation's weights of ``x`` on the nodes after the
+    first (whose value, log 1, is 0): (len(x), len(nodes) - 1)."""
+    step = nodes[1] - nodes[0]
+    position = np.clip(x / step, 0, nodes.size - 1)
+    low = np.minimum(np.floor(position).astype(int), nodes.size - 2)
+    frac = position - low
+    out = np.zeros((x.size, nodes.size))
+    rows = np.arange(x.size)
+    out[rows, low] = 1.0 - frac
+    out[rows, low + 1] = frac
+    return out[:, 1:]
+
+
+def _solve(design: np.ndarray, target: np.ndarray, weight: np.ndarray, curves: int, size: int):
+    """Weighted least squares for ``curves`` curves of ``size`` nodes each
+    (the first 0), smoothed by their second differences; the nodes the
+    data touch (``reach``, per curve)."""
+    k = size - 1
+    penalty = _penalty(curves, size)
+    weighted = design * weight[:, None]
+    # the normal equations: a few dozen unknowns, solved thousands of times for the intervals
+    normal = weighted.T @ weighted + penalty + 1e-10 * np.eye(curves * k)
+    solution = np.linalg.solve(normal, weighted.T @ (target * weight))
+    touched = np.abs(design).sum(axis=0).reshape(curves, k) > 0
+    reach = np.zeros((curves, size), bool)
+    for c in range(curves):
+        last = np.flatnonzero(touched[c])
+        reach[c, : (last[-1] + 2 if last.size else 1)] = True
+    return np.concatenate([np.concatenate([[0.0], part]) for part in np.split(solution, curves)]), reach
+
+
+@functools.lru_cache(maxsize=8)
+def _penalty(curves: int, size: int) -> np.ndarray:
+    """The smoothing's normal matrix: the squared second differences of
+    each curve's nodes (the first held at 0)."""
+    second = np.diff(np.eye(size), 2, axis=0)[:, 1:] * SMOOTHING
+    block = np.kron(np.eye(curves), second)
+    return block.T @ block
+
+
+def _interp(x: ArrayLike, nodes: np.ndarray, values: np.ndarray) -> np.ndarray:
+    x = np.asarray(x, float)
+    inside = (x >= 0) & (x <= nodes[-1] + 1e-12)
+    return np.where(inside, np.interp(x, nodes, values), np.nan)
+
+
+def _base_pair(normals: np.ndarray) -> tuple[int, int]:
+    """The two normals to invert from: at least ``MIN_SEPARATION_DEG``
+    apart, nearest the axes, then farthest apart."""
+    best, key = (0, 1), (math.inf, math.inf)
+    for i in range(normals.size):
+        for j in range(i + 1, normals.size):
+            apart = abs((normals[i] - normals[j] + 90.0) % 180.0 - 90.0)
+            if apart < MIN_SEPARATION_DEG:
+                continue
+            off_axis = sum(min(n % 90.0, 90.0 - n % 90.0) for n in (normals[i], normals[j]))
+            if (off_axis, -apart) < key:
+                best, key = (i, j), (off_axis, -apart)
+    return best
+
+
+def _tests(inputs, base, others, draws: int, seed: int) -> dict[str, float]:
+    """Each assumption's p-value for the orientations ``others``: its
+    prediction from the ``base`` pair against their measurement, at the
+    frequency where the two assumptions' predictions differ most."""
+    normals, f, m, sd = inputs
+    pair = list(base)
+    rng = np.random.default_rng(seed + 1)
+    shifts = rng.standard_normal((TEST_DRAWS, 2))
+    chi2 = dict.fromkeys(ASSUMPTIONS, 0.0)
+    for k in others:
+        theta = math.radians(normals[k])
+        u, v = f * abs(math.cos(theta)), f * abs(math.sin(theta))
+        predictions, spreads = {}, {}
+        for a in ASSUMPTIONS:
+            central = _model(a, normals[pair], f, m[pair], sd[pair])
+            predictions[a] = central.transfer(u, v)
+            drawn = np.array([_refit(a, central, normals[pair], f, np.clip(m[pair] + z[:, None] * sd[pair], 1e-6, None),
+                                     sd[pair]).transfer(u, v) for z in shifts[:TEST_DRAWS]]) if sd.any() else None
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)       # all-NaN beyond the reach
+                spreads[a] = np.zeros_like(f) if drawn is None else np.nanstd(drawn, axis=0)
+        total = {a: np.sqrt(spreads[a] ** 2 + sd[k] ** 2 + SD_FLOOR ** 2) for a in ASSUMPTIONS}
+        gap = np.abs(predictions[SEPARABLE] - predictions[ELLIPTICAL]) / np.maximum(total[SEPARABLE],
+                                                                                    total[ELLIPTICAL])
+        usable = np.isfinite(gap) & (f > 0) & (m[k] >= MIN_MTF) & (f <= REACH_CY_PX)
+        if not usable.any():
+            continue
+        at = int(np.flatnonzero(usable)[np.argmax(gap[usable])])
+        for a in ASSUMPTIONS:
+            chi2[a] += float(((predictions[a][at] - m[k, at]) / total[a][at]) ** 2)
+    return {a: float(stats.chi2.sf(chi2[a], len(others))) for a in ASSUMPTIONS}
+
+
+def _decision(tests: dict[str, float], others) -> tuple[str, str]:
+    if not tests:
+        return BRACKET, "two orientations cannot tell separable from elliptical"
+    where = "/".join(f"{n:.0f}" for n in others) + " deg"
+    fits = [a for a in ASSUMPTIONS if tests[a] >= TEST_ALPHA]
+    p = ", ".join(f"{a} p={tests[a]:.2g}" for a in ASSUMPTIONS)
+    if len(fits) == 2:
+        return BRACKET, f"the {where} section agrees with both ({p})"
+    if len(fits) == 1:
+        return fits[0], f"the {where} section rejects the other ({p})"
+    closer = max(ASSUMPTIONS, key=lambda a: tests[a])
+    return closer, f"the {where} section rejects both; {closer} is closer ({p})"
+
+
+def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tuple[TrackSection, TrackSection]:
+    """The model's across and along sections, with intervals from the
+    sections redrawn by ``shifts`` (draws x sections) and inverted again."""
+    normals, f, m, sd = inputs
+    curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
+    drawn = None
+    if shifts is not None:
+        drawn = np.array([_redrawn(assumption, model, normals, f, np.clip(m + z[:, None] * sd, 1e-6, None), sd)
+                          for z in shifts])
+    return tuple(_section(name, curves[k], None if drawn is None else drawn[:, k], confidence)
+                 for k, name in enumerate(("across-track", "along-track")))
+
+
+def _redrawn(assumption: str, model, normals, f, m, sd) -> list[np.ndarray]:
+    """The across and along sections of redrawn sections (``m``), inverted
+    again."""
+    again = _refit(assumption, model, normals, f, m, sd)
+    return [again.transfer(_GRID, 0.0 * _GRID), again.transfer(0.0 * _GRID, _GRID)]
+
+
+def _refit(assumption: str, model, normals, f, m, sd):
+    """The model refitted to redrawn sections ``m``; the elliptical aspect
+    searched near the central ``model``'s (it is uncertain too)."""
+    if assumption == SEPARABLE:
+        return separable_model(normals, f, m, sd)
+    near = math.log(model.aspect)
+    return _elliptical(normals, f, m, sd, (near - 0.3, near + 0.3), 1)
+
+
+def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float) -> TrackSection:
+    tail = (1 - confidence) / 2
+    if drawn is None:
+        low = high = np.full_like(curve, np.nan)
+        nyq_ci = fifty_ci = (math.nan, math.nan)
+    else:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)           # all-NaN beyond the reach
+            low, high = np.nanquantile(drawn, [tail, 1 - tail], axis=0)
+        low, high = np.minimum(low, curve), np.maximum(high, curve)
+        nyquist = drawn[:, _GRID.searchsorted(0.5)]
+        fifty = np.array([_mtf50(c) for c in drawn])
+        nyq_ci = _quantiles(nyquist, tail, curve[_GRID.searchsorted(0.5)])
+        fifty_ci = _quantiles(fifty, tail, _mtf50(curve))
+    return TrackSection(direction, _GRID.copy(), curve, low, high, float(curve[_GRID.searchsorted(0.5)]), nyq_ci,
+                        _mtf50(curve), fifty_ci, _fwhm(curve))
+
+
+def _quantiles(values: np.ndarray, tail: float, central: float) -> tuple[float, float]:
+    values = values[np.isfinite(values)]
+    if not values.size or not math.isfinite(central):
+        return (math.nan, math.nan)
+    low, high = np.quantile(values, [tail, 1 - tail])
+    return (float(min(low, central)), float(max(high, central)))
+
+
+def _bracket(first: TrackSection, second: TrackSection) -> TrackSection:
+    """The section spanning two assumptions': their mean, and an interval
+    from the lower's low to the higher's high (each at least its value)."""
+    def span(a: float, b: float, ia, ib) -> tuple[float, float]:
+        lows = [x for x in (a, b, ia[0], ib[0]) if math.isfinite(x)]
+        highs = [x for x in (a, b, ia[1], ib[1]) if math.isfinite(x)]
+        return (min(lows, default=math.nan), max(highs, default=math.nan))
+
+    curve = 0.5 * (first.mtf + second.mtf)
+    low = np.fmin(np.fmin(first.low, second.low), np.fmin(first.mtf, second.mtf))
+    high = np.fmax(np.fmax(first.high, second.high), np.fmax(first.mtf, second.mtf))
+    return TrackSection(first.direction, first.frequencies_cy_px, curve, low, high,
+                        0.5 * (first.mtf_nyquist + second.mtf_nyquist),
+                        span(first.mtf_nyquist, second.mtf_nyquist, first.mtf_nyquist_ci, second.mtf_nyquist_ci),
+                        0.5 * (first.mtf50_cy_px + second.mtf50_cy_px),
+                        span(first.mtf50_cy_px, second.mtf50_cy_px, first.mtf50_ci_cy_px, second.mtf50_ci_cy_px),
+                        0.5 * (first.fwhm_px + second.fwhm_px))
+
+
+def _mtf50(curve: np.ndarray) -> float:
+    """Where a section first falls to 0.5 (linear between samples), cy/px."""
+    below = np.flatnonzero(curve < 0.5)
+    if not below.size or below[0] == 0 or not np.isfinite(curve[: below[0] + 1]).all():
+        return math.nan
+    k = below[0]
+    return float(_GRID[k - 1] + (curve[k - 1] - 0.5) / (curve[k - 1] - curve[k]) * (_GRID[k] - _GRID[k - 1]))
+
+
+def _fwhm(curve: np.ndarray) -> float:
+    """The FWHM of the LSF whose MTF is ``curve`` (even, real): its cosine
+    transform over the section's reach, which must reach MTF 0.05 (else
+    NaN: a truncated transform's width is not the LSF's)."""
+    finite = np.isfinite(curve)
+    reach = int(np.argmin(finite)) if not finite.all() else curve.size
+    if reach < 3 or curve[reach - 1] > 0.05:
+        return math.nan
+    f, mtf = _GRID[:reach], curve[:reach]
+    x = np.linspace(0.0, 4.0, 801)
+    weights = np.full(reach, 0.01)
+    weights[[0, -1]] = 0.005
+    lsf = 2.0 * (np.cos(2 * np.pi * np.outer(x, f)) @ (mtf * weights))
+    half = lsf[0] / 2
+    below = np.flatnonzero(lsf < half)
+    if not below.size:
+        return math.nan
+    k = below[0]
+    return float(2 * (x[k - 1] + (lsf[k - 1] - half) / (lsf[k - 1] - lsf[k]) * (x[k] - x[k - 1])))
+
