@@ -319,7 +319,8 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
     rng = np.random.default_rng(seed)
     shifts = rng.standard_normal((draws, normals.size)) if sd is not None and draws > 0 else None
     alternatives = {a: _sections(a, models[a], inputs, shifts, confidence) for a in ASSUMPTIONS}
-    alternatives[BRACKET] = tuple(_bracket(alternatives[SEPARABLE][k], alternatives[ELLIPTICAL][k]) for k in (0, 1))
+    (sep_across, sep_along), (ell_across, ell_along) = alternatives[SEPARABLE], alternatives[ELLIPTICAL]
+    alternatives[BRACKET] = (_bracket(sep_across, ell_across), _bracket(sep_along, ell_along))
     across, along = alternatives[assumption]
     return MTF2D(assumption, because, across, along, alternatives, models, models[ELLIPTICAL].aspect,
                  tuple(float(n) for n in normals), tests)
@@ -477,8 +478,8 @@ def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tupl
     if shifts is not None:
         drawn = np.array([_redrawn(assumption, model, normals, f, np.clip(m + z[:, None] * sd, 1e-6, None), sd)
                           for z in shifts])
-    return tuple(_section(name, curves[k], None if drawn is None else drawn[:, k], confidence)
-                 for k, name in enumerate(("across-track", "along-track")))
+    return (_section("across-track", curves[0], None if drawn is None else drawn[:, 0], confidence),
+            _section("along-track", curves[1], None if drawn is None else drawn[:, 1], confidence))
 
 
 def _redrawn(assumption: str, model, normals, f, m, sd) -> list[np.ndarray]:
