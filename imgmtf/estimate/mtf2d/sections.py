@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import optimize, stats
+from scipy import optimize
+from scipy.special import chdtrc
 
 from ...errors import ParameterError
 
@@ -452,7 +453,7 @@ def _tests(inputs, base, others, draws: int, seed: int) -> dict[str, float]:
         at = int(np.flatnonzero(usable)[np.argmax(gap[usable])])
         for a in ASSUMPTIONS:
             chi2[a] += float(((predictions[a][at] - m[k, at]) / total[a][at]) ** 2)
-    return {a: float(stats.chi2.sf(chi2[a], len(others))) for a in ASSUMPTIONS}
+    return {a: float(chdtrc(len(others), chi2[a])) for a in ASSUMPTIONS}
 
 
 def _decision(tests: dict[str, float], others) -> tuple[str, str]:
@@ -554,11 +555,11 @@ def _mtf50(curve: np.ndarray) -> float:
 
 def _fwhm(curve: np.ndarray) -> float:
     """The FWHM of the LSF whose MTF is ``curve`` (even, real): its cosine
-    transform over the section's reach, which must reach MTF 0.05 (else
-    NaN: a truncated transform's width is not the LSF's)."""
+    transform over the section's reach, which must reach MTF 0.1 (else
+    NaN: a transform truncated higher is not the LSF's width)."""
     finite = np.isfinite(curve)
     reach = int(np.argmin(finite)) if not finite.all() else curve.size
-    if reach < 3 or curve[reach - 1] > 0.05:
+    if reach < 3 or curve[reach - 1] > 0.1:
         return math.nan
     f, mtf = _GRID[:reach], curve[:reach]
     x = np.linspace(0.0, 4.0, 801)
