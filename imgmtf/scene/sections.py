@@ -64,8 +64,8 @@ def section_rows(summaries: Sequence[Record]) -> list[Record]:
     --------
     >>> from imgmtf.scene.combine import summarise_scan                    # doctest: +SKIP
     >>> rows = section_rows(summarise_scan(scan_scene("baotou.tif")))      # doctest: +SKIP
-    >>> [(r.figures["direction"], r.figures["assumption"], r.figures["mtf_nyquist"]) for r in rows][:2]  # doctest: +SKIP
-    [('across-track', 'separable', 0.1811), ('along-track', 'separable', 0.1615)]
+    >>> [(r.figures["assumption"], r.figures["mtf_nyquist"]) for r in rows][:2]  # doctest: +SKIP
+    [('separable', 0.1811), ('separable', 0.1615)]
     """
     if any(not isinstance(r, Record) for r in summaries):
         raise ParameterError("summaries must be a scan's summary Records (imgmtf.summarise_scan)")
@@ -75,8 +75,7 @@ def section_rows(summaries: Sequence[Record]) -> list[Record]:
     for r in combined:
         groups.setdefault((r.site.get("scope"), r.site.get("target_id")), []).append(r)
     out: list[Record] = []
-    for (scope, target), group in sorted(groups.items(), key=lambda item: (item[0][0] != TARGET_SCOPE,
-                                                                           item[0][1] or 0)):
+    for _, group in sorted(groups.items(), key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0)):
         out += _group_rows(group)
     return out
 
@@ -134,7 +133,7 @@ def _row(records: list[Record], result, assumption: str, axis: int, track: float
     gsd = first.figures.get("gsd_m")
     normal = sensor_frame(track - 90.0 * axis, 0.0)       # across lies at the azimuth, along 90 deg before
     ids = [i for r in records for i in (r.figures.get("edge_ids") or [])]
-    snrs = [r.figures.get("snr_min") for r in records if r.figures.get("snr_min") is not None]
+    snrs = [float(r.figures["snr_min"]) for r in records if r.figures.get("snr_min") is not None]
     figures: dict[str, Any] = {
         "summary": SECTIONS, "direction": section.direction, "assumption": assumption,
         "chosen_assumption": result.assumption, "assumption_because": result.because,
@@ -173,8 +172,10 @@ def recommend(summaries: Sequence[Record]) -> list[Record]:
 
     Examples
     --------
-    >>> rows = recommend(summarise_scan(records) + section_rows(...) + fit_targets(records))  # doctest: +SKIP
-    >>> [(r.figures["summary"], r.figures["recommended"]) for r in rows if r.figures.get("direction") == "across-track"]  # doctest: +SKIP
+    >>> summaries = summarise_scan(records)                                 # doctest: +SKIP
+    >>> rows = recommend(summaries + section_rows(summaries) + fit_targets(records))  # doctest: +SKIP
+    >>> [(r.figures["summary"], r.figures["recommended"]) for r in rows
+    ...  if r.figures.get("direction") == "across-track"]                   # doctest: +SKIP
     [('sections', False), ('sections', False), ('sections', True), ('fit', False)]
     """
     marks: dict[int, tuple[bool, str]] = {}
@@ -195,8 +196,8 @@ def recommend(summaries: Sequence[Record]) -> list[Record]:
 
 def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]]:
     fits = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == "fit"]
-    sections = [(k, r) for k, r in zip(indices, rows)
-                if r.figures["summary"] == SECTIONS and r.figures.get("assumption") == r.figures.get("chosen_assumption")]
+    sections = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == SECTIONS
+                and r.figures.get("assumption") == r.figures.get("chosen_assumption")]
     chosen = sections[0] if sections else None
     marks: dict[int, tuple[bool, str]] = {}
     pick, why = None, ""
