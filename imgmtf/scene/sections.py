@@ -213,7 +213,7 @@ def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]
         pick, why = good_fits[0][0], "the model fits (no sections to compare)"
     elif chosen is not None:
         pick, why = chosen[0], (f"{chosen[1].figures['assumption']} sections: "
-                                f"{'the model does not fit' if fits else 'no model fitted'}")
+                                f"{'the model does not fit' if fits else 'no fit row to compare'}")
     fit_picked = any(k == pick for k, _ in fits)
     for k, r in zip(indices, rows):
         if k == pick:
