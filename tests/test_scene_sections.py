@@ -11,12 +11,6 @@ from imgmtf.scene.sections import recommend, section_rows, sensor_frame
 F = np.round(np.linspace(0.0, 1.0, 101), 2)
 
 
-@pytest.fixture(autouse=True)
-def fewer_draws(monkeypatch):
-    """The intervals from 30 draws, not the scan's 100: the tests stay fast."""
-    monkeypatch.setattr("imgmtf.scene.sections.DRAWS", 30)
-
-
 def truth(u, v):
     """Square pixel and an anisotropic Gaussian: separable and elliptical."""
     return np.sinc(u) * np.sinc(v) * np.exp(-2 * np.pi ** 2 * (0.35 ** 2 * u ** 2 + 0.45 ** 2 * v ** 2))

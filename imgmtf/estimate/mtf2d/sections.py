@@ -189,14 +189,7 @@ def separable_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: 
     >>> round(float(model.transfer(0.5, 0.0)), 3), round(float(truth(0.5, 0.0)), 3)
     (0.607, 0.607)
     """
-    theta, f, m, weight = _prepared(normals_deg, frequencies_cy_px, mtfs, sd)
-    nodes = _nodes(REACH_CY_PX)
-    u, v = np.abs(np.cos(theta))[:, None] * f, np.abs(np.sin(theta))[:, None] * f
-    use = (m >= MIN_MTF) & (u <= nodes[-1]) & (v <= nodes[-1])
-    design = np.hstack([_hat(u[use], nodes), _hat(v[use], nodes)])
-    solution, reach = _solve(design, np.log(m[use]), weight[use], 2, nodes.size)
-    log_x, log_y = np.split(solution, 2)
-    return SeparableModel(nodes, np.where(reach[0], log_x, np.nan), np.where(reach[1], log_y, np.nan))
+    return _SeparableProblem(*_prepared(normals_deg, frequencies_cy_px, mtfs, sd)).models()[0]
 
 
 def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
@@ -215,41 +208,90 @@ def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs:
     >>> round(model.aspect, 2), round(float(model.transfer(0.0, 0.5)), 3), round(float(truth(0.0, 0.5)), 3)
     (0.7, 0.114, 0.114)
     """
-    if aspect is not None:
-        return _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, (math.log(aspect),) * 2, 1)
-    return _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, tuple(np.log(ASPECT_BOUNDS)), 25)
+    problem = _EllipticalProblem(*_prepared(normals_deg, frequencies_cy_px, mtfs, sd))
+    log_aspect = problem.search() if aspect is None else math.log(aspect)
+    return problem.model(log_aspect, problem.log_r)
 
 
-def _elliptical(normals_deg, frequencies_cy_px, mtfs, sd, log_bounds: tuple[float, float],
-                coarse: int) -> EllipticalModel:
-    """The elliptical model whose log aspect, within ``log_bounds``, best
-    lays the remainders onto one curve: ``coarse`` trial values, then a
-    bounded search about the best."""
-    theta, f, m, weight = _prepared(normals_deg, frequencies_cy_px, mtfs, sd)
-    c, s = np.abs(np.cos(theta))[:, None], np.abs(np.sin(theta))[:, None]
-    pixel = np.sinc(f * c) * np.sinc(f * s)
-    use = (m >= MIN_MTF) & (np.maximum(f * c, f * s) <= REACH_CY_PX) & (pixel > 0.05)
-    log_r = np.log(m[use] / pixel[use])
-    weight = weight[use]
+class _SeparableProblem:
+    """The separable least squares of some sections: its design and
+    weights (fixed by the central sections), solved for any number of
+    redrawn ones at once."""
 
-    def fitted(log_aspect: float) -> tuple[float, EllipticalModel]:
-        a = math.exp(log_aspect)
-        w = (f * np.sqrt(c ** 2 + s ** 2 / a ** 2))[use]
+    def __init__(self, theta: np.ndarray, f: np.ndarray, m: np.ndarray, weight: np.ndarray):
+        self.nodes = _nodes(REACH_CY_PX)
+        u, v = np.abs(np.cos(theta))[:, None] * f, np.abs(np.sin(theta))[:, None] * f
+        self.use = (m >= MIN_MTF) & (u <= self.nodes[-1]) & (v <= self.nodes[-1])
+        self.design = np.hstack([_hat(u[self.use], self.nodes), _hat(v[self.use], self.nodes)])
+        self.weight = weight[self.use]
+        self.m = m
+
+    def models(self, many: np.ndarray | None = None) -> list[SeparableModel]:
+        """The models of the sections ``many`` (draws x sections x
+        frequencies; default the central ones)."""
+        many = self.m[None] if many is None else many
+        targets = np.log(np.clip(many[:, self.use], MIN_MTF / 2, None)).T
+        solution, reach = _solve(self.design, targets, self.weight, 2, self.nodes.size)
+        log_x, log_y = solution[: self.nodes.size], solution[self.nodes.size:]
+        return [SeparableModel(self.nodes, np.where(reach[0], log_x[:, k], np.nan),
+                               np.where(reach[1], log_y[:, k], np.nan)) for k in range(many.shape[0])]
+
+
+class _EllipticalProblem:
+    """The elliptical least squares of some sections: the remainders'
+    logs, weights and used samples (fixed by the central sections), for
+    any aspect and any number of redrawn sections."""
+
+    def __init__(self, theta: np.ndarray, f: np.ndarray, m: np.ndarray, weight: np.ndarray):
+        self.c, self.s, self.f = np.abs(np.cos(theta))[:, None], np.abs(np.sin(theta))[:, None], f
+        pixel = np.sinc(f * self.c) * np.sinc(f * self.s)
+        self.use = (m >= MIN_MTF) & (np.maximum(f * self.c, f * self.s) <= REACH_CY_PX) & (pixel > 0.05)
+        self.log_pixel = np.log(pixel[self.use])
+        self.log_r = np.log(m[self.use]) - self.log_pixel
+        self.weight = weight[self.use]
+
+    def remainders(self, many: np.ndarray) -> np.ndarray:
+        """The log remainders of sections ``many`` (draws x sections x
+        frequencies): samples x draws."""
+        return (np.log(np.clip(many[:, self.use], MIN_MTF / 2, None)) - self.log_pixel).T
+
+    def _fit(self, log_aspect: float, targets: np.ndarray):
+        w = (self.f * np.sqrt(self.c ** 2 + self.s ** 2 * math.exp(-2 * log_aspect)))[self.use]
         nodes = _nodes(max(float(w.max(initial=0.0)), NODE_STEP_CY_PX), count=33)
         design = _hat(w, nodes)
-        solution, reach = _solve(design, log_r, weight, 1, nodes.size)
-        residual = float(np.sum((weight * (design @ solution[1:] - log_r)) ** 2))
-        return residual, EllipticalModel(nodes, np.where(reach[0], solution, np.nan), a)
+        solution, reach = _solve(design, targets, self.weight, 1, nodes.size)
+        misfit = self.weight.reshape(-1, *([1] * (targets.ndim - 1))) * (design @ solution[1:] - targets)
+        return np.sum(misfit ** 2, axis=0), solution, reach, nodes
 
-    lo, hi = log_bounds
-    if coarse > 1:
-        trials = np.linspace(lo, hi, coarse)
-        best = int(np.argmin([fitted(x)[0] for x in trials]))
-        lo, hi = trials[max(best - 1, 0)], trials[min(best + 1, coarse - 1)]
-    if hi > lo:
-        return fitted(float(optimize.minimize_scalar(lambda x: fitted(x)[0], bounds=(lo, hi), method="bounded",
-                                                     options={"xatol": 1e-4}).x))[1]
-    return fitted(lo)[1]
+    def model(self, log_aspect: float, target: np.ndarray) -> EllipticalModel:
+        _, solution, reach, nodes = self._fit(log_aspect, target)
+        return EllipticalModel(nodes, np.where(reach[0], solution, np.nan), math.exp(log_aspect))
+
+    def search(self) -> float:
+        """The log aspect that best lays the central remainders onto one
+        curve: 25 trials across ``ASPECT_BOUNDS``, then a bounded search."""
+        trials = np.linspace(*np.log(ASPECT_BOUNDS), 25)
+        best = int(np.argmin([float(self._fit(x, self.log_r)[0]) for x in trials]))
+        lo, hi = trials[max(best - 1, 0)], trials[min(best + 1, trials.size - 1)]
+        return float(optimize.minimize_scalar(lambda x: float(self._fit(x, self.log_r)[0]), bounds=(lo, hi),
+                                              method="bounded", options={"xatol": 1e-4}).x)
+
+    def models(self, many: np.ndarray, near: float) -> list[EllipticalModel]:
+        """The models of sections ``many``, each with its own aspect (the
+        aspect is uncertain too): 13 trials within 0.3 of ``near`` (log)
+        for all of them at once, each refined by a parabola."""
+        targets = self.remainders(many)
+        trials = near + np.linspace(-0.3, 0.3, 13)
+        costs = np.array([self._fit(x, targets)[0] for x in trials])
+        step = trials[1] - trials[0]
+        out = []
+        for k in range(targets.shape[1]):
+            i = int(np.clip(np.argmin(costs[:, k]), 1, trials.size - 2))
+            left, mid, right = costs[i - 1:i + 2, k]
+            curvature = left - 2 * mid + right
+            shift = 0.5 * step * (left - right) / curvature if curvature > 0 else 0.0
+            out.append(self.model(float(trials[i] + np.clip(shift, -step, step)), targets[:, k]))
+        return out
 
 
 def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
@@ -377,20 +419,22 @@ def _hat(x: np.ndarray, nodes: np.ndarray) -> np.ndarray:
 
 def _solve(design: np.ndarray, target: np.ndarray, weight: np.ndarray, curves: int, size: int):
     """Weighted least squares for ``curves`` curves of ``size`` nodes each
-    (the first 0), smoothed by their second differences; the nodes the
-    data touch (``reach``, per curve)."""
-    k = size - 1
-    penalty = _penalty(curves, size)
+    (the first 0), smoothed by their second differences, for one target
+    (samples) or many (samples x k); the nodes the data touch (``reach``,
+    per curve)."""
     weighted = design * weight[:, None]
-    # the normal equations: a few dozen unknowns, solved thousands of times for the intervals
-    normal = weighted.T @ weighted + penalty + 1e-10 * np.eye(curves * k)
-    solution = np.linalg.solve(normal, weighted.T @ (target * weight))
-    touched = np.abs(design).sum(axis=0).reshape(curves, k) > 0
+    # the normal equations: a few dozen unknowns, solved for many draws at once
+    normal = weighted.T @ weighted + _penalty(curves, size) + 1e-10 * np.eye(curves * (size - 1))
+    rhs = weighted.T @ (target * weight.reshape(-1, *([1] * (target.ndim - 1))))
+    solution = np.linalg.solve(normal, rhs)
+    touched = np.abs(design).sum(axis=0).reshape(curves, size - 1) > 0
     reach = np.zeros((curves, size), bool)
     for c in range(curves):
         last = np.flatnonzero(touched[c])
         reach[c, : (last[-1] + 2 if last.size else 1)] = True
-    return np.concatenate([np.concatenate([[0.0], part]) for part in np.split(solution, curves)]), reach
+    parts = np.split(solution, curves)
+    zero = np.zeros((1, *solution.shape[1:]))
+    return np.concatenate([np.concatenate([zero, part]) for part in parts]), reach
 
 
 @functools.lru_cache(maxsize=8)
@@ -439,8 +483,9 @@ def _tests(inputs, base, others, draws: int, seed: int) -> dict[str, float]:
         for a in ASSUMPTIONS:
             central = _model(a, normals[pair], f, m[pair], sd[pair])
             predictions[a] = central.transfer(u, v)
-            drawn = np.array([_refit(a, central, normals[pair], f, np.clip(m[pair] + z[:, None] * sd[pair], 1e-6, None),
-                                     sd[pair]).transfer(u, v) for z in shifts[:TEST_DRAWS]]) if sd.any() else None
+            drawn = np.array([again.transfer(u, v) for again in
+                              _drawn_models(a, central, normals[pair], f, m[pair], sd[pair], shifts)]) \
+                if sd.any() else None
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)       # all-NaN beyond the reach
                 spreads[a] = np.zeros_like(f) if drawn is None else np.nanstd(drawn, axis=0)
@@ -477,26 +522,20 @@ def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tupl
     curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
     drawn = None
     if shifts is not None:
-        drawn = np.array([_redrawn(assumption, model, normals, f, np.clip(m + z[:, None] * sd, 1e-6, None), sd)
-                          for z in shifts])
+        drawn = np.array([[again.transfer(_GRID, 0.0 * _GRID), again.transfer(0.0 * _GRID, _GRID)]
+                          for again in _drawn_models(assumption, model, normals, f, m, sd, shifts)])
     return (_section("across-track", curves[0], None if drawn is None else drawn[:, 0], confidence),
             _section("along-track", curves[1], None if drawn is None else drawn[:, 1], confidence))
 
 
-def _redrawn(assumption: str, model, normals, f, m, sd) -> list[np.ndarray]:
-    """The across and along sections of redrawn sections (``m``), inverted
-    again."""
-    again = _refit(assumption, model, normals, f, m, sd)
-    return [again.transfer(_GRID, 0.0 * _GRID), again.transfer(0.0 * _GRID, _GRID)]
-
-
-def _refit(assumption: str, model, normals, f, m, sd):
-    """The model refitted to redrawn sections ``m``; the elliptical aspect
-    searched near the central ``model``'s (it is uncertain too)."""
+def _drawn_models(assumption: str, model, normals, f, m, sd, shifts: np.ndarray) -> list:
+    """The models of the sections redrawn by ``shifts`` (draws x sections,
+    in standard deviations ``sd``), each inverted again."""
+    prepared = _prepared(normals, f, m, sd)
+    many = m[None] + shifts[:, :, None] * sd[None]
     if assumption == SEPARABLE:
-        return separable_model(normals, f, m, sd)
-    near = math.log(model.aspect)
-    return _elliptical(normals, f, m, sd, (near - 0.3, near + 0.3), 1)
+        return _SeparableProblem(*prepared).models(many)
+    return _EllipticalProblem(*prepared).models(many, math.log(model.aspect))
 
 
 def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float) -> TrackSection:
@@ -505,9 +544,8 @@ def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confid
         low = high = np.full_like(curve, np.nan)
         nyq_ci = fifty_ci = (math.nan, math.nan)
     else:
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)           # all-NaN beyond the reach
-            low, high = np.nanquantile(drawn, [tail, 1 - tail], axis=0)
+        # NaN where a draw does not reach (beyond the sections' reach)
+        low, high = np.quantile(drawn, [tail, 1 - tail], axis=0)
         low, high = np.minimum(low, curve), np.maximum(high, curve)
         nyquist = drawn[:, _GRID.searchsorted(0.5)]
         fifty = np.array([_mtf50(c) for c in drawn])
