@@ -270,7 +270,7 @@ class _EllipticalProblem:
     def search(self) -> float:
         """The log aspect that best lays the central remainders onto one
         curve: 25 trials across ``ASPECT_BOUNDS``, then a bounded search."""
-        trials = np.linspace(*np.log(ASPECT_BOUNDS), 25)
+        trials = np.linspace(math.log(ASPECT_BOUNDS[0]), math.log(ASPECT_BOUNDS[1]), 25)
         best = int(np.argmin([float(self._fit(x, self.log_r)[0]) for x in trials]))
         lo, hi = trials[max(best - 1, 0)], trials[min(best + 1, trials.size - 1)]
         return float(optimize.minimize_scalar(lambda x: float(self._fit(x, self.log_r)[0]), bounds=(lo, hi),
