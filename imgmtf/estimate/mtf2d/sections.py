@@ -362,7 +362,10 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
         others = [k for k in range(normals.size) if k not in base]
         if others:
             tests = _tests(inputs, base, others, draws, seed)
-        assumption, because = _decision(tests, normals[list(others)] if others else None)
+            assumption, because = _decision(tests, normals[list(others)])
+        else:
+            tests = {ELLIPTICAL: _overlay_test(inputs, models[ELLIPTICAL], seed)}
+            assumption, because = _pair_decision(tests[ELLIPTICAL])
     else:
         because = "asked for"
     rng = np.random.default_rng(seed)
@@ -509,8 +512,6 @@ def _tests(inputs, base, others, draws: int, seed: int) -> dict[str, float]:
 
 
 def _decision(tests: dict[str, float], others) -> tuple[str, str]:
-    if not tests:
-        return BRACKET, "two orientations cannot tell separable from elliptical"
     where = "/".join(f"{n:.0f}" for n in others) + " deg"
     fits = [a for a in ASSUMPTIONS if tests[a] >= TEST_ALPHA]
     p = ", ".join(f"{a} p={tests[a]:.2g}" for a in ASSUMPTIONS)
@@ -520,6 +521,35 @@ def _decision(tests: dict[str, float], others) -> tuple[str, str]:
         return fits[0], f"the {where} section rejects the other ({p})"
     closer = max(ASSUMPTIONS, key=lambda a: tests[a])
     return closer, f"the {where} section rejects both; {closer} is closer ({p})"
+
+
+def _pair_decision(elliptical_p: float) -> tuple[str, str]:
+    """Two orientations: a separable model fits any two sections, an
+    elliptical one only sections whose remainders are one curve stretched."""
+    if elliptical_p < TEST_ALPHA:
+        return SEPARABLE, (f"the two sections are not one curve stretched (elliptical p={elliptical_p:.2g}); "
+                           "separable fits any two")
+    return BRACKET, f"two orientations cannot tell separable from elliptical (elliptical p={elliptical_p:.2g})"
+
+
+def _overlay_test(inputs, model: EllipticalModel, seed: int, draws: int = 100) -> float:
+    """The p-value of the elliptical model's fit to the sections: how often
+    sections drawn from the fitted model (within their uncertainty and
+    ``SD_FLOOR``, as whole-curve shifts) lay onto one curve worse than the
+    measured ones do."""
+    normals, f, m, sd = inputs
+    problem = _EllipticalProblem(*_prepared(normals, f, m, sd))
+    log_aspect = math.log(model.aspect)
+    observed = float(problem._fit(log_aspect, problem.log_r)[0])
+    theta = np.radians(normals)
+    predicted = np.array([model.transfer(f * abs(math.cos(t)), f * abs(math.sin(t))) for t in theta])
+    predicted = np.where(np.isfinite(predicted), predicted, m)
+    spread = np.hypot(sd, SD_FLOOR * f / 0.5)
+    shifts = np.random.default_rng(seed + 2).standard_normal((draws, normals.size))
+    null = _EllipticalProblem(*_prepared(normals, f, predicted, sd))
+    targets = null.remainders(predicted[None] + shifts[:, :, None] * spread[None])
+    costs = np.min([null._fit(x, targets)[0] for x in log_aspect + np.linspace(-0.3, 0.3, 13)], axis=0)
+    return float(np.mean(costs >= observed))
 
 
 def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tuple[TrackSection, TrackSection]:
