@@ -86,9 +86,12 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
     the others were rejected, combine the accepted half-edges of each
-    target and of the scene into one result per measured direction, and
-    fit the sensor model to each target's half-edges for its across- and
-    along-track MTF.  With --campaign, each scene's results go into a
+    target and of the scene into one result per measured direction,
+    invert those directions for the across- and along-track MTF without a
+    model (separable, elliptical, or the bracket of both when the data
+    cannot tell), fit the sensor model to each target's half-edges for its
+    own, and mark the row to quote per direction (*; never a misfit
+    fit).  With --campaign, each scene's results go into a
     campaign store as it completes.  Exit status 1 when a scene cannot be
     scanned or has no usable target; on Ctrl-C or SIGTERM the results so
     far are reported and kept (130 or 143): every scene finished is in the
