@@ -104,3 +104,48 @@ def test_the_table_marks_the_recommended_row_and_says_when_only_misfits_exist(ca
     assert "bracket: two orientations cannot tell separable from elliptical" in text
     print_recommended(recommend([fit("along-track", 0.003, True)]))
     assert "target 1 along-track: only misfit fit rows, no figure to quote" in capsys.readouterr().out
+
+
+def test_a_third_orientation_in_the_scene_chooses_for_the_scene():
+    # two targets tilted 16.8 and 40 deg under an elliptical blur (a square pixel and an isotropic
+    # exponential remainder): each target alone is a bracket, the scene's four orientations choose
+    def elliptical(u, v):
+        return np.sinc(u) * np.sinc(v) * np.exp(-2 * np.pi * 0.35 * np.hypot(u, v))
+
+    def row(normal, scope, target):
+        a = np.radians(normal)
+        record = combined(normal, scope, target)
+        curve = elliptical(F * np.cos(a), F * np.sin(a))
+        nyquist = float(curve[50])
+        return record.with_(figures={**record.figures, "mtf": curve.tolist(), "mtf_nyquist": nyquist,
+                                     "mtf_nyquist_ci": [nyquist - 0.008, nyquist + 0.008]})
+
+    rows = section_rows([row(16.8, "target", 1), row(-73.2, "target", 1), row(40.0, "target", 2),
+                         row(-50.0, "target", 2), *(row(n, "scene", None) for n in (16.8, -73.2, 40.0, -50.0))])
+    chosen = {(r.site["scope"], r.site.get("target_id")): r.figures["chosen_assumption"] for r in rows}
+    assert chosen == {("target", 1): "bracket", ("target", 2): "bracket", ("scene", None): "elliptical"}
+    scene = [r for r in rows if r.site["scope"] == "scene"]
+    assert {r.figures["assumption"] for r in scene} == {"separable", "elliptical"}     # no bracket row
+    assert "section rejects the other" in scene[0].figures["assumption_because"]
+    for r in scene:
+        if r.figures["assumption"] == "elliptical":
+            exact = elliptical(0.5, 0.0)
+            assert abs(r.figures["mtf_nyquist"] - exact) < 0.003
+            assert r.figures["mtf_nyquist_ci"][0] < exact < r.figures["mtf_nyquist_ci"][1]
+
+
+@pytest.mark.parametrize("name", ["baotou_l0r_checkerboard.tif", "pan_l0r_checkerboard.tif"])
+def test_the_real_chips_quote_sections_not_their_misfit_fits(name):
+    from imgmtf.scene.series import scan_one
+    from imgmtf.scene.settings import ScanSettings
+
+    from conftest import real_scene
+    outcome = scan_one(str(real_scene(name)), ScanSettings(track_azimuth_deg=0.0))
+    quoted = [r for r in outcome.summaries if r.figures.get("recommended")]
+    assert sorted((r.site["scope"], r.figures["direction"]) for r in quoted) == [
+        ("scene", "across-track"), ("scene", "along-track"), ("target", "across-track"), ("target", "along-track")]
+    for r in quoted:
+        assert r.figures["summary"] == "sections" and r.figures["assumption"] == "bracket"
+        assert 0.06 < r.figures["mtf_nyquist"] < 0.2
+    fits = [r for r in outcome.summaries if r.figures.get("summary") == "fit"]
+    assert fits and all(r.figures["misfit"] and not r.figures["recommended"] for r in fits)
