@@ -89,6 +89,10 @@ def test_one_row_per_direction_is_recommended_and_never_a_misfit():
     because = {r.figures["direction"]: r.figures["recommended_because"] for r in rows if r.figures["summary"] == "fit"}
     assert because == {"across-track": "the model does not fit",
                        "along-track": "it disagrees with the sections at Nyquist"}
+    # without intervals (--intervals none) a fit that fits is quoted: nothing says it disagrees
+    bare = [r.with_(figures={**r.figures, "mtf_nyquist_ci": [None, None]}) for r in sections]
+    rows = recommend([*bare, fit("across-track", across + 0.1, False)])
+    assert quoted(rows)[("target", "across-track")] == ("fit", None)
     # only misfit rows: none recommended, and the table says so
     rows = recommend([fit("across-track", 0.002, True)])
     assert quoted(rows) == {} and rows[0].figures["recommended"] is False

@@ -204,7 +204,10 @@ def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]
     good_fits = [(k, r) for k, r in fits if not r.figures.get("misfit")]
     if good_fits and chosen is not None:
         k, fit = good_fits[0]
-        if _overlap(fit.figures.get("mtf_nyquist_ci"), chosen[1].figures.get("mtf_nyquist_ci")):
+        intervals = fit.figures.get("mtf_nyquist_ci"), chosen[1].figures.get("mtf_nyquist_ci")
+        if not all(_interval(i) for i in intervals):
+            pick, why = k, "the model fits (no intervals to compare it with the sections)"
+        elif _overlap(*intervals):
             pick, why = k, "the model fits and agrees with the sections"
         else:
             pick, why = chosen[0], (f"{chosen[1].figures['assumption']} sections: the model fits but disagrees "
@@ -228,8 +231,11 @@ def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]
     return marks
 
 
+def _interval(pair) -> bool:
+    """Whether ``pair`` is an interval (low, high), not missing."""
+    return bool(pair) and None not in pair
+
+
 def _overlap(first, second) -> bool:
-    """Whether two intervals (low, high) meet; False when one is missing."""
-    if not first or not second or None in (*first, *second):
-        return False
+    """Whether two intervals (low, high) meet."""
     return first[0] <= second[1] and second[0] <= first[1]
