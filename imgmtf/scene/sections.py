@@ -140,7 +140,7 @@ def _row(records: list[Record], result, assumption: str, axis: int, track: float
         "assumption_tests": {k: finite(v) for k, v in result.tests.items()},
         "aspect": finite(result.aspect) if assumption == "elliptical" else None,
         "normal_angle_deg": round(normal, 3),
-        "normals_deg": [round(n, 3) for n in result.normals_deg],
+        "normals_deg": [r.figures["normal_angle_deg"] for r in records],   # the image's, as the combined rows'
         "n_edges": int(sum(r.figures.get("n_edges") or 0 for r in records)), "edge_ids": ids,
         "mtf_nyquist": finite(section.mtf_nyquist), "mtf_nyquist_ci": [finite(v) for v in section.mtf_nyquist_ci],
         "mtf50_cy_px": finite(section.mtf50_cy_px), "mtf50_ci_cy_px": [finite(v) for v in section.mtf50_ci_cy_px],
