@@ -110,7 +110,16 @@ class MTF2D:
         The sections' normals from the across-track axis, deg.
     tests : dict
         For each assumption, the p-value of its prediction of the
-        orientations it was not fitted to (absent with two orientations).
+        orientations it was not fitted to; with two orientations, the
+        elliptical model's fit to them.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> gaussian = [np.sinc(f) * np.exp(-2 * f ** 2)] * 2          # the same along both normals
+    >>> result = mtf2d_from_sections([0.0, 90.0], f, gaussian)
+    >>> result.assumption, round(float(result.transfer(0.5, 0.0)), 3), round(result.along.mtf_nyquist, 3)
+    ('bracket', 0.386, 0.386)
     """
 
     assumption: str
@@ -125,7 +134,19 @@ class MTF2D:
 
     def transfer(self, fx_cy_px: ArrayLike, fy_cy_px: ArrayLike) -> np.ndarray:
         """The 2-D MTF at (across, along) frequencies, cy/px; the bracket's
-        is the mean of the two assumptions'.  NaN beyond the data's reach."""
+        is the mean of the two assumptions'.  NaN beyond the data's reach.
+
+        Parameters
+        ----------
+        fx_cy_px, fy_cy_px : array_like
+            Across-track (u) and along-track (v) frequencies, cy/px
+            (broadcast together).
+
+        Returns
+        -------
+        numpy.ndarray
+            The MTF (1 at zero frequency).
+        """
         if self.assumption == BRACKET:
             return 0.5 * sum(self.models[a].transfer(fx_cy_px, fy_cy_px) for a in ASSUMPTIONS)
         return self.models[self.assumption].transfer(fx_cy_px, fy_cy_px)
@@ -177,6 +198,8 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
     Returns
     -------
     MTF2D
+        The chosen assumption, why, its across/along sections with their
+        intervals, every assumption's, and the 2-D MTF (``transfer``).
 
     Raises
     ------
