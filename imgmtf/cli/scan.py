@@ -27,8 +27,8 @@ DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without impo
 # fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
 # of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
 # Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
-SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit", "numpy.fft",
-                    "numpy.ma", "numpy.polynomial")
+SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
+                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial")
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 
 
