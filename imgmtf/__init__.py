@@ -38,6 +38,7 @@ _LAZY = {
     "Record": "records", "measure_file": "batch", "MeasureSettings": "measure_settings",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "fit_targets": "scene.targetfit", "scan_scenes": "scene.series",
+    "mtf2d_from_sections": "estimate.mtf2d", "MTF2D": "estimate.mtf2d",
     "run_selftest": "selftest",
     "QualityError": "estimate.gate", "TwoTargetsError": "estimate.gate",
     "Acquisition": "campaign.acquisitions", "read_acquisition": "campaign.acquisitions",

@@ -341,7 +341,12 @@ CSV_COLUMNS = SUMMARY_COLUMNS + CURVE_COLUMNS
 # across and along track (``fit``, :mod:`imgmtf.scene.targetfit`), whose
 # rows add the ``stages`` fitted, their ``reduced_chi_square``, whether the
 # model does not fit (``misfit``, with the smallest p-value of the
-# half-edges' residual structure, ``misfit_p``)
+# half-edges' residual structure, ``misfit_p``) and from the 2-D MTF's
+# sections without a model (``sections``, :mod:`imgmtf.scene.sections`),
+# whose rows name the ``assumption`` they hold under (separable, elliptical,
+# or the bracket spanning both); of every across/along row one per scope,
+# target and direction is ``recommended`` (``recommended_because`` says why;
+# a misfit fit never is)
 #: a scan row's ``scope``: one candidate (a half-edge, or a bar: named
 #: "edge" whatever the target kind), or a summary of a target or of the scene
 CANDIDATE_SCOPE = "edge"
@@ -351,7 +356,7 @@ SCAN_COLUMNS = (
     "id", "rank", "scope", "target_id", "x0_px", "y0_px", "x1_px", "y1_px", "length_px", "line_length_px",
     "map_x0", "map_y0", "map_x1", "map_y1", "bar_width_px", "line_rms_px", "side_variation", "verdict_by",
     "summary", "n_edges", "edge_ids", "consistency", "weights", "snr_min", "x_px", "y_px",
-    "stages", "reduced_chi_square", "misfit", "misfit_p",
+    "stages", "reduced_chi_square", "misfit", "misfit_p", "assumption", "recommended", "recommended_because",
 )
 
 # a scan's CSV: id and rank first, then the summary, the site's columns, the curve

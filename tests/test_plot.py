@@ -209,3 +209,21 @@ def test_the_sensor_figures_legends_lie_off_the_curves():
         assert ax.get_legend().get_window_extent().y1 < ax.get_window_extent().y0
     assert fig.axes[2].get_xlabel() == "frequency (cy/px)"
     assert min(ax.get_tightbbox().x0 for ax in fig.axes) >= 0          # nothing cut at the left edge
+
+
+def test_the_sections_figure_draws_each_assumption_and_the_measured_sections():
+    from imgmtf.errors import ParameterError
+    from imgmtf.estimate.mtf2d import mtf2d_from_sections, sd_from_nyquist
+    from imgmtf.plot import plot_sections
+    f = np.linspace(0.0, 1.0, 101)
+    normals = [16.8, -73.2]
+    m = np.array([np.sinc(f) * np.exp(-2 * (f * np.cos(np.radians(a))) ** 2 - 3 * (f * np.sin(np.radians(a))) ** 2)
+                  for a in normals])
+    result = mtf2d_from_sections(normals, f, m, sd_from_nyquist([0.01, 0.01], f), draws=20)
+    ax = plot_sections(result, (f, m)).axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[:2] == ["measured along 16.8 deg", "measured along -73.2 deg"]
+    assert "across, bracket (chosen)" in labels and "along, elliptical" in labels
+    assert len(ax.collections) == 2           # the chosen assumption's intervals, across and along
+    with pytest.raises(ParameterError, match="MTF2D"):
+        plot_sections("not a result")

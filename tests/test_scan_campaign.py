@@ -100,12 +100,23 @@ def test_fit_rows_are_printed_and_written_beside_the_combined_ones(tmp_path):
     assert "fitted per target, across and along track (sensor model: optics, detector" in result.output
     rows = list(csv.DictReader((out / "targets.csv").open()))
     fits = {r["direction"]: r for r in rows if r["summary"] == "fit"}
-    assert {r["summary"] for r in rows if r["scope"] == "target"} == {"combined", "fit"}
+    assert {r["summary"] for r in rows if r["scope"] == "target"} == {"combined", "sections", "fit"}
     for direction, row in fits.items():
         truth = sensor.mtf_nyquist(direction.split("-")[0])
         assert abs(float(row["mtf_nyquist"]) - truth) < 0.006
         assert float(row["mtf_nyquist_ci_low"]) < float(row["mtf_nyquist"]) < float(row["mtf_nyquist_ci_high"])
         assert row["status"] == "fitted" and row["misfit"] == "False" and json.loads(row["stages"])
+        # a Gaussian blur over a square pixel is separable and elliptical both: every assumption's
+        # sections cover the truth, and the fit, which fits and agrees with them, is the row to quote
+        sections = [r for r in rows if r["summary"] == "sections" and r["direction"] == direction
+                    and r["scope"] == "target"]
+        assert {r["assumption"] for r in sections} == {"separable", "elliptical", "bracket"}
+        for r in sections:
+            assert float(r["mtf_nyquist_ci_low"]) < truth < float(r["mtf_nyquist_ci_high"])
+            assert abs(float(r["mtf_nyquist"]) - truth) < 0.006
+        quoted = [r for r in rows if r["direction"] == direction and r["scope"] == "target"
+                  and r["recommended"] == "True"]
+        assert [r["summary"] for r in quoted] == ["fit"] and "agrees" in quoted[0]["recommended_because"]
     features = json.loads((out / "targets.geojson").read_text())["features"]
     assert sum(f["properties"].get("summary") == "fit" for f in features) == 2
 

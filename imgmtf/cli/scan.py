@@ -27,8 +27,8 @@ DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it fo
 # fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
 # of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
 # Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
-SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit", "numpy.fft",
-                    "numpy.ma", "numpy.polynomial")
+SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
+                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial")
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 
 
@@ -87,9 +87,12 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
     the others were rejected, combine the accepted half-edges of each
-    target and of the scene into one result per measured direction, and
-    fit the sensor model to each target's half-edges for its across- and
-    along-track MTF.  With --campaign, each scene's results go into a
+    target and of the scene into one result per measured direction,
+    invert those directions for the across- and along-track MTF without a
+    model (separable, elliptical, or the bracket of both when the data
+    cannot tell), fit the sensor model to each target's half-edges for its
+    own, and mark the row to quote per direction (*; never a misfit
+    fit).  With --campaign, each scene's results go into a
     campaign store as it completes.  Exit status 1 when a scene cannot be
     scanned or has no usable target; on Ctrl-C or SIGTERM the results so
     far are reported and kept (130 or 143): every scene finished is in the

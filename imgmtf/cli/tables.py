@@ -144,7 +144,8 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
     if not verbose:
         print_rejections([r for r in records if not r.ok])
-    combined = [r for r in summaries if r.figures.get("summary") != "fit"]
+    combined = [r for r in summaries if r.figures.get("summary") not in ("fit", "sections")]
+    sections = [r for r in summaries if r.figures.get("summary") == "sections"]
     fitted = [r for r in summaries if r.figures.get("summary") == "fit"]
     if combined:
         click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
@@ -159,8 +160,11 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
                        f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
                        f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
                        f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('consistency'), 8, 2)}")
+    if sections:
+        print_sections(sections)
     if fitted:
         print_target_fits(fitted)
+    print_recommended(sections + fitted)
     for path in written:
         click.echo(f"wrote {path}")
 
@@ -171,13 +175,13 @@ def print_target_fits(fitted) -> None:
     stages: list[str] = next((r.figures["stages"] for r in fitted if r.figures.get("stages")), [])
     click.echo(f"fitted per target, across and along track (sensor model: {', '.join(stages) or '-'}; "
                "misfit p: the smallest p-value of structure in its half-edges' residuals):")
-    click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
+    click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
     warned: set[str] = set()
     hinted = False
     for summary in fitted:
         r = summary.to_dict()
-        head = f"{r['scope']:>6} {r.get('target_id') or '':>3}"
+        head = f"{_mark(r)}{r['scope']:>6} {r.get('target_id') or '':>3}"
         if not summary.ok:
             click.echo(f"{head} {'fit failed':>7}  {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
             continue
@@ -190,10 +194,55 @@ def print_target_fits(fitted) -> None:
         for warning in r.get("warnings") or []:
             if warning not in warned:           # across and along share their fit's warnings
                 warned.add(warning)
-                click.echo(f"{'':>10} warning: {warning}")
+                click.echo(f"{'':>11} warning: {warning}")
                 if "does not fit" in warning and not hinted:
                     hinted = True
-                    click.echo(f"{'':>10} (--fit-stages fits other stages; the combined rows assume no model)")
+                    click.echo(f"{'':>11} (--fit-stages fits other stages; the combined and sections rows "
+                               "assume no model)")
+
+
+def print_sections(sections) -> None:
+    """The 2-D MTF's across- and along-track sections from each target's
+    combined directions, under each assumption, and why the chosen one."""
+    click.echo("across and along track without a model (the 2-D MTF's sections from the combined directions, "
+               "under each assumption):")
+    click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'assumption':>10} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
+               f"{'MTF50':>7} {'interval':>15} {'FWHM':>6}")
+    said: set[tuple] = set()
+    for summary in sections:
+        r = summary.to_dict()
+        key = (r["scope"], r.get("target_id"))
+        click.echo(f"{_mark(r)}{r['scope']:>6} {r.get('target_id') or '':>3} "
+                   f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} {r['assumption']:>10} "
+                   f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
+                   f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
+                   f"{num_cell(r.get('fwhm_px'), 6, 3)}")
+        if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] == "along-track":
+            said.add(key)
+            click.echo(f"{'':>11} {r['chosen_assumption']}: {r.get('assumption_because')}")
+
+
+def print_recommended(rows) -> None:
+    """The legend of the recommended rows' mark, and the directions whose
+    only rows are misfit fits (no figure to quote)."""
+    if not any(r.figures.get("recommended") is not None for r in rows):
+        return
+    if any(r.figures.get("recommended") for r in rows):
+        click.echo("* the across/along row to quote per target and direction: the model's fit when it fits and "
+                   "agrees with the sections, else the sections' assumption")
+    directions: dict[tuple, list] = {}
+    for r in rows:
+        if r.ok and r.figures.get("direction") in SHORT_DIRECTIONS:
+            directions.setdefault((r.site.get("scope"), r.site.get("target_id"), r.figures["direction"]), []).append(r)
+    for (scope, target, direction), group in directions.items():
+        if not any(r.figures.get("recommended") for r in group):
+            where = "the scene" if scope != "target" else f"target {target}"
+            click.echo(f"{where} {direction}: only misfit fit rows, no figure to quote (the model does not fit; "
+                       "a second orientation of edge gives the sections)")
+
+
+def _mark(row: dict) -> str:
+    return "*" if row.get("recommended") else " "
 
 
 SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}

@@ -1,5 +1,5 @@
 """Figures, one module per subject: the sensor model, a measurement, a sensor
-fit, a scene scan, a campaign's trends, a restoration and the paper's study.
+fit, a scene scan, the 2-D MTF's sections, a campaign's trends, a restoration and the paper's study.
 Each function draws on ``ax`` (a new figure when None) and returns the figure;
 nothing here touches pyplot's global state, so the figures render with the Agg
 canvas whatever the session's backend."""
@@ -9,10 +9,11 @@ from .measurement import plot_locations, plot_lsf, plot_measurement, plot_mtf, p
 from .paper import plot_estimates, plot_ground_noise_layers, plot_noise_sweep, plot_threshold
 from .restore import plot_restoration, plot_restore_tradeoff, plot_restored_edge, plot_restored_mtf
 from .scan import plot_scan
+from .sections import plot_sections
 from .sensor import plot_psf, plot_sensor, plot_sensor_lsf, plot_sensor_mtf
 
 __all__ = ["plot_campaign", "plot_estimates", "plot_fit", "plot_fit_edge", "plot_fit_lsf", "plot_fit_residuals",
            "plot_ground_noise_layers", "plot_locations", "plot_lsf", "plot_measurement", "plot_mtf",
            "plot_noise_sweep", "plot_profile", "plot_psf", "plot_restoration", "plot_restore_tradeoff",
-           "plot_restored_edge", "plot_restored_mtf", "plot_scan", "plot_sensor", "plot_sensor_lsf",
+           "plot_restored_edge", "plot_restored_mtf", "plot_scan", "plot_sections", "plot_sensor", "plot_sensor_lsf",
            "plot_sensor_mtf", "plot_threshold", "plot_trend"]

@@ -144,7 +144,9 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     targets = [s for s in summary_rows if s.get("scope") == TARGET_SCOPE]
     target_labels = []
     for target_id in sorted({s["target_id"] for s in targets}):
-        rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None]
+        # of the sections, the chosen assumption's rows only (the table and the CSV hold the others)
+        rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None
+                and (s.get("summary") != "sections" or s.get("assumption") == s.get("chosen_assumption"))]
         lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"
                                      for s in rows]
         if len(lines) > 1:
@@ -154,7 +156,7 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     ids = "ids as in the table and the CSV" + (f" ({unlabelled} in reasons too common to label)" if unlabelled
                                                  else "")
     ax.set_title(f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
-                 f"target{'s' * (n_targets != 1)} (labels: MTF at Nyquist | MTF50 cy/px per direction); "
+                 f"target{'s' * (n_targets != 1)} (labels: MTF at Nyquist | MTF50 cy/px per direction, * to quote); "
                  f"{len(rejected)} rejected; {ids}", fontsize=7.5, loc="left")
     if handles:
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7,
@@ -255,11 +257,15 @@ class _Labels:
 
 def _label(summary: Mapping[str, Any]) -> str:
     """A summary's line in its target's label: a combined direction and its
-    normal, or the sensor model's fit across or along track (and whether it
-    fits)."""
+    normal, the sections across or along track (and their assumption), or
+    the sensor model's fit (and whether it fits); ``*`` marks the row to
+    quote."""
     direction = _DIRECTION_SHORT.get(summary["direction"], summary["direction"])
+    mark = "*" if summary.get("recommended") else ""
     if summary.get("summary") == "fit":
-        return f"fit {direction}{' (misfit)' if summary.get('misfit') else ''}"
+        return f"{mark}fit {direction}{' (misfit)' if summary.get('misfit') else ''}"
+    if summary.get("summary") == "sections":
+        return f"{mark}{direction} ({summary.get('assumption')})"
     return f"{direction} {summary['normal_angle_deg']:.0f}\u00b0"
 
 

@@ -37,7 +37,9 @@ class SceneOutcome:
         Its candidates (:func:`imgmtf.scene.measure.scan_scene`).
     summaries : tuple of Record
         Its combined summaries (:func:`imgmtf.scene.combine.summarise_scan`),
-        then its fitted ones (:func:`imgmtf.scene.targetfit.fit_targets`).
+        its across/along sections (:func:`imgmtf.scene.sections.section_rows`),
+        then its fitted ones (:func:`imgmtf.scene.targetfit.fit_targets`), the
+        one to quote per direction marked (:func:`imgmtf.scene.sections.recommend`).
     acquisition : imgmtf.campaign.acquisitions.Acquisition or None
         With a store: the acquisition its rows were stored as.
     error, reason : str or None
@@ -177,6 +179,7 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
     the records so far on Ctrl-C."""
     from .combine import summarise_scan
     from .measure import scan_scene
+    from .sections import recommend, section_rows
     from .targetfit import fit_targets
     try:
         acquisition = None
@@ -195,8 +198,10 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                 raise
             return SceneOutcome(path, _reported(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
+        summaries += section_rows(summaries)
         if get_kind(settings.target).fits_sensor and stages:
             summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
+        summaries = recommend(summaries)
     except ImgmtfError as exc:
         message = " ".join(str(exc).split())
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
@@ -218,9 +223,12 @@ def _stored(outcome: SceneOutcome, store: str | None) -> Iterator[SceneOutcome]:
     from ..parallel import signals_deferred
     with signals_deferred():
         if store is not None and outcome.acquisition is not None and outcome.ok and not outcome.interrupted:
-            from ..campaign.store import write_acquisition
-            write_acquisition(store, outcome.acquisition, [r for r in outcome.records if r.ok],
-                              [r for r in outcome.summaries if r.ok])
+            from ..campaign import store as stores
+            # a store whose schema predates a kind of summary (the sections) keeps the others
+            kept = getattr(stores, "SUMMARY_METHODS", ())
+            stores.write_acquisition(store, outcome.acquisition, [r for r in outcome.records if r.ok],
+                                     [r for r in outcome.summaries
+                                      if r.ok and (not kept or (r.figures.get("summary") or "combined") in kept)])
         yield outcome
 
 

@@ -1,0 +1,333 @@
+"""The 2-D MTF's across- and along-track sections from MTFs measured
+along two or more normals, without a sensor model.
+
+An edge whose normal makes the angle theta with the across-track axis
+measures the central section of the 2-D MTF along that normal (the Fourier
+slice theorem): m(f) = M(f cos theta, f sin theta), f in cy/px along the
+normal.  Two sections do not fix a 2-D function; each named assumption
+does:
+
+``separable`` (M(u, v) = Mx(u) My(v)) or ``elliptical`` (the square pixel
+times g(sqrt(u^2 + v^2 / a^2))), each inverted by :mod:`.inversion`.
+
+Across track is u (theta = 0), along track v (theta = 90 deg); with rows
+along track those are the image's x and y.  Any two sections fit the
+separable assumption; the elliptical one only if their remainders are one
+curve stretched (:mod:`.assumptions` tests it).  When it fits, two
+orientations cannot tell the assumptions apart: :func:`mtf2d_from_sections`
+then gives both and the ``bracket`` spanning them.  A third orientation is
+predicted from the two nearest the axes under each assumption and compared
+with its measurement; the assumption it does not reject is chosen.
+
+Intervals: each section's uncertainty (one standard deviation per
+frequency) is drawn as a whole-curve shift (the noise of one edge's MTF is
+correlated across frequency), every draw inverted, and the percentiles
+taken.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...errors import ParameterError
+from .assumptions import (
+    ASSUMPTIONS,
+    BRACKET,
+    ELLIPTICAL,
+    SEPARABLE,
+    base_pair,
+    decision,
+    overlay_test,
+    pair_decision,
+    prediction_tests,
+)
+from .inversion import (
+    REACH_CY_PX,
+    drawn_models,
+    fitted_model,
+    prepared,
+)
+
+_GRID = np.round(np.arange(0.0, REACH_CY_PX + 1e-9, 0.01), 2)
+
+
+@dataclass(frozen=True)
+class TrackSection:
+    """One section of a 2-D MTF (across- or along-track) and its interval.
+
+    Attributes
+    ----------
+    direction : str
+        "across-track" (u) or "along-track" (v).
+    frequencies_cy_px, mtf, low, high : numpy.ndarray
+        The section (MTF 1 at zero frequency) and its pointwise interval;
+        NaN beyond what the measured sections reach.
+    mtf_nyquist, mtf50_cy_px, fwhm_px : float
+        MTF at 0.5 cy/px, where it falls to 0.5, the LSF's full width at
+        half maximum (px).
+    mtf_nyquist_ci, mtf50_ci_cy_px : (float, float)
+        Their intervals (NaN without uncertainties).
+    """
+
+    direction: str
+    frequencies_cy_px: np.ndarray = field(repr=False)
+    mtf: np.ndarray = field(repr=False)
+    low: np.ndarray = field(repr=False)
+    high: np.ndarray = field(repr=False)
+    mtf_nyquist: float
+    mtf_nyquist_ci: tuple[float, float]
+    mtf50_cy_px: float
+    mtf50_ci_cy_px: tuple[float, float]
+    fwhm_px: float
+
+
+@dataclass(frozen=True)
+class MTF2D:
+    """The 2-D MTF from measured sections, under a named assumption.
+
+    Attributes
+    ----------
+    assumption : str
+        "separable", "elliptical" or "bracket" (the data cannot tell the
+        two apart: the interval spans both).
+    because : str
+        Why that assumption (a short phrase).
+    across, along : TrackSection
+        The chosen assumption's across-track (u, cy/px) and along-track
+        (v) sections.
+    alternatives : dict
+        Every assumption's (``across``, ``along``) sections, the bracket's
+        among them.
+    models : dict
+        Each assumption's fitted model (:class:`SeparableModel`,
+        :class:`EllipticalModel`).
+    aspect : float
+        The elliptical remainder's aspect a (along/across widths).
+    normals_deg : tuple of float
+        The sections' normals from the across-track axis, deg.
+    tests : dict
+        For each assumption, the p-value of its prediction of the
+        orientations it was not fitted to; with two orientations, the
+        elliptical model's fit to them.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> gaussian = [np.sinc(f) * np.exp(-2 * f ** 2)] * 2          # the same along both normals
+    >>> result = mtf2d_from_sections([0.0, 90.0], f, gaussian)
+    >>> result.assumption, round(float(result.transfer(0.5, 0.0)), 3), round(result.along.mtf_nyquist, 3)
+    ('bracket', 0.386, 0.386)
+    """
+
+    assumption: str
+    because: str
+    across: TrackSection
+    along: TrackSection
+    alternatives: dict = field(repr=False)
+    models: dict = field(repr=False)
+    aspect: float
+    normals_deg: tuple
+    tests: dict
+
+    def transfer(self, fx_cy_px: ArrayLike, fy_cy_px: ArrayLike) -> np.ndarray:
+        """The 2-D MTF at (across, along) frequencies, cy/px; the bracket's
+        is the mean of the two assumptions'.  NaN beyond the data's reach.
+
+        Parameters
+        ----------
+        fx_cy_px, fy_cy_px : array_like
+            Across-track (u) and along-track (v) frequencies, cy/px
+            (broadcast together).
+
+        Returns
+        -------
+        numpy.ndarray
+            The MTF (1 at zero frequency).
+        """
+        if self.assumption == BRACKET:
+            return 0.5 * sum(self.models[a].transfer(fx_cy_px, fy_cy_px) for a in ASSUMPTIONS)
+        return self.models[self.assumption].transfer(fx_cy_px, fy_cy_px)
+
+
+def sd_from_nyquist(sd_nyquist: ArrayLike, frequencies_cy_px: ArrayLike) -> np.ndarray:
+    """Per-frequency standard deviations of sections from theirs at Nyquist
+    (n,), growing in proportion to frequency (0 at 0, where an MTF is 1 by
+    construction): (n, len(frequencies)).
+
+    Examples
+    --------
+    >>> sd_from_nyquist([0.01], [0.0, 0.25, 0.5]).tolist()
+    [[0.0, 0.005, 0.01]]
+    """
+    return np.outer(np.asarray(sd_nyquist, float), np.asarray(frequencies_cy_px, float) / 0.5)
+
+
+def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
+                        sd: ArrayLike | None = None, *, assumption: str = "auto", draws: int = 100,
+                        confidence: float = 0.95, seed: int = 0) -> MTF2D:
+    """The across- and along-track sections of the 2-D MTF from MTFs
+    measured along two or more normals.
+
+    Parameters
+    ----------
+    normals_deg : sequence of float
+        Each section's normal from the across-track axis (deg; 180 apart
+        is the same section), at least two of them ``MIN_SEPARATION_DEG``
+        apart.
+    frequencies_cy_px : array_like
+        The sections' common frequencies along their normals, cy/px.
+    mtfs : array_like
+        (n, len(frequencies)): the measured MTFs (1 at zero frequency).
+    sd : array_like, optional
+        (n, len(frequencies)): their standard deviations
+        (:func:`sd_from_nyquist`); without, no intervals and the tests
+        assume ``SD_FLOOR``.
+    assumption : str, optional
+        "auto" (default: chosen as the module says), "separable",
+        "elliptical" or "bracket".
+    draws : int, optional
+        Draws of the sections within their uncertainty for the intervals.
+    confidence : float, optional
+        Of the intervals (default 0.95).
+    seed : int, optional
+        Of the draws: the same inputs give the same intervals.
+
+    Returns
+    -------
+    MTF2D
+        The chosen assumption, why, its across/along sections with their
+        intervals, every assumption's, and the 2-D MTF (``transfer``).
+
+    Raises
+    ------
+    ParameterError
+        Shapes that do not agree, fewer than two distinct normals, or an
+        unknown assumption.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> truth = lambda u, v: np.sinc(u) * np.sinc(v) * np.exp(-2 * u ** 2 - 4 * v ** 2)
+    >>> t = np.radians([16.8, -73.2])
+    >>> result = mtf2d_from_sections([16.8, -73.2], f, [truth(f * np.cos(a), f * np.sin(a)) for a in t])
+    >>> result.assumption, round(result.across.mtf_nyquist, 3), round(float(truth(0.5, 0)), 3)
+    ('bracket', 0.386, 0.386)
+    """
+    if assumption not in ("auto", BRACKET, *ASSUMPTIONS):
+        raise ParameterError(f"assumption must be auto, separable, elliptical or bracket, got {assumption!r}")
+    theta, f, m, _ = prepared(normals_deg, frequencies_cy_px, mtfs, sd)
+    normals = np.degrees(theta)
+    spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
+    base = base_pair(normals)
+    inputs = (normals, f, m, spread)
+    models = {a: fitted_model(a, normals, f, m, spread) for a in ASSUMPTIONS}
+    tests: dict[str, float] = {}
+    if assumption == "auto":
+        others = [k for k in range(normals.size) if k not in base]
+        if others:
+            tests = prediction_tests(inputs, base, others, draws, seed)
+            assumption, because = decision(tests, normals[list(others)])
+        else:
+            tests = {ELLIPTICAL: overlay_test(inputs, models[ELLIPTICAL], seed)}
+            assumption, because = pair_decision(tests[ELLIPTICAL])
+    else:
+        because = "asked for"
+    rng = np.random.default_rng(seed)
+    shifts = rng.standard_normal((draws, normals.size)) if sd is not None and draws > 0 else None
+    alternatives = {a: _sections(a, models[a], inputs, shifts, confidence) for a in ASSUMPTIONS}
+    (sep_across, sep_along), (ell_across, ell_along) = alternatives[SEPARABLE], alternatives[ELLIPTICAL]
+    alternatives[BRACKET] = (_bracket(sep_across, ell_across), _bracket(sep_along, ell_along))
+    across, along = alternatives[assumption]
+    return MTF2D(assumption, because, across, along, alternatives, models, models[ELLIPTICAL].aspect,
+                 tuple(float(n) for n in normals), tests)
+
+
+def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tuple[TrackSection, TrackSection]:
+    """The model's across and along sections, with intervals from the
+    sections redrawn by ``shifts`` (draws x sections) and inverted again."""
+    normals, f, m, sd = inputs
+    curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
+    drawn = None
+    if shifts is not None:
+        drawn = np.array([[again.transfer(_GRID, 0.0 * _GRID), again.transfer(0.0 * _GRID, _GRID)]
+                          for again in drawn_models(assumption, model, normals, f, m, sd, shifts)])
+    return (_section("across-track", curves[0], None if drawn is None else drawn[:, 0], confidence),
+            _section("along-track", curves[1], None if drawn is None else drawn[:, 1], confidence))
+
+
+def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float) -> TrackSection:
+    tail = (1 - confidence) / 2
+    if drawn is None:
+        low = high = np.full_like(curve, np.nan)
+        nyq_ci = fifty_ci = (math.nan, math.nan)
+    else:
+        # NaN where a draw does not reach (beyond the sections' reach)
+        low, high = np.quantile(drawn, [tail, 1 - tail], axis=0)
+        low, high = np.minimum(low, curve), np.maximum(high, curve)
+        nyquist = drawn[:, _GRID.searchsorted(0.5)]
+        fifty = np.array([_mtf50(c) for c in drawn])
+        nyq_ci = _quantiles(nyquist, tail, curve[_GRID.searchsorted(0.5)])
+        fifty_ci = _quantiles(fifty, tail, _mtf50(curve))
+    return TrackSection(direction, _GRID.copy(), curve, low, high, float(curve[_GRID.searchsorted(0.5)]), nyq_ci,
+                        _mtf50(curve), fifty_ci, _fwhm(curve))
+
+
+def _quantiles(values: np.ndarray, tail: float, central: float) -> tuple[float, float]:
+    values = values[np.isfinite(values)]
+    if not values.size or not math.isfinite(central):
+        return (math.nan, math.nan)
+    low, high = np.quantile(values, [tail, 1 - tail])
+    return (float(min(low, central)), float(max(high, central)))
+
+
+def _bracket(first: TrackSection, second: TrackSection) -> TrackSection:
+    """The section spanning two assumptions': their mean, and an interval
+    from the lower's low to the higher's high (each at least its value)."""
+    def span(a: float, b: float, ia, ib) -> tuple[float, float]:
+        lows = [x for x in (a, b, ia[0], ib[0]) if math.isfinite(x)]
+        highs = [x for x in (a, b, ia[1], ib[1]) if math.isfinite(x)]
+        return (min(lows, default=math.nan), max(highs, default=math.nan))
+
+    curve = 0.5 * (first.mtf + second.mtf)
+    low = np.fmin(np.fmin(first.low, second.low), np.fmin(first.mtf, second.mtf))
+    high = np.fmax(np.fmax(first.high, second.high), np.fmax(first.mtf, second.mtf))
+    return TrackSection(first.direction, first.frequencies_cy_px, curve, low, high,
+                        0.5 * (first.mtf_nyquist + second.mtf_nyquist),
+                        span(first.mtf_nyquist, second.mtf_nyquist, first.mtf_nyquist_ci, second.mtf_nyquist_ci),
+                        0.5 * (first.mtf50_cy_px + second.mtf50_cy_px),
+                        span(first.mtf50_cy_px, second.mtf50_cy_px, first.mtf50_ci_cy_px, second.mtf50_ci_cy_px),
+                        0.5 * (first.fwhm_px + second.fwhm_px))
+
+
+def _mtf50(curve: np.ndarray) -> float:
+    """Where a section first falls to 0.5 (linear between samples), cy/px."""
+    below = np.flatnonzero(curve < 0.5)
+    if not below.size or below[0] == 0 or not np.isfinite(curve[: below[0] + 1]).all():
+        return math.nan
+    k = below[0]
+    return float(_GRID[k - 1] + (curve[k - 1] - 0.5) / (curve[k - 1] - curve[k]) * (_GRID[k] - _GRID[k - 1]))
+
+
+def _fwhm(curve: np.ndarray) -> float:
+    """The FWHM of the LSF whose MTF is ``curve`` (even, real): its cosine
+    transform over the section's reach, which must reach MTF 0.1 (else
+    NaN: a transform truncated higher is not the LSF's width)."""
+    finite = np.isfinite(curve)
+    reach = int(np.argmin(finite)) if not finite.all() else curve.size
+    if reach < 3 or curve[reach - 1] > 0.1:
+        return math.nan
+    f, mtf = _GRID[:reach], curve[:reach]
+    x = np.linspace(0.0, 4.0, 801)
+    weights = np.full(reach, 0.01)
+    weights[[0, -1]] = 0.005
+    lsf = 2.0 * (np.cos(2 * np.pi * np.outer(x, f)) @ (mtf * weights))
+    half = lsf[0] / 2
+    below = np.flatnonzero(lsf < half)
+    if not below.size:
+        return math.nan
+    k = below[0]
+    return float(2 * (x[k - 1] + (lsf[k - 1] - half) / (lsf[k - 1] - lsf[k]) * (x[k] - x[k - 1])))
+
