@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import ParameterError, TargetNotFoundError
+from ...errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ...metrics import first_crossing, fwhm
 from ...version import __version__
 from ..intervals import Interval, Intervals, as_intervals
@@ -252,6 +252,9 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
     ------
     TargetNotFoundError
         No target usable (the message counts the refusals by reason).
+    UnsuitableTargetError
+        (reason ``not-points``) Most features found reach across their
+        stamps: an edge or a bar.
     ParameterError
         A bad setting.
 
@@ -274,6 +277,12 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
     found = find_sources(image, polarity=polarity, stamp_radius_px=stamp_radius_px, min_snr=min_snr,
                          min_separation_px=min_separation_px, saturation=saturation)
     if not found.used:
+        counts = found.refusal_counts()
+        if counts.get("extended", 0) * 2 > len(found.sources):
+            raise UnsuitableTargetError(
+                f"{counts['extended']} of the {len(found.sources)} {found.polarity} features found reach across "
+                f"their {2 * stamp_radius_px + 1} px stamps: the chip holds an edge or a bar, not point targets",
+                reason="not-points")
         raise TargetNotFoundError(_nothing_usable(found, np.asarray(image).shape))
     stack = Stack(found, float(point_size_px))
     directions = tuple(stack.direction(name, vector, settings) for name, vector in DIRECTIONS)

@@ -5,11 +5,12 @@ them).
 A target is a local maximum of the background-subtracted chip (its sign
 turned for dark targets), smoothed by a 1 px Gaussian, above five times the
 smoothed noise.  Each is cut out as a square stamp and refused, with a
-reason code and a message, when its stamp touches the chip's edge
-(``edge``), another target lies within the separation (``blended``), a pixel
-of it is at the recorded range's end (``clipped``), its peak is under the
-SNR floor (``faint``), signal reaches the stamp's border (``extended``: an
-edge or a bar, not a point) or it is sharper than any optics (``hot-pixel``).
+reason code and a message, when its peak is under the SNR floor
+(``faint``), signal reaches its stamp's border (``extended``: an edge or a
+bar, not a point), its stamp touches the chip's edge (``edge``), another
+target lies within the separation (``blended``), a pixel of it is at the
+recorded range's end (``clipped``) or it is sharper than any optics
+(``hot-pixel``).
 The rest are located by a least-squares fit of an elliptical Gaussian
 integrated over each pixel, plus a constant: exact for Gaussian optics and
 a square pixel, and unbiased at the phases 0 and 1/2 for any symmetric PSF.
@@ -25,7 +26,7 @@ from scipy import ndimage, optimize, special
 from ...errors import ParameterError
 
 #: refusal reasons of a target, in the order they are tested
-REASONS = ("edge", "blended", "clipped", "faint", "extended", "hot-pixel", "fit")
+REASONS = ("faint", "extended", "edge", "blended", "clipped", "hot-pixel", "fit")
 POLARITIES = ("auto", "bright", "dark")
 #: the narrowest Gaussian sigma (px) a point's image may have: below it, a lone hot pixel
 MIN_SIGMA_PX = 0.15
@@ -175,10 +176,12 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     Examples
     --------
     >>> import numpy as np
-    >>> image = np.zeros((40, 40)); image[20, 20] = image[20, 21] = 50.0; image[10, 30] = 80.0
+    >>> n = np.arange(-3, 4.0)
+    >>> image = np.zeros((40, 40)); image[10, 30] = 80.0                 # a hot pixel
+    >>> image[17:24, 17:24] = pixel_gaussian((100.0, 0.25, -0.5, 0.6, 0.7, 0.0), n)
     >>> found = find_sources(image, stamp_radius_px=3)
-    >>> [(s.status, round(s.x_px, 2)) for s in found.sources]
-    [('hot-pixel', 30.0), ('used', 20.5)]
+    >>> [(s.status, round(s.x_px, 3), round(s.y_px, 3)) for s in found.sources]
+    [('hot-pixel', 30.0, 10.0), ('used', 20.25, 19.5)]
     """
     if polarity not in POLARITIES:
         raise ParameterError(f"polarity must be one of {POLARITIES}, got {polarity!r}")
@@ -209,10 +212,13 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     radius = int(stamp_radius_px)
     separation = 2 * radius + 2 if min_separation_px is None else float(min_separation_px)
     sources, stamps, phases = [], [], []
+    padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
+    peaks_xy = np.column_stack([ix, iy])
     for k, (y, x) in enumerate(zip(iy, ix)):
         distance = np.hypot(ix - x, iy - y)
         distance[k] = np.inf
-        source, stamp, phase = _judge(data, signal, smoothed, (int(x), int(y)), radius, float(distance.min()),
+        source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
+                                      radius, float(distance.min()),
                                       separation, noise, min_snr, saturation, polarity)
         sources.append(source)
         if stamp is not None:
@@ -223,7 +229,8 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
                         np.array(phases, float).reshape(-1, 2), polarity, noise, radius)
 
 
-def _judge(data, signal, smoothed, at, radius, nearest, separation, noise, min_snr, saturation, polarity):
+def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separation, noise, min_snr, saturation,
+           polarity):
     """One target's verdict, and its stamp and phase when used."""
     x, y = at
     rows, cols = data.shape
@@ -232,6 +239,21 @@ def _judge(data, signal, smoothed, at, radius, nearest, separation, noise, min_s
 
     def refused(reason, message):
         return Source(float(x), float(y), snr, reason, message), None, None
+    if snr < min_snr:
+        return refused("faint", f"its peak is {snr:.1f} times the noise (under {min_snr:g})")
+    # an edge or a bar: its signal reaches the stamp's border (what of the stamp lies on the chip)
+    # (less what lies within 3 px of another target's peak: that is a neighbour, judged next)
+    ring = np.ones((2 * radius + 1,) * 2, bool)
+    ring[1:-1, 1:-1] = False
+    ry, rx = np.nonzero(ring)
+    near = ((rx[:, None] + x - radius - others[None, :, 0]) ** 2
+            + (ry[:, None] + y - radius - others[None, :, 1]) ** 2 <= 9).any(axis=1)
+    values = padded[ry + y, rx + x][~near]
+    border = float(np.nanmax(np.abs(values), initial=0.0)) if np.isfinite(values).any() else 0.0
+    if border > MAX_BORDER_FRACTION * float(smoothed[y, x]):
+        share = 100 * border / smoothed[y, x]
+        return refused("extended", f"its signal reaches {2 * radius + 1} px across ({share:.0f} % of its peak on "
+                       "the border): an edge or a bar, not a point")
     if x - radius < 0 or y - radius < 0 or x + radius >= cols or y + radius >= rows:
         return refused("edge", f"its {2 * radius + 1} px stamp touches the chip's edge")
     if nearest < separation:
@@ -241,14 +263,6 @@ def _judge(data, signal, smoothed, at, radius, nearest, separation, noise, min_s
     if saturation is not None and (stamp.max() >= saturation[1] or stamp.min() <= saturation[0]):
         return refused("clipped", f"a pixel of it is at the recorded range's end ({saturation[0]:g}, "
                        f"{saturation[1]:g} DN)")
-    if snr < min_snr:
-        return refused("faint", f"its peak is {snr:.1f} times the noise (under {min_snr:g})")
-    ring = np.ones((2 * radius + 1,) * 2, bool)
-    ring[1:-1, 1:-1] = False
-    border = float(np.abs(smoothed[window][ring]).max())
-    if border > MAX_BORDER_FRACTION * float(smoothed[y, x]):
-        return refused("extended", f"its signal reaches {2 * radius + 1} px across ({100 * border / smoothed[y, x]:.0f} "
-                       "% of its peak on the border): an edge or a bar, not a point")
     sign = 1.0 if polarity == "bright" else -1.0
     fit = fit_pixel_gaussian(sign * stamp)
     if fit is None:
