@@ -77,6 +77,8 @@ class Target:
 
     def __post_init__(self):
         kind = get_kind(self.kind)
+        if kind.scene_response is None:
+            raise ParameterError(f"a {kind.name} target is no straight line: {kind.renderer} renders it")
         for name in ("angle_deg", "low_dn", "high_dn", "offset_px", "width_px"):
             value = getattr(self, name)
             if isinstance(value, (bool, np.bool_)) or not isinstance(

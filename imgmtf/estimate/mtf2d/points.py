@@ -38,8 +38,9 @@ from ...version import __version__
 from ..intervals import Interval, Intervals, as_intervals
 from .sources import FoundSources, Source, find_sources
 
-#: the directions measured: name, and the unit frequency vector (fx, fy)
-DIRECTIONS = (("across-track", (1.0, 0.0)), ("along-track", (0.0, 1.0)))
+#: the directions' names: across and along the ground track, or the image's axes when the track is unknown
+ACROSS, ALONG = "across-track", "along-track"
+IMAGE_X, IMAGE_Y = "image-x", "image-y"
 #: the highest alias order the model correction covers, and the band (cy/px) the PSF is drawn from
 ALIAS_ORDER = 4
 BAND_CY_PX = 2.0
@@ -56,7 +57,11 @@ class DirectionMTF:
     Attributes
     ----------
     direction : str
-        "across-track" (frequency along x) or "along-track" (along y).
+        "across-track" or "along-track" ("image-x", "image-y" when the
+        track is unknown).
+    angle_deg : float
+        The frequency axis's angle from the image's x axis towards +y, in
+        (-90, 90] (0: across track in sensor geometry).
     frequencies_cy_px, mtf : numpy.ndarray
         The section, 0 to 1 cy/px in 0.01 steps (1 at zero).
     mtf_nyquist : float
@@ -75,6 +80,7 @@ class DirectionMTF:
     """
 
     direction: str
+    angle_deg: float
     frequencies_cy_px: np.ndarray
     mtf: np.ndarray
     mtf_nyquist: float
@@ -180,7 +186,7 @@ class PointsResult:
         for section in self.directions:
             row: dict[str, Any] = {
                 "target": self.target, "method": self.method, "direction": section.direction,
-                "normal_angle_deg": 0.0 if section.direction == "across-track" else 90.0,
+                "normal_angle_deg": _finite(section.angle_deg),
                 "polarity": self.polarity, "snr": _finite(snr), "noise_dn": _finite(self.noise_dn),
                 "mtf_nyquist": _finite(section.mtf_nyquist),
                 "mtf_nyquist_ci": [_finite(section.mtf_nyquist_ci.low), _finite(section.mtf_nyquist_ci.high)],
@@ -214,7 +220,7 @@ def _finite(value: Any) -> float | None:
 def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: str = "auto",
                    stamp_radius_px: int = 4, min_snr: float = 20.0, min_separation_px: float | None = None,
                    saturation: tuple[float, float] | None = None, intervals: Intervals | str | int | None = None,
-                   gsd_m: float | None = None) -> PointsResult:
+                   gsd_m: float | None = None, track_azimuth_deg: float | None = 0.0) -> PointsResult:
     """The 2-D PSF and MTF of the point targets on ``image``, stacked by
     their sub-pixel phases (see the module).
 
@@ -241,6 +247,10 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
         or a number of replicates.
     gsd_m : float, optional
         The pixel on the ground, m (figures in m too).
+    track_azimuth_deg : float or None, optional
+        The ground track's direction, degrees clockwise from the image's up
+        (0, the default: rows along track); None when unknown: the sections
+        are then along the image's x and y ("image-x", "image-y").
 
     Returns
     -------
@@ -285,7 +295,7 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
                 reason="not-points")
         raise TargetNotFoundError(_nothing_usable(found, np.asarray(image).shape))
     stack = Stack(found, float(point_size_px))
-    directions = tuple(stack.direction(name, vector, settings) for name, vector in DIRECTIONS)
+    directions = tuple(stack.direction(name, vector, settings) for name, vector in section_axes(track_azimuth_deg))
     psf, step = stack.psf()
     f2d = np.round(np.arange(-50, 51) * 0.02, 10)
     mtf2d = stack.mtf(f2d[None, :], f2d[:, None])
@@ -302,6 +312,17 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
               "intervals": settings.as_dict()}
     return PointsResult(directions, psf, step, mtf2d, f2d, found.sources, found.polarity, float(point_size_px),
                         found.noise_dn, stack.alias_weight, gsd_m, (0, 0, cols, rows), params, tuple(warnings))
+
+
+def section_axes(track_azimuth_deg: float | None) -> tuple[tuple[str, tuple[float, float]], ...]:
+    """The sections' names and unit frequency vectors (fx, fy): across and
+    along a track ``track_azimuth_deg`` clockwise from the image's up (x
+    right, y down), or the image's axes when it is None."""
+    if track_azimuth_deg is None:
+        return ((IMAGE_X, (1.0, 0.0)), (IMAGE_Y, (0.0, 1.0)))
+    a = math.radians(float(track_azimuth_deg))
+    along = (math.sin(a), -math.cos(a))
+    return ((ACROSS, (math.cos(a), math.sin(a))), (ALONG, (along[0] + 0.0, along[1] + 0.0)))
 
 
 def _nothing_usable(found: FoundSources, shape) -> str:
@@ -385,19 +406,21 @@ class Stack:
         mtf = np.abs(self.transfer(f * ux, f * uy))
         nyquist = steps // 2
         lsf_x, lsf = self.lsf(vector)
-        low_ci = high_ci = Interval.none()
+        nyquist_ci = mtf50_ci = Interval.none()
         if settings.method != "none" and len(self.stamps) > 1:
             rng = np.random.default_rng(settings.seed)
             n = len(self.stamps)
             reps = np.abs(self.replicates(f * ux, f * uy, rng.integers(0, n, (settings.replicates, n))))
             tail = 100 * (1 - settings.confidence) / 2
             ny = reps[:, nyquist]
-            low_ci = Interval(*np.nanpercentile(ny, [tail, 100 - tail])).clipped_at_zero()
+            nyquist_ci = Interval(*np.nanpercentile(ny, [tail, 100 - tail])).clipped_at_zero()
             m50 = first_crossing(f, reps, 0.5)
-            high_ci = (Interval(*np.nanpercentile(m50, [tail, 100 - tail])) if np.isfinite(m50).any()
+            mtf50_ci = (Interval(*np.nanpercentile(m50, [tail, 100 - tail])) if np.isfinite(m50).any()
                        else Interval.none())
-        return DirectionMTF(name, f, mtf, float(mtf[nyquist]), low_ci, first_crossing(f, mtf, 0.5), high_ci,
-                            fwhm(lsf_x, lsf), lsf_x, lsf)
+        angle = math.degrees(math.atan2(uy, ux))
+        angle = angle - 180.0 if angle > 90.0 else angle + 180.0 if angle <= -90.0 else angle
+        return DirectionMTF(name, angle + 0.0, f, mtf, float(mtf[nyquist]), nyquist_ci, first_crossing(f, mtf, 0.5),
+                            mtf50_ci, fwhm(lsf_x, lsf), lsf_x, lsf)
 
     def lsf(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """The line spread function along ``vector``: the inverse transform
@@ -420,3 +443,4 @@ class Stack:
         t = self.transfer(fx.ravel(), fy.ravel(), divide_size=False).reshape(fx.shape)
         psf = np.fft.fftshift(np.fft.ifft2(t).real) / step ** 2
         return psf, step
+
