@@ -45,8 +45,8 @@ class PointsEstimator:
     >>> chip = render_points(imgmtf.Sensor(), PointArray(4, 4), 64)
     >>> estimate = PointsEstimator(intervals="none")
     >>> result = estimate(chip.image, gsd_m=1.0)
-    >>> round(result.directions[1].mtf_nyquist, 3), round(float(chip.true_mtf(0.5, "along")), 3)
-    (0.26, 0.26)
+    >>> abs(result.directions[1].mtf_nyquist - float(chip.true_mtf(0.5, "along"))) < 0.005
+    True
     """
 
     def __init__(self, method: str = "msg", *, intervals: Intervals | str | int | None = None, force: bool = False,

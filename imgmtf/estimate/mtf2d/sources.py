@@ -337,7 +337,7 @@ def points_seen(image: np.ndarray) -> str | None:
     >>> n = np.arange(-3, 4.0)
     >>> image = np.zeros((30, 30)); image[10:17, 10:17] = pixel_gaussian((900.0, 0.2, 0.1, 0.6, 0.6, 0.0), n)
     >>> points_seen(np.random.default_rng(0).normal(image, 1.0))
-    '1 compact bright point target (median peak SNR 266)'
+    '1 compact bright point target (median peak SNR 318)'
     >>> points_seen(np.zeros((30, 30))) is None
     True
     """
