@@ -262,7 +262,7 @@ def _measurement_figure(result, raster, warnings):
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
     kind = get_kind(result.target)
     if kind.figure is not None:             # a kind with a figure of its own (points: the 2-D PSF and MTF)
-        return kind.load("figure")(result, truth=kind_truth(raster), title=title, warnings=warnings)
+        return kind.load("figure")(result, raster.data, truth=kind_truth(raster), title=title, warnings=warnings)
     return plot_measurement(result, truth=true_mtf(raster), title=title, warnings=warnings)
 
 

@@ -4,10 +4,11 @@ mirrors, lamps, Rauchmiller's squares): every target found and located
 
 The stack is a transform of the scatter: each target's stamp ``v_k``
 (flux 1, background 0) at its pixels' distances from its fitted centre
-``p_k``, so that
+``p_k``, weighted by ``w_k`` (the inverse of its noise's variance: its
+flux squared, capped at 3 times the median flux), so that
 
-    F(f) = mean_k sum_n v_k[n] exp(-2 pi i f . (n - p_k))
-         = T(f) + sum_{j != 0} c_j T(f + j),   c_j = mean_k exp(-2 pi i j . p_k),
+    F(f) = sum_k w_k sum_n v_k[n] exp(-2 pi i f . (n - p_k))
+         = T(f) + sum_{j != 0} c_j T(f + j),   c_j = sum_k w_k exp(-2 pi i j . p_k),
 
 ``T`` the transfer of sensor and target, ``j`` the integer aliases (the
 Poisson sum of the pixel samples).  Targets whose phases tile the pixel
@@ -346,6 +347,10 @@ class Stack:
         self.radius = radius
         used = found.used
         self.sigmas = np.array([[s.sigma_x_px, s.sigma_y_px] for s in used])
+        # inverse variance: a stamp divided by its flux has noise / flux; capped at 3x the median flux so that
+        # no one bright target (one phase) carries the stack alone
+        flux = np.array([s.flux_dn for s in used])
+        self.weights = np.minimum(flux, 3.0 * np.median(flux)) ** 2
         j = np.arange(-ALIAS_ORDER, ALIAS_ORDER + 1)
         jx, jy = np.meshgrid(j, j)
         keep = (jx != 0) | (jy != 0)
@@ -353,7 +358,8 @@ class Stack:
         # exp(-2 pi i j . p_k), per target and alias
         self.alias_phasors = np.exp(-2j * np.pi * (self.phases @ self.aliases.T))
         first = np.max(np.abs(self.aliases), axis=1) == 1
-        self.alias_weight = float(np.abs(self.alias_phasors[:, first].mean(axis=0)).max())
+        share = self.weights / self.weights.sum()
+        self.alias_weight = float(np.abs(share @ self.alias_phasors[:, first]).max())
 
     def contributions(self, fx: np.ndarray, fy: np.ndarray) -> np.ndarray:
         """Each target's phase-corrected transform at the frequency pairs
@@ -386,7 +392,8 @@ class Stack:
         for r, pick in enumerate(picks):
             aliased = self.model(fx0[:, None] + self.aliases[None, :, 0], fy0[:, None] + self.aliases[None, :, 1],
                                  self.sigmas[pick])
-            out[r] = each[pick].mean(axis=0) - aliased @ self.alias_phasors[pick].mean(axis=0)
+            share = self.weights[pick] / self.weights[pick].sum()
+            out[r] = share @ each[pick] - aliased @ (share @ self.alias_phasors[pick])
         t = out[:, :-1] / out[:, -1:].real
         if divide_size and self.size > 0:
             divisor = np.sinc(self.size * fx) * np.sinc(self.size * fy)
