@@ -240,7 +240,8 @@ def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: Array
     chip's own pixels have its outliers (points among them) left out: the
     image as given is what is looked at."""
     from .mtf2d.sources import points_seen
-    if exc.reason not in ("no-target", "two-targets", "not-straight", "unsuitable", "not-an-edge", "not-a-bar"):
+    if exc.reason not in ("no-target", "two-targets", "not-straight", "unsuitable", "not-an-edge", "not-a-bar",
+                          "angle", "snr", "non-uniform"):
         return exc
     x0, y0 = chip.origin
     rows, cols = chip.pixels.shape
