@@ -195,6 +195,8 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
         polarity = "bright" if residual.max() >= -residual.min() else "dark"
     signal = residual if polarity == "bright" else -residual
     noise = robust_noise(data)
+    if np.issubdtype(np.asarray(image).dtype, np.integer):
+        noise = max(noise, 1.0 / math.sqrt(12.0))        # an integer chip's rounding, where nothing else shows
     smoothed = ndimage.gaussian_filter(signal, 1.0)
     # a 1 px Gaussian averages white noise over 4 pi sigma^2 pixels
     floor = max(5.0 * noise / math.sqrt(4.0 * math.pi), 1e-3 * float(np.abs(smoothed).max()))
