@@ -7,7 +7,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
+from matplotlib.figure import Figure, SubFigure
 
 from ._common import figure_axes, title_once
 
@@ -26,7 +26,7 @@ def _expect_points(result: object) -> None:
                              f"got {type(result).__name__}")
 
 
-def plot_point_sources(result, image: np.ndarray, ax: Axes | None = None) -> Figure:
+def plot_point_sources(result, image: np.ndarray, ax: Axes | None = None) -> Figure | SubFigure:
     """The chip with every target found: those used circled, those refused
     marked by their reason.
 
@@ -78,7 +78,7 @@ def plot_point_sources(result, image: np.ndarray, ax: Axes | None = None) -> Fig
     return fig
 
 
-def plot_point_psf(result, ax: Axes | None = None) -> Figure:
+def plot_point_psf(result, ax: Axes | None = None) -> Figure | SubFigure:
     """The stacked 2-D PSF (pixel aperture and target size in), peak 1, with
     contours at 10 %, 30 %, 50 %, 70 % and 90 % of its peak; x across and y
     along track, px.
@@ -124,7 +124,7 @@ def plot_point_psf(result, ax: Axes | None = None) -> Figure:
     return fig
 
 
-def plot_point_mtf2d(result, ax: Axes | None = None) -> Figure:
+def plot_point_mtf2d(result, ax: Axes | None = None) -> Figure | SubFigure:
     """The 2-D MTF, ``fx`` across and ``fy`` along track (cy/px), with
     contours at 0.1, 0.3, 0.5, 0.7 and 0.9; the Nyquist square dashed.
 
@@ -168,7 +168,7 @@ def plot_point_mtf2d(result, ax: Axes | None = None) -> Figure:
 
 
 def plot_point_mtf(result, truth: Callable[[np.ndarray, float], np.ndarray] | None = None,
-                   ax: Axes | None = None) -> Figure:
+                   ax: Axes | None = None) -> Figure | SubFigure:
     """The MTF across and along track, each with its interval at Nyquist,
     and the truth (dashed) when known.
 

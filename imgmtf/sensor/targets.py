@@ -132,5 +132,7 @@ class Target:
         numpy.ndarray
             The target's values there, DN.
         """
-        inside = get_kind(self.kind).scene_response(d_px, esf, self.width_px)
+        response = get_kind(self.kind).scene_response
+        assert response is not None, "a target is a line (checked when it was made)"
+        inside = response(d_px, esf, self.width_px)
         return self.low_dn + (self.high_dn - self.low_dn) * inside
