@@ -4,12 +4,16 @@ MTF across and along track with their intervals and the truth when known."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
 from ._common import figure_axes, title_once
+
+if TYPE_CHECKING:
+    from ..estimate.mtf2d.points import PointsResult
 
 #: how each refusal is drawn: (marker, colour)
 _REFUSED_STYLE = {"faint": ("+", "0.55"), "edge": ("s", "tab:orange"), "blended": ("x", "tab:red"),
@@ -20,13 +24,13 @@ _COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
 
 def _expect_points(result: object) -> None:
     from ..errors import ParameterError
-    from ..estimate.mtf2d.points import PointsResult
-    if not isinstance(result, PointsResult):
+    from ..estimate.mtf2d.points import PointsResult as Result
+    if not isinstance(result, Result):
         raise ParameterError(f"this figure draws a point-target measurement (measure_points), "
                              f"got {type(result).__name__}")
 
 
-def plot_point_sources(result, image: np.ndarray, ax: Axes | None = None) -> Figure | SubFigure:
+def plot_point_sources(result: PointsResult, image: np.ndarray, ax: Axes | None = None) -> Figure | SubFigure:
     """The chip with every target found: those used circled, those refused
     marked by their reason.
 
@@ -78,7 +82,7 @@ def plot_point_sources(result, image: np.ndarray, ax: Axes | None = None) -> Fig
     return fig
 
 
-def plot_point_psf(result, ax: Axes | None = None) -> Figure | SubFigure:
+def plot_point_psf(result: PointsResult, ax: Axes | None = None) -> Figure | SubFigure:
     """The stacked 2-D PSF (pixel aperture and target size in), peak 1, with
     contours at 10 %, 30 %, 50 %, 70 % and 90 % of its peak; x across and y
     along track, px.
@@ -124,7 +128,7 @@ def plot_point_psf(result, ax: Axes | None = None) -> Figure | SubFigure:
     return fig
 
 
-def plot_point_mtf2d(result, ax: Axes | None = None) -> Figure | SubFigure:
+def plot_point_mtf2d(result: PointsResult, ax: Axes | None = None) -> Figure | SubFigure:
     """The 2-D MTF, ``fx`` across and ``fy`` along track (cy/px), with
     contours at 0.1, 0.3, 0.5, 0.7 and 0.9; the Nyquist square dashed.
 
@@ -167,7 +171,7 @@ def plot_point_mtf2d(result, ax: Axes | None = None) -> Figure | SubFigure:
     return fig
 
 
-def plot_point_mtf(result, truth: Callable[[np.ndarray, float], np.ndarray] | None = None,
+def plot_point_mtf(result: PointsResult, truth: Callable[[np.ndarray, float], np.ndarray] | None = None,
                    ax: Axes | None = None) -> Figure | SubFigure:
     """The MTF across and along track, each with its interval at Nyquist,
     and the truth (dashed) when known.
@@ -221,7 +225,7 @@ def plot_point_mtf(result, truth: Callable[[np.ndarray, float], np.ndarray] | No
     return fig
 
 
-def plot_points(result, image: np.ndarray | None = None,
+def plot_points(result: PointsResult, image: np.ndarray | None = None,
                 truth: Callable[[np.ndarray, float], np.ndarray] | None = None, title: str | None = None,
                 warnings: Iterable[str] | None = None) -> Figure:
     """The point-target measurement in four panels: the targets found on the
