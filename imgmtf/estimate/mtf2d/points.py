@@ -75,7 +75,7 @@ class DirectionMTF:
         Its interval.
     fwhm_px : float
         The FWHM of the line spread function in this direction (the PSF
-        integrated across it), px.
+        integrated across it), px; a square target's size is in it.
     lsf_x_px, lsf : numpy.ndarray
         That LSF (1/px) and its positions, px.
     """
@@ -431,8 +431,9 @@ class Stack:
 
     def lsf(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """The line spread function along ``vector``: the inverse transform
-        of the section over the band, on a 0.01 px grid (1/px); the target's
-        size is left in where it masks nothing of the band."""
+        of the section over the band, on a 0.01 px grid (1/px), the target's
+        size left in (the LSF as imaged: its sinc cannot be divided out over
+        the whole band)."""
         df = 1.0 / (4 * (2 * self.radius + 1))
         f = np.arange(-BAND_CY_PX, BAND_CY_PX + df / 2, df)
         t = self.transfer(f * vector[0], f * vector[1], divide_size=False)
