@@ -76,7 +76,8 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
             force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
             workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
-    image of a folder.  With --format json, one JSON object per line (JSON
+    image of a folder; with --target points, the 2-D PSF and MTF of the
+    point targets on it, one row across and one along track.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
     line and the rest go on (exit status 1 if any failed).  Rows are printed
     and written to the CSV as each file completes; on Ctrl-C or SIGTERM the
