@@ -131,6 +131,21 @@ class PointsResult:
         The settings.
     warnings : tuple of str
         What the reader should know.
+    method, target : str
+        "points": the stack (no resampling method of the 1-D pipeline), and
+        the kind.
+    checks : tuple
+        Empty: a point stack has no gate of line checks; its targets are
+        refused one by one (``sources``).
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.sensor.points import PointArray, render_points
+    >>> chip = render_points(imgmtf.Sensor(), PointArray(4, 4), 64)
+    >>> result = measure_points(chip.image, intervals="none")
+    >>> result.direction("along-track").direction, len(result.used), result.psf_step_px
+    ('along-track', 16, 0.25)
     """
 
     directions: tuple[DirectionMTF, ...]
@@ -160,7 +175,23 @@ class PointsResult:
         return tuple(s for s in self.sources if not s.used)
 
     def direction(self, name: str) -> DirectionMTF:
-        """The section called ``name`` ("across-track", "along-track")."""
+        """The section called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            "across-track", "along-track" (or "image-x", "image-y").
+
+        Returns
+        -------
+        DirectionMTF
+            That section and its figures.
+
+        Raises
+        ------
+        ParameterError
+            No section of that name.
+        """
         for section in self.directions:
             if section.direction == name:
                 return section
@@ -209,7 +240,18 @@ class PointsResult:
         return out
 
     def to_dict(self, curves: bool = True) -> dict:
-        """The across-track summary (:meth:`summaries` gives both)."""
+        """The first section's summary (:meth:`summaries` gives both).
+
+        Parameters
+        ----------
+        curves : bool, optional
+            Include the MTF section (default True).
+
+        Returns
+        -------
+        dict
+            The across-track (or image-x) summary.
+        """
         return self.summaries(curves)[0]
 
 
