@@ -23,7 +23,8 @@ model as much as its one phase leaves aliased, and the result says how much
 
 Directions: "across-track" is frequency along the image's x (columns),
 "along-track" along y (rows), as in sensor geometry.  The intervals are a
-percentile bootstrap over the targets.
+percentile bootstrap over the targets, expanded for their small number
+(:meth:`Stack.small_sample_factor`).
 """
 from __future__ import annotations
 
@@ -255,6 +256,13 @@ class PointsResult:
         return self.summaries(curves)[0]
 
 
+def _widened(replicates: np.ndarray, estimate: float, tail: float, widen: float) -> Interval:
+    """The percentile interval of ``replicates``, its ends moved ``widen``
+    times as far from ``estimate``."""
+    low, high = np.nanpercentile(replicates, [tail, 100 - tail])
+    return Interval(estimate - widen * (estimate - low), estimate + widen * (high - estimate))
+
+
 def _finite(value: Any) -> float | None:
     value = float(value)
     return round(value, 6) if math.isfinite(value) else None
@@ -461,15 +469,29 @@ class Stack:
             n = len(self.stamps)
             reps = np.abs(self.replicates(f * ux, f * uy, rng.integers(0, n, (settings.replicates, n))))
             tail = 100 * (1 - settings.confidence) / 2
-            ny = reps[:, nyquist]
-            nyquist_ci = Interval(*np.nanpercentile(ny, [tail, 100 - tail])).clipped_at_zero()
+            widen = self.small_sample_factor(settings.confidence)
+            nyquist_ci = _widened(reps[:, nyquist], float(mtf[nyquist]), tail, widen).clipped_at_zero()
             m50 = first_crossing(f, reps, 0.5)
-            mtf50_ci = (Interval(*np.nanpercentile(m50, [tail, 100 - tail])) if np.isfinite(m50).any()
-                       else Interval.none())
+            mtf50 = first_crossing(f, mtf, 0.5)
+            mtf50_ci = (_widened(m50, mtf50, tail, widen) if np.isfinite(m50).any() and np.isfinite(mtf50)
+                        else Interval.none())
         angle = math.degrees(math.atan2(uy, ux))
         angle = angle - 180.0 if angle > 90.0 else angle + 180.0 if angle <= -90.0 else angle
         return DirectionMTF(name, angle + 0.0, f, mtf, float(mtf[nyquist]), nyquist_ci, first_crossing(f, mtf, 0.5),
                             mtf50_ci, fwhm(lsf_x, lsf), lsf_x, lsf)
+
+    def small_sample_factor(self, confidence: float) -> float:
+        """How much wider than its bootstrap percentiles an interval over
+        few targets is drawn: Student's t over the normal quantile, times
+        sqrt(n / (n - 1)) (the bootstrap's variance of a mean is (n - 1) / n
+        of the truth), n the weights' effective count (Hesterberg's
+        expanded percentile interval); 1.09 x 1.03 for 16 targets."""
+        from scipy import stats
+        n = float(self.weights.sum() ** 2 / (self.weights ** 2).sum())
+        if n <= 1.5:
+            return math.inf
+        q = 0.5 + confidence / 2
+        return float(stats.t.ppf(q, n - 1) / stats.norm.ppf(q) * math.sqrt(n / (n - 1)))
 
     def lsf(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """The line spread function along ``vector``: the inverse transform
