@@ -18,6 +18,7 @@ import numpy as np
 from .atomic import ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .figures import with_figure
+from .file_notes import file_notes as raster_notes
 from .inputs import saturation_levels
 from .io import open_raster, read_raster
 from .measure_settings import MeasureSettings
@@ -46,6 +47,30 @@ def expand_inputs(paths, recursive: bool = False) -> list[str]:
         else:
             out.append(raw)
     return out
+
+
+def once_each(files: list[str]) -> tuple[list[str], dict[str, int]]:
+    """The files in their order with each file once (the same file named
+    twice, or by two paths, as ``a.tif ./a.tif``, or inside a folder also
+    named), and how many times each repeated one was named (by its first
+    name): a batch measures a file once and says so.
+
+    Examples
+    --------
+    >>> once_each(["a.tif", "b.tif", "./a.tif", "a.tif"])
+    (['a.tif', 'b.tif'], {'a.tif': 3})
+    """
+    first: dict[str, str] = {}
+    counts: dict[str, int] = {}
+    kept = []
+    for name in files:
+        key = os.path.normcase(os.path.realpath(name)) if name else name
+        if key in first:
+            counts[first[key]] = counts.get(first[key], 1) + 1
+            continue
+        first[key] = name
+        kept.append(name)
+    return kept, counts
 
 
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
@@ -145,17 +170,12 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
     once and named by each."""
     path, info = file.path, file.info
     records: list[Record] = []
-    if raster.band == "luminance":
-        # a photo's stored values are gamma-encoded: their edge is not the light's, and the MTF differs
-        encoding = ("gamma-encoded as stored (not linearised: the sRGB or a gamma transfer curve linearises "
-                    "them)" if settings.transfer == "linear" else f"then linearised ({settings.transfer}: exact "
-                    "for a grey target, whose channels are equal)")
-        file_notes = [*file_notes, f"measured on the Rec. 709 luminance of the stored RGB values, {encoding}"
-                      + (", alpha ignored" if info.alpha_bands else "")]
+    # what the file says about every number in it, as a scan says it of each edge it accepts
+    file_notes = [*file_notes, *raster_notes(raster, settings.transfer, bool(info.alpha_bands))]
     for summary in summaries:
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
-        record = _with_file_notes(record, raster, settings, result.checks)
+        record = _untrusted_when_forced(record, settings, result.checks)
         if plot_path and records and records[0].plot:
             record = record.with_(plot=records[0].plot)
         elif plot_path:
@@ -166,23 +186,9 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
     return records
 
 
-def _with_file_notes(record: Record, raster, settings: MeasureSettings, checks) -> Record:
-    """What the file itself says about the number: a lossy codec's loss in
-    it, values taken as linear that may not be, and a forced number that
-    no one should use (status ``untrusted``: printed, and a failure)."""
-    notes = []
-    if raster.compression:
-        notes.append(f"the file is stored with {raster.compression} compression: the MTF includes the codec's loss "
-                     "(measure an uncompressed copy for the system's own)")
-    # (an RGB file's luminance carries its own note of the encoding)
-    if (raster.dtype == "uint8" and settings.transfer == "linear" and raster.provenance is None
-            and raster.band != "luminance"):
-        notes.append("8-bit values are measured as stored, taken as linear: if the image is gamma-encoded "
-                     "(sRGB, as most 8-bit camera images are) the MTF reads wrong; linearise it with the sRGB "
-                     "or a gamma transfer curve (MTF Mapper assumes sRGB for 8-bit input, Imatest its "
-                     "gamma setting)")
-    if notes:
-        record = record.with_(figures={"warnings": [*record.get("warnings", []), *notes]})
+def _untrusted_when_forced(record: Record, settings: MeasureSettings, checks) -> Record:
+    """A forced number that no one should use: status ``untrusted``
+    (printed, and a failure)."""
     if settings.force:
         from .estimate.gate import untrusted_when_forced
         failed = untrusted_when_forced(checks)

@@ -311,7 +311,8 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "direction", "normal_angle_deg", "tilt_deg", "polarity", "rows_used", "snr",
     "mtf_nyquist", "mtf_nyquist_ci_low", "mtf_nyquist_ci_high",
     "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
-    "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px",
+    "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "mtf_peak", "mtf_peak_cy_px",
+    "sharpened",
     "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
 # each kind of target's own figures (imgmtf.kinds.Kind.record_fields) are

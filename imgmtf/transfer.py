@@ -64,6 +64,28 @@ class Transfer:
         return out * full_scale
 
 
+def noise_gain(transfer: Transfer, linear_values, full_scale: float) -> np.ndarray:
+    """How linearisation scales the noise of the stored values at each
+    linear value (DN): the slope d(linear) / d(stored) of ``transfer`` at
+    the stored value that decodes to it.  Noise uniform in the stored
+    values becomes this much larger (bright) or smaller (dark) in linear
+    light; 1 for "linear".
+
+    Examples
+    --------
+    >>> [round(float(g), 3) for g in noise_gain(parse_transfer("gamma:2"), np.array([25.0, 100.0]), 100.0)]
+    [1.0, 2.0]
+    """
+    u = np.clip(np.asarray(linear_values, np.float64) / full_scale, 0.0, 1.0)
+    if transfer.name == "srgb":
+        encoded = np.where(u <= 0.0031308, 12.92 * u, 1.055 * u ** (1 / 2.4) - 0.055)
+        return np.where(encoded <= 0.04045, 1 / 12.92, 2.4 / 1.055 * ((encoded + 0.055) / 1.055) ** 1.4)
+    if transfer.name == "gamma":
+        gamma = float(transfer.gamma)  # type: ignore[arg-type]
+        return gamma * u ** ((gamma - 1.0) / gamma)
+    return np.ones_like(u)
+
+
 def parse_transfer(value) -> Transfer:
     """A :class:`Transfer` from "linear", "srgb" or "gamma:G" (G, the
     decoding exponent, in [0.2, 5]), or a Transfer as it is.

@@ -199,7 +199,11 @@ def test_an_unexpected_failure_is_an_internal_error_record_for_that_file_only(tm
 
 def test_mixed_batch_keeps_every_row_in_input_order_with_workers(tmp_path, good):
     cases = bad_inputs(tmp_path)
-    paths = [str(p) for p, _ in cases.values()] * 2 + [str(good)] * 3
+    # distinct files (a file named twice is measured once): the good one copied under three names
+    copies = [tmp_path / f"good{i}.tif" for i in range(3)]
+    for copy in copies:
+        copy.write_bytes(good.read_bytes())
+    paths = [str(p) for p, _ in cases.values()] + [str(c) for c in copies]
     out_csv = tmp_path / "rows.csv"
     result = CliRunner().invoke(main, ["measure", "--format", "json", "--workers", "2", "--bootstrap", "0",
                                        "--csv", str(out_csv), *paths])
@@ -260,3 +264,13 @@ def test_measure_file_returns_what_measure_format_json_prints_on_the_sample_data
     assert by_words.method == "spline" and by_words.get("params")["intervals"]["method"] == "none"
     with pytest.raises(im.ParameterError, match="not both"):
         imgmtf.measure_file(files[0], imgmtf.MeasureSettings(), method="spline")
+
+
+def test_a_file_named_twice_in_one_batch_is_measured_once_and_said_so(tmp_path, good):
+    from imgmtf.batch import once_each
+    other = os.path.join(os.path.dirname(good), ".", os.path.basename(good))       # the same file, another name
+    assert once_each([str(good), "b.tif", other, str(good)]) == ([str(good), "b.tif"], {str(good): 3})
+    result = CliRunner().invoke(main, ["measure", "--format", "json", str(good), other, str(tmp_path)])
+    rows = [json.loads(line) for line in result.stdout.splitlines()]
+    assert result.exit_code == 0 and [row["path"] for row in rows] == [str(good)]
+    assert f"{good} is named 3 times: measured once" in result.stderr

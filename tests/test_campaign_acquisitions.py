@@ -131,3 +131,28 @@ def test_an_unreadable_file_is_a_clear_error(tmp_path):
     (tmp_path / "x.tif").write_text("not an image")
     with pytest.raises(ImageReadError, match="x.tif"):
         read_acquisition(tmp_path / "x.tif")
+
+
+def test_the_sensor_key_tells_sensors_apart_by_camera_tags_or_image_signature(tmp_path):
+    from dataclasses import replace
+
+    from imgmtf.campaign.acquisitions import sensor_key
+    from imgmtf.io import raster_info, raster_metadata
+    a = read_acquisition(scene(tmp_path / "a.tif", gsd_m=2.0), band=1)
+    b = read_acquisition(scene(tmp_path / "b.tif", gsd_m=2.0, value=5), band=1)
+    assert a.sensor_key == b.sensor_key == "16 x 16 px uint16, GSD 2 m"       # one sensor's chips, cut alike
+    other = read_acquisition(scene(tmp_path / "c.tif", {"TIFFTAG_SOFTWARE": "SSTL Terra v1.1.4.0"}, gsd_m=2.0), band=1)
+    assert other.sensor_key == "16 x 16 px uint16, GSD 2 m, SSTL Terra v1.1.4.0"
+    info = raster_info(tmp_path / "a.tif")
+    camera = {"default": {"EXIF_Make": "Canon", "EXIF_Model": "EOS 5D", "EXIF_BodySerialNumber": "0421"}}
+    assert sensor_key(info, camera) == "camera Canon EOS 5D 0421"
+    assert sensor_key(replace(info, count=3, width=20), raster_metadata(tmp_path / "a.tif")) == (
+        "20 x 16 px uint16, 3 bands, GSD 2 m")
+
+
+def test_the_real_baotou_and_pan_chips_are_two_sensors():
+    # neither names a platform: a store of both must not trend them together (issue #31)
+    from conftest import real_scene
+    keys = {read_acquisition(real_scene(name), band=1).sensor_key
+            for name in ("baotou_l0r_checkerboard.tif", "pan_l0r_checkerboard.tif")}
+    assert keys == {"101 x 101 px uint16", "80 x 80 px uint16, SSTL Terra v1.1.4.0"}

@@ -2,6 +2,7 @@
 a self-contained page, the figures; measure and fit with --campaign."""
 import csv
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -122,6 +123,14 @@ def test_the_report_command(tmp_path):
     assert missing.exit_code == 1 and "none.gpkg: no such campaign store" in missing.output
     bad = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "o"), "--requirement", "nan"])
     assert bad.exit_code == 2
+    per = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "per"),
+                                    "--requirement", "across=0.25,along=0.1"])
+    assert per.exit_code == 0, per.output
+    page = (tmp_path / "per" / "report.html").read_text(encoding="utf-8")
+    assert "at least across-track 0.25, along-track 0.1." in page
+    assert '<span class="pass">pass</span> (&ge; 0.25)' in page      # the latest, 0.26 +- 0.004
+    wrong = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "o"), "--requirement", "across"])
+    assert wrong.exit_code == 2 and "DIRECTION=MTF" in wrong.output
 
 
 def chip(path, angle, when=None, sigma=0.4):
@@ -192,3 +201,119 @@ def test_the_page_embeds_the_latest_acquisitions_figures_only(tmp_path):
     assert page.count("<img ") == MAX_ACQUISITIONS_WITH_FIGURES
     assert "2 earlier ones" in page and f"{2000 + count - 1}-01-01: s{count - 1}.tif" in page
     assert "2000-01-01: s0.tif" not in page
+
+
+def direction_row(direction, value, method, *, misfit=None, recommended=None, assumption=None, plot=None):
+    figures = {"summary": method, "direction": direction, "mtf_nyquist": value,
+               "mtf_nyquist_ci": [value - 0.004, value + 0.004], "fwhm_px": 1.5}
+    if misfit is not None:
+        figures["misfit"] = misfit
+    if recommended is not None:
+        figures.update(recommended=recommended, recommended_because="the data decide")
+    if assumption:
+        figures["assumption"] = assumption
+    return Record("scene.tif", 1, "edge", "", "fitted" if method == "fit" else "combined", figures=figures,
+                  site={"scope": "scene"}, plot=plot)
+
+
+@pytest.fixture(scope="module")
+def real_like(tmp_path_factory):
+    """Three yearly acquisitions as the real chips give them: across track a
+    misfit fit and the recommended model-free sections; along track only a
+    misfit fit; and one acquisition of another platform."""
+    tmp_path = tmp_path_factory.mktemp("real")
+    store = tmp_path / "site.gpkg"
+    for k in range(3):
+        rows = [direction_row("across-track", 0.002, "fit", misfit=True, recommended=False),
+                direction_row("across-track", 0.12 - 0.02 * k, "sections", recommended=True, assumption="bracket"),
+                direction_row("along-track", 0.003, "fit", misfit=True, recommended=False)]
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2020 + k}-06-01", "Sat-A"), [], rows)
+    write_acquisition(store, Acquisition("b0", "b.tif", "1" * 64, "2021-01-01", "Sat-B"), [],
+                      [direction_row("across-track", 0.09, "combined")])
+    return write_report(store, tmp_path / "report", requirement=0.105)
+
+
+def test_the_drift_table_quotes_the_recommended_rows_and_marks_the_others(real_like):
+    page = open(real_like.report_html, encoding="utf-8").read()
+    table = page[page.index("<h2>Drift of the MTF at Nyquist"):page.index("<h2>Figures of merit")]
+    rows = re.findall(r"<tr class=\"([^\"]*)\">(.*?)</tr>", table)
+    cells = [(kind, re.sub(r"<[^>]+>", "", row)) for kind, row in rows]
+    assert [(kind, "recommended" in text, "Sat-A" in text) for kind, text in cells] == [
+        ("drift", True, True), ("misfit", False, True), ("misfit", False, True), ("", True, False)]
+    assert "sections (bracket)" in cells[0][1] and "misfit" in cells[1][1] and "nothing to quote" not in cells[1][1]
+    assert "only misfit rows:nothing to quote" in cells[2][1]            # along track: the fit alone, misfit
+    assert "misfit: not trended" in cells[2][1]
+    assert "one acquisition: no slope" in cells[3][1]
+    # the requirement judged on the latest acquisition: 0.08 +- 0.004 against 0.105 fails; 0.09 fails
+    assert re.findall(r'<span class="(pass|fail|undecided)">', table) == ["fail", "fail"]
+    # one figure: the recommended series of Sat-A across track, and Sat-B's single point; nothing misfit drawn
+    drawn = re.findall(r'<div class="figure"><h3>([^<]*)</h3>', page)
+    assert drawn == ["Sat-A: across-track, sections (bracket)", "Sat-B: across-track, combined"]
+
+
+def test_the_command_says_which_directions_have_only_misfit_rows(real_like, tmp_path):
+    store = str(Path(real_like.report_html).parent.parent / "site.gpkg")
+    result = CliRunner().invoke(main, ["report", store, "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    assert "note: Sat-A, along-track: only misfit rows, nothing to quote or trend" in result.output
+    assert result.output.count("note:") == 1
+    assert "drift: Sat-A, across-track, sections: MTF at Nyquist -0.0200/year" in result.output
+
+
+def test_trend_csv_holds_every_group_with_method_assumption_recommended_and_misfit(real_like):
+    with open(real_like.trend_csv, newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["figure"] == "mtf_nyquist"]
+    got = sorted((r["sensor"], r["direction"], r["method"], r["assumption"], r["recommended"], r["misfit"],
+                  r["slope_per_year"] != "", r["meets_requirement"]) for r in rows)
+    assert got == [("Sat-A", "across-track", "fit", "", "False", "True", False, ""),
+                   ("Sat-A", "across-track", "sections", "bracket", "True", "False", True, "fail"),
+                   ("Sat-A", "along-track", "fit", "", "False", "True", False, ""),
+                   ("Sat-B", "across-track", "combined", "", "True", "False", False, "fail")]
+
+
+def test_a_single_acquisition_is_a_point_not_a_line():
+    from imgmtf.campaign.trend import trends
+    rows = [{"acquisition_id": "a", "acquired_utc": "2021-06-01", "platform": "S", "direction": "across-track",
+             "method": "combined", "mtf_nyquist": 0.1}]
+    [trend] = [t for t in trends(rows) if t.figure == "mtf_nyquist"]
+    ax = plot_trend(rows, trend=trend).axes[0]
+    assert ax.lines and all(len(line.get_xdata()) == 1 for line in ax.lines)   # the point, no line through it
+    assert not any("/year" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def test_every_figure_opens_at_full_resolution_and_a_missing_one_is_reported(tmp_path):
+    out = tmp_path / "scan"
+    out.mkdir()
+    for name in ("overview.png", "edge1.png", "edge2.png"):
+        imgmtf.write_png(out / name, np.zeros((8, 8), np.uint8))
+    store = tmp_path / "site.gpkg"
+    rows = [direction_row("across-track", 0.3 - 0.01 * k, "combined", plot=str(out / f"edge{k + 1}.png"))
+            for k in range(2)]
+    for k, row in enumerate(rows):
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2020 + k}-01-01", "S",
+                                             overview=str(out / "overview.png")), [], [row])
+    (out / "edge2.png").unlink()                                        # moved away after the scan
+    written = write_report(store, tmp_path / "report")
+    page = open(written.report_html, encoding="utf-8").read()
+    links = re.findall(r'<a href="([^"]+)"><img ', page)
+    assert len(links) == page.count("<img ") == 1 + 2 + 1               # trend, two overviews, one edge figure
+    assert all((tmp_path / "report" / link).is_file() for link in links)
+    assert links[0].startswith("figures/") and links[1] == "../scan/overview.png"
+    assert written.warnings == (f"{store}: figure scan/edge2.png is missing (looked for {out / 'edge2.png'}): "
+                                "moved or deleted",)
+    assert "1 figure(s) the store names are missing" in page and "<code title=" in page
+    (tmp_path / "report" / "figures" / "07-trend.png").write_bytes(b"an earlier report's")
+    write_report(store, tmp_path / "report")
+    assert sorted(p.name for p in (tmp_path / "report" / "figures").iterdir()) == ["01-trend.png"]
+    result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "again")])
+    assert result.exit_code == 0 and "warning: " in result.output and "edge2.png is missing" in result.output
+
+
+def test_the_page_escapes_what_the_store_holds(tmp_path):
+    # the template autoescapes: a platform or file name is text, never markup
+    store = tmp_path / "site.gpkg"
+    for k in range(2):
+        write_acquisition(store, Acquisition(f"a{k}", f"<b>s{k}.tif", "0" * 64, f"{2020 + k}-01-01",
+                                             "<script>alert(1)</script>"), [], [fit_row("across-track", 0.3)])
+    page = open(write_report(store, tmp_path / "out").report_html, encoding="utf-8").read()
+    assert "<script" not in page and "&lt;script&gt;alert(1)&lt;/script&gt;" in page and "&lt;b&gt;s1.tif" in page

@@ -2,6 +2,7 @@
 acquisition in one transaction, concurrent writers losing nothing."""
 import multiprocessing
 import sqlite3
+from pathlib import Path
 
 import fiona
 import numpy as np
@@ -188,9 +189,64 @@ def test_bad_stores_and_rows_are_clear_errors(tmp_path, acquisition):
         read_layer(tmp_path / "missing.gpkg", "edges")
     with pytest.raises(ParameterError, match="layer must be one of"):
         read_layer(tmp_path / "notes.gpkg", "bridges")
-    with pytest.raises(ParameterError, match="summary must be one of combined, fit"):
+    with pytest.raises(ParameterError, match="summary must be one of combined, sections, fit"):
         write_acquisition(tmp_path / "s.gpkg", acquisition, [], [summary("scene", "across-track", "mean")])
     with pytest.raises(ParameterError, match="must be Records"):
         write_acquisition(tmp_path / "s.gpkg", acquisition, [{"mtf_nyquist": 0.2}], [])
     with pytest.raises(FileWriteError, match="does not exist"):
         write_acquisition(tmp_path / "no" / "s.gpkg", acquisition, [], [])
+
+
+def test_recommended_rows_their_assumption_and_misfit_are_kept(tmp_path, acquisition):
+    store = tmp_path / "site.gpkg"
+    sections = summary("scene", "across-track", "sections")
+    sections.figures.update(recommended=True, recommended_because="a third orientation decides",
+                            assumption="elliptical")
+    fit = summary("scene", "across-track", "fit")
+    fit.figures.update(recommended=True, misfit=True)          # a misfit is never stored as recommended
+    write_acquisition(store, acquisition, [], [sections, fit])
+    got = {r["method"]: r for r in read_layer(store, "targets")}
+    assert (got["sections"]["recommended"], got["sections"]["assumption"],
+            got["sections"]["recommended_because"]) == (1, "elliptical", "a third orientation decides")
+    assert (got["fit"]["recommended"], got["fit"]["misfit"]) == (0, 1)
+    assert got["fit"]["sensor_key"] == "16 x 16 px uint16, GSD 15 m"
+
+
+def test_a_schema_1_store_gains_the_new_columns_and_keeps_its_rows(tmp_path, acquisition):
+    store = tmp_path / "site.gpkg"
+    write_acquisition(store, acquisition, [], [summary("scene", "across-track", "fit")])
+    with sqlite3.connect(store) as db:           # as imgmtf's schema 1 left it
+        for column in ("recommended", "recommended_because", "assumption", "sensor_key"):
+            db.execute(f"ALTER TABLE targets DROP COLUMN {column}")
+        db.execute("ALTER TABLE acquisitions DROP COLUMN sensor_key")
+        db.execute("UPDATE store_info SET value = '1' WHERE key = 'schema_version'")
+    [old] = read_layer(store, "targets")
+    assert old["recommended"] is None and old["assumption"] is None and old["method"] == "fit"
+    other = read_acquisition(acquisition.path, band=1, settings={"other": True})
+    write_acquisition(store, other, [], [summary("scene", "along-track", "combined")])
+    assert schema_version(store) == SCHEMA_VERSION == 2
+    assert sorted(str(r["sensor_key"]) for r in read_layer(store, "targets")) == [
+        "16 x 16 px uint16, GSD 15 m", "None"]
+
+
+def test_figures_are_kept_relative_to_the_store_and_found_after_it_moves(tmp_path, acquisition, monkeypatch):
+    import shutil
+    from dataclasses import replace
+
+    from imgmtf.campaign.store import figure_path
+    site = tmp_path / "site"
+    (site / "out").mkdir(parents=True)
+    (site / "out" / "edge1.png").write_bytes(b"png")
+    monkeypatch.chdir(tmp_path)                               # figures named relative to the working folder
+    edge = half_edge("e1", 0, 0.0)
+    edge = Record(edge.path, edge.band, edge.target, edge.method, edge.status, figures=edge.figures,
+                  site=edge.site, plot="site/out/edge1.png")
+    write_acquisition(site / "s.gpkg", replace(acquisition, overview=str(site / "out" / "edge1.png")), [edge], [])
+    assert [r["plot"] for r in read_layer(site / "s.gpkg", "edges")] == ["out/edge1.png"]
+    assert read_layer(site / "s.gpkg", "acquisitions")[0]["overview"] == "out/edge1.png"
+    shutil.move(site, tmp_path / "moved")
+    assert figure_path(tmp_path / "moved" / "s.gpkg", "out/edge1.png").read_bytes() == b"png"
+    # an older store's path, relative to where it was written from, is found there too
+    assert figure_path(tmp_path / "moved" / "s.gpkg", "moved/out/edge1.png") == Path("moved/out/edge1.png")
+    assert figure_path(tmp_path / "moved" / "s.gpkg", "/abs/fig.png") == Path("/abs/fig.png")
+    assert figure_path(tmp_path / "moved" / "s.gpkg", None) is None

@@ -118,3 +118,66 @@ def test_a_targets_two_oblique_directions_make_two_trends():
     assert set(found) == {"oblique (normal 17 deg)", "oblique (normal -73 deg)"}
     assert found["oblique (normal 17 deg)"].slope_per_year == pytest.approx(-0.01, rel=0.01)
     assert found["oblique (normal -73 deg)"].slope_per_year == pytest.approx(-0.02, rel=0.01)
+
+
+def test_two_unnamed_sensors_are_never_one_trend():
+    # the real Baotou and PAN chips name no platform: before, they made one line between two sensors
+    rows = [row(0, "2021-06-01", 0.11, platform=None, sensor_key="101 x 101 px uint16"),
+            row(1, "2022-06-01", 0.09, platform=None, sensor_key="80 x 80 px uint16, SSTL Terra v1.1.4.0")]
+    found = [t for t in trends(rows) if t.figure == "mtf_nyquist"]
+    assert sorted(t.sensor for t in found) == ["unnamed: 101 x 101 px uint16",
+                                               "unnamed: 80 x 80 px uint16, SSTL Terra v1.1.4.0"]
+    assert all(not t.has_slope and t.note == "one acquisition: no slope" and not t.drift for t in found)
+    same = [row(k, f"{2021 + k}-06-01", 0.11 - 0.01 * k, platform=None, sensor_key="101 x 101 px uint16")
+            for k in range(3)]
+    [joined] = [t for t in trends(same) if t.figure == "mtf_nyquist"]
+    assert joined.n_acquisitions == 3 and joined.slope_per_year == pytest.approx(-0.01, rel=1e-2)
+    alone = [row(k, f"{2021 + k}-06-01", 0.11, platform=None) for k in range(2)]       # an older store
+    assert len([t for t in trends(alone) if t.figure == "mtf_nyquist"]) == 2
+
+
+def test_misfit_rows_are_listed_but_never_trended_and_never_recommended():
+    rows = [row(k, f"{2020 + k}-01-01", 0.002 + 0.001 * k, misfit=1) for k in range(4)]
+    rows += [row(k, f"{2020 + k}-01-01", 0.12 - 0.01 * k, method="sections", assumption="bracket",
+                 recommended=1) for k in range(4)]
+    found = {t.method: t for t in trends(rows) if t.figure == "mtf_nyquist"}
+    fit, sections = found["fit"], found["sections"]
+    assert fit.misfit and not fit.recommended and not fit.has_slope and fit.note.startswith("misfit: not trended")
+    assert fit.n_acquisitions == 4 and fit.latest == pytest.approx(0.005)
+    assert sections.recommended and sections.assumption == "bracket" and sections.drift
+    assert sections.slope_per_year == pytest.approx(-0.01, rel=1e-2)
+
+
+def test_a_method_recommended_in_some_years_only_makes_two_series():
+    rows = [row(k, f"{2020 + k}-01-01", 0.12, method="sections", recommended=int(k < 2)) for k in range(4)]
+    found = sorted((t.recommended, t.n_acquisitions) for t in trends(rows) if t.figure == "mtf_nyquist")
+    assert found == [(False, 2), (True, 2)]
+
+
+def test_the_requirement_is_judged_on_the_latest_acquisitions_interval():
+    from imgmtf.campaign.trend import requirement_verdict
+    rows = [row(k, f"{2020 + k}-01-01", 0.30 - 0.05 * k, half=0.01) for k in range(3)]   # latest 0.20 +- 0.01
+    [t] = [t for t in trends(rows) if t.figure == "mtf_nyquist"]
+    assert (t.latest, t.latest_ci_low, t.latest_ci_high) == (pytest.approx(0.20), pytest.approx(0.19),
+                                                             pytest.approx(0.21))
+    assert [requirement_verdict(t, r) for r in (0.18, 0.185, 0.205, 0.22, None)] == [
+        "pass", "pass", "undecided", "fail", ""]
+    [fwhm] = [t for t in trends([row(0, "2020-01-01", 0.3, fwhm_px=1.4)]) if t.figure == "fwhm_px"]
+    assert requirement_verdict(fwhm, 1.3) == "pass" and requirement_verdict(fwhm, 1.5) == "fail"  # value alone
+    misfit = [t for t in trends([row(0, "2020-01-01", 0.3, misfit=1)]) if t.figure == "mtf_nyquist"]
+    assert requirement_verdict(misfit[0], 0.1) == ""
+
+
+def test_a_requirement_per_direction_is_read_and_applied():
+    from imgmtf.campaign.trend import Requirement, requirement_verdict
+    need = Requirement.parse("0.1, along=0.3, oblique (normal 17 deg)=0.05")
+    assert (need.for_direction("across-track"), need.for_direction("along-track"),
+            need.for_direction("oblique (normal 17 deg)")) == (0.1, 0.3, 0.05)
+    assert Requirement.parse("across-track=0.2").for_direction("along-track") is None
+    assert Requirement.of(0.25) == Requirement(0.25) and Requirement.of(None) is None
+    rows = [row(0, "2020-01-01", 0.2, half=0.01), row(0, "2020-01-01", 0.2, direction="along-track", half=0.01)]
+    verdicts = {t.direction: requirement_verdict(t, need) for t in trends(rows) if t.figure == "mtf_nyquist"}
+    assert verdicts == {"across-track": "pass", "along-track": "fail"}
+    for bad in ("1.5", "across=", "=0.1", "across=0.1,across=0.2", "0.1,0.2", "nan", "fast"):
+        with pytest.raises(ParameterError, match="requirement"):
+            Requirement.parse(bad)

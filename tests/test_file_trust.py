@@ -122,3 +122,23 @@ def test_refusals_a_scan_solves_point_to_it_and_others_do_not(tmp_path):
     im.write_geotiff(path, (first.astype(float) + second).astype(np.uint16))
     result = CliRunner().invoke(main, ["measure", str(path)])
     assert result.exit_code == 1 and f"imgmtf scan {path}" in result.output
+
+
+@pytest.mark.parametrize("name, options", [("gamma.tif", {}), ("gamma.jpg", {"driver": "JPEG", "QUALITY": 90})])
+def test_scan_and_measure_give_one_edge_the_same_warnings(tmp_path, name, options):
+    from imgmtf.batch import measure_file
+    from imgmtf.measure_settings import MeasureSettings
+    from imgmtf.scene.measure import scan_scene
+    from imgmtf.scene.settings import ScanSettings
+    linear = exact_edge_chip(H, 6.0, offset=0.2, low=0.05, high=0.8, noise_std=0.002, dtype=np.float64,
+                             shape=(128, 128))
+    encoded = np.clip(np.rint(255 * linear ** (1 / 2.2)), 0, 255).astype(np.uint8)     # 8-bit, gamma 2.2
+    path = str(write(tmp_path / name, encoded, **options))
+    accepted = [r.to_dict() for r in scan_scene(path, ScanSettings(track_azimuth_deg=0.0)) if r.status == "accepted"]
+    assert accepted
+    scanned = accepted[0]
+    (measured,) = measure_file(path, MeasureSettings(roi=tuple(scanned["roi"])))
+    assert measured.status == "ok"
+    assert scanned["warnings"] == measured.to_dict()["warnings"]
+    assert any(w.startswith("8-bit values are measured as stored") for w in scanned["warnings"])
+    assert any("JPEG compression" in w for w in scanned["warnings"]) == name.endswith(".jpg")

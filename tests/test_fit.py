@@ -56,10 +56,14 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     assert wrong.edges[0].misfit_p < 1e-3
     # the advice names stages the model lacks, never one it has
     from imgmtf.estimate.fit.model import other_stages as _other_stages
-    assert _other_stages(wrong.sensor.stages) == "try other stages (e.g. diffraction, defocus, olpf)"
-    assert _other_stages(right.sensor.stages) == "try other stages (e.g. defocus, olpf)"
-    everything = im.Sensor(1.0, [st.Diffraction(8.0), st.Defocus(1.0), st.OLPF(0.7), st.Detector()])
-    assert "imgmtf measure" in _other_stages(everything.stages)
+    assert _other_stages(wrong.sensor.stages) == ("try the stages real blur adds (diffusion, halo, lag; stages "
+                                                  "'auto' tries them) or others (e.g. diffraction, defocus, olpf)")
+    assert _other_stages(right.sensor.stages).endswith("or others (e.g. defocus, olpf)")
+    real = [st.GaussianOptics(), st.Detector(), st.Diffusion(), st.Halo(), st.Lag()]
+    assert _other_stages(real) == "try other stages (e.g. diffraction, defocus, olpf), or quote the rows measured " \
+                                  "without a model"
+    everything = [st.Diffraction(8.0), st.Defocus(1.0), st.OLPF(0.7), *real]
+    assert _other_stages(everything) == "quote the rows measured without a model, which assume no form of blur"
 
 
 def test_profile_noise_needs_no_model():

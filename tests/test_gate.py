@@ -11,7 +11,7 @@ import imgmtf as im
 from imgmtf.errors import ImgmtfError, MultipleTargetsError, TargetNotFoundError
 from imgmtf.estimate import gate
 
-from conftest import exact_edge_chip, gaussian_pixel_transfer
+from conftest import exact_edge_chip, exact_esf, gaussian_pixel_transfer
 
 H = gaussian_pixel_transfer(0.5, 6.0)
 
@@ -294,3 +294,28 @@ def test_a_road_beside_an_edge_and_a_shadow_beside_a_bar_are_second_targets():
     refused(bar - 300.0 * ((d > 7) & (d < 11)), "two-targets", measure=im.measure_pulse, width_px=2.0)
     assert gate.mixed_profile(np.r_[np.full(10, 200.0), np.full(5, 800.0), np.full(10, 200.0), np.full(10, 1200.0)])
     assert not gate.mixed_profile(np.r_[np.full(10, 200.0), np.linspace(200, 1200, 5), np.full(10, 1200.0)])
+
+
+def test_a_side_whose_plateau_never_arrives_is_refused_not_passed_unchecked():
+    # the bright side keeps rising as a curve beyond the edge, 200 + (1000 + 12 d^1.5) DN: read as
+    # blur the edge measured 0.04 at Nyquist (truth 0.19) with no side left to check and no word
+    d = _normal_distance()
+    fx, esf = exact_esf(H)
+    chip = 200 + (1000 + 12 * np.clip(d, 0, None) ** 1.5) * np.interp(d, fx, esf)
+    error = refused(chip + np.random.default_rng(3).normal(0, 3, chip.shape), "non-uniform")
+    assert "holds no plateau within the chip" in str(error)
+
+
+def test_every_check_is_listed_with_its_outcome_and_one_that_cannot_run_says_why():
+    # 30 rows: too few for the 8-row block grid; measured, the check listed as not run
+    r = im.measure_edge(edge(shape=(30, 100)))
+    outcomes = {(c.reason, c.outcome) for c in r.checks}
+    assert ("compression", "not-run") in outcomes and all(not c.failed for c in r.checks)
+    listed = r.to_dict()["checks"]
+    assert len(listed) == len(r.checks) and {c["outcome"] for c in listed} == {"passed", "not-run"}
+    not_run = next(c for c in listed if c["outcome"] == "not-run")
+    assert not not_run["passed"] and not_run["message"].startswith("not run: ")
+    # a check that did not run is no pass, and no refusal either
+    check = gate.not_run("varying-blur", "too few rows")
+    assert (check.passed, check.failed, check.outcome) == (False, False, "not-run")
+    assert gate.enforce([check], force=False) == ()

@@ -97,3 +97,18 @@ def test_the_shared_data_variable_points_the_tests_at_a_copy(tmp_path, monkeypat
     monkeypatch.setattr(conftest, "REAL_SCENES", copy / "real-scenes")
     with pytest.raises(pytest.fail.Exception, match="no real-scenes/missing.tif there"):
         conftest.real_scene("missing.tif")
+
+
+@pytest.mark.parametrize("name, reason, said", [
+    # in light the bright side's level falls by 13 % of the contrast towards the crop's bottom rows
+    ("x0552_y1976_F16", "non-uniform", "the bright side's level drifts by 13 % of the contrast along"),
+    # and here by 16 % along the edge (as stored, the encoding squeezes both under the 10 % allowed)
+    ("x2084_y0616_F2", "non-uniform", "the bright side's level drifts by 16 % of the contrast along"),
+    # the bright side darkens away from the edge: an MTF above 1 at the lowest frequencies
+    ("x2088_y0616_F2_8", "mtf-above-one", "the lowest frequencies"),
+])
+def test_the_real_camera_edges_linearised_are_refused_for_what_they_are(name, reason, said):
+    raster = read_raster(DATA / f"{name}.png")
+    with pytest.raises(im.ImgmtfError) as info:
+        im.measure_edge(raster.data, dtype=raster.dtype, transfer="srgb")
+    assert info.value.reason == reason and said in str(info.value)

@@ -36,8 +36,12 @@ def report(tmp_path):
         row = Record("scene.tif", 1, "edge", "", "fitted", site={"scope": "scene"},
                      figures={"summary": "fit", "direction": "across-track", "mtf_nyquist": value,
                               "mtf_nyquist_ci": [value - 0.005, value + 0.005], "fwhm_px": 1.2 + 0.05 * k})
-        write_acquisition(store, Acquisition(f"a{k}", f"scene{k}.tif", "0" * 64, f"{2020 + k}-06-01"), [], [row])
-    return write_report(store, tmp_path / "report", requirement=0.2).report_html
+        oblique = Record("scene.tif", 1, "edge", "", "combined", site={"scope": "scene"},
+                         figures={"summary": "combined", "direction": "oblique", "normal_angle_deg": -73.2,
+                                  "mtf_nyquist": value, "mtf_nyquist_ci": [value - 0.005, value + 0.005]})
+        write_acquisition(store, Acquisition(f"a{k}", f"scene{k}.tif", "0" * 64, f"{2020 + k}-06-01T03:30:00Z",
+                                             "Simsat-1", None, "PAN"), [], [row, oblique])
+    return write_report(store, tmp_path / "report", requirement="across=0.2,along=0.1").report_html
 
 
 @pytest.fixture
@@ -58,10 +62,16 @@ def test_the_report_loads_without_console_errors_and_every_figure_renders(report
     browser.get(Path(report).as_uri())
     assert browser.title.startswith("MTF campaign")
     images = browser.find_elements("tag name", "img")
-    assert len(images) == 1
+    assert len(images) == 2                                  # across track, and the oblique normal
     complete = browser.execute_script(
         "return Array.from(document.images).map(i => [i.complete, i.naturalWidth, i.naturalHeight])")
     assert all(done and width > 0 and height > 0 for done, width, height in complete), complete
+    # the figure opens at full resolution: a link to its PNG beside the page, larger than the page's copy
+    link = browser.execute_script("return document.images[0].parentElement.href")
+    browser.get(link)
+    full = browser.execute_script("return [document.images[0].naturalWidth, document.images[0].complete]")
+    assert full[1] and full[0] > complete[0][1]
+    browser.back()
     errors = [entry for entry in browser.get_log("browser") if entry["level"] in ("SEVERE", "ERROR")]
     assert not errors, errors
     external = browser.execute_script(

@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import imgmtf as im
-from imgmtf.campaign.store import read_layer
+from imgmtf.campaign.store import figure_path, read_layer
 from imgmtf.cli.main import main
 from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
 from imgmtf.sensor.series import SyntheticCampaign
@@ -170,9 +170,10 @@ def test_scenes_scanned_with_outputs_name_their_overviews_in_the_store(campaign,
     assert result.exit_code == 0, result.output
     rows = read_layer(store, "acquisitions")
     assert len(rows) == 2
-    for row in rows:
-        overview = row["overview"]
-        assert os.path.isabs(overview) and os.path.isfile(overview) and overview.endswith("overview.png")
+    for row in rows:                      # kept relative to the store, so that they move with it
+        assert not os.path.isabs(row["overview"]) and row["overview"].startswith("out/")
+        overview = str(figure_path(store, row["overview"]))
+        assert os.path.isfile(overview) and overview.endswith("overview.png")
         assert os.path.basename(os.path.dirname(overview)) == os.path.splitext(os.path.basename(row["path"]))[0]
 
 
@@ -184,4 +185,4 @@ def test_a_scene_scanned_with_edge_figures_names_each_in_the_store(campaign, tmp
                                        "--edge-figures", "--fit-stages", "none", "--format", "json"])
     assert result.exit_code == 0, result.output
     plots = [row["plot"] for row in read_layer(store, "edges")]
-    assert plots and all(os.path.isabs(p) and os.path.isfile(p) for p in plots)
+    assert plots and all(p.startswith("out/edges/") and figure_path(store, p).is_file() for p in plots)

@@ -74,3 +74,22 @@ def test_cli_simulate_campaign_prints_the_truth_and_refuses_what_a_campaign_is_n
     assert result.exit_code == 2 and "--degradation describes a campaign" in result.output
     result = CliRunner().invoke(main, ["simulate"])
     assert result.exit_code == 2 and "--out FILE" in result.output
+
+
+def test_an_l0r_campaign_has_exponential_wings_a_halo_and_a_lag_its_scenes_show(tmp_path):
+    # (bench/campaign.py scans a whole L0R campaign and checks the fit's rows against this truth)
+    campaign = SyntheticCampaign(acquisitions=2, size_px=128, seed=3, fill=True, blur="l0r")
+    assert [s.name for s in campaign.sensor(1).stages] == ["optics", "detector", "diffusion", "halo", "lag"]
+    assert campaign.truth(0)["stages"] == ["optics", "detector", "diffusion", "halo", "lag"]
+    assert 0.05 < campaign.truth(1)["mtf_nyquist_along"] < campaign.truth(0)["mtf_nyquist_across"] < 0.2
+    assert campaign.as_dict()["blur"] == "l0r" and campaign.optics_sigma_px == (0.25, 0.3)
+    scene = campaign.render(1)
+    path = write_campaign(tmp_path, campaign, platform="P", instrument="I", band_name="B")[1]
+    records = [r for r in scan_scene(str(path)) if r.ok]
+    assert len(records) == 4
+    for record in records:
+        truth = float(scene.true_mtf(0.5, record.figures["normal_angle_deg"]))
+        low, high = record.figures["mtf_nyquist_ci"]
+        assert low - 0.01 <= truth <= high + 0.01
+    with pytest.raises(ParameterError, match="blur"):
+        SyntheticCampaign(blur="motion")

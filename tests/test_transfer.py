@@ -45,3 +45,35 @@ def test_the_curves_and_their_names():
             parse_transfer(bad)
     with pytest.raises(ParameterError):
         im.measure_edge(encoded("srgb"), transfer="cubic")
+
+
+def test_linearisation_scales_the_noise_by_the_curves_slope():
+    from imgmtf.transfer import noise_gain
+    gamma = parse_transfer("gamma:2.2")
+    u = np.array([0.01, 0.2, 0.9])
+    # d(V^G)/dV at V = u^(1/G): G u^((G-1)/G)
+    assert noise_gain(gamma, 255 * u, 255.0) == pytest.approx(2.2 * u ** (1.2 / 2.2))
+    # the sRGB curve's slope by finite differences of its own decoding
+    srgb, v = parse_transfer("srgb"), np.array([0.02, 0.3, 0.95])
+    linear = srgb.linearise(v, 1.0)
+    slope = (srgb.linearise(v + 1e-6, 1.0) - srgb.linearise(v - 1e-6, 1.0)) / 2e-6
+    assert noise_gain(srgb, linear, 1.0) == pytest.approx(slope, rel=1e-4)
+    assert noise_gain(parse_transfer("linear"), u, 1.0) == pytest.approx(1.0)
+
+
+def test_a_clean_low_contrast_camera_edge_linearised_is_measured_and_a_textured_side_is_not():
+    # camera noise (3 DN) added to the sRGB-encoded values: linearised, it grows with the level, and the
+    # bright side's scatter is its own noise, not texture (judged against the chip's one noise, refused)
+    linear = exact_edge_chip(H, 6.0, offset=0.2, low=0.01, high=0.1, dtype=np.float64, shape=(80, 80))
+    code = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055) * 255
+    noisy = code + np.random.default_rng(1).normal(0, 3.0, code.shape)
+    r = im.measure_edge(np.clip(np.rint(noisy), 0, 255).astype(np.uint8), transfer="srgb")
+    assert abs(r.mtf_nyquist - H(0.5)) < 0.03 and not any(c.failed for c in r.checks)
+    # real texture on the bright side (in light, 12 % of the contrast) stays refused
+    texture = 1 + 0.12 * (0.1 - 0.01) / 0.1 * np.random.default_rng(2).standard_normal(linear.shape)
+    lit = np.where(linear > 0.055, linear * texture, linear)
+    code = np.where(lit <= 0.0031308, 12.92 * lit, 1.055 * lit ** (1 / 2.4) - 0.055) * 255
+    with pytest.raises(im.ImgmtfError) as info:
+        im.measure_edge(np.clip(np.rint(code + np.random.default_rng(1).normal(0, 3.0, code.shape)), 0, 255)
+                        .astype(np.uint8), transfer="srgb")
+    assert info.value.reason == "non-uniform" and "texture" in str(info.value)

@@ -27,11 +27,14 @@ import re
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ImageReadError, ParameterError
 from ..records import json_safe, utc_now
 from ..version import __version__
+
+if TYPE_CHECKING:
+    from ..io import RasterInfo
 
 # the facts an acquisition carries besides its file, in the order the CLI lists them
 FACTS = ("acquired_utc", "platform", "instrument", "band_name", "level")
@@ -92,6 +95,13 @@ class Acquisition:
         campaign report shows beside the acquisition.
     imgmtf_version, run_utc : str
         Provenance of the run.
+    sensor_key : str or None
+        What identifies the file's sensor when no platform is named
+        (:func:`sensor_key`): the camera's make, model and serial number
+        when the file is tagged with them, else the image's size, data
+        type, bands, GSD and the software that wrote it.  The campaign's
+        trends group unnamed platforms by it, so that two sensors are
+        never trended together.
 
     Examples
     --------
@@ -118,6 +128,7 @@ class Acquisition:
     overview: str | None = None
     imgmtf_version: str = __version__
     run_utc: str = ""
+    sensor_key: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The acquisition as a JSON-ready dict (settings and sources as mappings)."""
@@ -251,6 +262,55 @@ def _landsat_facts(match: re.Match) -> dict[str, str]:
     return facts
 
 
+# tags that name the camera itself (TIFF and EXIF, as GDAL reports them), in the order the key lists them
+_CAMERA_TAGS = (("TIFFTAG_MAKE", "EXIF_Make"), ("TIFFTAG_MODEL", "EXIF_Model"),
+                ("EXIF_BodySerialNumber", "EXIF_CameraSerialNumber"))
+
+
+def sensor_key(info: RasterInfo, metadata: dict[str, dict[str, str]]) -> str:
+    """What identifies the sensor of a file that names no platform.
+
+    The camera's make, model and serial number when the file's TIFF or
+    EXIF tags give them; otherwise the image's signature: its size (px),
+    data type, number of bands, GSD (m) and the software tag.  Files of
+    one sensor cut or written alike share it; files that differ in any
+    of these are never taken for one sensor.
+
+    Parameters
+    ----------
+    info : imgmtf.io.RasterInfo
+        The file's header (:func:`imgmtf.io.raster_info`).
+    metadata : dict
+        Its metadata by domain (:func:`imgmtf.io.raster_metadata`).
+
+    Returns
+    -------
+    str
+        E.g. ``camera Canon EOS 5D`` or ``101 x 101 px uint16``.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.io import raster_info, raster_metadata
+    >>> imgmtf.write_geotiff("chip.tif", imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 64).image)
+    >>> sensor_key(raster_info("chip.tif"), raster_metadata("chip.tif"))
+    '64 x 64 px uint16, GSD 1 m'
+    """
+    default = metadata.get("default", {})
+    camera = [next((default[t].strip() for t in tags if default.get(t, "").strip()), "") for tags in _CAMERA_TAGS]
+    if camera[0] or camera[1]:
+        return "camera " + " ".join(part for part in camera if part)
+    parts = [f"{info.width} x {info.height} px {info.dtype}"]
+    if info.count > 1:
+        parts.append(f"{info.count} bands")
+    if info.gsd_m:
+        parts.append(f"GSD {info.gsd_m:g} m")
+    software = default.get("TIFFTAG_SOFTWARE", "").strip()
+    if software:
+        parts.append(software)
+    return ", ".join(parts)
+
+
 def read_acquisition(path: str | Path, *, band: int | str | None = None, settings: dict | None = None,
                      acquired: str | None = None, platform: str | None = None, instrument: str | None = None,
                      band_name: str | None = None, level: str | None = None,
@@ -324,7 +384,8 @@ def read_acquisition(path: str | Path, *, band: int | str | None = None, setting
             pass        # a malformed tag says nothing; the other facts stand
     sha = file_sha256(path)
     return Acquisition(acquisition_id(sha, band, settings), path, sha, gsd_m=info.gsd_m, band=band,
-                       settings=settings, sources=sources, run_utc=run_utc or utc_now(), **facts)
+                       settings=settings, sources=sources, run_utc=run_utc or utc_now(),
+                       sensor_key=sensor_key(info, metadata), **facts)
 
 
 def _metadata_facts(metadata: dict[str, dict[str, str]]) -> dict[str, str]:

@@ -13,12 +13,25 @@ Layers
     bounds), with their figures and the whole record as JSON.
 ``targets``
     The summaries per target or scene and direction, combined (``method``
-    ``combined``) or fitted (``fit``): MTF at Nyquist, MTF50, FWHM and RER
-    with intervals (a Point at the target's centre); a fit's
+    ``combined``), model-free across/along-track sections of the 2-D MTF
+    (``sections``, under the named ``assumption``: separable, elliptical
+    or the bracket of both) or fitted (``fit``): MTF at Nyquist, MTF50,
+    FWHM and RER with intervals (a Point at the target's centre); a fit's
     ``constrained`` (0 when no edge lay near that axis: the value is the
-    other axis's, tied) and ``misfit``.
+    other axis's, tied) and ``misfit``; ``recommended`` (1 on the row to
+    quote for its direction, 0 on the others, never on a misfit) and
+    ``recommended_because``.
 ``store_info`` (a table without geometry)
     ``schema_version`` and who created the store.
+
+Figures (a row's ``plot``, an acquisition's ``overview``) are kept
+relative to the store's folder, so that a store moved with its figures
+still finds them (:func:`figure_path`).
+
+Schema versions: 1 the first; 2 adds ``sensor_key`` (what identifies an
+unnamed platform's sensor), ``recommended``, ``recommended_because`` and
+``assumption``, and keeps figure paths relative to the store.  Older
+stores read (their missing columns None) and are upgraded when written.
 
 Geometry is longitude/latitude (EPSG:4326, one CRS for scenes of any UTM
 zone) when the scene is georeferenced, and empty otherwise (as a scan's
@@ -51,11 +64,11 @@ from .acquisitions import Acquisition
 if TYPE_CHECKING:
     from ..io import RasterInfo
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 LAYERS = ("acquisitions", "edges", "targets")
 BUSY_TIMEOUT_S = 30.0           # SQLite waits this long for another writer's lock...
 WRITE_ATTEMPTS = 5              # ...and a write is tried this many times before it fails
-SUMMARY_METHODS = ("combined", "fit")
+SUMMARY_METHODS = ("combined", "sections", "fit")
 
 # column -> type ("str", "float", "int"); the acquisition's facts repeat in
 # edges and targets so that each layer reads on its own in QGIS
@@ -63,10 +76,10 @@ _ACQUISITION_COLUMNS = {
     "acquisition_id": "str", "path": "str", "sha256": "str", "band": "str", "acquired_utc": "str",
     "platform": "str", "instrument": "str", "band_name": "str", "gsd_m": "float", "level": "str",
     "product_id": "str", "site": "str", "settings": "str", "sources": "str", "overview": "str",
-    "imgmtf_version": "str", "run_utc": "str",
+    "imgmtf_version": "str", "run_utc": "str", "sensor_key": "str",
 }
 _REPEATED = {"acquisition_id": "str", "acquired_utc": "str", "platform": "str", "instrument": "str",
-             "band_name": "str"}
+             "band_name": "str", "sensor_key": "str"}
 _FIGURES = {
     "direction": "str", "normal_angle_deg": "float",
     "mtf_nyquist": "float", "mtf_nyquist_ci_low": "float", "mtf_nyquist_ci_high": "float",
@@ -81,7 +94,8 @@ _EDGE_COLUMNS = {
 _TARGET_COLUMNS = {
     **_REPEATED, "scope": "str", "target_id": "int", "method": "str", "status": "str", "reason": "str",
     **_FIGURES, "n_edges": "int", "consistency": "float", "constrained": "int", "misfit": "int",
-    "snr_min": "float", "edge_ids": "str", "x_px": "float", "y_px": "float", "plot": "str", "record": "str",
+    "recommended": "int", "recommended_because": "str", "assumption": "str", "snr_min": "float", "edge_ids": "str",
+    "x_px": "float", "y_px": "float", "plot": "str", "record": "str",
 }
 SCHEMA: dict[str, dict[str, str]] = {"acquisitions": _ACQUISITION_COLUMNS, "edges": _EDGE_COLUMNS,
                                      "targets": _TARGET_COLUMNS}
@@ -161,9 +175,10 @@ def write_acquisition(store_path: str | Path, acquisition: Acquisition, edges: S
             raise ParameterError(f"edges and targets must be Records, got {record!r}")
     store = Path(store_path)
     geo = _Georeference.of(acquisition.path, info)
-    rows = {"acquisitions": [_acquisition_row(acquisition)],
-            "edges": [_edge_row(acquisition, r, geo) for r in edges],
-            "targets": [_target_row(acquisition, r, geo) for r in targets]}
+    home = _home(store)
+    rows = {"acquisitions": [_acquisition_row(acquisition, home)],
+            "edges": [_edge_row(acquisition, r, geo, home) for r in edges],
+            "targets": [_target_row(acquisition, r, geo, home) for r in targets]}
     ensure_store(store)
     with _scratch(store) as scratch:
         staged = Path(scratch) / "rows.gpkg"
@@ -281,30 +296,72 @@ class _Georeference:
         return {"type": kind, "coordinates": shaped}
 
 
-def _acquisition_row(acquisition: Acquisition) -> dict[str, Any]:
+def figure_path(store_path: str | Path, stored: str | None) -> Path | None:
+    """Where a figure the store names is: a path relative to the store's
+    folder (as this imgmtf writes them) or absolute; for a store older
+    than schema 2, whose relative paths were the writer's working
+    folder's, that folder (the current one) is tried second.  None when
+    ``stored`` is empty; the path returned may not exist (the figure was
+    moved or deleted): the caller says so.
+
+    Examples
+    --------
+    >>> str(figure_path("/data/site/site.gpkg", "out/edges/edge1.png"))
+    '/data/site/out/edges/edge1.png'
+    """
+    if not stored:
+        return None
+    path = Path(stored)
+    if path.is_absolute():
+        return path
+    beside = Path(store_path).parent / path
+    if beside.exists() or not path.exists():
+        return beside
+    return path                 # an older store's path, relative to where it was written from
+
+
+def _home(store: Path) -> Path:
+    """The store's folder, absolute, as figure paths are kept relative to it."""
+    return store.parent.resolve()
+
+
+def _relative(path: str | None, home: Path) -> str | None:
+    """A figure's path (absolute or relative to the working folder) relative to ``home``;
+    absolute when no relative path joins them (another drive)."""
+    if not path:
+        return None
+    absolute = Path(path).resolve()
+    try:
+        return Path(os.path.relpath(absolute, home)).as_posix()
+    except ValueError:
+        return str(absolute)
+
+
+def _acquisition_row(acquisition: Acquisition, home: Path) -> dict[str, Any]:
     row = acquisition.to_dict()
+    row["overview"] = _relative(acquisition.overview, home)
     row["settings"] = json.dumps(row["settings"], sort_keys=True)
     row["sources"] = json.dumps(row["sources"], sort_keys=True)
     row["band"] = None if acquisition.band is None else str(acquisition.band)
     return row
 
 
-def _common(acquisition: Acquisition, record: Record) -> dict[str, Any]:
+def _common(acquisition: Acquisition, record: Record, home: Path) -> dict[str, Any]:
     flat = record.to_dict()
     row: dict[str, Any] = {key: getattr(acquisition, key) for key in _REPEATED}
     row.update({key: flat.get(key) for key in _FIGURES})
     for column, (key, index) in _INTERVALS.items():
         pair = flat.get(key) or (None, None)
         row[column] = pair[index]
-    row.update(resampling=record.method, target=record.target, plot=record.plot,
+    row.update(resampling=record.method, target=record.target, plot=_relative(record.plot, home),
                scope=flat.get("scope"), target_id=flat.get("target_id"),
                record=json.dumps(json_safe(flat), sort_keys=True, default=_jsonable))
     return row
 
 
-def _edge_row(acquisition: Acquisition, record: Record, geo: _Georeference) -> dict[str, Any]:
+def _edge_row(acquisition: Acquisition, record: Record, geo: _Georeference, home: Path) -> dict[str, Any]:
     flat = record.to_dict()
-    row = _common(acquisition, record)
+    row = _common(acquisition, record, home)
     row.update({key: flat.get(key) for key in ("status", "reason", "snr", "rows_used",
                                                "x0_px", "y0_px", "x1_px", "y1_px")})
     row["edge_id"] = None if flat.get("id") is None else str(flat["id"])
@@ -320,14 +377,17 @@ def _edge_row(acquisition: Acquisition, record: Record, geo: _Georeference) -> d
     return row
 
 
-def _target_row(acquisition: Acquisition, record: Record, geo: _Georeference) -> dict[str, Any]:
+def _target_row(acquisition: Acquisition, record: Record, geo: _Georeference, home: Path) -> dict[str, Any]:
     flat = record.to_dict()
     method = flat.get("summary") or "combined"
     if method not in SUMMARY_METHODS:
         raise ParameterError(f"a target's summary must be one of {', '.join(SUMMARY_METHODS)}, got {method!r}")
-    row = _common(acquisition, record)
+    row = _common(acquisition, record, home)
     row.update({key: flat.get(key) for key in ("status", "reason", "n_edges", "consistency", "constrained",
-                                               "misfit", "snr_min", "x_px", "y_px")})
+                                               "misfit", "recommended", "recommended_because", "assumption",
+                                               "snr_min", "x_px", "y_px")})
+    if row["recommended"] is not None and row["misfit"]:
+        row["recommended"] = False          # a model that does not fit the data is never the value to quote
     row["method"] = method
     row["edge_ids"] = json.dumps(flat["edge_ids"], default=_jsonable) if flat.get("edge_ids") is not None else None
     centre = [(flat["x_px"] + 0.5, flat["y_px"] + 0.5)] if flat.get("x_px") is not None else []

@@ -1,5 +1,13 @@
-"""Drift: how a figure (MTF at Nyquist, MTF50, FWHM, RER) of one platform,
+"""Drift: how a figure (MTF at Nyquist, MTF50, FWHM, RER) of one sensor,
 band, direction and method changes with time over a campaign.
+
+Rows are grouped by sensor (the platform named, or what identifies an
+unnamed one's files: :func:`imgmtf.campaign.recommended.sensor_of`), band,
+direction, method and assumption, and whether they are the recommended
+rows (:func:`imgmtf.campaign.recommended.mark_recommended`) or misfit:
+two sensors, two methods or a quoted and an unquoted series are never
+one line.  A group of misfit rows is listed but not trended (its values
+may be biased); a group with one acquisition time has no slope.
 
 The drift is the slope of a weighted least-squares line through the
 figure against the acquisition time, in the figure's units per year
@@ -36,11 +44,16 @@ FIGURES = {
     "fwhm_px": None,
     "rer": None,
 }
-GROUP_KEYS = ("platform", "band_name", "direction", "method")
+GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recommended", "misfit")
 ACROSS_ALONG = ("across-track", "along-track")
-TREND_COLUMNS = (*GROUP_KEYS, "figure", "n_acquisitions", "n_points", "first_utc", "last_utc",
-                 "value_at_first", "slope_per_year", "slope_ci_low", "slope_ci_high", "confidence", "weights",
-                 "consistency", "drift")
+TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
+                 "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest",
+                 "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low",
+                 "slope_ci_high", "confidence", "weights", "consistency", "drift", "requirement", "meets_requirement",
+                 "note")
+NOTE_MISFIT = "misfit: not trended (the sensor model does not fit; its values may be biased)"
+NOTE_ONE = "one acquisition: no slope"
+NOTE_TWO = "two acquisitions: a slope without interval"
 
 
 @dataclass(frozen=True)
@@ -60,19 +73,30 @@ class Line:
 
 @dataclass(frozen=True)
 class Trend:
-    """The drift of one figure of one platform, band, direction and method
-    (the columns of ``trend.csv``); ``drift`` is True when the slope's
-    interval excludes 0."""
+    """The drift of one figure of one sensor, band, direction, method and
+    assumption (the columns of ``trend.csv``): ``recommended`` when its
+    rows are the ones to quote, ``misfit`` when they are misfit fits (no
+    slope then); ``latest`` the last acquisition's value with its
+    interval; ``drift`` True when the slope's interval excludes 0; the
+    slope NaN with one acquisition time (``note`` says why)."""
 
+    sensor: str
     platform: str | None
     band_name: str | None
     direction: str | None
     method: str | None
+    assumption: str | None
+    recommended: bool
+    misfit: bool
+    recommended_because: str
     figure: str
     n_acquisitions: int
     n_points: int
     first_utc: str
     last_utc: str
+    latest: float
+    latest_ci_low: float
+    latest_ci_high: float
     value_at_first: float
     slope_per_year: float
     slope_ci_low: float
@@ -81,6 +105,12 @@ class Trend:
     weights: str
     consistency: float
     drift: bool
+    note: str = ""
+
+    @property
+    def has_slope(self) -> bool:
+        """A line was fitted (two acquisition times at least, not misfit)."""
+        return math.isfinite(self.slope_per_year)
 
     def value_at(self, years: np.ndarray) -> np.ndarray:
         """The line at ``years`` after the first acquisition."""
@@ -155,14 +185,18 @@ def parse_utc(text: str) -> datetime:
 
 
 def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
-    """The targets layer's rows that make each trend, by (platform, band
-    name, direction, method): per acquisition its scene-wide rows, or its
-    targets' rows when it has no scene-wide one; rows without an
-    acquisition time, and fits of a direction no edge constrained, are
-    left out.  Oblique (or unknown) directions are told apart by their
-    normals (:func:`imgmtf.scene.combine.normal_families`): their label
-    becomes ``oblique (normal 17 deg)``."""
-    usable = [r for r in rows if r.get("acquired_utc") and r.get("mtf_nyquist") is not None
+    """The targets layer's rows that make each trend, by :data:`GROUP_KEYS`
+    (sensor, band name, direction, method, assumption, recommended,
+    misfit; the rows marked by
+    :func:`imgmtf.campaign.recommended.mark_recommended`): per acquisition
+    its scene-wide rows, or its targets' rows when it has no scene-wide
+    one; rows without an acquisition time, and fits of a direction no
+    edge constrained, are left out.  Oblique (or unknown) directions are
+    told apart by their normals
+    (:func:`imgmtf.scene.combine.normal_families`): their label becomes
+    ``oblique (normal 17 deg)``."""
+    from .recommended import mark_recommended
+    usable = [r for r in mark_recommended(rows) if r.get("acquired_utc") and r.get("mtf_nyquist") is not None
               and r.get("constrained") != 0]
     groups: dict[tuple, dict[str, list[Mapping]]] = {}
     for row in _by_normal(usable):
@@ -178,7 +212,7 @@ def trend_points(rows: Iterable[Mapping]) -> dict[tuple, list[Mapping]]:
     return dict(sorted(out.items(), key=lambda item: tuple(str(v) for v in item[0])))
 
 
-def _by_normal(rows: list[Mapping]) -> list[Mapping]:
+def _by_normal(rows: Sequence[Mapping]) -> list[Mapping]:
     """``rows`` with each oblique or unknown direction labelled by its
     family of normals, so that a target's two oblique directions make two
     trends, not one."""
@@ -214,10 +248,11 @@ def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> 
 
 
 def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
-    """The drift of every figure (:data:`FIGURES`) of every platform, band,
-    direction and method of a store's targets layer
-    (:func:`imgmtf.campaign.store.read_layer`); groups whose points span
-    less than two times are left out.
+    """The drift of every figure (:data:`FIGURES`) of every group
+    (:func:`trend_points`) of a store's targets layer
+    (:func:`imgmtf.campaign.store.read_layer`).  A group of one
+    acquisition time, or of misfit rows, gets a Trend without a slope
+    (NaN; its ``note`` says why), so that it is listed, not drawn as a line.
 
     Examples
     --------
@@ -230,24 +265,133 @@ def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
     z = NormalDist().inv_cdf(0.5 + confidence / 2)
     out = []
     for key, points in trend_points(rows).items():
-        first = points[0]["acquired_utc"]
+        group = dict(zip(GROUP_KEYS, key))
+        platform = points[0].get("platform")
         for figure, bounds in FIGURES.items():
             usable = [p for p in points if p.get(figure) is not None and math.isfinite(p[figure])]
+            if not usable:
+                continue
             times = [p["acquired_utc"] for p in usable]
-            if len({parse_utc(t) for t in times}) < 2:
+            first, last = usable[0], usable[-1]
+            low, high = (last.get(b) for b in bounds) if bounds else (None, None)
+            common = dict(**group, platform=platform, recommended_because=last.get("recommended_because") or "",
+                          figure=figure,
+                          n_acquisitions=len({p["acquisition_id"] for p in usable}), n_points=len(usable),
+                          first_utc=times[0], last_utc=times[-1], latest=float(last[figure]),
+                          latest_ci_low=math.nan if low is None else float(low),
+                          latest_ci_high=math.nan if high is None else float(high), confidence=confidence)
+            if group["misfit"] or len({parse_utc(t) for t in times}) < 2:
+                out.append(Trend(**common, value_at_first=float(first[figure]), slope_per_year=math.nan,
+                                 slope_ci_low=math.nan, slope_ci_high=math.nan, weights="", consistency=math.nan,
+                                 drift=False, note=NOTE_MISFIT if group["misfit"] else NOTE_ONE))
                 continue
             sd = None
             if bounds:
                 sd = np.array([_half_width(p, bounds) / z for p in usable])
-            line = fit_line(years_since(times, first), [p[figure] for p in usable], sd, confidence)
-            group = dict(zip(GROUP_KEYS, key))
-            out.append(Trend(**group, figure=figure, n_acquisitions=len({p["acquisition_id"] for p in usable}),
-                             n_points=len(usable), first_utc=times[0], last_utc=times[-1],
-                             value_at_first=float(line.intercept + line.slope * years_since([times[0]], first)[0]),
-                             slope_per_year=line.slope, slope_ci_low=line.low, slope_ci_high=line.high,
-                             confidence=confidence, weights=line.weights, consistency=line.consistency,
-                             drift=bool(line.low > 0 or line.high < 0)))
+            line = fit_line(years_since(times, times[0]), [p[figure] for p in usable], sd, confidence)
+            out.append(Trend(**common, value_at_first=line.intercept, slope_per_year=line.slope,
+                             slope_ci_low=line.low, slope_ci_high=line.high, weights=line.weights,
+                             consistency=line.consistency, drift=bool(line.low > 0 or line.high < 0),
+                             note="" if math.isfinite(line.low) else NOTE_TWO))
     return out
+
+
+_DIRECTION_NAMES = {"across": "across-track", "along": "along-track"}
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """The lowest acceptable MTF at Nyquist: one ``default`` for every
+    direction, and values ``per_direction`` (direction label -> value)
+    that override it for theirs.
+
+    Examples
+    --------
+    >>> need = Requirement.parse("across=0.12,along=0.10")
+    >>> need.for_direction("across-track"), need.for_direction("oblique (normal 17 deg)"), str(need)
+    (0.12, None, 'across-track 0.12, along-track 0.1')
+    >>> str(Requirement.parse("0.1,along=0.08"))
+    'along-track 0.08, 0.1 in any other direction'
+    """
+
+    default: float | None = None
+    per_direction: tuple[tuple[str, float], ...] = ()
+
+    def for_direction(self, direction: str | None) -> float | None:
+        """The value a trend of ``direction`` is judged against (None: none applies)."""
+        return dict(self.per_direction).get(str(direction), self.default)
+
+    def __str__(self) -> str:
+        parts = [f"{d} {v:g}" for d, v in self.per_direction]
+        if self.default is not None:
+            parts.append(f"{self.default:g} in any other direction" if parts else f"{self.default:g}")
+        return ", ".join(parts)
+
+    @classmethod
+    def of(cls, value: float | str | Requirement | None) -> Requirement | None:
+        """A requirement from a number (every direction), its text (:meth:`parse`) or itself."""
+        if value is None or isinstance(value, Requirement):
+            return value
+        return cls.parse(value) if isinstance(value, str) else cls.parse(repr(float(value)))
+
+    @classmethod
+    def parse(cls, text: str) -> Requirement:
+        """``0.1`` (every direction), ``across=0.12,along=0.10`` (``across``
+        and ``along`` stand for ``across-track`` and ``along-track``; any
+        direction label of the store may be named), or both
+        (``0.1,along=0.08``: the value for the directions not named).
+
+        Raises
+        ------
+        ParameterError
+            An item that is not ``MTF`` or ``DIRECTION=MTF`` with MTF a
+            number from 0 to 1, or a direction named twice.
+        """
+        default, named = None, {}
+        for item in (part.strip() for part in str(text).split(",")):
+            direction, equals, value = item.rpartition("=")
+            direction = _DIRECTION_NAMES.get(direction.strip(), direction.strip())
+            try:
+                number = float(value)
+            except ValueError:
+                number = math.nan
+            if not (0.0 <= number <= 1.0) or (equals and not direction):
+                raise ParameterError(f"requirement {item!r} is not an MTF from 0 to 1 or DIRECTION=MTF "
+                                     "(e.g. 0.1 or across=0.12,along=0.10)")
+            if direction in named or (not direction and default is not None):
+                raise ParameterError(f"requirement {text!r} gives {direction or 'the default'} twice")
+            if direction:
+                named[direction] = number
+            else:
+                default = number
+        return cls(default, tuple(named.items()))
+
+
+def requirement_verdict(trend: Trend, requirement: float | Requirement | None) -> str:
+    """Whether a trend's latest acquisition meets ``requirement`` (a
+    lowest acceptable value of its figure): ``pass`` when its interval
+    lies at or above it, ``fail`` when below, ``undecided`` when the
+    interval straddles it; without an interval the value alone decides.
+    Empty without a requirement (or none for the trend's direction), and
+    for a misfit trend (its value is not one to judge).
+
+    Examples
+    --------
+    >>> t = trends([{"acquisition_id": "a", "acquired_utc": "2021-01-01", "platform": "Sim", "direction": "x",
+    ...              "mtf_nyquist": 0.11, "mtf_nyquist_ci_low": 0.09, "mtf_nyquist_ci_high": 0.13}])[0]
+    >>> requirement_verdict(t, 0.08), requirement_verdict(t, 0.10), requirement_verdict(t, 0.14)
+    ('pass', 'undecided', 'fail')
+    """
+    if isinstance(requirement, Requirement):
+        requirement = requirement.for_direction(trend.direction)
+    if requirement is None or trend.misfit:
+        return ""
+    low, high = trend.latest_ci_low, trend.latest_ci_high
+    if not (math.isfinite(low) and math.isfinite(high)):
+        low = high = trend.latest
+    if low >= requirement:
+        return "pass"
+    return "fail" if high < requirement else "undecided"
 
 
 def _half_width(row: Mapping, bounds: tuple[str, str]) -> float:
@@ -257,9 +401,11 @@ def _half_width(row: Mapping, bounds: tuple[str, str]) -> float:
     return (high - low) / 2.0
 
 
-def write_trend_csv(found: Sequence[Trend], path: str) -> None:
+def write_trend_csv(found: Sequence[Trend], path: str, requirement: float | Requirement | None = None) -> None:
     """``found`` as ``trend.csv`` (columns :data:`TREND_COLUMNS`; slopes in
-    the figure's units per year; NaN as empty), written atomically.
+    the figure's units per year; NaN as empty), written atomically; with a
+    ``requirement`` on the MTF at Nyquist, its rows say whether their
+    latest acquisition meets it (:func:`requirement_verdict`).
 
     Raises
     ------
@@ -272,7 +418,11 @@ def write_trend_csv(found: Sequence[Trend], path: str) -> None:
                 writer = csv.DictWriter(fh, fieldnames=list(TREND_COLUMNS))
                 writer.writeheader()
                 for trend in found:
-                    writer.writerow({k: _cell(v) for k, v in asdict(trend).items()})
+                    need = Requirement.of(requirement)
+                    judged = need.for_direction(trend.direction) if need and trend.figure == "mtf_nyquist" else None
+                    writer.writerow({**{k: _cell(v) for k, v in asdict(trend).items()},
+                                     "requirement": _cell(judged), "meets_requirement": requirement_verdict(trend,
+                                                                                                          judged)})
         except OSError as exc:
             raise FileWriteError(f"{path}: cannot write: {exc.strerror or exc}") from None
 

@@ -17,7 +17,8 @@ from .tables import print_fit
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
 @click.option("--stages", metavar="NAMES",
               help="comma-separated stages to fit: optics, detector, motion, electronics, diffraction, "
-                   "defocus, olpf, jitter (default: those of --sensor, else the paper's four)")
+                   "defocus, olpf, jitter, diffusion, halo, lag; or auto: the simplest of optics+detector, "
+                   "+diffusion, +lag, +halo that fits (default: those of --sensor, else the paper's four)")
 @click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False),
               help="sensor TOML giving starting (and held) values, e.g. a known detector or wavelength")
 @click.option("--hold", metavar="PARAMS",

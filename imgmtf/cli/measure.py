@@ -94,7 +94,7 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
         from ..parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:
             prestart_workers(workers, MEASURING_MODULES)     # their imports overlap ours
-        from ..batch import expand_inputs, measure_files
+        from ..batch import expand_inputs, measure_files, once_each
         from ..measure_settings import MeasureSettings
         from ..records import CsvWriter, JsonLinesWriter, utc_now
         with option_errors():
@@ -102,9 +102,11 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
                                        interval_settings(interval_method, replicates, confidence), force=force,
                                        saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer,
                                        point_size=point_size)
-        files = expand_inputs(paths, recursive)
+        files, repeated = once_each(expand_inputs(paths, recursive))
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
+        for name, times in repeated.items():
+            click.echo(f"imgmtf: {name} is named {times} times: measured once", err=True)
         if plot_path and len(files) > 1:
             raise click.UsageError(f"--plot takes a single input, got {len(files)} files; "
                                    "use --plot-dir for several")

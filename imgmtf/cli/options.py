@@ -30,6 +30,23 @@ class FiniteFloat(click.FloatRange):
         return number
 
 
+class RequirementType(click.ParamType):
+    """--requirement: the lowest acceptable MTF at Nyquist, for every
+    direction (``0.1``) or per direction (``across=0.12,along=0.10``)."""
+
+    name = "requirement"
+
+    def convert(self, value, param, ctx):
+        from ..campaign.trend import Requirement
+        from ..errors import ParameterError
+        if isinstance(value, Requirement):
+            return value
+        try:
+            return Requirement.parse(value)
+        except ParameterError as exc:
+            self.fail(str(exc), param, ctx)
+
+
 class Replicates(click.IntRange):
     """--bootstrap N: 0 (no intervals) or MIN_REPLICATES to MAX_REPLICATES."""
 

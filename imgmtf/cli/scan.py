@@ -22,7 +22,7 @@ from .options import (
 )
 from .tables import print_scan
 
-DEFAULT_STAGES = "optics,detector"   # as imgmtf.scene.targetfit's, without importing it for --help
+DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it for --help
 # what a scan's workers load, NumPy's lazily loaded parts included: imported once by the workers'
 # fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
 # of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
@@ -54,7 +54,8 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
                    "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
 @click.option("--fit-stages", default=DEFAULT_STAGES, show_default=True, metavar="STAGES",
               help="the sensor model's stages fitted to each target's half-edges for its across- and "
-                   "along-track MTF (imgmtf fit's names, comma-separated); 'none' for no fit")
+                   "along-track MTF (imgmtf fit's names, comma-separated); 'auto' for the simplest of "
+                   "optics+detector, +diffusion, +lag, +halo that fits; 'none' for no fit")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
               help="write targets.csv, targets.geojson and overview.png here (with several scenes, in a "
@@ -110,7 +111,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     interrupted, outcomes = None, []
     with reported_errors():
         from ..batch import expand_inputs
-        from ..parallel import prestart_workers
+        from ..parallel import prestart_workers, signals_deferred
         from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
         with option_errors():           # a malformed option: exit 2, before any work
@@ -147,7 +148,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             with closing(completed):
                 for outcome in completed:
                     outcomes.append(outcome)
-                    _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
+                    with signals_deferred():    # a JSON line cut in two by Ctrl-C is a row lost
+                        _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
         except KeyboardInterrupt as exc:
             interrupted = exc
     _closing_notes(outcomes, paths, store, kind, fmt)
@@ -172,11 +174,13 @@ def _stages(text: str) -> str | None:
     names = [n.strip() for n in text.split(",") if n.strip()]
     if names == ["none"]:
         return None
+    if names == ["auto"]:
+        return "auto"
     from ..sensor.stages import STAGES
     unknown = [n for n in names if n not in STAGES]
     if unknown or not names:
         raise ParameterError(f"--fit-stages: unknown stage {unknown[0] if unknown else text!r}; known: "
-                             f"{', '.join(STAGES)}, or none")
+                             f"{', '.join(STAGES)}, or auto, or none")
     return ",".join(names)
 
 

@@ -32,7 +32,7 @@ CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std
 LINE_ONLY = ("angle", "pulse_width", "offset", "ground_noise", "oversampling")
 POINTS_ONLY = ("point_size", "spacing")
 CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
-                 "band_name")
+                 "band_name", "blur")
 CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says otherwise
 
 
@@ -84,18 +84,22 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
               help="campaign: the smallest step between the target's quadrants over the noise")
 @click.option("--fill", is_flag=True,
               help="campaign: every pixel outside the target 0, as in an L0R chip (its inner half-edges only)")
+@click.option("--blur", type=click.Choice(["gaussian", "l0r"]), default="gaussian", show_default=True,
+              help="campaign: the sensor's blur: Gaussian optics and a pixel, or a real L0R sensor's (a small "
+                   "Gaussian core, exponential wings, a scatter halo and a one-sided lag along track)")
 @click.option("--platform", default="SYNTHSAT-1", show_default=True, help="campaign: PLATFORM tag of every scene")
 @click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
 @click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
 @click.pass_context
 def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
-             degradation, snr, fill, platform, instrument, band_name):
+             degradation, snr, fill, blur, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
     (or a PNG); or, with --campaign DIR, a calibration campaign:
     DIR/site_<time>.tif, one scene per acquisition (a four-quadrant target
-    tilted 16.8 deg on a uniform field; anisotropic Gaussian optics and a
-    square pixel, the optics blurring more each year), each tagged
+    tilted 16.8 deg on a uniform field; anisotropic Gaussian optics, or with
+    --blur l0r a real L0R sensor's blur, and a square pixel, the blur
+    growing each year), each tagged
     ACQUISITION_DATETIME, PLATFORM, INSTRUMENT and BAND_NAME, and
     DIR/truth.json and truth.csv: each acquisition's exact MTF at Nyquist
     across and along track, and the true slope per year."""
@@ -107,7 +111,7 @@ def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offs
         with reported_errors():
             _campaign(campaign_dir, acquisitions, start, interval_days, degradation,
                       size if "size" in given else CAMPAIGN_SIZE_PX, snr, int(bits), seed or 0, gsd, fill,
-                      platform, instrument, band_name)
+                      blur, platform, instrument, band_name)
         return
     clash = [name for name in CAMPAIGN_ONLY if name in given]
     if clash:
@@ -207,11 +211,11 @@ def _flag(ctx, name: str) -> str:
 
 
 def _campaign(folder, acquisitions, start, interval_days, degradation, size_px, snr, bits, seed, gsd, fill,
-              platform, instrument, band_name) -> None:
+              blur, platform, instrument, band_name) -> None:
     from ..sensor.series import SyntheticCampaign
     from ..synthetic import write_campaign
     campaign = SyntheticCampaign(acquisitions, start, interval_days, degradation, snr=snr, size_px=size_px,
-                                 bits=bits, seed=seed, gsd_m=1.0 if gsd is None else gsd, fill=fill)
+                                 bits=bits, seed=seed, gsd_m=1.0 if gsd is None else gsd, fill=fill, blur=blur)
     paths = write_campaign(folder, campaign, platform=platform, instrument=instrument, band_name=band_name)
     click.echo(f"{'scene':<28} {'acquired (UTC)':<21} {'true MTF@Nyq across':>19} {'along':>7}")
     for k, path in enumerate(paths):

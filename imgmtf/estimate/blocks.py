@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from .evidence import Evidence
-from .gate import Check
+from .gate import Check, not_run
 
 BLOCK_PX = 8
 MIN_BOUNDARIES = 6             # boundary jumps needed to judge
@@ -33,7 +33,7 @@ def block_boundaries(ev: Evidence) -> tuple[list[Check], list[str]]:
     ``compression`` check and a warning for visible but smaller blocks."""
     geometry = ev.geometry
     if geometry is None:
-        return [], []
+        return [not_run("compression", f"the {ev.name}'s row locations are not known")], []
     rows, kept = geometry.rows, geometry.kept
     residual = geometry.locations - (geometry.slope * rows + geometry.intercept)
     adjacent = kept[:-1] & kept[1:] & (np.diff(rows) == 1)
@@ -41,7 +41,9 @@ def block_boundaries(ev: Evidence) -> tuple[list[Check], list[str]]:
     phase = (rows[:-1] % BLOCK_PX)[adjacent]
     counts = np.bincount(phase, minlength=BLOCK_PX)
     if counts.min() < MIN_BOUNDARIES:
-        return [], []
+        return [not_run("compression", f"{int(counts.min())} row-to-row jumps at some phase of an {BLOCK_PX}-row "
+                        f"grid (at least {MIN_BOUNDARIES} needed): too few rows to see {BLOCK_PX} x {BLOCK_PX} "
+                        "blocks")], []
     means = np.bincount(phase, weights=jumps, minlength=BLOCK_PX) / counts
     boundary = int(np.argmax(means))
     others = phase != boundary

@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from .evidence import Evidence
-from .gate import Check
+from .gate import Check, not_run
 
 MIN_REACH_PX = 3.0              # the fit sees at least this far either side of the centre
 MIN_GROUP_SAMPLES = 40
@@ -44,7 +44,8 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     """
     rows = np.unique(ev.rows)
     if rows.size < 2 * MIN_GROUP_ROWS:
-        return [], []
+        return [not_run("varying-blur", f"the {ev.name} crosses {rows.size} rows (at least "
+                        f"{2 * MIN_GROUP_ROWS} needed to compare its halves)")], []
     splits = [np.array_split(rows, parts) for parts in (2, 3) if rows.size >= parts * MIN_GROUP_ROWS]
     # the five groups' fits run together (one fit's iterations on small
     # arrays cost mostly the interpreter's time)
@@ -63,7 +64,9 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
                 if worst is None or (z >= WARN_SIGNIFICANCE, change) > (worst[1] >= WARN_SIGNIFICANCE, worst[0]):
                     worst = (change, z, (bounds[i], wi), (bounds[j], wj))
     if worst is None:
-        return [], []
+        return [not_run("varying-blur", f"the {ev.name}'s width could not be fitted in its halves or thirds "
+                        f"(fewer than {MIN_GROUP_SAMPLES} samples within {max(ev.plateau_px, MIN_REACH_PX):.1f} px "
+                        "of its centre, or a fit that did not converge)")], []
     change, z, (rows_a, width_a), (rows_b, width_b) = worst
     where = (f"{width_a:.3f} px over rows {rows_a[0]}-{rows_a[-1]} and {width_b:.3f} px over rows "
              f"{rows_b[0]}-{rows_b[-1]}")

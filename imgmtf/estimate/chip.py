@@ -4,12 +4,15 @@ sensor's limits, the values' quantum, the pixel noise) and the pixels left
 out (nodata, isolated hot and dead pixels)."""
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
 from ..errors import ParameterError
 from ..inputs import as_array, check_number, prepare_image, quantum, saturation_levels
-from ..transfer import full_scale
+from ..transfer import full_scale, noise_gain
 from . import gate
 from .detection import robust_noise
 from .outliers import isolated_outliers
@@ -73,7 +76,12 @@ def prepare_chip(image: ArrayLike, settings: Settings, *, roi: tuple[int, int, i
         track_azimuth_deg = check_number("track_azimuth_deg", track_azimuth_deg, signed=True)
     limits = _saturation(saturation) if saturation is not None else saturation_levels(stored)
     decoded = []
+    gain, stored_noise = None, math.nan
     if not settings.transfer.is_linear:
+        # the noise of the values as stored, and how linearising them scales it at each level
+        scale = full_scale(stored)
+        stored_noise = max(robust_noise(pixels), quantum(pixels, stored) / math.sqrt(12.0))
+        gain = functools.partial(_noise_gain, settings.transfer, scale)
         # linear light in the same DN scale; the type's limits stay put, its
         # quantum does not (the decoded steps are uneven)
         scale = full_scale(stored)
@@ -90,7 +98,13 @@ def prepare_chip(image: ArrayLike, settings: Settings, *, roi: tuple[int, int, i
     chosen = None if mask is None else np.asarray(mask)[y0:y0 + rows, x0:x0 + cols]
     left_out, said = _left_out_pixels(pixels, chosen, noise_dn)
     return Chip(pixels, (x0, y0), limits, quantum_dn, noise_dn, gsd_m, track_azimuth_deg, (fill,),
-                tuple(said + decoded), left_out)
+                tuple(said + decoded), left_out, gain, stored_noise)
+
+
+def _noise_gain(transfer, scale: float, level_dn: float) -> float:
+    """How linearising with ``transfer`` (full scale ``scale``, DN) scales
+    the stored values' noise at the linear level ``level_dn``."""
+    return float(noise_gain(transfer, np.array([level_dn]), scale)[0])
 
 
 def _left_out_pixels(data: np.ndarray, mask: np.ndarray | None, noise: float) -> tuple[dict[str, int], list[str]]:

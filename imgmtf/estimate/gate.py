@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
+from .phase import without_phase_bias
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
 MIN_SNR = 8.0                   # below this an edge's MTF at Nyquist is mostly noise (about +-0.1)
@@ -67,7 +68,14 @@ class Check:
     ``reason`` is the machine-readable code, ``message`` one line saying
     what was measured against what limit; ``value`` and ``limit`` are the
     numbers (units in the message); ``share`` the fraction of the chip a
-    failure covers, where that is known (fill).
+    failure covers, where that is known (fill).  ``ran`` is False for a
+    check that could not run on this chip (too few samples, no side left
+    to judge): it is no pass (``passed`` False), and no refusal either
+    (``failed`` False); its message says why it could not run
+    (:func:`not_run`).  Where being unable to judge is itself a fault
+    (a side whose plateau never arrives within the chip), the check
+    fails instead.  ``explained_by`` names a known cause that makes what
+    would fail the check pass (a sharpening kernel's MTF above 1).
     """
 
     reason: str
@@ -76,6 +84,40 @@ class Check:
     value: float | None = None
     limit: float | None = None
     share: float | None = None
+    ran: bool = True
+    explained_by: str | None = None
+
+    @property
+    def failed(self) -> bool:
+        """Did the check run and refuse the chip?"""
+        return self.ran and not self.passed
+
+    @property
+    def outcome(self) -> str:
+        """"passed", "failed" or "not-run"."""
+        return "not-run" if not self.ran else "passed" if self.passed else "failed"
+
+    def to_dict(self) -> dict:
+        """JSON-ready: reason, outcome, passed, message, value and limit
+        (None where not known)."""
+        def number(x):
+            return round(float(x), 6) if x is not None and math.isfinite(float(x)) else None
+        out = {"reason": self.reason, "outcome": self.outcome, "passed": bool(self.passed and self.ran),
+               "message": self.message, "value": number(self.value), "limit": number(self.limit)}
+        return {**out, "explained_by": self.explained_by} if self.explained_by else out
+
+
+def not_run(reason: str, why: str) -> Check:
+    """The record of a check that could not run on a chip, and ``why``
+    (one line): neither a pass nor a refusal.
+
+    Examples
+    --------
+    >>> check = not_run("compression", "too few rows to see an 8-row block grid")
+    >>> check.outcome, check.passed, check.failed
+    ('not-run', False, False)
+    """
+    return Check(reason, False, f"not run: {why}", ran=False)
 
 
 class QualityError(UnsuitableTargetError):
@@ -139,13 +181,15 @@ MOSTLY_FILL = 0.5               # a forced chip more than this much fill measure
 
 def untrusted_when_forced(checks) -> Check | None:
     """The check that makes a forced number unusable, or None: an MTF above
-    1 beyond its noise (even within the gate's allowance), figures that
+    1 beyond its noise (even within the gate's allowance) that no
+    sharpening kernel explains, figures that
     cannot be read off (not an MTF), or fill that is most of the chip or
     comes with a second target (whose edge is then the fill's boundary).
     A caller reports such a number as a failure, printed with its reason."""
-    failed = {c.reason: c for c in checks if not c.passed}
+    failed = {c.reason: c for c in checks if c.failed}
     for check in checks:
-        if check.reason == "mtf-above-one" and check.value is not None and check.value > 0:
+        if (check.reason == "mtf-above-one" and check.value is not None and check.value > 0
+                and check.explained_by is None):
             return Check("mtf-above-one", False, check.message, check.value, 0.0)
     if "mtf-undefined" in failed:
         return failed["mtf-undefined"]
@@ -158,7 +202,7 @@ def untrusted_when_forced(checks) -> Check | None:
 def enforce(checks: list[Check], force: bool) -> tuple[str, ...]:
     """Raise :class:`QualityError` for failed checks, unless ``force``:
     then return them as warnings."""
-    failed = [c for c in checks if not c.passed]
+    failed = [c for c in checks if c.failed]
     if failed and not force:
         raise (TwoTargetsError if failed[0].reason == "two-targets" else QualityError)(failed)
     return tuple(f"{c.reason}: {c.message} (measured anyway: forced)" for c in failed)
@@ -238,11 +282,13 @@ def fill_contrast(value: float, rest: np.ndarray) -> float:
 
 def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
     """Does the target run straight through the rows?  The kept fraction of
-    rows, their robust scatter about the line (against what the pixel noise
-    explains), and the bow of a quadratic through them."""
+    rows, their robust scatter about the line beyond what their sub-pixel
+    phase explains (against what the pixel noise explains), and the bow of
+    a quadratic through them."""
     rows, loc, kept = geometry.rows, geometry.locations, geometry.kept
     fraction = kept.sum() / max(rows.size, 1)
-    resid = loc[kept] - (geometry.slope * rows[kept] + geometry.intercept)
+    line = geometry.slope * rows[kept] + geometry.intercept
+    resid = without_phase_bias(loc[kept] - line, line)
     scatter = float(1.4826 * np.median(np.abs(resid))) if resid.size else math.inf
     limit = max(MAX_LINE_SCATTER_PX, 3.0 * expected_scatter_px)
     checks = [
@@ -265,6 +311,9 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
         checks.append(Check("not-straight", not bowed,
                             f"the {name} bows by {sagitta:.2f} px over its length (at most "
                             f"{MAX_SAGITTA_PX} px): a curved {name}", sagitta, MAX_SAGITTA_PX))
+    else:
+        checks.append(not_run("not-straight", f"only {int(kept.sum())} rows on the line: too few (10) to see "
+                              f"the {name} bow"))
     return checks
 
 
@@ -316,22 +365,31 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Chec
     return Check(reason, False, message)
 
 
-def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power) -> list[Check]:
+def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power,
+                names: tuple[str, str] = ("left", "right")) -> list[Check]:
     """Uniform sides: each side's samples beyond ``start_px`` from the
     centre fitted with its level, its tail (a / |s|^p), a trend across and
     a trend along the target; a trend over the side larger than
     ``MAX_SIDE_TREND`` of the contrast, texture beyond the pixel noise, or
-    a 1-px band far off the model (another edge or bar) fail."""
+    a 1-px band far off the model (another edge or bar) fail.
+    ``pixel_noise`` (DN): one for both sides, or (left, right) where it
+    differs (linearised values: the stored noise scaled at each level);
+    ``names`` what the left and right sides are called ("dark", "bright")."""
     checks = []
     s = distance - centre
-    for name, mask in (("left", s <= -start_px), ("right", s >= start_px)):
+    noises = tuple(pixel_noise) if np.ndim(pixel_noise) else (pixel_noise, pixel_noise)
+    for (name, mask), pixel_noise in zip(((names[0], s <= -start_px), (names[1], s >= start_px)), noises):
         if mask.sum() < 20:
+            # the sides' settling check (:mod:`.settling`) refuses a side without a plateau
+            checks.append(not_run("non-uniform", f"the {name} side holds {int(mask.sum())} samples beyond "
+                                  f"{start_px:.1f} px (20 needed): its trend and texture not measured"))
             continue
         ss, v, t = np.abs(s[mask]), values[mask], along[mask]
         design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
         coef, *_ = np.linalg.lstsq(design, v, rcond=None)
         resid = v - design @ coef
-        trend = max(abs(coef[2]) * np.ptp(ss), abs(coef[3]) * np.ptp(t)) / contrast
+        across, along_target = abs(coef[2]) * np.ptp(ss) / contrast, abs(coef[3]) * np.ptp(t) / contrast
+        trend, way = max((across, "across"), (along_target, "along"))
         texture = math.sqrt(max(np.var(resid) - pixel_noise ** 2, 0.0)) / contrast
         bands = np.floor(ss).astype(int)
         counts = np.bincount(bands)
@@ -344,8 +402,8 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
                   if full.any() and band_means[worst] > 5 * band_noise[worst] else 0.0)
         checks += [
             Check("non-uniform", trend <= MAX_SIDE_TREND,
-                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast (at most "
-                  f"{100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
+                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast {way} the target (at "
+                  f"most {100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
             Check("non-uniform", texture <= MAX_SIDE_TEXTURE,
                   f"the {name} side carries texture of {100 * texture:.0f} % of the contrast beyond the "
                   f"pixel noise (at most {100 * MAX_SIDE_TEXTURE:g} %): not a uniform field",
@@ -377,7 +435,8 @@ def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
     wrong profile does.  Checked up to the noise limit (and 1 cy/px)."""
     f = np.arange(0.01, min(limit_cy_px, 1.0) + 1e-9, 0.01)
     if f.size == 0:
-        return Check("mtf-above-one", True, "MTF not checked")
+        return not_run("mtf-above-one", f"the MTF falls into its noise below 0.01 cy/px ({limit_cy_px:.3f}): "
+                       "nothing to compare with 1")
     excess = mtf(f) - 1.0 - 3.0 * noise_sd(f)
     worst = int(np.nanargmax(excess)) if np.isfinite(excess).any() else 0
     over = float(excess[worst]) if np.isfinite(excess).any() else -1.0

@@ -56,6 +56,7 @@ from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
 from .saturation import saturation_checks
 from .settings import Settings
+from .sharpening import mtf_peak, sharpening_check
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
@@ -138,6 +139,7 @@ class Measurement:
         """
         geometry, spectrum = self.located.geometry, self.estimate.spectrum
         normal = normal_angle(geometry)
+        peak = mtf_peak(spectrum.mtf, spectrum.noise_limit_cy_px)
         return dict(
             normal_angle_deg=normal, tilt_deg=geometry.tilt_deg,
             direction=direction_label(normal, self.chip.track_azimuth_deg),
@@ -150,7 +152,9 @@ class Measurement:
             lsf_x_px=spectrum.lsf_x_px, lsf=spectrum.lsf, samples_x_px=self.estimate.samples.distance_px,
             samples_dn=self.estimate.samples.raw_dn, geometry=geometry, roi=self.chip.roi,
             noise_limit_cy_px=spectrum.noise_limit_cy_px, lsf_half_width_px=self.estimate.window.core_px,
-            tail_fraction=self.estimate.lsf.tail_share, checks=self.checks, mtf_function=spectrum.mtf)
+            tail_fraction=self.estimate.lsf.tail_share, checks=self.checks, mtf_function=spectrum.mtf,
+            mtf_peak=peak.mtf, mtf_peak_cy_px=peak.cy_px,
+            sharpened=any(c.explained_by == "sharpening" for c in self.checks))
 
 
 def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[int, int, int, int] | None = None,
@@ -434,21 +438,27 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
                                 noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
                                 bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone,
                                 contrast=contrast, bar_edge_px=kind.known_half_width_px(shape))
+    # each side's texture against its own pixel noise (linearisation scales it with the level)
+    side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     checks += gate.side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
-                               chip.noise_dn, kind.tail_power)
+                               side_noise, kind.tail_power, (side_names[0], side_names[1]))
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    checks.append(gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px))
+    evidence = Evidence(distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
+                        noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile,
+                        (side_names[0], side_names[1]), located.geometry)
+    # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
+    excess, sharpening_notes, _, _ = sharpening_check(
+        gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)
+    checks.append(excess)
     checks.append(_figures_check(spectrum))
     # the registered checks come last: a failure above (a sharpened halo) names the cause better
-    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
-    profile_checks, profile_warnings = run_profile_checks(Evidence(
-        distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
-        noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile, (side_names[0], side_names[1]),
-        located.geometry))
+    profile_checks, profile_warnings = run_profile_checks(evidence)
     checks += profile_checks
-    warnings = list(gate.enforce(checks, settings.force)) + snr_warnings + profile_warnings + list(chip.warnings)
+    warnings = (list(gate.enforce(checks, settings.force)) + snr_warnings + sharpening_notes + profile_warnings
+                + list(chip.warnings))
     if window.cut:
         warnings.append(f"the LSF window's core ({window.core_px:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")

@@ -78,11 +78,19 @@ class MTFResult:
         The LSF window's flat core, and the share of the LSF's area the
         tail model supplies beyond it.
     checks : tuple of imgmtf.estimate.gate.Check
-        Every quality check and its outcome.
+        Every quality check and its outcome (passed, failed, or not run
+        and why), in the JSON form too.
     warnings : tuple of str
         What the user should know (low SNR, forced checks...).
     mtf_function : callable or None
         The corrected MTF at any frequency (:meth:`mtf_at`).
+    mtf_peak, mtf_peak_cy_px : float
+        The MTF's largest value up to the noise limit (1 at zero frequency
+        for an unsharpened system) and its frequency, cy/px.
+    sharpened : bool
+        The MTF rises above 1 as a sharpening kernel raises it (MTF
+        compensation of a delivered product): the figures are the
+        product's, not the sensor's (said in the warnings).
     """
 
     target: ClassVar[str] = ""
@@ -118,6 +126,9 @@ class MTFResult:
     checks: tuple = field(default=(), repr=False)
     warnings: tuple[str, ...] = ()
     mtf_function: Callable | None = field(default=None, repr=False)
+    mtf_peak: float = math.nan
+    mtf_peak_cy_px: float = math.nan
+    sharpened: bool = False
 
     def __repr__(self) -> str:
         ci = self.mtf_nyquist_ci
@@ -183,11 +194,12 @@ class MTFResult:
             "fwhm_px": finite(self.fwhm_px), "mtfa": finite(self.mtfa), "gsd_m": self.gsd_m,
             "mtf50_cy_m": finite(self.mtf50_cy_m), "fwhm_m": finite(self.fwhm_m),
             "noise_limit_cy_px": finite(self.noise_limit_cy_px),
+            "mtf_peak": finite(self.mtf_peak), "mtf_peak_cy_px": finite(self.mtf_peak_cy_px),
+            "sharpened": bool(self.sharpened),
             "lsf_half_width_px": finite(self.lsf_half_width_px), "tail_fraction": finite(self.tail_fraction),
             **self._specific(),
             "roi": list(self.roi), "warnings": list(self.warnings),
-            "checks": [{"reason": c.reason, "passed": bool(c.passed), "message": c.message}
-                       for c in self.checks if not c.passed],
+            "checks": [c.to_dict() for c in self.checks],
             "params": self.params, "imgmtf_version": __version__,
         }
         if curves:

@@ -11,7 +11,7 @@ from statistics import NormalDist
 
 import numpy as np
 
-from .gate import Check
+from .gate import Check, not_run
 
 SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
 PILE_UP = 3.0                   # samples at the extreme value / samples one quantum below it
@@ -43,7 +43,11 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
     checks = []
     sides = list(sides)
     for name, mask, _ in sides:
-        if limits is None or mask.sum() < 5:
+        if limits is None:
+            continue
+        if mask.sum() < 5:
+            checks.append(not_run("saturated", f"the {name} side holds {int(mask.sum())} samples beyond its "
+                                  "plateau's start (5 needed): its share at the limits not measured"))
             continue
         low, high = limits
         at_limit = float(np.mean((values[mask] <= low) | (values[mask] >= high)))

@@ -23,10 +23,11 @@ import math
 import numpy as np
 
 from .evidence import Evidence
-from .gate import Check
+from .gate import Check, not_run
 
 MIN_SIDE_SAMPLES = 40
-MIN_SIDE_EXTENT_PX = 4.0
+MIN_SIDE_EXTENT_PX = 4.0       # a side spanning less beyond the plateau's start is too short to see curve...
+MIN_PLATEAU_PX = 2.0           # ...and one spanning less than this holds no plateau at all: refused
 BAND_PX = 1.0                  # the side's residuals are averaged in bands this wide
 MIN_BAND_SAMPLES = 5
 SMOOTH_DEGREE = 3              # a smooth departure: a cubic across the side's extent
@@ -51,7 +52,14 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
     checks: list[Check] = []
     warnings: list[str] = []
     for name, fit in zip(ev.side_names, fits):
-        if fit is None:
+        if isinstance(fit, Check):
+            # (no value: the gate's figures of a side's variation are shares of the contrast)
+            checks.append(Check(fit.reason, fit.passed, fit.message.format(name=name), ran=fit.ran))
+            continue
+        if fit["departure"] is None:
+            checks.append(not_run("non-uniform", f"the {name} side spans too little beyond its plateau's start "
+                                  f"(at least {MIN_SIDE_EXTENT_PX:g} px in {SMOOTH_DEGREE + 2} 1-px bands of "
+                                  f"{MIN_BAND_SAMPLES} samples) to see its level curve"))
             continue
         departure, sd, where = fit["departure"]
         share = departure / ev.contrast
@@ -65,7 +73,11 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
             warnings.append(f"the {name} side's level departs from a settled level by {100 * share:.1f} % of "
                             f"the contrast ({where:.0f} px from the {ev.name}): a shading, a halo or a "
                             "texture there changes the MTF")
-    if all(fit is not None for fit in fits):
+    if any(isinstance(fit, Check) for fit in fits):
+        checks.append(not_run("non-uniform", "the two sides' tails cannot be compared: "
+                              + " and ".join(ev.side_names[i] for i, fit in enumerate(fits) if isinstance(fit, Check))
+                              + " side not fitted"))
+    else:
         (left, left_sd), (right, right_sd) = (fit["unsettled"] for fit in fits)  # type: ignore[index]
         asymmetry, slow = abs(left - right), max(left, right)
         significant = asymmetry > SIGNIFICANCE * math.hypot(left_sd, right_sd)
@@ -85,15 +97,25 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
     return checks, warnings
 
 
-def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
+def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     """One side's level + A / |s|^p fit: its smooth departure (DN, its
-    standard deviation, where, px) and its unsettled share at the side's
-    start (fraction of the contrast towards the other level, and its sd)."""
-    if np.count_nonzero(mask) < MIN_SIDE_SAMPLES:
-        return None
+    standard deviation, where, px; None where the side holds too few bands
+    to see a curve) and its unsettled share at the side's start (fraction
+    of the contrast towards the other level, and its sd).  Where no fit
+    can be made, the side's check instead (its message holds ``{name}``
+    for the side's name): failed where the side holds no plateau within
+    the chip (too few samples, too short a span beyond ``plateau_px``:
+    a level still changing there reads as blur, and nothing would
+    show it), not run where the fit is ill-conditioned."""
+    count = int(np.count_nonzero(mask))
+    extent = float(np.ptp(np.abs(s[mask]))) if count else 0.0
+    if count < MIN_SIDE_SAMPLES or extent < MIN_PLATEAU_PX:
+        return Check("non-uniform", False,
+                     f"the {{name}} side holds no plateau within the chip: {count} samples over {extent:.1f} px lie "
+                     f"beyond {ev.plateau_px:.1f} px from the {ev.name} (at least {MIN_SIDE_SAMPLES} over "
+                     f"{MIN_PLATEAU_PX:g} px needed to see it settle): its level may still be changing "
+                     "(illumination, a slope) and would read as blur; crop wider or choose a flatter side")
     reach, v = np.abs(s[mask]), ev.values[mask]
-    if np.ptp(reach) < MIN_SIDE_EXTENT_PX:
-        return None
     u = reach ** -float(ev.tail_power)
     # the straight line in u in closed form about its mean: the normal
     # matrix [[n, sum u], [sum u, sum u^2]] has determinant n * spread
@@ -104,7 +126,8 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
     trace = n + spread + n * mean_u ** 2
     largest = 0.5 * (trace + math.hypot(n - spread - n * mean_u ** 2, 2.0 * n * mean_u))
     if not spread > 0 or largest ** 2 > 1e12 * n * spread:      # its condition number, largest^2 / det
-        return None
+        return not_run("non-uniform", "the {name} side's level and tail cannot be told apart (its samples span "
+                       "too little of the tail): its settling not judged")
     coef = np.empty(2)
     coef[1] = float(centred @ v) / spread
     coef[0] = float(np.mean(v)) - coef[1] * mean_u
@@ -120,8 +143,8 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | None:
     counts = np.bincount(band)
     sums = np.bincount(band, weights=resid)
     full = counts >= MIN_BAND_SAMPLES
-    if full.sum() <= SMOOTH_DEGREE + 1:
-        return {"departure": (0.0, math.inf, 0.0), "unsettled": unsettled}
+    if full.sum() <= SMOOTH_DEGREE + 1 or extent < MIN_SIDE_EXTENT_PX:
+        return {"departure": None, "unsettled": unsettled}
     centres = reach.min() + (np.nonzero(full)[0] + 0.5) * BAND_PX
     means = sums[full] / counts[full]
     error2 = sigma2 / counts[full] + ev.rounding_floor ** 2

@@ -9,6 +9,7 @@ stages.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -54,6 +55,12 @@ class Chip:
         What was done to the pixels that the result must say.
     left_out_px : dict
         How many pixels were left out, by cause (provenance).
+    noise_gain : callable or None
+        Where the values were linearised: how that scaled the stored
+        values' noise at a linear level (DN), and ``stored_noise_dn`` that
+        noise; None where the values are measured as stored.
+    stored_noise_dn : float
+        The robust pixel noise of the values as stored, DN.
     """
 
     pixels: np.ndarray
@@ -66,6 +73,17 @@ class Chip:
     checks: tuple[Check, ...]
     warnings: tuple[str, ...]
     left_out_px: dict[str, int]
+    noise_gain: Callable[[float], float] | None = None
+    stored_noise_dn: float = math.nan
+
+    def noise_at(self, level_dn: float) -> float:
+        """The pixel noise (DN) expected at a level (DN): ``noise_dn``
+        for values measured as stored; for linearised values the stored
+        noise as linearisation shapes it there (larger on a bright side,
+        smaller on a dark one)."""
+        if self.noise_gain is None or not math.isfinite(self.stored_noise_dn):
+            return self.noise_dn
+        return float(self.stored_noise_dn * self.noise_gain(level_dn))
 
     @property
     def roi(self) -> tuple[int, int, int, int]:

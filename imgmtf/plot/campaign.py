@@ -92,7 +92,7 @@ def plot_trend(rows: Sequence[Mapping], figure: str = "mtf_nyquist", *, trend: T
     if misfit:
         ax.plot(misfit, [r[figure] for r in usable if r.get("misfit")], "x", ms=9, color="C3", zorder=4,
                 label="the model misfits: may be biased")
-    if trend is not None:
+    if trend is not None and trend.has_slope:       # one acquisition, or misfit rows: points, no line
         span = np.array([trend.first_utc, trend.last_utc])
         ends: list[Any] = [parse_utc(t).replace(tzinfo=None) for t in span]
         years = years_since(list(span), trend.first_utc)

@@ -1,7 +1,7 @@
 """Figures of a sensor fit: measured against model MTF per edge, residuals."""
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -146,6 +146,79 @@ def plot_fit_residuals(fit: SensorFit, ax: Axes | None = None) -> Figure | SubFi
            ylabel="data - model (% of the step)")
     ax.legend(fontsize="x-small", title="structure (RMS)", title_fontsize="x-small", loc="upper center",
               bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)       # below the axes, off the data
+    return fig
+
+
+def plot_fit_lsf(fit: SensorFit, index: int, ax: Axes | None = None,
+                 others: Mapping[str, SensorFit] | None = None, reach_px: float = 8.0) -> Figure | SubFigure:
+    """One edge's measured line spread function on a log scale against the
+    fitted model's along the same direction (and other fits' to compare):
+    the shape of the blur, which an MTF alone hides (a Gaussian's LSF is a
+    parabola here, an exponential wing a straight line, a one-sided lag a
+    lean, a halo a raised foot).
+
+    Parameters
+    ----------
+    fit : SensorFit
+        A sensor fit (:func:`imgmtf.fit_sensor`).
+    index : int
+        The edge, an index into ``fit.edges`` (negative from the end).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default a new figure's).
+    others : mapping of str to SensorFit, optional
+        Other fits of the same edges, by label, drawn dashed.
+    reach_px : float, optional
+        Distances drawn either side of the edge, px (default 8).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure holding ``ax``.
+
+    Raises
+    ------
+    ParameterError
+        ``fit`` or one of ``others`` is not a sensor fit, or an ``index``
+        outside its edges.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.plot import plot_fit_lsf
+    >>> fit = imgmtf.fit_sensor([imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60).image])
+    >>> plot_fit_lsf(fit, 0).axes[0].get_yscale()
+    'log'
+    """
+    from ..estimate.fit.data import profile_angle_deg
+    expect(fit, "fit")
+    for other in (others or {}).values():
+        expect(other, "fit")
+    if not -len(fit.edges) <= index < len(fit.edges):
+        from ..errors import ParameterError
+        raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
+    fig, ax = figure_axes(ax)
+    edge = fit.edges[index]
+    m = edge.measurement
+    x, lsf = np.asarray(m.lsf_x_px, float), np.asarray(m.lsf, float)
+    lsf = lsf / float(np.trapezoid(lsf, x))         # unit area, as every model's
+    peak = float(lsf.max())
+    near = np.abs(x) <= reach_px
+    ax.plot(x[near], lsf[near] / peak, color="k", lw=1.2, label="measured (no model)")
+    angle = profile_angle_deg(m)
+    d = np.linspace(-reach_px, reach_px, 801)
+    fits = {f"{'+'.join(s.name for s in fit.sensor.stages)}" + (" (misfit)" if fit.misfit else ""): fit}
+    fits.update({label + (" (misfit)" if other.misfit else ""): other for label, other in (others or {}).items()})
+    for k, (label, model) in enumerate(fits.items()):
+        response = model.sensor.line_response(angle, model.edges[index].gsd_m)
+        # the measured profile's distances are from the located edge, the model's from its fitted offset
+        model_lsf = response.lsf(d - model.edges[index].offset_px)
+        ax.plot(d, model_lsf / peak, ls="-" if k == 0 else "--", lw=1.4, color=f"C{k}", label=label)
+    ax.set_yscale("log")
+    ax.set(xlim=(-reach_px, reach_px), ylim=(1e-3, 1.5), xlabel="distance along the profile (px)",
+           ylabel="LSF (peak = 1)")
+    ax.set_title(f"{_short(edge.source)}\nnormal {edge.normal_angle_deg:.1f} deg ({edge.direction})",
+                 fontsize="medium")
+    ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18), frameon=False)   # off the data
     return fig
 
 

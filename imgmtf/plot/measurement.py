@@ -244,6 +244,11 @@ def plot_mtf(result: MTFResult, ax: Axes | None = None, truth: Callable[[np.ndar
     interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
     ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
                 label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px', missing_cause(result, 'mtf50'))}{interval50}")
+    if getattr(result, "sharpened", False):
+        # a sharpened product's MTF rises above 1: its peak marked, the axis taken above it
+        ax.axhline(1.0, color="0.5", lw=0.6)
+        ax.plot([result.mtf_peak_cy_px], [result.mtf_peak], "^", color=c, ms=5,
+                label=f"peak {result.mtf_peak:.3f} at {result.mtf_peak_cy_px:.3f} cy/px (sharpened)")
     top = max(1.05, float(np.nanmax(result.mtf)) + 0.05)
     ax.set(xlim=(0, f.max()), ylim=(0, top), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
     if result.gsd_m:

@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import ImgmtfError
 from ..estimate.detection import robust_noise
 from ..figures import with_figure
+from ..file_notes import file_notes
 from ..inputs import saturation_levels
 from ..io import RasterInfo, read_raster
 from ..kinds import get_kind
@@ -194,6 +195,9 @@ def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
     roi_box = band.site["roi"]
     figures = {**result.to_dict(curves=True), "roi": [x_ + roi_box[0], y_ + roi_box[1], w_, h_],
                "line_rms_px": _line_rms(result.geometry), **_gate_figures(result.checks)}
+    # what the file says about every number in it, as measure says it (one set of warnings)
+    figures["warnings"] = [*figures["warnings"], *file_notes(raster, settings.measure_settings().transfer,
+                                                             bool(context.info.alpha_bands))]
     record = Record.measured(context.path, raster.band, figures, params=context.params, run_utc=context.run_utc,
                              status="accepted", site={**band.site, "verdict_by": "gate"}, measurement=result)
     if context.figures_dir:

@@ -38,9 +38,10 @@ from ..estimate.results import finite
 from ..kinds import get_kind
 from ..records import CANDIDATE_SCOPE, SCENE_SCOPE, TARGET_SCOPE, Record
 
-#: the stages fitted to a target's half-edges by default: blur and pixel,
-#: what a target's few edges determine on both axes
-DEFAULT_STAGES = "optics,detector"
+#: the stages fitted to a target's half-edges by default: the simplest
+#: candidate that fits (:mod:`imgmtf.estimate.fit.choice`): blur and pixel
+#: on a synthetic chip, the exponential wings, lag and halo real L0R needs
+DEFAULT_STAGES = "auto"
 _DIRECTIONS = {"across": "across-track", "along": "along-track"}
 
 
@@ -259,6 +260,7 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
         "mtf50_ci_cy_px": [finite(v) for v in figures_of["mtf50_cy_px_ci"]],
         "fwhm_px": finite(fwhm_px), "rer": finite(relative_edge_response(grid, esf, _half_point(grid, esf))),
         "stages": [s.name for s in sensor.stages],
+        "model_choice": fit.choice.reason if fit.choice is not None else None,
         "parameters": {p.key: finite(p.value) for p in fit.parameters if p.status == "fitted"},
         "reduced_chi_square": finite(fit.reduced_chi_square), "misfit": bool(fit.misfit),
         "misfit_p": finite(min(e.misfit_p for e in fit.edges)),

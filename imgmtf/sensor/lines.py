@@ -215,7 +215,9 @@ class LineGrid:
             Their edge and line spread functions on the grid.
         """
         _, to_lsf, to_esf = _inverse_factors(self.step_px, self.size)
-        spectra = np.asarray(spectra, float)
+        spectra = np.asarray(spectra)
+        if not np.iscomplexobj(spectra):
+            spectra = spectra.astype(float, copy=False)
         both = np.empty((2, *spectra.shape), complex)
         np.multiply(spectra, to_lsf, out=both[0])
         np.multiply(spectra, to_esf, out=both[1])
@@ -492,7 +494,7 @@ def line_grid(sensor: _Blur, angle_deg: float, gsd: float, *, reach_px: float = 
     else:
         # any smooth reference of about the LSF's width keeps the remainder small
         if transfer_at_probe is None:
-            transfer_at_probe = float(sensor.normal_transfer(PROBE_CY_PX, angle_deg, gsd))
+            transfer_at_probe = float(np.real(sensor.normal_transfer(PROBE_CY_PX, angle_deg, gsd)))
         variance = (1.0 - transfer_at_probe) / (2 * math.pi**2 * PROBE_CY_PX**2)
         reference = ("gaussian", min(max(math.sqrt(max(variance, 0.0)), 0.1), 10.0))
     half = reach_px + sensor.support_radius_m() / gsd + 8 * reference[1] + 4.0

@@ -3,10 +3,13 @@ a known rate: the synthetic campaign, with its exact truth.
 
 Each acquisition is a Baotou-like scene (:mod:`.scenes`: a four-quadrant
 target tilted 16.8 deg on a uniform field, placed a little differently
-each time) rendered through anisotropic Gaussian optics and a square
-pixel (:class:`.stages.GaussianOptics`, :class:`.stages.Detector`) whose
-optics blur ``degradation`` more (as a fraction of their width at the
-start) every year.  The truth of each acquisition is that sensor's exact
+each time) rendered through a square pixel and a blur that grows
+``degradation`` more (as a fraction of its width at the start) every
+year: anisotropic Gaussian optics (``blur="gaussian"``), or the blur of a
+real L0R sensor (``blur="l0r"``): a small Gaussian core, exponential wings
+per axis (:class:`.stages.Diffusion`), a scatter halo (:class:`.stages.Halo`)
+and a one-sided lag along track (:class:`.stages.Lag`), the core and the
+wings growing.  The truth of each acquisition is that sensor's exact
 MTF across and along track; the true drift per year is the least-squares
 slope of those values over the acquisitions' times, what a trend over
 the campaign estimates.
@@ -22,10 +25,21 @@ import numpy as np
 from ..errors import ParameterError
 from .model import Sensor
 from .scenes import QuadrantScene, QuadrantTarget, render_quadrants
-from .stages import Detector, GaussianOptics
+from .stages import Detector, Diffusion, GaussianOptics, Halo, Lag
 
 #: a year, days: the unit of the drift (as a trend over a campaign reports it)
 YEAR_DAYS = 365.25
+#: the blurs a campaign's sensor can have
+BLURS = ("gaussian", "l0r")
+#: the L0R blur beside the Gaussian core, px: the wings' lengths across and
+#: along track (growing with the core), the halo's share and radius and the
+#: lag along track (fixed): MTF at Nyquist 0.17 / 0.12 at the start, 0.10 /
+#: 0.06 after five years of 6 % (the Baotou chip's half-edges read 0.10-0.12)
+L0R_WINGS_PX = (0.4, 0.35)
+L0R_HALO = (0.05, 2.5)
+L0R_LAG_PX = 0.35
+#: the L0R blur's core, px (the Gaussian blur's is ``optics_sigma_px``)
+L0R_CORE_PX = (0.25, 0.3)
 #: the quadrants' levels and the field's at 16 bits (DN); the smallest step
 #: between quadrants (4500 DN) over the SNR gives the noise
 LEVELS_16_DN = (9000.0, 2500.0, 9000.0, 4500.0)
@@ -52,7 +66,8 @@ class SyntheticCampaign:
         year (>= 0; 0.06: 6 % a year).
     optics_sigma_px : (float, float)
         The optics' Gaussian standard deviations across (x) and along (y)
-        track at the start, px.
+        track at the start, px (with ``blur="l0r"``, default
+        :data:`L0R_CORE_PX`).
     snr : float
         The smallest step between quadrants over the noise (> 0).
     size_px : int
@@ -66,6 +81,9 @@ class SyntheticCampaign:
     fill : bool
         Set every pixel outside the target to 0, as an L0R chip cuts a
         target out of its scene: only its four inner half-edges remain.
+    blur : {"gaussian", "l0r"}
+        Gaussian optics and a pixel (default), or a real L0R sensor's blur
+        (see the module's docstring).
 
     Raises
     ------
@@ -79,21 +97,29 @@ class SyntheticCampaign:
     [0.3841, 0.3608, 0.3378]
     >>> round(campaign.true_slopes_per_year()["across"], 4)
     -0.0232
+    >>> real = SyntheticCampaign(acquisitions=6, blur="l0r")
+    >>> [round(real.truth(k)["mtf_nyquist_along"], 4) for k in (0, 5)]
+    [0.1182, 0.0632]
     """
 
     acquisitions: int = 6
     start_utc: str = "2020-06-01T03:30:00Z"
     interval_days: float = 365.0
     degradation: float = 0.06
-    optics_sigma_px: tuple[float, float] = (0.32, 0.42)
+    optics_sigma_px: tuple[float, float] | None = None
     snr: float = 180.0
     size_px: int = 320
     bits: int = 16
     seed: int = 0
     gsd_m: float = 1.0
     fill: bool = False
+    blur: str = "gaussian"
 
     def __post_init__(self):
+        if self.blur not in BLURS:
+            raise ParameterError(f"blur must be one of {', '.join(BLURS)}, got {self.blur!r}")
+        if self.optics_sigma_px is None:
+            object.__setattr__(self, "optics_sigma_px", L0R_CORE_PX if self.blur == "l0r" else (0.32, 0.42))
         if not (isinstance(self.acquisitions, int) and self.acquisitions >= 2):
             raise ParameterError(f"a campaign needs at least 2 acquisitions, got {self.acquisitions!r}")
         _start(self.start_utc)
@@ -119,11 +145,17 @@ class SyntheticCampaign:
         return k * self.interval_days / YEAR_DAYS
 
     def sensor(self, k: int) -> Sensor:
-        """The sensor at the ``k``-th acquisition: optics blurred
-        (1 + degradation x years) times their starting width, a square pixel."""
+        """The sensor at the ``k``-th acquisition: optics (and an L0R blur's
+        wings) blurred (1 + degradation x years) times their starting width,
+        a square pixel (and an L0R blur's halo and lag)."""
         grow = 1.0 + self.degradation * self.years(k)
-        sx, sy = (s * grow * self.gsd_m for s in self.optics_sigma_px)
-        return Sensor(self.gsd_m, [GaussianOptics(sx, sy), Detector(self.gsd_m, self.gsd_m)])
+        g = self.gsd_m
+        sx, sy = (s * grow * g for s in self.optics_sigma_px)  # type: ignore[union-attr]
+        stages = [GaussianOptics(sx, sy), Detector(g, g)]
+        if self.blur == "l0r":
+            stages += [Diffusion(L0R_WINGS_PX[0] * grow * g, L0R_WINGS_PX[1] * grow * g),
+                       Halo(L0R_HALO[0], L0R_HALO[1] * g), Lag(0.0, L0R_LAG_PX * g)]
+        return Sensor(g, stages)
 
     def target(self, k: int) -> QuadrantTarget:
         """The ``k``-th scene's target: tilted 16.8 deg, centred within a
@@ -162,6 +194,7 @@ class SyntheticCampaign:
         sensor = self.sensor(k)
         optics = sensor.stages[0]
         return {"acquired_utc": self.acquired_utc(k), "years": self.years(k),
+                "stages": [s.name for s in sensor.stages],
                 "optics_sigma_x_m": optics.sigma_x_m, "optics_sigma_y_m": optics.sigma_y_m,  # type: ignore[attr-defined]
                 **{f"mtf_nyquist_{d}": float(sensor.mtf_nyquist(d)) for d in ("across", "along")},
                 **{f"mtf50_{d}_cy_px": float(sensor.mtf50_cy_px(d)) for d in ("across", "along")}}
@@ -178,9 +211,9 @@ class SyntheticCampaign:
 
     def as_dict(self) -> dict:
         return {"acquisitions": self.acquisitions, "start_utc": self.start_utc, "interval_days": self.interval_days,
-                "degradation_per_year": self.degradation, "optics_sigma_px": list(self.optics_sigma_px),
+                "degradation_per_year": self.degradation, "optics_sigma_px": list(self.optics_sigma_px or ()),
                 "snr": self.snr, "size_px": self.size_px, "bits": self.bits, "seed": self.seed,
-                "gsd_m": self.gsd_m, "fill": self.fill}
+                "gsd_m": self.gsd_m, "fill": self.fill, "blur": self.blur}
 
 
 def _start(text: str) -> datetime:

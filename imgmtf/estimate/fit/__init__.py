@@ -35,7 +35,8 @@ Identifiability, in three steps:
 3. Holding.  After a fit, a parameter whose one-standard-error range is
    wider than ``DETERMINED_RELATIVE`` (50 %) of its blur length and than
    ``DETERMINED_PX`` (0.2 px) is not determined by the data: the best-known
-   of those (detector first, optics last) is held at its starting value,
+   of those (detector first, optics last) is held at its starting value
+   (a lag started from the edges' lean, :mod:`.seeds`, at none),
    and the fit is redone, until every free parameter is determined.  Then,
    best-known first, a parameter is held when freeing it gains less than
    ``LIKELIHOOD_RATIO`` in chi-square, keeping one free parameter on each

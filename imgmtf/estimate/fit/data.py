@@ -135,7 +135,16 @@ def bin_profile(x: np.ndarray, y: np.ndarray, width_px: float = FIT_BIN_PX) -> P
 class EdgeData:
     """What one edge gives the fit: its samples (distances px, ascending,
     and values DN), binned (what the model is fitted to), their noise (DN,
-    of one sample), levels (DN, as measured) and geometry."""
+    of one sample), levels (DN, as measured) and geometry.
+
+    ``profile_angle_deg`` is the direction the samples' distances grow
+    along, from the x axis: the normal's (``normal_angle_deg``, in
+    (-90, 90]) or, ``reversed_profile``, the opposite one.  A near-horizontal edge's distances
+    grow toward increasing row whatever its normal's sign, so for a normal
+    that points toward decreasing row it is the normal + 180 deg.  Only a
+    one-sided stage (a complex transfer, an asymmetric LSF) tells the two
+    apart.
+    """
 
     source: str
     x: np.ndarray
@@ -147,6 +156,12 @@ class EdgeData:
     noise: float
     levels: tuple[float, float]
     measurement: EdgeResult
+    reversed_profile: bool = False
+
+    @property
+    def profile_angle_deg(self) -> float:
+        """The direction (deg from the x axis) the samples' distances grow along."""
+        return self.normal_angle_deg + 180.0 if self.reversed_profile else self.normal_angle_deg
 
 
 def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | None) -> EdgeData:
@@ -189,8 +204,19 @@ def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | 
     floor = 1 / math.sqrt(12) if integer else 1e-5 * step
     noise = max(profile_noise(x, y), floor)           # of one sample, from the samples themselves
     gsd = result.gsd_m if result.gsd_m else (gsd_m or 1.0)
-    return EdgeData(source, x, y, bin_profile(x, y), float(result.normal_angle_deg), float(gsd), bool(result.gsd_m),
-                    noise, levels, result)
+    normal = float(result.normal_angle_deg)
+    return EdgeData(source, x, y, bin_profile(x, y), normal, float(gsd), bool(result.gsd_m),
+                    noise, levels, result, profile_angle_deg(result) != normal)
+
+
+def profile_angle_deg(result: EdgeResult) -> float:
+    """The direction (deg from the x axis) an edge measurement's sample
+    distances (and its LSF's) grow along: its normal, or for a
+    near-horizontal edge whose normal points toward decreasing row the
+    opposite one (the vertical frame's distances grow toward +x, a
+    transposed frame's toward +y)."""
+    normal = float(result.normal_angle_deg)
+    return normal + 180.0 if result.orientation == "horizontal" and normal < 0 else normal
 
 
 def profile_noise(x: np.ndarray, y: np.ndarray) -> float:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -12,10 +13,13 @@ from ..._blas import one_blas_thread
 from ...errors import ImgmtfError, ParameterError
 from ...inputs import check_number
 from ...sensor.model import Sensor
+from ...sensor.stages import STAGES
+from .choice import AUTO, AUTO_CANDIDATES, ModelChoice, candidate_summary, choose
 from .data import EdgeImage, edge_data
 from .model import Model, hold_keys, initial_stages, listed, parameter_covariance, stage_names
 from .report import fit_report
 from .results import SensorFit
+from .seeds import seeded
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
@@ -47,8 +51,10 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
         :class:`imgmtf.EdgeResult` already measured; one edge per image.
     stages : str or sequence of str, optional
         Stage names to fit (comma-separated or a list; see
-        :data:`imgmtf.sensor.stages.STAGES`); default the stages of
-        ``start``, or the paper's four.
+        :data:`imgmtf.sensor.stages.STAGES`), or ``"auto"``: the simplest
+        of :data:`.choice.AUTO_CANDIDATES` that fits (see
+        :mod:`.choice`); default the stages of ``start``, or the paper's
+        four.
     start : Sensor, optional
         Starting (and held) values of the stages it has; other stages
         start from their defaults scaled to the GSD.
@@ -83,7 +89,10 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     >>> abs(fit.edges[0].mtf_nyquist - 0.2667) < 0.002
     True
     """
+    auto = is_auto(stages)
     names, gsd_m = checked_arguments(stages, start, gsd_m, confidence)
+    if auto:
+        check_auto_hold(hold)
     items = listed("edges", edges, "arrays or EdgeResults")
     data = [edge_data(item, k, gsd_m) for k, item in enumerate(items)]
     if not data:
@@ -91,7 +100,55 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
     importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
     with one_blas_thread():
-        return run_fit(Model(gsd, initial_stages(names, start, gsd), data), hold, confidence)
+        if not auto:
+            return run_fit(new_model(gsd, initial_stages(names, start, gsd), data, start), hold, confidence)
+        fits, failed = [], []
+        for candidate in AUTO_CANDIDATES:
+            model = new_model(gsd, initial_stages(list(candidate), start, gsd), data, start)
+            try:
+                fits.append(run_fit(model, candidate_hold(hold, model.keys), confidence))
+            except ImgmtfError as exc:          # one that does not converge: the next is tried
+                failed.append((candidate, str(exc)))
+                continue
+            if not fits[-1].misfit:
+                break               # the simplest that fits
+    if not fits:
+        raise ImgmtfError("no candidate sensor model could be fitted: "
+                          + "; ".join(f"{'+'.join(c)}: {message}" for c, message in failed), reason="fit")
+    index, reason = choose(fits, tried=len(fits) + len(failed))
+    kept = tuple(s.name for s in fits[index].sensor.stages)
+    choice = ModelChoice(tuple(candidate_summary(f) for f in fits), kept, reason, tuple(failed))
+    return replace(fits[index], choice=choice)
+
+
+def new_model(gsd: float, stages: list, data: list, start: Sensor | None) -> Model:
+    """The model of ``stages``, a lag started where the edges lean
+    (:func:`.seeds.seeded`) but held, if held, at none."""
+    return Model(gsd, seeded(stages, data, gsd, start), data, held_at=stages)
+
+
+def held_where(model: Model, key: str) -> str:
+    """Where a held parameter is held, in words."""
+    return "its starting value" if model.held_at[key] == model.start[key] else "none (0)"
+
+
+def is_auto(stages) -> bool:
+    """Whether ``stages`` asks for the model chosen by the data."""
+    return isinstance(stages, str) and stages.strip() == AUTO
+
+
+def check_auto_hold(hold) -> None:
+    """With ``auto``, a held name must name a parameter of some candidate."""
+    keys = sorted({f"{name}.{parameter}" for candidate in AUTO_CANDIDATES for name in candidate
+                   for parameter in STAGES[name].fit_specs()})
+    hold_keys(hold, keys)
+
+
+def candidate_hold(hold, keys: list[str]) -> list[str]:
+    """The held names that name a stage or parameter of this candidate."""
+    if isinstance(hold, str):
+        hold = [h.strip() for h in hold.split(",") if h.strip()]
+    return [item for item in hold if any(k == item or k.split(".")[0] == item for k in keys)]
 
 
 def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, gsd_m: float | None,
@@ -109,7 +166,7 @@ def checked_arguments(stages: str | Sequence[str] | None, start: Sensor | None, 
         gsd_m = check_number("gsd_m", gsd_m, positive=True)
     if start is not None and not isinstance(start, Sensor):
         raise ParameterError(f"start must be a Sensor, got {start!r}")
-    return stage_names(stages, start), gsd_m
+    return (["auto"] if is_auto(stages) else stage_names(stages, start)), gsd_m
 
 
 def run_fit(model: Model, hold, confidence: float) -> SensorFit:
@@ -128,7 +185,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         worst = max(undetermined, key=lambda i: (model.specs[model.free[i]].rank, undetermined[i]))
         notes[model.free[worst]] = ("held", f"not determined by the data (within one standard error its blur "
                                             f"length spans {undetermined[worst]:.2g} px); "
-                                            "held at its starting value")
+                                            f"held at {held_where(model, model.free[worst])}")
         z = model.hold(z, worst, covariance)
     # hold, best-known first, each parameter the data do not need (holding it
     # at its starting value costs less than the likelihood-ratio threshold),
@@ -148,7 +205,7 @@ def run_fit(model: Model, hold, confidence: float) -> SensorFit:
         cost = (trial.chi_square(z_held) - model.chi_square(z)) / scale
         if cost < LIKELIHOOD_RATIO:
             notes[key] = ("held", f"the data do not need it (freeing it gains chi-square {max(cost, 0):.1f} "
-                                  f"< {LIKELIHOOD_RATIO:g}); held at its starting value")
+                                  f"< {LIKELIHOOD_RATIO:g}); held at {held_where(model, key)}")
             model, z = trial, z_held
             scale = max(model.reduced_chi_square(z), 1.0)
             covariance = parameter_covariance(jacobian_held, scale)

@@ -93,7 +93,8 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     Parameters
     ----------
     stages : str or sequence of str, optional
-        Stage names to fit, as :func:`imgmtf.fit_sensor` takes them.
+        Stage names to fit, as :func:`imgmtf.fit_sensor` takes them
+        (``"auto"`` included).
     hold : str or sequence of str, optional
         Parameters held: "stage" or "stage.name".
     start : Sensor, optional
@@ -102,7 +103,7 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     Returns
     -------
     list of str
-        The stages' names.
+        The stages' names (``["auto"]`` for the model the data choose).
 
     Raises
     ------
@@ -115,6 +116,10 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     >>> check_names("optics,detector", "detector.width_x_m")
     ['optics', 'detector']
     """
+    from .fitting import check_auto_hold, is_auto
+    if is_auto(stages):
+        check_auto_hold(hold)
+        return ["auto"]
     names = stage_names(stages, start)
     hold_keys(hold, [f"{name}.{parameter}" for name in names for parameter in STAGES[name].fit_specs()])
     return names
@@ -137,7 +142,7 @@ class Model:
     """The shared stage parameters and each edge's nuisance parameters as
     one vector z = [free stage coordinates, then L, R, x0 per edge]."""
 
-    def __init__(self, gsd: float, stages: list[Stage], data: list[EdgeData]):
+    def __init__(self, gsd: float, stages: list[Stage], data: list[EdgeData], held_at: list[Stage] | None = None):
         self.gsd, self.stages, self.data = gsd, stages, data
         self.specs, self.keys, self.units = {}, [], {}
         for stage in stages:
@@ -149,18 +154,22 @@ class Model:
         # each stage's parameters: (key, name), in the order the coordinates are
         self._stage_keys = [[(f"{stage.name}.{name}", name) for name in stage.fit_specs()] for stage in stages]
         self.start = {k: v for s in stages for k, v in stage_coordinates(s, gsd).items()}
+        # where a held parameter is held: its start, but for a stage started from the data (a lag's
+        # lean, :mod:`.seeds`), the value it had before (none): a guess is no value to hold
+        self.held_at = dict(self.start) if held_at is None else {
+            k: v for s in held_at for k, v in stage_coordinates(s, gsd).items()}
         # a bin's residual weight: its mean's noise is noise / sqrt(count)
         self.weights = [np.sqrt(d.bins.count) / d.noise for d in data]
         self.counts = [d.bins.x.size for d in data]
         self.starts = np.cumsum([0, *self.counts[:-1]]).tolist()      # each edge's first bin among all
         self._stacked_bins: tuple[ProfileBins, np.ndarray] | None = None
         self._layout: tuple = (None, None, None)
-        self.values = dict(self.start)           # coordinates of held parameters live here
+        self.values = dict(self.held_at)         # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
         self._last_responses: tuple = (None, [])
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
-        self.edges = [EdgeResponses(d.normal_angle_deg, d.gsd_m, self.reach(d)) for d in data]
+        self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
@@ -210,8 +219,8 @@ class Model:
         the held one), the refit's starting point: a few steps from its end."""
         key = self.free.pop(index)
         if covariance is not None and covariance[index, index] > 0:
-            z = z + covariance[:, index] / covariance[index, index] * (self.start[key] - z[index])
-        self.values[key] = self.start[key]
+            z = z + covariance[:, index] / covariance[index, index] * (self.held_at[key] - z[index])
+        self.values[key] = self.held_at[key]
         return np.delete(z, index)
 
     @property
@@ -236,7 +245,7 @@ class Model:
     def bounds(self):
         upper = [self.specs[k].upper_px ** self.specs[k].power for k in self.free]
         big = np.inf
-        lower = [0.0] * self.n_free + [-big] * (3 * len(self.data))
+        lower = [self.specs[k].lower for k in self.free] + [-big] * (3 * len(self.data))
         return np.array(lower), np.array(upper + [big] * (3 * len(self.data)))
 
     def sensor(self, u: np.ndarray) -> Sensor:
@@ -478,8 +487,11 @@ class Model:
         for i, key in enumerate(self.free):
             power = self.specs[key].power
             u, se = z[i], math.sqrt(max(covariance[i, i], 0.0))
-            length = u ** (1 / power)
-            width = ((u + se) ** (1 / power) - max(u - se, 0.0) ** (1 / power)) / 2
+            if power == 1:              # a length or share taken as it is (a signed one included)
+                length, width = abs(u), se
+            else:
+                length = u ** (1 / power)
+                width = ((u + se) ** (1 / power) - max(u - se, 0.0) ** (1 / power)) / 2
             if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
                 out[i] = width if np.isfinite(width) else math.inf
         return out
@@ -501,10 +513,14 @@ def other_stages(stages) -> str:
     """What to try when the model misfits: the long-tailed stages it lacks,
     or, with all of them in, the non-parametric estimate."""
     have = {s.name for s in stages}
-    missing = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
-    if missing:
-        return f"try other stages (e.g. {', '.join(missing)})"
-    return "compare with the non-parametric estimate (imgmtf measure), which assumes no form of blur"
+    real = [name for name in ("diffusion", "halo", "lag") if name not in have]
+    optical = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
+    if real:
+        return (f"try the stages real blur adds ({', '.join(real)}; stages 'auto' tries them)"
+                + (f" or others (e.g. {', '.join(optical)})" if optical else ""))
+    if optical:
+        return f"try other stages (e.g. {', '.join(optical)}), or quote the rows measured without a model"
+    return "quote the rows measured without a model, which assume no form of blur"
 
 
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:

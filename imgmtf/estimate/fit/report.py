@@ -11,7 +11,7 @@ from ...sensor.model import DIRECTIONS, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
 from .model import Model, model_mtf50_band, model_mtf_band, other_stages
-from .results import MISFIT_FRACTION, MISFIT_P, EdgeFit, FittedParameter, SensorFit
+from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test
 MISFIT_BIN_PX = 0.25
@@ -80,7 +80,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
                        (float(lo), float(hi)), float(x0), chi, p, fraction, bins.x, res, bins.count, measured)
         edges.append(edge)
-        if p < MISFIT_P and fraction > MISFIT_FRACTION:
+        if edge.misfit:
             warnings.append(f"{d.source}: the model does not fit this edge: its residuals are structured "
                             f"along the normal ({100 * fraction:.2f} % of the step, p = {p:.1g}); its MTF may be "
                             f"biased: {other_stages(model.stages)}")
@@ -112,9 +112,10 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
 def value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> float:
     """Standard error of a parameter in its own unit, from that of its fit
     coordinate (linearised; one-sided at the coordinate's zero)."""
+    lower = stage.fit_specs()[name].lower
     def value(coordinate):
-        return getattr(stage.with_fit_coordinates({name: max(coordinate, 0.0)}, gsd), name)
-    if u > se_u:
+        return getattr(stage.with_fit_coordinates({name: max(coordinate, lower)}, gsd), name)
+    if u - se_u > lower:
         return abs(value(u + se_u) - value(u - se_u)) / 2
     return abs(value(u + se_u) - value(u))
 

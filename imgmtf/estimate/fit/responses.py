@@ -146,7 +146,7 @@ class EdgeResponses:
             grid of ``response``: for :func:`esf_changes`.
         """
         grid, base, response = self._base(sensor, given)
-        spectra = np.empty((len(shifted), base.size))
+        spectra = np.empty((len(shifted), base.size), base.dtype)       # complex for a one-sided stage
         for row, other in zip(spectra, shifted):
             np.subtract(self._transfer(other, keep=False, given=given)[1:], base, out=row)
         esf, lsf = grid.remainders(spectra)
@@ -162,7 +162,7 @@ class EdgeResponses:
             # the transfer on the last grid's frequencies: the next grid's, but when its size changes
             transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
             grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
-                             transfer_at_probe=None if transfer is None else float(transfer[0]))
+                             transfer_at_probe=None if transfer is None else float(transfer[0].real))
             if self._use(grid) or transfer is None:
                 transfer = self._transfer(sensor, keep=True, given=given)
             self._last = (key, grid, transfer[1:], grid.response(transfer[1:]))

@@ -13,6 +13,7 @@ from .model import Model, model_mtf_band
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
+    from .choice import ModelChoice
 
 #: misfit warning: binned residuals significant at this level ...
 MISFIT_P = 1e-3
@@ -132,6 +133,13 @@ class EdgeFit:
     bin_counts: np.ndarray = field(repr=False)
     measurement: EdgeResult = field(repr=False)
 
+    @property
+    def misfit(self) -> bool:
+        """Whether the model does not fit this edge: its residuals are
+        structured beyond the noise (p below :data:`MISFIT_P`) and beyond
+        :data:`MISFIT_FRACTION` of the step."""
+        return self.misfit_p < MISFIT_P and self.misfit_fraction > MISFIT_FRACTION
+
     def to_dict(self) -> dict:
         return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
                 "constrains": self.constrains, "gsd_m": self.gsd_m, "rows_used": self.rows_used,
@@ -141,7 +149,7 @@ class EdgeFit:
                 "measured_mtf_nyquist": json_value(self.measured_mtf_nyquist), "noise_dn": self.noise_dn,
                 "step_dn": self.step_dn, "levels_dn": list(self.levels_dn), "offset_px": self.offset_px,
                 "reduced_chi_square": self.reduced_chi_square, "misfit_p": self.misfit_p,
-                "misfit_fraction": self.misfit_fraction}
+                "misfit_fraction": self.misfit_fraction, "misfit": self.misfit}
 
 
 @dataclass(frozen=True, eq=False)
@@ -176,6 +184,9 @@ class SensorFit:
     warnings : tuple of str
         Where the model does not fit an edge, and which direction no edge
         constrains.
+    choice : ModelChoice or None
+        With ``stages="auto"``: the candidate stage sets fitted, their
+        information criterion and verdicts, and why this one was kept.
 
     Examples
     --------
@@ -197,12 +208,13 @@ class SensorFit:
     _model: Model = field(repr=False)
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
+    choice: ModelChoice | None = None
 
     @property
     def misfit(self) -> bool:
         """True when the model does not fit: an edge's residuals are
         structured, or a fitted parameter sits at the bound of its range."""
-        return any(e.misfit_p < MISFIT_P and e.misfit_fraction > MISFIT_FRACTION for e in self.edges) or any(
+        return any(e.misfit for e in self.edges) or any(
             p.note == "at the bound of its range" for p in self.parameters)
 
     def mtf_band(self, f_cy_px: ArrayLike, angle_deg: float,
@@ -243,6 +255,7 @@ class SensorFit:
                                    else [json_value(x) for x in vv] for kk, vv in v.items()}
                                for k, v in self.directions.items()},
                 "warnings": list(self.warnings), "sensor": self.sensor.to_dict(),
+                "model_choice": self.choice.to_dict() if self.choice is not None else None,
                 "edges": [e.to_dict() for e in self.edges]}
 
 
