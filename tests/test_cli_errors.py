@@ -7,10 +7,14 @@ import pathlib
 import pkgutil
 import re
 
+import numpy as np
 import pytest
+from click.testing import CliRunner
 
 import imgmtf
-from imgmtf.cli.hints import CHIP, HINTS, SCAN, option_hints, refusal_hint, rejection_hint
+from imgmtf.cli import main
+from imgmtf.cli.hints import CHIP, HINTS, OPTION, SCAN, Command, option_hints, refusal_hint, rejection_hint
+from imgmtf.cli.main import COMMANDS
 
 PACKAGE = pathlib.Path(imgmtf.__file__).parent
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z-]+")
@@ -43,7 +47,9 @@ def test_no_library_message_names_a_command_line_option():
 ])
 def test_the_cli_answers_a_reason_with_its_option(reason, option):
     answers = option_hints(CHIP, reason)
-    assert option in refusal_hint(reason, "a message") and len(answers) == 1 and option in answers[0]
+    # one answer per refusal, per command ("--band all" only where --band takes it)
+    assert option in refusal_hint(reason, "a message") and option in answers[0]
+    assert len(answers) == len({h.only for h in HINTS if h.command == CHIP and h.reason == reason})
 
 
 def test_a_reason_no_option_answers_gets_no_option():
@@ -68,4 +74,55 @@ def test_a_scan_names_no_option_where_none_moves_the_limit():
 def test_every_hint_is_for_a_command_that_shows_it_and_names_an_option():
     assert {h.command for h in HINTS} == {CHIP, SCAN}
     assert all(FLAG.search(h.text) for h in HINTS)
-    assert len({(h.command, h.reason, h.words) for h in HINTS}) == len(HINTS)   # one answer per refusal
+    assert len({(h.command, h.reason, h.words, h.only) for h in HINTS}) == len(HINTS)   # one answer per refusal
+
+
+def _every_refusal():
+    """(reason, message) of every refusal a hint may answer: the reasons the
+    hints, the gate's forcible checks and a scan's remedies name, each with
+    every message a hint looks for."""
+    from imgmtf.cli.hints import SCAN_SOLVES
+    from imgmtf.estimate.gate import FORCIBLE
+    reasons = {h.reason for h in HINTS} | FORCIBLE | SCAN_SOLVES | {"misfit", "noise-dominated", "untrusted"}
+    messages = {h.words for h in HINTS} | {"", "two straight pieces meet inside the chip"}
+    return [(r, m) for r in sorted(reasons) for m in sorted(messages)]
+
+
+@pytest.mark.parametrize("command", COMMANDS, ids=lambda c: c.name)
+def test_every_hint_a_command_gives_names_only_options_it_has(command):
+    running = Command.of(command)
+    for reason, message in _every_refusal():
+        for hint in (refusal_hint(reason, message, "x.tif", running=running),
+                     rejection_hint(reason, message, running=running)):
+            named = set(OPTION.findall(hint))
+            assert named <= running.options, (command.name, reason, message, hint)
+
+
+def test_every_hint_reaches_some_command_and_only_measure_takes_band_all():
+    running = [Command.of(c) for c in COMMANDS]
+    for h in HINTS:
+        assert any(r.gives(h.text, h.only) for r in running), h
+    fit = Command.of(next(c for c in COMMANDS if c.name == "fit"))
+    assert refusal_hint("bands", "", running=fit) == " (--band N chooses one)"
+    assert refusal_hint("fit", "", running=fit) == " (--stages fits fewer, --hold holds some)"
+    assert refusal_hint("fill", "", "a.tif", running=fit) == (
+        " (--roi X,Y,W,H once per file fits the edges imgmtf scan finds; imgmtf scan a.tif finds and measures "
+        "each edge in it; --force measures it anyway)")
+    restore = Command.of(next(c for c in COMMANDS if c.name == "restore"))
+    assert refusal_hint("fill", "", "a.tif", running=restore) == \
+        " (imgmtf scan a.tif finds and measures each edge in it)"
+    assert refusal_hint("misfit", "", running=restore) == " (--allow-misfit restores with it anyway)"
+    assert refusal_hint("misfit", "", running=fit) == ""
+
+
+def test_a_command_s_refusal_names_its_own_options_end_to_end(tmp_path):
+    # a two-band file that is not RGB: fit is told of --band N, never of measure's --band all
+    image = np.zeros((2, 60, 60), np.uint16)
+    import rasterio
+    with rasterio.open(tmp_path / "two.tif", "w", driver="GTiff", width=60, height=60, count=2, dtype="uint16",
+                       transform=rasterio.Affine(1.0, 0.0, 0.0, 0.0, -1.0, 60.0)) as dst:
+        dst.write(image)
+    fit = CliRunner().invoke(main, ["fit", str(tmp_path / "two.tif")])
+    measure = CliRunner().invoke(main, ["measure", str(tmp_path / "two.tif")])
+    assert fit.exit_code == 1 and "(--band N chooses one)" in fit.output and "--band all" not in fit.output
+    assert "--band all measures each" in measure.output

@@ -124,3 +124,108 @@ def test_bad_sensor_and_outputs_exit_1(chip, tmp_path):
         assert result.exit_code == 2 and words in result.output, (options, result.output)
     assert run("restore", chip, chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.3,
                "--out", tmp_path / "r.tif").exit_code == 2          # two images, one file: a contradiction
+
+
+MISFIT_TOML = """[fit]
+misfit = true
+reduced_chi_square = 3.8
+misfit_p = 0.0
+misfit_fraction = 0.025
+stages = ["optics", "detector"]
+sources = ["chip.tif"]
+
+[sensor]
+gsd_m = 1.0
+
+[[sensor.stages]]
+stage = "optics"
+sigma_x_m = 0.6
+sigma_y_m = 0.6
+
+[[sensor.stages]]
+stage = "detector"
+width_x_m = 1.0
+width_y_m = 1.0
+"""
+
+
+def test_a_misfit_sensor_is_refused_unless_allowed_and_the_report_says_so(chip, tmp_path):
+    toml = tmp_path / "misfit.toml"
+    toml.write_text(MISFIT_TOML)
+    result = run("restore", chip, "--sensor", toml, "--target-nyquist", 0.25, "--out", tmp_path / "r.tif")
+    assert result.exit_code == 1 and not (tmp_path / "r.tif").exists()
+    assert result.output == (f"imgmtf: error: {toml}: the model (optics, detector) does not fit the 1 edge(s) it was "
+                             "fitted to (reduced chi-square 3.8, misfit p 0, structure 2.50 % of the step): a filter "
+                             "designed from it inverts a blur the sensor does not have (--allow-misfit restores with "
+                             "it anyway)\n")
+    result = run("restore", chip, "--sensor", toml, "--target-nyquist", 0.25, "--out", tmp_path / "r.tif",
+                 "--allow-misfit")
+    assert result.exit_code == 0, result.output
+    assert "sensor: the model (optics, detector) does not fit the 1 edge(s)" in result.output
+    assert "warning: MISFIT SENSOR, restored with anyway: " in result.output
+    result = run("restore", chip, "--sensor", toml, "--target-nyquist", 0.25, "--out", tmp_path / "r.tif",
+                 "--allow-misfit", "--format", "json")
+    report = json.loads(result.stdout)
+    assert report["sensor_fit"]["misfit"] is True and report["warnings"][0].startswith("MISFIT SENSOR")
+    # a sensor that fits says so; one without a record (written by hand) makes no claim
+    result = run("restore", chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.25,
+                 "--out", tmp_path / "t.tif")
+    assert result.exit_code == 0 and "sensor:" not in result.output and "MISFIT" not in result.output
+    # (a fitted sensor that fits says so: docs/restore.md's examples show it)
+
+
+def test_a_restoration_whose_noise_dominates_is_refused_unless_a_noise_budget_is_given(chip, tmp_path):
+    # the chip's sensor (MTF 0.107 at Nyquist) lifted to 0.6: a noise gain of 5.3 (0.5 asks 4.2, 0.4 asks 3.2)
+    true = chip.parent / "true.toml"
+    result = run("restore", chip, "--sensor", true, "--target-nyquist", 0.6, "--out", tmp_path / "r.tif")
+    assert result.exit_code == 1 and not (tmp_path / "r.tif").exists()
+    assert "the filter multiplies the noise by 5.3 (over 4)" in result.output
+    assert "(--max-noise-gain G sets the noise budget" in result.output
+    result = run("restore", chip, "--sensor", true, "--target-nyquist", 0.6, "--out", tmp_path / "r.tif",
+                 "--max-noise-gain", 6)
+    assert result.exit_code == 0 and "warning: NOISE DOMINATES: the filter multiplies the noise by 5.3" in result.output
+    result = run("restore", chip, "--sensor", true, "--target-nyquist", 0.4, "--out", tmp_path / "r.tif")
+    assert result.exit_code == 0 and "NOISE" not in result.output
+    # a batch reports each refusal with its hint and goes on
+    result = run("restore", chip, tmp_path / "r.tif", "--sensor", true, "--target-nyquist", 0.6,
+                 "--out", tmp_path / "b")
+    assert result.exit_code == 1 and result.output.count("(--max-noise-gain G sets the noise budget") == 2
+    assert "0 restored, 2 failed" in result.output
+
+
+def test_a_target_below_the_sensor_s_own_mtf_is_noted_as_blurring(chip, tmp_path):
+    result = run("restore", chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.05,
+                 "--out", tmp_path / "r.tif")
+    assert result.exit_code == 0
+    assert ("warning: the target MTF at Nyquist, 0.05, is below the sensor's own across track, 0.1077: the filter "
+            "blurs across track rather than sharpening") in result.output
+    assert "below the sensor's own along track, 0.1077" in result.output
+    result = run("restore", chip, "--sensor", chip.parent / "true.toml", "--target-nyquist", 0.2,
+                 "--out", tmp_path / "r.tif")
+    assert result.exit_code == 0 and "blurs" not in result.output
+
+
+def test_baotou_fit_then_restore_is_refused_twice_as_a_new_user_meets_it(tmp_path):
+    """The issue's run on the real Baotou L0R chip (JorgeGIlG/MTF_Estimator, GPL-3.0, read in place):
+    fit to the four half-edges scan accepts (their ROIs), then restore from the fitted TOML
+    (docs/restore.md shows it)."""
+    from conftest import real_scene
+    path = real_scene("baotou_l0r_checkerboard.tif", "JorgeGIlG/MTF_Estimator (GPL-3.0, read in place)")
+    result = run("fit", path)
+    assert result.exit_code == 1 and "--force measures it anyway" in result.output
+    rois = [a for roi in ("42,14,31,36", "15,29,36,32", "30,52,32,36", "53,41,36,32") for a in ("--roi", roi)]
+    toml = tmp_path / "baotou.toml"
+    assert run("fit", path, path, path, path, *rois, "--stages", "optics,detector", "--out", toml).exit_code == 0
+    restore = ["restore", path, "--sensor", toml, "--target-nyquist", 0.25, "--out", tmp_path / "r.tif"]
+    result = run(*restore)
+    assert result.exit_code == 1 and "does not fit the 4 edge(s)" in result.output
+    assert "(--allow-misfit restores with it anyway)" in result.output
+    result = run(*restore, "--allow-misfit")
+    assert result.exit_code == 1 and "the filter multiplies the noise by 11 (over 4)" in result.output
+    assert not (tmp_path / "r.tif").exists()
+    result = run(*restore, "--allow-misfit", "--max-noise-gain", 20, "--format", "json")
+    assert result.exit_code == 0
+    report = json.loads(result.stdout)
+    assert report["sensor_fit"]["misfit"] and 10 < report["noise_gain"] < 12
+    assert [w.split(":")[0] for w in report["warnings"][:2]] == ["MISFIT SENSOR, restored with anyway",
+                                                                 "NOISE DOMINATES"]

@@ -120,3 +120,81 @@ def test_kernel_files_round_trip(gaussian_pixel, tmp_path):
         filt.save(tmp_path / "k.csv")
     with pytest.raises(im.FileWriteError, match="cannot write"):
         filt.save(tmp_path / "missing" / "k.npy")
+
+
+#: the one-sided lag of the stand-in sensor below, m (0.4 px at its 1 m pixel)
+LAG_M = 0.4
+
+
+class LaggedSensor(im.Sensor):
+    """A stand-in for a sensor with a one-sided stage along track: its
+    transfer is the base sensor's times 1 / (1 + 2 pi i tau fy), complex
+    (its MTF the modulus), so that the design's handling of a phase is
+    tested without the stage itself."""
+
+    def transfer(self, fx, fy):
+        return super().transfer(fx, fy) / (1 + 2j * np.pi * LAG_M * np.asarray(fy, float))
+
+
+def test_a_complex_transfer_gets_real_taps_that_undo_its_phase():
+    sensor = LaggedSensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0)])
+    filt = im.design_filter(sensor, 0.3, noise_std_dn=1.0, signal_std_dn=500.0)
+    k = (1.0 / 500.0) ** 2
+    # real taps summing to 1, not point-symmetric: the filter's own transfer is complex
+    assert filt.taps.dtype == np.float64 and filt.taps.sum() == pytest.approx(1.0, abs=1e-12)
+    assert not filt.point_symmetric and np.iscomplexobj(filt.axis_transfer(0.3, "along"))
+    # below 0.4 cy/px in both axes the taps' transfer is T conj(H) (1 + K) / (|H|^2 + K), to the crop of the
+    # taps (measured within 4e-4); the phase is then undone less and less up to Nyquist, where a real
+    # filter's transfer is real (W(0.5) = W(-0.5) = conj(W(0.5))) and the lag's phase is not
+    fx, fy = np.meshgrid(np.linspace(-0.4, 0.4, 17), np.linspace(-0.4, 0.4, 17))
+    h = sensor.transfer(fx, fy)
+    closed = target_transfer(fx, 0.3) * target_transfer(fy, 0.3) * np.conj(h) * (1 + k) / (np.abs(h) ** 2 + k)
+    assert np.abs(filt.transfer(fx, fy) - closed).max() < 1e-3
+    # the restored system H W: real (the phase undone) to 0.4 cy/px, its modulus the target's to Nyquist
+    f = np.linspace(0.0, 0.5, 11)
+    restored = sensor.transfer(0.0, f) * filt.axis_transfer(f, "along")
+    assert np.abs(restored.imag[f <= 0.4]).max() < 1e-3 and restored.real[f <= 0.4].min() > 0
+    assert np.abs(np.abs(restored) - target_transfer(f, 0.3)).max() < 3e-3
+    # W is continuous across Nyquist: its taps decay within the design grid (cropped below 257)
+    assert filt.taps.shape[0] < 257
+    # across track the lag does nothing: that axis's design is the real sensor's (to the taps' crop)
+    real = im.design_filter(im.Sensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0)]), 0.3,
+                            noise_std_dn=1.0, signal_std_dn=500.0)
+    f = np.linspace(0.0, 0.4, 5)
+    assert np.abs(filt.axis_transfer(f, "across") - real.axis_transfer(f, "across")).max() < 1e-3
+    assert abs(filt.axis_transfer(0.5, "across") - real.axis_transfer(0.5, "across")) < 0.01    # (measured 4e-3)
+    # the report reads the MTF, |H|: 1 / sqrt(1 + (2 pi tau f)^2) of the real sensor's along track
+    report = im.restoration_report(filt)
+    lag = 1 / math.sqrt(1 + (2 * math.pi * LAG_M * 0.5) ** 2)
+    assert report.axes["along"].system_mtf_nyquist == pytest.approx(
+        im.restoration_report(real).axes["along"].system_mtf_nyquist * lag, rel=1e-9)
+    assert report.axes["along"].achieved_mtf_nyquist == pytest.approx(0.3, abs=3e-3)
+    assert np.isrealobj(filt(np.full((20, 20), 500.0)))
+
+
+def test_the_phase_weight_and_a_real_transfer_kept_with_its_sign():
+    from imgmtf.restore.design import phase_tapered_conjugate, phase_weight
+    assert phase_weight([0.0, 0.4, 0.45, 0.5, -0.5]).tolist() == pytest.approx([1.0, 1.0, 0.5, 0.0, 0.0])
+    real = np.array([0.5, -0.2, 0.0])
+    assert phase_tapered_conjugate(real, np.zeros(3)) is real          # a sinc's negative lobe keeps its sign
+    h = np.array([0.3 - 0.4j, -0.3 - 0.4j])
+    assert phase_tapered_conjugate(h, np.ones(2)) == pytest.approx(np.conj(h))
+    # no phase undone: the signed modulus, real (-0.5 where the real part is negative)
+    assert phase_tapered_conjugate(h, np.zeros(2)) == pytest.approx([0.5, -0.5])
+
+
+def test_the_lag_stage_restored_to_its_target_with_a_symmetric_edge():
+    from imgmtf.restore.report import edge_responses
+    from imgmtf.sensor.stages import Lag
+    sensor = im.Sensor(1.0, [GaussianOptics(0.5, 0.5), Detector(1.0, 1.0), Lag(0.0, 0.6)])
+    filt = im.design_filter(sensor, 0.3, noise_std_dn=1.0, signal_std_dn=500.0)
+    along = im.restoration_report(filt).axes["along"]
+    assert along.system_mtf_nyquist == pytest.approx(float(np.abs(sensor.transfer(0.0, 0.5))), rel=1e-12)
+    assert along.achieved_mtf_nyquist == pytest.approx(0.3, abs=3e-3)
+    # the lag leans the edge: 1 px before it the response has risen 0.012, 1 px after it still lacks 0.276;
+    # restored, the phase undone below 0.4 cy/px, the two sides differ by 0.04 (measured), not 0.26
+    x, before, after = edge_responses(filt, "along")
+
+    def lean(esf):
+        return abs(np.interp(-1.0, x, esf) - (1.0 - np.interp(1.0, x, esf)))
+    assert lean(before) > 0.25 and lean(after) < 0.2 * lean(before)

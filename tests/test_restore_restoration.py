@@ -46,8 +46,13 @@ def test_baotou_a_model_that_does_not_fit_asks_an_absurd_filter(tmp_path):
     sigma 1.063 and 1.035 px and the pixel; a misfit, reduced chi-square 4.1): docs/restore.md."""
     path = real_scene("baotou_l0r_checkerboard.tif", "JorgeGIlG/MTF_Estimator (GPL-3.0, read in place)")
     sensor = im.Sensor(1.0, [GaussianOptics(1.0633, 1.0346), Detector(1.0, 1.0)])
-    done = im.restore_image(path, sensor, tmp_path / "r.tif", target_nyquist=0.25)
-    assert done.filter.noise_std_dn == pytest.approx(29.4, rel=0.05)
+    # its noise would dominate the result: refused before anything is written, unless a noise budget is given
+    with pytest.raises(im.ImgmtfError, match="multiplies the noise by 11 ") as refused:
+        im.restore_image(path, sensor, tmp_path / "r.tif", target_nyquist=0.25)
+    assert refused.value.reason == "noise-dominated" and not (tmp_path / "r.tif").exists()
+    done = im.restore_image(path, sensor, tmp_path / "r.tif", target_nyquist=0.25, max_noise_gain=20.0)
+    assert done.warnings[0].startswith("NOISE DOMINATES: the filter multiplies the noise by 11 ")
+    assert done.filter.noise_std_dn == pytest.approx(29.4, rel=0.05) and not done.filter.limited
     assert 8 < done.filter.noise_gain < 15
     achieved = [a.achieved_mtf_nyquist for a in done.report.axes.values()]
     assert max(achieved) < 0.05 and done.file.clipped_fraction > 0.005
@@ -62,7 +67,8 @@ def test_pure_noise_needs_the_signal_given(tmp_path):
     im.write_geotiff(tmp_path / "noise.tif", np.rint(noise).astype(np.uint16))
     with pytest.raises(im.ImageContentError, match="no signal above its noise"):
         im.restore_image(tmp_path / "noise.tif", SCALED, tmp_path / "r.tif", target_nyquist=0.3)
+    # (the file's 1 m pixel sees the 2 m sensor's blur doubled: a noise gain of 4.6, a budget given)
     done = im.restore_image(tmp_path / "noise.tif", SCALED, tmp_path / "r.tif", target_nyquist=0.3,
-                            signal_std_dn=400.0)
+                            signal_std_dn=400.0, max_noise_gain=10.0)
     assert done.noise_source == "given and measured"
     assert done.filter.noise_std_dn == pytest.approx(10.0, rel=0.05)

@@ -9,7 +9,7 @@ from ..errors import ParameterError
 from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
-from .options import FiniteFloat, parse_roi
+from .options import FiniteFloat, parse_pair, parse_rois
 from .tables import print_fit
 
 
@@ -27,9 +27,19 @@ from .tables import print_fit
 @click.option("--gsd", type=FiniteFloat(0, min_open=True),
               help="GSD in metres (default: the files', else 1: parameters in px)")
 @click.option("--band", type=click.IntRange(min=1), help="1-based band of multi-band files")
-@click.option("--roi", callback=parse_roi,
-              help="X,Y,W,H window in pixels read from every file (default: the whole image)")
+@click.option("--roi", multiple=True, callback=parse_rois, metavar="X,Y,W,H",
+              help="X,Y,W,H window in pixels: once for every file, or once per file in their order (a file "
+                   "named again with another window gives another edge; default: the whole image)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
+@click.option("--force", is_flag=True,
+              help="measure an edge even where a quality check fails (fill, saturation, non-uniform "
+                   "sides...): every failed check becomes a warning")
+@click.option("--saturation", callback=parse_pair, metavar="LO,HI",
+              help="DN range the sensor records (default: an integer file's type range); "
+                   "sides at or beyond it are saturated")
+@click.option("--transfer", default="linear", show_default=True, metavar="linear|srgb|gamma:G",
+              help="how the stored values relate to light: linearised before measuring (srgb: the sRGB "
+                   "curve, gamma:2.2 a power law; 8-bit camera images are usually sRGB)")
 @click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the intervals")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")
@@ -38,25 +48,35 @@ from .tables import print_fit
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
 @campaign_options
-def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence, out_path, fmt, plot_path,
-        campaign, acquired, platform, instrument, band_name):
+def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, force, saturation, transfer, confidence,
+        out_path, fmt, plot_path, campaign, acquired, platform, instrument, band_name):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model.  With
     --campaign, the files are the chips of one acquisition: it is added to
     the store with the model's across- and along-track rows (those some
-    edge constrains)."""
+    edge constrains).  Each file is read and its edge measured as
+    imgmtf measure does (--roi, --band, --transfer, --force; nodata and
+    fill as measure treats them); a file named twice with the same window
+    is measured once.  --out writes the sensor with a [fit] table saying
+    whether the model fits (imgmtf restore refuses one that does not)."""
     from ..batch import expand_inputs
     from ..estimate.fit import check_names
     from ..sensor.model import Sensor
-    from ..sensor_fit import fit_sensor
+    from ..sensor_fit import edge_sources, fit_sensor
     with reported_errors():
         start = Sensor.from_toml(sensor_path) if sensor_path else None
         with option_errors():
             check_names(stages, hold or (), start)
+            from ..transfer import parse_transfer
+            parse_transfer(transfer)
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
+        if len(roi) > 1 and len(roi) != len(files):            # options that contradict the inputs: exit 2
+            raise click.UsageError(f"--roi given {len(roi)} times for {len(files)} file(s): give it once for "
+                                   "every file, or once per file")
+        rois = roi[0] if len(roi) == 1 else (list(roi) if roi else None)
         if plot_path:
             check_figure_file(plot_path)
         if out_path:
@@ -66,23 +86,27 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, confidence,
         if store:
             store.check_one_acquisition(files, band)
         result = fit_sensor(files, stages=stages, start=start, hold=hold or (), gsd_m=gsd, band=band,
-                            roi=roi, confidence=confidence)
+                            roi=rois, confidence=confidence, force=force, transfer=transfer, saturation=saturation)
         written = []
         if out_path:
             from ..version import __version__
-            result.sensor.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(files)} edge(s): "
-                                                     f"{', '.join(e.source for e in result.edges)}")
+            sources = [e.source for e in result.edges]
+            result.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(sources)} edge(s): "
+                                             f"{', '.join(sources)}", sources=sources)
             written.append(out_path)
         if plot_path:
             from ..batch import file_truth
             from ..plot import plot_fit
             # the truth of each chip imgmtf simulated (its GeoTIFF says how), drawn beside the model
-            truths = [file_truth(edge.source, band, roi) for edge in result.edges]
+            per_file = rois if isinstance(rois, list) else [rois] * len(files)
+            where = dict(zip(edge_sources(files, rois), zip(files, per_file)))
+            truths = [file_truth(where[e.source][0], band, where[e.source][1]) for e in result.edges]
             save_figure(plot_fit(result, truths=truths), plot_path)
             written.append(plot_path)
         if store:
             settings = {"command": "fit", "stages": stages, "sensor": sensor_path, "hold": hold, "gsd_m": gsd,
-                        "band": band, "roi": roi, "confidence": confidence}
+                        "band": band, "roi": rois, "confidence": confidence, "force": force, "transfer": transfer,
+                        "saturation": saturation}
             store.add_fit(files, result, settings, band=band, plot=plot_path)
             store.summary()
     if fmt == "json":

@@ -6,10 +6,14 @@ to do about it on the command line, so that no library message names a flag.
 A command that measures one file (``measure``, ``fit``, ``restore``, ...)
 and ``scan``, which finds the targets in a scene itself, answer some reasons
 differently: a chip holding two targets wants ``--roi``, a scan's candidate
-that reaches another target wants a smaller ``--margin``.
+that reaches another target wants a smaller ``--margin``.  A command is
+given only the hints whose options it has (:func:`command_options`): ``fit``
+is never told of ``--pulse-width``, ``restore`` of ``--force``.
 """
 from __future__ import annotations
 
+import re
+from collections.abc import Collection
 from dataclasses import dataclass
 
 #: the commands a hint is written for: one file measured as given, or a scene searched
@@ -27,6 +31,8 @@ class Hint:
     reason: str
     text: str
     words: str = ""
+    #: the commands (by name) that take the values the text names, when not every one with its options does
+    only: frozenset[str] = frozenset()
 
 
 HINTS = (
@@ -36,10 +42,16 @@ HINTS = (
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
-    Hint(CHIP, "bands", "--band N chooses one, --band all measures each"),
+    Hint(CHIP, "bands", "--band N chooses one"),
+    Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
     Hint(CHIP, "fit", "--stages fits fewer, --hold holds some"),
+    # a scene's half-edges: fit takes the ROIs scan prints, one per file named
+    Hint(CHIP, "fill", "--roi X,Y,W,H once per file fits the edges imgmtf scan finds", only=frozenset({"fit"})),
     Hint(CHIP, "no-signal", "--signal-std gives it"),
+    Hint(CHIP, "misfit", "--allow-misfit restores with it anyway"),
+    Hint(CHIP, "noise-dominated", "--max-noise-gain G sets the noise budget, the target then met only within it; "
+                                  "a lower --target-nyquist asks less"),
     # a too-short line, not too few rows clear of the junctions, which no option moves
     Hint(SCAN, "too-short", "--min-length sets the minimum", words="shorter than the minimum"),
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
@@ -52,27 +64,67 @@ HINTS = (
 SCAN_SOLVES = frozenset({"fill", "two-targets"})
 
 
-def option_hints(command: str, reason: str | None, message: str = "") -> list[str]:
-    """The options in :data:`HINTS` that answer a refusal ``command`` met."""
-    return [h.text for h in HINTS if h.command == command and h.reason == reason and h.words in message]
+#: an option named in a hint's text
+OPTION = re.compile(r"--[a-z][a-z0-9-]*")
 
 
-def refusal_hint(reason: str | None, message: str = "", path: str | None = None) -> str:
+@dataclass(frozen=True)
+class Command:
+    """What a hint needs to know of the command that met a refusal: its
+    name and its options (every spelling: ``--roi``, ``--no-progress``)."""
+
+    name: str
+    options: frozenset[str]
+
+    @classmethod
+    def of(cls, command) -> Command:
+        """The :class:`Command` of a click command."""
+        options = {o for p in command.params for o in (*getattr(p, "opts", ()), *getattr(p, "secondary_opts", ()))}
+        return cls(command.name or "", frozenset(options))
+
+    def gives(self, text: str, only: Collection[str] = ()) -> bool:
+        """True when every option ``text`` names is one of this command's."""
+        return (not only or self.name in only) and all(o in self.options for o in OPTION.findall(text))
+
+
+def command_options(command=None) -> Command | None:
+    """The running click command (or ``command``) as a :class:`Command`;
+    None outside a command (every hint is then given)."""
+    if command is None:
+        import click
+        context = click.get_current_context(silent=True)
+        if context is None:
+            return None
+        command = context.command
+    return Command.of(command)
+
+
+def option_hints(command: str, reason: str | None, message: str = "", *, running: Command | None = None) -> list[str]:
+    """The options in :data:`HINTS` that answer a refusal ``command`` met
+    (only those ``running`` has, when given)."""
+    return [h.text for h in HINTS if h.command == command and h.reason == reason and h.words in message
+            and (running is None or running.gives(h.text, h.only))]
+
+
+def refusal_hint(reason: str | None, message: str = "", path: str | None = None, *,
+                 running: Command | None = None) -> str:
     """What the CLI adds to the refusal of one file, in parentheses: the
     option that answers its reason, ``imgmtf scan`` where the file holds
     fill, several targets or a checkerboard's corner, and the flag that
-    overrules the gate; ``""`` when nothing answers it."""
+    overrules the gate; ``""`` when nothing answers it.  Only the options
+    the command ``running`` (default: the click command running) has."""
     from ..estimate.gate import FORCIBLE
-    hints = option_hints(CHIP, reason, message)
+    running = running or command_options()
+    hints = option_hints(CHIP, reason, message, running=running)
     if reason in SCAN_SOLVES or (reason == "not-straight" and "meet inside the chip" in message):
         hints.append(f"imgmtf scan {path or 'FILE'} finds and measures each edge in it")
-    if reason in FORCIBLE:
+    if reason in FORCIBLE and (running is None or running.gives("--force")):
         hints.append("--force measures it anyway")
     return f" ({'; '.join(hints)})" if hints else ""
 
 
-def rejection_hint(reason: str | None, message: str) -> str:
+def rejection_hint(reason: str | None, message: str, *, running: Command | None = None) -> str:
     """What the CLI adds to a scan's rejected candidate, in parentheses;
     ``""`` when no option moves the limit it failed."""
-    hints = option_hints(SCAN, reason, message)
+    hints = option_hints(SCAN, reason, message, running=running or command_options())
     return f" ({'; '.join(hints)})" if hints else ""

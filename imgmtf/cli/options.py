@@ -159,6 +159,13 @@ def parse_roi(ctx, param, value):
                                  f"measured), got {value!r}")
     return parts
 
+
+def parse_rois(ctx, param, values):
+    """Click callback of a repeated --roi: a tuple of (x, y, w, h), each
+    checked as :func:`parse_roi` checks one."""
+    return tuple(parse_roi(ctx, param, v) for v in values or ())
+
+
 def parse_band(ctx, param, value):
     if value is None or value.lower() == "all":
         return value and "all"

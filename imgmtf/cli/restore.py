@@ -30,7 +30,11 @@ def _odd_kernel(ctx, param, value):
 @click.option("--target-nyquist", required=True, type=FiniteFloat(0, 1, min_open=True), metavar="V",
               help="restored MTF at Nyquist in both axes, by a smooth (Gaussian) target transfer never above 1")
 @click.option("--max-noise-gain", type=FiniteFloat(1), metavar="G",
-              help="limit of the filter's white-noise gain (restored / input noise std); wins over the target")
+              help="limit of the filter's white-noise gain (restored / input noise std); wins over the target. "
+                   "Without it a design whose gain exceeds 4 (the result more noise than detail) is refused")
+@click.option("--allow-misfit", is_flag=True,
+              help="restore with a sensor whose fit says its model does not fit its edges ([fit] misfit = true "
+                   "in the TOML imgmtf fit --out writes), which is otherwise refused; the report says so")
 @click.option("--kernel-size", type=click.IntRange(3, 63), callback=_odd_kernel, metavar="N",
               help="an N x N spatial kernel (odd), as operational MTFC applies; default: the FFT form, taps as "
                    "far as they reach")
@@ -57,14 +61,17 @@ def _odd_kernel(ctx, param, value):
               help="json: one object per image (JSON Lines)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @parallel_options
-def restore(paths, sensor_path, target_nyquist, max_noise_gain, kernel_size, noise_std, signal_std, gsd, out_path,
-            kernel_path, plot_path, saturation, tile_px, recursive, fmt, progress, workers, scheduler):
+def restore(paths, sensor_path, target_nyquist, max_noise_gain, allow_misfit, kernel_size, noise_std, signal_std, gsd,
+            out_path, kernel_path, plot_path, saturation, tile_px, recursive, fmt, progress, workers, scheduler):
     """Design a regularised inverse (Wiener) filter from the sensor's 2-D
     transfer and each image's noise so that the restored MTF follows a target,
     apply it tile by tile (georeference, data type, nodata and tags kept),
     and report the designed and achieved MTF at Nyquist, the RER before and
-    after, the noise gain and the ringing.  An image that cannot be restored
-    gives an error line and the rest go on (exit status 1 if any failed)."""
+    after, the noise gain and the ringing.  A sensor whose fit says its
+    model does not fit is refused (--allow-misfit overrides), and so is a
+    filter whose noise would dominate the result (--max-noise-gain sets
+    the noise budget).  An image that cannot be restored gives an error
+    line and the rest go on (exit status 1 if any failed)."""
     with reported_errors():
         from ..batch import expand_inputs
         files = expand_inputs(paths, recursive)
@@ -79,15 +86,20 @@ def restore(paths, sensor_path, target_nyquist, max_noise_gain, kernel_size, noi
             check_output_file(kernel_path)
         if plot_path:
             check_figure_file(plot_path)
-        outputs = _output_paths(files, out_path)
         sensor = load_sensor(sensor_path)
+        from ..estimate.fit.record import read_fit_record
+        from ..restore.restoration import check_model_fits
+        fit = read_fit_record(sensor_path)
+        check_model_fits(fit, sensor_path, allow_misfit=allow_misfit)       # before any output is made
+        outputs = _output_paths(files, out_path)
     from ..records import utc_now
     from ..restore.restoration import restore_image
     from ..version import __version__
     run_utc, failed = utc_now(), 0
     options = dict(target_nyquist=target_nyquist, noise_std_dn=noise_std, signal_std_dn=signal_std,
                    max_noise_gain=max_noise_gain, kernel_size=kernel_size, gsd_m=gsd, tile_px=tile_px,
-                   saturation=saturation, workers=workers, scheduler=scheduler, progress=progress, run_utc=run_utc)
+                   saturation=saturation, workers=workers, scheduler=scheduler, progress=progress, run_utc=run_utc,
+                   fit=fit, allow_misfit=allow_misfit)
     with reported_errors():
         for path, out in zip(files, outputs):
             try:
@@ -147,7 +159,8 @@ def _print_failure(path: str, exc: BaseException, fmt: str) -> None:
     if fmt == "json":
         click.echo(json.dumps({"input": path, "status": "error", "reason": reason, "error": message}))
     else:
-        click.echo(f"imgmtf: error: {message}", err=True)
+        from .hints import refusal_hint
+        click.echo(f"imgmtf: error: {message}{refusal_hint(reason, message, path)}", err=True)
 
 
 def _print_text(done, written: list[str]) -> None:
@@ -158,6 +171,8 @@ def _print_text(done, written: list[str]) -> None:
     click.echo(f"filter: {form}; noise {d.noise_std_dn:.3g} DN, signal {d.signal_std_dn:.4g} DN ({done.noise_source}): "
                f"regulariser {d.regulariser:.3g}; noise gain {d.noise_gain:.3f}"
                + (f" (limited to {d.max_noise_gain:g})" if d.limited else ""))
+    if done.fit is not None:
+        click.echo(f"sensor: {done.fit.summary()}")
     click.echo(f"{'axis':<7} {'MTF@Nyq':>7} {'target':>7} {'restored':>8} {'peak':>5} {'RER':>6} {'RER':>6} "
                f"{'over':>5} {'under':>5} {'ring':>5}")
     click.echo(f"{'':<7} {'sensor':>7} {'':>7} {'':>8} {'':>5} {'before':>6} {'after':>6} "

@@ -2,23 +2,42 @@
 
 The filter is the normalised Wiener (regularised inverse) filter
 
-    W(fx, fy) = T(fx, fy) H(fx, fy) (1 + K) / (H(fx, fy)^2 + K)
+    W(fx, fy) = T(fx, fy) conj(H(fx, fy)) (1 + K) / (|H(fx, fy)|^2 + K)
 
-where ``H`` is the sensor's real 2-D transfer at the image's pixel
-(:meth:`imgmtf.Sensor.transfer`), ``T`` the target transfer and ``K`` the
+where ``H`` is the sensor's 2-D transfer at the image's pixel
+(:meth:`imgmtf.Sensor.transfer`; complex for a sensor with a one-sided
+stage, whose MTF is ``|H|``), ``T`` the target transfer and ``K`` the
 regulariser, the noise-to-signal power ratio ``(noise_std / signal_std)^2``
-of a scene with a white spectrum.  The restored system ``H W`` follows the
-target where the sensor passes signal well above the noise (``H^2 >> K``)
-and falls to zero where it does not, so an exact zero of ``H`` (motion, an
-OLPF) is never divided by: ``|W| <= T (1 + K) / (2 sqrt K)``.  The factor
-``1 + K`` keeps the DC gain at exactly 1 (the image's radiometry).
+of a scene with a white spectrum.  The restored system ``H W = T |H|^2 (1 +
+K) / (|H|^2 + K)`` is real: the filter undoes the sensor's phase with its
+blur.  It follows the target where the sensor passes signal well above the
+noise (``|H|^2 >> K``) and falls to zero where it does not, so an exact zero
+of ``H`` (motion, an OLPF) is never divided by: ``|W| <= T (1 + K) / (2 sqrt
+K)``.  The factor ``1 + K`` keeps the DC gain at exactly 1 (the image's
+radiometry).  ``H`` is the transfer of a real PSF, Hermitian (``H(-f) =
+conj(H(f))``), and so is ``W``: its taps are real.
+
+A real filter's transfer is real at Nyquist (``W(0.5) = W(-0.5) =
+conj(W(0.5))``), where a one-sided stage's phase is not: no real filter
+undoes a phase there.  ``conj(H)`` is therefore taken as ``R exp(-i c psi)``,
+``H = R exp(i psi)`` with ``R`` real (signed) and ``psi`` in (-pi/2, pi/2],
+``c = p(fx) p(fy)`` and ``p`` 1 up to :data:`PHASE_FULL_CY_PX` and falling
+as a raised cosine to 0 at Nyquist: exactly ``conj(H)`` below 0.4 cy/px in
+both axes, the phase undone less and less beyond, not at all at Nyquist.  The
+restored system keeps its modulus ``T |H|^2 (1 + K) / (|H|^2 + K)`` at
+every frequency (the target is met at Nyquist too) and is real below 0.4
+cy/px; ``W`` is continuous across Nyquist and its taps decay.  A real ``H``
+(``psi = 0``) is unchanged.
 
 The target is smooth, separable and never above 1: ``T(fx, fy) = g(fx)
 g(fy)`` with ``g(f) = V ** ((f / 0.5) ** 2)``, a Gaussian whose value at
 Nyquist (0.5 cy/px) is ``V`` in both axes.
 
 The filter's taps are the inverse DFT of ``W`` on a grid fine enough that
-they have decayed at its border (the FFT form), or those taps cut to a small
+they have decayed at its border (the FFT form; taps that have not decayed
+on the largest grid, of a transfer that jumps across Nyquist, are tapered by
+a Tukey window over the outer half of their reach rather than ringing about
+the design at every frequency), or those taps cut to a small
 ``N x N`` kernel as operational MTFC applies (the spatial form; the cut
 is the least-squares fit of ``W`` with the DC gain held at 1).  Its
 white-noise gain is the root of the sum of its squared taps.  A noise-gain
@@ -42,6 +61,9 @@ from ..errors import FileWriteError, ParameterError
 from ..inputs import check_number
 from ..sensor.model import Sensor, check_gsd
 
+#: below this frequency (cy/px, in both axes) the filter undoes the sensor's phase in full; beyond,
+#: less and less, and not at all at Nyquist, where a real filter's transfer is real
+PHASE_FULL_CY_PX = 0.4
 #: the smallest regulariser K: a noise-free image still has its sensor's zeros bounded
 #: (|W| <= (1 + K) / (2 sqrt K) = 500)
 MIN_REGULARISER = 1e-6
@@ -138,7 +160,9 @@ class RestorationFilter:
         return "fft" if self.kernel_size is None else "spatial"
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
-        """The filter's (real, periodic) transfer at (``fx``, ``fy``) cy/px.
+        """The filter's (periodic) transfer at (``fx``, ``fy``) cy/px: real
+        for point-symmetric taps (a sensor whose transfer is real), complex
+        otherwise (its modulus is the filter's gain).
 
         Parameters
         ----------
@@ -153,10 +177,20 @@ class RestorationFilter:
         """
         fx, fy = np.broadcast_arrays(np.asarray(fx, float), np.asarray(fy, float))
         offsets = np.arange(self.taps.shape[0]) - self.radius_px
-        # taps are even in x and in y: the transfer is a sum of cosines, separable per term
-        cx = np.cos(2 * np.pi * fx[..., None] * offsets)
-        cy = np.cos(2 * np.pi * fy[..., None] * offsets)
-        return np.einsum("...i,ij,...j->...", cy, self.taps, cx)
+        # the taps' DFT, tap (j, k) at (y, x) = (j, k) - radius: W = sum t e^(-2 pi i (fy y + fx x)),
+        # the sign of a convolution's (and of a PSF's) transfer
+        ex = np.exp(-2j * np.pi * fx[..., None] * offsets)
+        ey = np.exp(-2j * np.pi * fy[..., None] * offsets)
+        w = np.einsum("...i,ij,...j->...", ey, self.taps, ex)
+        # point-symmetric taps (t(-y, -x) = t(y, x), to rounding): a sum of cosines, real
+        return w.real if self.point_symmetric else w
+
+    @property
+    def point_symmetric(self) -> bool:
+        """True when the taps are point-symmetric (to 1e-12 of the largest):
+        the filter's transfer is real (a sensor whose transfer is real)."""
+        return bool(np.allclose(self.taps, self.taps[::-1, ::-1], rtol=0.0,
+                                atol=1e-12 * float(np.abs(self.taps).max())))
 
     def axis_transfer(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """The filter's transfer along one axis: across track (fx, fy = 0) or
@@ -342,22 +376,32 @@ class _DesignGrid:
         self.kernel_size = kernel_size
         for n in DESIGN_GRIDS:
             f = np.fft.fftfreq(n)
-            self.h = sensor.transfer(f[None, :] / gsd_m, f[:, None] / gsd_m)
+            h = sensor.transfer(f[None, :] / gsd_m, f[:, None] / gsd_m)
+            self.power = np.abs(h) ** 2
+            self.inverse = phase_tapered_conjugate(h, phase_weight(f)[None, :] * phase_weight(f)[:, None])
             g = target_transfer(f, target)
             self.t = g[None, :] * g[:, None]
             # the smallest regulariser's taps reach furthest: a grid they fit fits every design
             taps = self._full_taps(MIN_REGULARISER)
             if _border_fraction(taps) < CROP_TOLERANCE:
                 break
+        # taps that have not decayed even on the largest grid come from a transfer that jumps at
+        # Nyquist (a phase there, which a real filter's transfer cannot have): cut bare, they ring
+        # about the design at every frequency; tapered, they follow it to Nyquist's neighbourhood
+        self.window = None if _border_fraction(taps) < CROP_TOLERANCE else _tukey(taps.shape[0])
 
     def _full_taps(self, regulariser: float) -> np.ndarray:
-        w = self.t * self.h * (1 + regulariser) / (self.h ** 2 + regulariser)
+        # conj(H) / (|H|^2 + K): on the odd grid every frequency has its negative, W is Hermitian and
+        # its inverse DFT real to rounding (the imaginary part dropped is that rounding)
+        w = self.t * self.inverse * (1 + regulariser) / (self.power + regulariser)
         return np.fft.fftshift(np.fft.ifft2(w).real)
 
     def taps(self, regulariser: float) -> np.ndarray:
         taps = self._full_taps(regulariser)
         centre = taps.shape[0] // 2
         if self.kernel_size is None:
+            if self.window is not None:
+                taps = taps * self.window
             half = _crop_half_width(taps)
         else:
             half = self.kernel_size // 2
@@ -383,6 +427,41 @@ class _DesignGrid:
             if high - low < 1e-4:          # K to 0.01 %: the gain to about 1e-5
                 break
         return math.exp(high)
+
+
+def phase_weight(f_cy_px: ArrayLike) -> np.ndarray:
+    """How much of the sensor's phase the filter undoes at ``f_cy_px``
+    along one axis: 1 up to :data:`PHASE_FULL_CY_PX`, a raised cosine to 0
+    at Nyquist (and beyond).
+
+    Examples
+    --------
+    >>> from imgmtf.restore.design import phase_weight
+    >>> [round(float(v), 3) for v in phase_weight([0.0, 0.4, 0.45, 0.5])]
+    [1.0, 1.0, 0.5, 0.0]
+    """
+    x = np.clip((np.abs(np.asarray(f_cy_px, float)) - PHASE_FULL_CY_PX) / (0.5 - PHASE_FULL_CY_PX), 0.0, 1.0)
+    return 0.5 * (1.0 + np.cos(np.pi * x))
+
+
+def phase_tapered_conjugate(h: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """``conj(h)`` with its phase scaled by ``weight``: ``R exp(-i weight
+    psi)`` for ``h = R exp(i psi)``, ``R`` real (signed) and ``psi`` in
+    (-pi/2, pi/2] (a real ``h`` is returned as it is, its sign kept)."""
+    if not np.iscomplexobj(h):
+        return h
+    psi = np.arctan2(h.imag, h.real)
+    psi = np.where(psi > np.pi / 2, psi - np.pi, np.where(psi <= -np.pi / 2, psi + np.pi, psi))
+    signed = h.real * np.cos(psi) + h.imag * np.sin(psi)
+    return signed * np.exp(-1j * weight * psi)
+
+
+def _tukey(n: int, flat: float = 0.5) -> np.ndarray:
+    """A separable n x n Tukey window: 1 over the inner ``flat`` of the
+    half-width, a raised cosine to 0 beyond the outermost tap."""
+    x = np.abs(np.arange(n) - n // 2) / (n // 2 + 1)
+    w = np.where(x <= flat, 1.0, 0.5 * (1 + np.cos(np.pi * (x - flat) / (1 - flat))))
+    return w[:, None] * w[None, :]
 
 
 def _gain(taps: np.ndarray) -> float:

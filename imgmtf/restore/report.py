@@ -107,12 +107,14 @@ def restoration_report(restoration: RestorationFilter) -> RestorationReport:
 
 def axis_curves(restoration: RestorationFilter, direction: str, f_cy_px: ArrayLike) -> dict[str, np.ndarray]:
     """The transfers along one axis at ``f_cy_px``: ``system`` (the sensor's
-    MTF), ``filter`` (the filter's transfer), ``restored`` (their product's
+    MTF, ``|H|``), ``filter`` (the filter's transfer; its modulus when it is
+    complex, for a sensor with a phase), ``restored`` (their product's
     magnitude) and ``target``."""
     f = np.asarray(f_cy_px, float)
     system = restoration.system_transfer(f, direction)
     gain = restoration.axis_transfer(f, direction)
-    return {"system": np.abs(system), "filter": gain, "restored": np.abs(system * gain),
+    return {"system": np.abs(system), "filter": np.abs(gain) if np.iscomplexobj(gain) else gain,
+            "restored": np.abs(system * gain),
             "target": target_transfer(f, restoration.target_nyquist)}
 
 

@@ -1,19 +1,45 @@
 """One image restored end to end: its noise measured (unless given), the
 filter designed from the sensor for its pixel, applied tile by tile, and
-the figures of merit; what ``imgmtf restore`` does for each input."""
+the figures of merit; what ``imgmtf restore`` does for each input.
+
+Two restorations are refused before anything is written, because their
+result would mislead:
+
+* one from a sensor whose fit says its model does not fit the edges it was
+  fitted to (:class:`~imgmtf.estimate.fit.record.FitRecord`, reason
+  ``misfit``): the filter would invert a blur the sensor does not have;
+  ``allow_misfit`` restores anyway, and the restoration's warnings say so;
+* one whose noise dominates the result (reason ``noise-dominated``): a
+  filter whose white-noise gain exceeds :data:`NOISE_DOMINATED_GAIN` when no
+  noise-gain limit was given.  A noise-gain limit is the caller's noise
+  budget: a design within it is made, and warned about above that gain.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..errors import ImageContentError
+from ..errors import ImageContentError, ImgmtfError
 from ..sensor.model import Sensor
 from .apply import DEFAULT_TILE_PX, RestoredFile, measure_noise, restore_file
 from .design import RestorationFilter, design_filter
 from .report import RestorationReport, restoration_report
 
+if TYPE_CHECKING:
+    from ..estimate.fit.record import FitRecord
+
 #: relative difference between the image's and the sensor's GSD worth a warning
 GSD_TOLERANCE = 1e-3
+#: the white-noise gain above which the restored image is more the filter's noise than
+#: the scene's detail.  The gain is about the lift the filter gives the MTF near Nyquist
+#: (on Gaussian-and-pixel sensors of MTF 0.04-0.23 at Nyquist, targets 1.5, 2, 3 and 4 times the
+#: sensor's cost gains of 1.1-1.3, 1.3-1.7, 1.8-2.6 and 2.2-3.6 at SNR 50-200): above 4 the filter
+#: lifts frequencies where the sensor passes under a quarter of the target, the restored noise's
+#: standard deviation is more than 4 times the image's (its SNR under a quarter, -12 dB) and more
+#: than 15/16 of its noise power is the filter's.  The documented restorations stay under 1.4; the
+#: Baotou chip restored from its misfit model asks 11.
+NOISE_DOMINATED_GAIN = 4.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,7 +58,12 @@ class Restoration:
     noise_source : str
         ``"measured"`` (from the image), ``"given"`` or ``"given and measured"``.
     warnings : tuple of str
-        What the caller should know (a file's GSD unlike the sensor's).
+        What the caller should know (a file's GSD unlike the sensor's, a
+        misfit sensor restored with anyway, a target below the sensor's
+        own MTF: a blurring filter, a noise gain above
+        :data:`NOISE_DOMINATED_GAIN` within the limit given).
+    fit : FitRecord or None
+        What the sensor's fit said of its model (None: no record).
 
     Examples
     --------
@@ -50,12 +81,20 @@ class Restoration:
     file: RestoredFile
     noise_source: str
     warnings: tuple[str, ...] = field(default=())
+    fit: FitRecord | None = None
+
+    @property
+    def restored_noise_std_dn(self) -> float:
+        """The restored image's noise std, DN: the noise gain times the image's noise."""
+        return self.filter.noise_gain * self.filter.noise_std_dn
 
     def to_dict(self) -> dict:
-        """JSON-ready: the file's figures, the filter's design, ``noise_gain``
-        and the per-axis figures (units in the names)."""
+        """JSON-ready: the file's figures, the filter's design, ``noise_gain``,
+        the restored noise, the per-axis figures (units in the names) and
+        the sensor's fit record (``sensor_fit``, null when it has none)."""
         return {**self.file.to_dict(), "noise_source": self.noise_source, "filter": self.filter.to_dict(),
-                **self.report.to_dict(), "warnings": list(self.warnings)}
+                **self.report.to_dict(), "restored_noise_std_dn": self.restored_noise_std_dn,
+                "sensor_fit": self.fit.to_dict() if self.fit else None, "warnings": list(self.warnings)}
 
 
 def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_nyquist: float,
@@ -63,7 +102,8 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
                   max_noise_gain: float | None = None, kernel_size: int | None = None,
                   gsd_m: float | None = None, tile_px: int = DEFAULT_TILE_PX,
                   saturation: tuple[float, float] | None = None, workers: int = 1, scheduler: str | None = None,
-                  progress: bool | None = None, run_utc: str | None = None) -> Restoration:
+                  progress: bool | None = None, run_utc: str | None = None, fit: FitRecord | None = None,
+                  allow_misfit: bool = False) -> Restoration:
     """Restore an image file to a target MTF at Nyquist with a filter
     designed from ``sensor`` and the image's noise.
 
@@ -84,7 +124,9 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
         (:func:`imgmtf.restore.apply.measure_noise`).
     max_noise_gain : float, optional
         Upper bound (>= 1) of the filter's white-noise gain
-        (:func:`imgmtf.design_filter`).
+        (:func:`imgmtf.design_filter`).  Without it, a design whose gain
+        exceeds :data:`NOISE_DOMINATED_GAIN` is refused; with it, the
+        caller has set the noise budget and such a design is warned about.
     kernel_size : int, optional
         Side (odd, 3 to 63 px) of a spatial kernel; None for the FFT form.
     gsd_m : float, optional
@@ -104,6 +146,11 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
         Show a progress bar on stderr (default: when stderr is a terminal).
     run_utc : str, optional
         The run's start (UTC, ISO 8601) for the provenance tag.
+    fit : FitRecord, optional
+        What the sensor's fit said of its model
+        (:func:`imgmtf.estimate.fit.read_fit_record` of its TOML).
+    allow_misfit : bool, optional
+        Restore with a sensor whose ``fit`` says misfit (warned about).
 
     Returns
     -------
@@ -113,6 +160,10 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
 
     Raises
     ------
+    ImgmtfError
+        A misfit sensor (reason ``misfit``) unless ``allow_misfit``; a
+        filter whose noise dominates the result (reason
+        ``noise-dominated``): both before anything is written.
     ImageReadError, ImageContentError, ParameterError, FileWriteError
         As :func:`imgmtf.design_filter` and :func:`imgmtf.restore_file`.
 
@@ -127,8 +178,8 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
     ('measured', 0.35)
     """
     from ..io import raster_info
+    warnings: list[str] = list(check_model_fits(fit, allow_misfit=allow_misfit))
     info = raster_info(path)
-    warnings: list[str] = []
     if gsd_m is None:
         gsd_m = info.gsd_m or sensor.gsd_m
         if info.gsd_m and abs(info.gsd_m / sensor.gsd_m - 1) > GSD_TOLERANCE:
@@ -148,14 +199,101 @@ def restore_image(path: str | Path, sensor: Sensor, out: str | Path, *, target_n
     if restoration.limited:
         warnings.append(f"the noise-gain limit {max_noise_gain:g} won over the target: the restored MTF at "
                         "Nyquist is below it (see achieved_mtf_nyquist)")
+    noisy = noise_domination(restoration)
+    if noisy and max_noise_gain is None:
+        raise ImgmtfError(f"{path}: {noisy}", reason="noise-dominated")
+    if noisy:
+        warnings.append(f"NOISE DOMINATES: {noisy}")
     report = restoration_report(restoration)
+    warnings += blurring_note(report)
     done = restore_file(path, restoration, out, tile_px=tile_px, saturation=saturation, workers=workers,
                         scheduler=scheduler, progress=progress, run_utc=run_utc)
     if done.clipped_fraction > 0:
         warnings.append(f"{100 * done.clipped_fraction:.3g} % of the restored pixels were clipped to the "
                         f"{done.dtype} range (overshoot at bright or dark edges)")
     source = sources.pop() if len(sources) == 1 else "given and measured"
-    return Restoration(restoration, report, done, source, tuple(warnings))
+    return Restoration(restoration, report, done, source, tuple(warnings), fit)
+
+
+def check_model_fits(fit: FitRecord | None, source: str = "the sensor", *,
+                     allow_misfit: bool = False) -> tuple[str, ...]:
+    """Refuse a sensor whose fit record says its model does not fit, unless
+    ``allow_misfit``; the warnings a restoration with it then carries.
+
+    Parameters
+    ----------
+    fit : FitRecord or None
+        The sensor file's ``[fit]`` record (None: no record, no claim).
+    source : str, optional
+        What the message names (the sensor file).
+    allow_misfit : bool, optional
+        Go ahead with a misfit sensor, warned.
+
+    Returns
+    -------
+    tuple of str
+        The warning of a misfit restored anyway, else none.
+
+    Raises
+    ------
+    ImgmtfError
+        A misfit (reason ``misfit``) not allowed.
+
+    Examples
+    --------
+    >>> from imgmtf import ImgmtfError
+    >>> from imgmtf.estimate.fit.record import FitRecord
+    >>> from imgmtf.restore.restoration import check_model_fits
+    >>> record = FitRecord(True, 3.8, 0.0, 0.025, ("optics", "detector"), ("chip.tif",))
+    >>> try:
+    ...     check_model_fits(record, "s.toml")
+    ... except ImgmtfError as refusal:
+    ...     print(refusal.reason, "|", str(refusal)[:60])
+    misfit | s.toml: the model (optics, detector) does not fit the 1 edge
+    >>> check_model_fits(record, "s.toml", allow_misfit=True)[0][:40]
+    'MISFIT SENSOR, restored with anyway: the'
+    """
+    if fit is None or not fit.misfit:
+        return ()
+    if not allow_misfit:
+        raise ImgmtfError(f"{source}: {fit.summary()}: a filter designed from it inverts a blur the sensor does "
+                          "not have", reason="misfit")
+    return (f"MISFIT SENSOR, restored with anyway: {fit.summary()}; the restored MTF is the model's, not the "
+            "image's",)
+
+
+def noise_domination(restoration: RestorationFilter) -> str:
+    """Why the restored image would be more the filter's noise than the
+    scene's detail (a white-noise gain above :data:`NOISE_DOMINATED_GAIN`),
+    or ``""``.
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor, design_filter
+    >>> from imgmtf.restore.restoration import noise_domination
+    >>> noise_domination(design_filter(Sensor(), 0.35, noise_std_dn=5.0, signal_std_dn=500.0))
+    ''
+    >>> blurry = Sensor(optics_sigma_x_m=0.7, optics_sigma_y_m=0.7)      # MTF 0.05 at Nyquist
+    >>> noise_domination(design_filter(blurry, 0.4, noise_std_dn=1.0, signal_std_dn=500.0))[:40]
+    'the filter multiplies the noise by 8.5 ('
+    """
+    gain = restoration.noise_gain
+    if gain <= NOISE_DOMINATED_GAIN:
+        return ""
+    noise = restoration.noise_std_dn
+    signal = ("" if restoration.signal_std_dn != restoration.signal_std_dn
+              else f" against the scene's {restoration.signal_std_dn:.4g} DN")
+    return (f"the filter multiplies the noise by {gain:.2g} (over {NOISE_DOMINATED_GAIN:g}): the restored noise, "
+            f"{gain * noise:.3g} DN{signal}, is {1 - 1 / gain ** 2:.0%} the filter's, and its MTF is lifted "
+            "where the sensor passes a small fraction of the target")
+
+
+def blurring_note(report: RestorationReport) -> list[str]:
+    """A note for each axis whose target lies below the sensor's own MTF at
+    Nyquist: the filter blurs it."""
+    return [f"the target MTF at Nyquist, {a.designed_mtf_nyquist:g}, is below the sensor's own {direction} track, "
+            f"{a.system_mtf_nyquist:.4f}: the filter blurs {direction} track rather than sharpening"
+            for direction, a in report.axes.items() if a.designed_mtf_nyquist < a.system_mtf_nyquist]
 
 
 def _first_band(info) -> int:

@@ -55,7 +55,8 @@ normal, show structure the noise cannot explain.
 from .data import EdgeImage, profile_noise
 from .fitting import fit_edges
 from .model import check_names
+from .record import FitRecord, read_fit_record
 from .results import EdgeFit, FittedParameter, SensorFit
 
-__all__ = ["EdgeFit", "EdgeImage", "FittedParameter", "SensorFit", "check_names", "fit_edges",
-           "profile_noise"]
+__all__ = ["EdgeFit", "EdgeImage", "FitRecord", "FittedParameter", "SensorFit", "check_names", "fit_edges",
+           "profile_noise", "read_fit_record"]

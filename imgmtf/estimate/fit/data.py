@@ -50,6 +50,29 @@ class EdgeImage:
     dtype: DTypeLike | None = None
 
 
+@dataclass(frozen=True, eq=False)
+class MeasuredEdge:
+    """An edge already measured from a file, as ``imgmtf measure`` reads
+    and measures it (its window, nodata, transfer curve, forced checks),
+    with the name its file gives it: what :func:`imgmtf.fit_sensor` makes
+    of a file.
+
+    Attributes
+    ----------
+    result : EdgeResult
+        The measurement (its samples, levels and geometry are what the fit takes).
+    source : str
+        What messages and results name it by (the file, with its ROI).
+    integer : bool
+        True when its samples are a file's integer DN as stored (their
+        rounding, 1/sqrt(12) DN, is then the noise floor).
+    """
+
+    result: EdgeResult
+    source: str
+    integer: bool = False
+
+
 #: the fit's bins along the normal, px.  The model of a bin is the mean of
 #: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`.model.bin_esf`);
 #: it leaves out the third and fourth moments' terms, at most f''' w^3 / 48
@@ -164,7 +187,7 @@ class EdgeData:
         return self.normal_angle_deg + 180.0 if self.reversed_profile else self.normal_angle_deg
 
 
-def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | None) -> EdgeData:
+def edge_data(item: np.ndarray | EdgeImage | MeasuredEdge | EdgeResult, k: int, gsd_m: float | None) -> EdgeData:
     """What edge ``k`` (0-based) gives the fit: an image measured (its
     geometry only), or a measurement taken as it is."""
     from ...inputs import saturation_levels
@@ -177,7 +200,9 @@ def edge_data(item: np.ndarray | EdgeImage | EdgeResult, k: int, gsd_m: float | 
     if isinstance(item, (str, os.PathLike)):
         raise ParameterError(f"edge {k + 1}: a file ({item}); the fit takes images and measurements: "
                              "imgmtf.fit_sensor reads files")
-    if isinstance(item, EdgeResult):
+    if isinstance(item, MeasuredEdge):
+        source, result, integer = item.source, item.result, item.integer
+    elif isinstance(item, EdgeResult):
         source, result, integer = f"edge {k + 1}", item, False
     else:
         if not isinstance(item, EdgeImage):

@@ -13,10 +13,18 @@ from ..._blas import one_blas_thread
 from ...errors import ImgmtfError, ParameterError
 from ...inputs import check_number
 from ...sensor.model import Sensor
-from ...sensor.stages import STAGES
-from .choice import AUTO, AUTO_CANDIDATES, ModelChoice, candidate_summary, choose
+from .choice import AUTO_CANDIDATES, ModelChoice, candidate_summary, choose
 from .data import EdgeImage, edge_data
-from .model import Model, hold_keys, initial_stages, listed, parameter_covariance, stage_names
+from .model import (
+    Model,
+    check_auto_hold,
+    hold_keys,
+    initial_stages,
+    is_auto,
+    listed,
+    parameter_covariance,
+    stage_names,
+)
 from .report import fit_report
 from .results import SensorFit
 from .seeds import seeded
@@ -130,18 +138,6 @@ def new_model(gsd: float, stages: list, data: list, start: Sensor | None) -> Mod
 def held_where(model: Model, key: str) -> str:
     """Where a held parameter is held, in words."""
     return "its starting value" if model.held_at[key] == model.start[key] else "none (0)"
-
-
-def is_auto(stages) -> bool:
-    """Whether ``stages`` asks for the model chosen by the data."""
-    return isinstance(stages, str) and stages.strip() == AUTO
-
-
-def check_auto_hold(hold) -> None:
-    """With ``auto``, a held name must name a parameter of some candidate."""
-    keys = sorted({f"{name}.{parameter}" for candidate in AUTO_CANDIDATES for name in candidate
-                   for parameter in STAGES[name].fit_specs()})
-    hold_keys(hold, keys)
 
 
 def candidate_hold(hold, keys: list[str]) -> list[str]:

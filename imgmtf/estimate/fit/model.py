@@ -34,6 +34,7 @@ from ...metrics import first_crossing
 from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
+from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
 
@@ -116,13 +117,24 @@ def check_names(stages: str | Sequence[str] | None = None, hold: str | Sequence[
     >>> check_names("optics,detector", "detector.width_x_m")
     ['optics', 'detector']
     """
-    from .fitting import check_auto_hold, is_auto
     if is_auto(stages):
         check_auto_hold(hold)
         return ["auto"]
     names = stage_names(stages, start)
     hold_keys(hold, [f"{name}.{parameter}" for name in names for parameter in STAGES[name].fit_specs()])
     return names
+
+
+def is_auto(stages) -> bool:
+    """Whether ``stages`` asks for the model chosen by the data (:mod:`.choice`)."""
+    return isinstance(stages, str) and stages.strip() == AUTO
+
+
+def check_auto_hold(hold) -> None:
+    """With ``auto``, a held name must name a parameter of some candidate."""
+    keys = sorted({f"{name}.{parameter}" for candidate in AUTO_CANDIDATES for name in candidate
+                   for parameter in STAGES[name].fit_specs()})
+    hold_keys(hold, keys)
 
 
 def hold_keys(hold, fitted: list[str]) -> set[str]:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -10,6 +11,7 @@ from numpy.typing import ArrayLike
 
 from ...sensor.model import Sensor
 from .model import Model, model_mtf_band
+from .record import write_fitted_sensor
 
 if TYPE_CHECKING:
     from ..edge import EdgeResult
@@ -240,6 +242,28 @@ class SensorFit:
         gsd = self.sensor.gsd_m if gsd_m is None else gsd_m
         return model_mtf_band(self._model, self._u, self._covariance, np.asarray(f_cy_px, float),
                          angle_deg, gsd, self.confidence)
+
+    def to_toml(self, path: str | os.PathLike, comment: str = "", sources: list[str] | None = None) -> None:
+        """Write the fitted sensor as TOML with a ``[fit]`` table saying
+        whether the model fits (:mod:`imgmtf.estimate.fit.record`):
+        :meth:`imgmtf.Sensor.from_toml` reads the sensor, ``imgmtf
+        restore`` refuses a misfit one.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file (replaced if it exists).
+        comment : str, optional
+            Lines written as TOML comments on top.
+        sources : list of str, optional
+            What the edges were (default the edges' names).
+
+        Raises
+        ------
+        FileWriteError
+            The file cannot be written.
+        """
+        write_fitted_sensor(path, self, comment=comment, sources=sources)
 
     def to_dict(self) -> dict:
         """JSON-ready: one object holding the sensor, parameters, fit
