@@ -30,6 +30,8 @@ _LAZY = {
     "render": "sensor.rendering",
     "measure_edge": "estimate.edge", "EdgeEstimator": "estimate.edge", "EdgeResult": "estimate.edge",
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
+    "measure_points": "estimate.mtf2d.points", "PointsResult": "estimate.mtf2d.points",
+    "PointsEstimator": "estimate.mtf2d.estimator", "PointArray": "sensor.points", "render_points": "sensor.points",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "sensor_fit", "SensorFit": "estimate.fit", "FitRecord": "estimate.fit.record",

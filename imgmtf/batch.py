@@ -154,20 +154,34 @@ def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: s
         try:
             raster = file.read(band, window=settings.roi)
             result = measure_raster(raster, settings)
-            summary = result.to_dict(curves=True)
+            # one record per result, or per direction of a kind that measures several (points)
+            summaries = result.summaries(curves=True)
         except Exception as exc:
             failed = settings.failed(path, band, exc, run_utc)
             records.append(failed.with_(figures={"warnings": file_notes}) if file_notes else failed)
             continue
-        # what the file says about every number in it, as a scan says it of each edge it accepts
-        file_notes = [*file_notes, *raster_notes(raster, settings.transfer, bool(info.alpha_bands))]
+        records.extend(_band_records(file, band, len(bands), raster, result, summaries, file_notes, settings,
+                                     plot_path, run_utc))
+    return records
+
+
+def _band_records(file, band, n_bands, raster, result, summaries, file_notes, settings, plot_path, run_utc):
+    """The records of one band's result: one per summary, the figure drawn
+    once and named by each."""
+    path, info = file.path, file.info
+    records: list[Record] = []
+    # what the file says about every number in it, as a scan says it of each edge it accepts
+    file_notes = [*file_notes, *raster_notes(raster, settings.transfer, bool(info.alpha_bands))]
+    for summary in summaries:
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         record = _untrusted_when_forced(record, settings, result.checks)
-        if plot_path:
+        if plot_path and records and records[0].plot:
+            record = record.with_(plot=records[0].plot)
+        elif plot_path:
             record = with_figure(record, functools.partial(_measurement_figure, result, raster,
                                                            summary["warnings"]),
-                                 _band_plot_path(plot_path, band, len(bands)))
+                                 _band_plot_path(plot_path, band, n_bands))
         records.append(record)
     return records
 
@@ -249,8 +263,12 @@ def _measurement_figure(result, raster, warnings):
     """The measurement figure, titled with the file (and band), counting
     every warning its record carries (the file's own among them), with the
     true MTF when the file is a chip imgmtf simulated."""
+    from .kinds import get_kind
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
+    kind = get_kind(result.target)
+    if kind.figure is not None:             # a kind with a figure of its own (points: the 2-D PSF and MTF)
+        return kind.load("figure")(result, raster.data, truth=kind_truth(raster), title=title, warnings=warnings)
     return plot_measurement(result, truth=true_mtf(raster), title=title, warnings=warnings)
 
 
@@ -270,6 +288,23 @@ def true_mtf(raster):
     except (KeyError, TypeError, ValueError, ImgmtfError):
         return None
     return lambda f_cy_px: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
+
+
+def kind_truth(raster):
+    """The true MTF of a chip imgmtf simulated as a function of (cy/px,
+    angle in deg from the x axis), for kinds measured in several directions;
+    None for any other file."""
+    provenance = raster.provenance
+    if not isinstance(provenance, dict):
+        return None
+    from .sensor.model import Sensor
+    try:
+        sensor = Sensor.from_dict(provenance["sensor"])
+        gsd_m = float(provenance["gsd_m"])
+        sensor.normal_transfer(0.5, 0.0, gsd_m)
+    except (KeyError, TypeError, ValueError, ImgmtfError):
+        return None
+    return lambda f_cy_px, angle_deg: np.abs(sensor.normal_transfer(f_cy_px, angle_deg, gsd_m))
 
 
 def file_truth(path: str, band=None, window=None):

@@ -56,11 +56,15 @@ class MeasureSettings:
     transfer : str, optional
         How the stored values relate to light, "linear" (as stored), "srgb"
         or "gamma:G" (:mod:`imgmtf.transfer`): linearised before measuring.
+    point_size : (float, str), float or str, optional
+        Each point target's known size (a square's side), as
+        ``pulse_width`` takes it; for the kinds that take one (points).
 
     Raises
     ------
     ParameterError
-        A setting out of range, or a pulse width for an edge.
+        A setting out of range, a pulse width for an edge, or a point size
+        for a kind without one.
 
     Examples
     --------
@@ -80,6 +84,7 @@ class MeasureSettings:
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
     transfer: str = "linear"
+    point_size: tuple[float, str] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
@@ -89,6 +94,12 @@ class MeasureSettings:
             raise ParameterError("a pulse width applies to pulse targets only")
         if self.pulse_width is not None and self.pulse_width[1] == "px":
             check_width(self.pulse_width[0])
+        if self.point_size is not None:
+            object.__setattr__(self, "point_size", parse_length(self.point_size))
+            if get_kind(self.target, "target").size_keyword is None:
+                raise ParameterError(f"a point size applies to point targets only, not to a {self.target}")
+            if not 0.0 <= self.point_size[0] <= 20.0 and self.point_size[1] == "px":
+                raise ParameterError(f"a point size must be 0 to 20 px, got {self.point_size[0]:g}")
         check_method(self.method)   # an unknown method fails here, before any file is read
         object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
@@ -118,7 +129,8 @@ class MeasureSettings:
         ParameterError
             A width in metres on a raster without a GSD.
         """
-        return get_kind(self.target).estimator_keywords(pulse_width_px(self.pulse_width, raster))
+        return get_kind(self.target).estimator_keywords(pulse_width_px(self.pulse_width, raster),
+                                                        point_size_px(self.point_size, raster))
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
@@ -126,7 +138,8 @@ class MeasureSettings:
                 "band": self.band, "force": self.force,
                 "saturation": list(self.saturation) if self.saturation else None,
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
-                "pulse_width": list(self.pulse_width) if self.pulse_width else None}
+                "pulse_width": list(self.pulse_width) if self.pulse_width else None,
+                **({"point_size": list(self.point_size)} if self.point_size else {})}
 
     def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
         """The error record of a file (or band) that could not be measured.
@@ -164,3 +177,19 @@ def pulse_width_px(width: tuple[float, str] | None, raster: Raster) -> float | N
                              "(its GSD is unknown); give the width in px")
     check_width(value / raster.gsd_m)
     return value / raster.gsd_m
+
+
+def point_size_px(size: tuple[float, str] | None, raster: Raster) -> float | None:
+    """A point target's size (value, unit) in pixels for this raster
+    (metres need its GSD), 0 to 20 px."""
+    if size is None:
+        return None
+    value, unit = size
+    if unit == "m":
+        if raster.gsd_m is None:
+            raise ParameterError(f"{raster.path}: a point size in metres needs a georeferenced image "
+                                 "(its GSD is unknown); give the size in px")
+        value = value / raster.gsd_m
+    if not 0.0 <= value <= 20.0:
+        raise ParameterError(f"{raster.path}: a point size of {value:g} px: it must be 0 to 20 px")
+    return value

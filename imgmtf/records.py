@@ -63,9 +63,10 @@ class Record:
     band : int, str or None
         1-based band, ``"luminance"`` for RGB, None when not known.
     target : str
-        ``"edge"`` or ``"pulse"``.
+        ``"edge"``, ``"pulse"`` or ``"points"`` (a kind of
+        :data:`imgmtf.kinds.KINDS`; points give one record per direction).
     method : str
-        The resampling method.
+        The resampling method (``"points"`` for the point stack).
     status : str
         ``ok``/``error`` (measure), ``accepted``/``rejected`` (a scan
         candidate), ``combined`` or ``fitted`` (a scan's summary of a

@@ -14,6 +14,7 @@ import imgmtf
 from imgmtf.errors import ParameterError
 from imgmtf.kinds import KINDS, Kind, get_kind, kind_names, kinds_with_width
 from imgmtf.kinds.edge import EDGE
+from imgmtf.kinds.points import POINTS
 from imgmtf.kinds.pulse import PULSE
 from imgmtf.records import SUMMARY_COLUMNS
 
@@ -54,15 +55,15 @@ def test_no_module_outside_the_registry_compares_a_kind_name():
 
 
 def test_lookup_returns_the_registered_kinds_in_order():
-    assert kind_names() == ("edge", "pulse")
-    assert get_kind("edge") is EDGE and get_kind("pulse") is PULSE
+    assert kind_names() == ("edge", "pulse", "points")
+    assert get_kind("edge") is EDGE and get_kind("pulse") is PULSE and get_kind("points") is POINTS
     assert all(KINDS[name].name == name for name in KINDS)
     assert kinds_with_width() == (PULSE,)
 
 
 @pytest.mark.parametrize("name", ["star", "Edge", "", None, 3])
 def test_an_unknown_kind_is_refused_naming_the_kinds_there_are(name):
-    with pytest.raises(ParameterError, match=r"target kind must be one of \('edge', 'pulse'\), got ") as info:
+    with pytest.raises(ParameterError, match=r"target kind must be one of \('edge', 'pulse', 'points'\), got ") as info:
         get_kind(name)
     assert isinstance(info.value, ValueError)
     with pytest.raises(ParameterError, match=r"^target must be one of"):
@@ -71,9 +72,14 @@ def test_an_unknown_kind_is_refused_naming_the_kinds_there_are(name):
 
 def test_each_kind_names_its_parts_and_they_name_it_back():
     for kind in KINDS.values():
-        result, measuring = kind.load("result"), kind.load("measuring")
+        result = kind.load("result")
         assert result.target == kind.name
-        assert measuring.registered is kind
+        if kind.measuring is not None:                  # a kind of the 1-D pipeline
+            assert kind.load("measuring").registered is kind
+        else:                                           # a kind with its own: drawn and measured apart
+            assert kind.scene_response is None and kind.renderer is not None
+            with pytest.raises(ParameterError, match="has no measuring part"):
+                kind.load("measuring")
         assert type(kind.make_estimator("msg")).__name__ == kind.estimator.rpartition(":")[2]
         assert set(kind.record_fields) <= set(SUMMARY_COLUMNS)
         assert kind.column.field in kind.record_fields
@@ -105,7 +111,11 @@ def test_each_kinds_column_is_in_its_measurement():
     sensor = imgmtf.Sensor()
     for kind in KINDS.values():
         width = 1.5 if kind.has_width else 0.0
-        chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width), 60)
+        if kind.renderer is not None:
+            from imgmtf.sensor.points import PointArray
+            chip = kind.load("renderer")(sensor, PointArray(2, 2), 60)
+        else:
+            chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width), 60)
         result = kind.make_estimator("msg", intervals=imgmtf.Intervals("none"))(
             chip.image, **kind.estimator_keywords(width or None))
         figures = result.to_dict(curves=False)
@@ -128,7 +138,16 @@ def test_the_registry_loads_nothing_numerical_and_nothing_above_it():
             "m in ('numpy', 'scipy', 'cv2', 'matplotlib')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert eval(out.stdout) == ["imgmtf", "imgmtf.errors", "imgmtf.kinds", "imgmtf.kinds.edge",
-                                "imgmtf.kinds.kind", "imgmtf.kinds.pulse"]
+                                "imgmtf.kinds.kind", "imgmtf.kinds.points", "imgmtf.kinds.pulse"]
+
+
+def test_the_facts_of_points():
+    assert (POINTS.noun, POINTS.has_width, POINTS.column.field) == ("point", False, "points_used")
+    assert POINTS.measuring is None and POINTS.scene_response is None and not POINTS.fits_sensor
+    assert POINTS.estimator_keywords(None, 1.0) == {"point_size_px": 1.0}
+    assert EDGE.estimator_keywords(None, 1.0) == {}
+    with pytest.raises(ParameterError, match="a points target is no straight line"):
+        imgmtf.Target("points")
 
 
 def test_kind_is_a_frozen_record_of_facts():

@@ -39,6 +39,8 @@ HINTS = (
     Hint(CHIP, "two-targets", "--roi X,Y,W,H crops it to one target"),
     Hint(CHIP, "not-an-edge", "--target pulse measures a bar"),
     Hint(CHIP, "not-a-bar", "--target edge measures an edge"),
+    Hint(CHIP, "points", "--target points measures point targets"),
+    Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),

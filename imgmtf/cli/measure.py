@@ -41,6 +41,9 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width, 0.2 to 10 px: 1.4px or 1.4 (pixels), 18.3m (metres, needs a GSD); "
                    "estimated from the profile when omitted")
+@click.option("--point-size", callback=length_option("px"),
+              help="--target points: each target's side when it is a square of known size, 0 to 20 px: 1 or "
+                   "1px (pixels), 30m (metres, needs a GSD); its sinc is divided out of the MTF")
 @click.option("--method", cls=MethodOption)
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
@@ -69,11 +72,12 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @interval_options
 @parallel_options
 @campaign_options
-def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
+def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
             force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
             workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
-    image of a folder.  With --format json, one JSON object per line (JSON
+    image of a folder; with --target points, the 2-D PSF and MTF of the
+    point targets on it, one row across and one along track.  With --format json, one JSON object per line (JSON
     Lines) per file and band; a file that cannot be measured gives an error
     line and the rest go on (exit status 1 if any failed).  Rows are printed
     and written to the CSV as each file completes; on Ctrl-C or SIGTERM the
@@ -84,6 +88,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         raise click.UsageError("give --plot or --plot-dir, not both")
     if pulse_width and not get_kind(kind).has_width:
         raise click.UsageError(width_refusal())
+    if point_size and get_kind(kind).size_keyword is None:
+        raise click.UsageError(f"--point-size applies to --target points only, not to a {kind}")
     with reported_errors():
         from ..parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:
@@ -94,7 +100,8 @@ def measure(paths, kind, pulse_width, method, roi, band, fmt, csv_path, plot_pat
         with option_errors():
             settings = MeasureSettings(kind, method, band, roi, pulse_width,
                                        interval_settings(interval_method, replicates, confidence), force=force,
-                                       saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer)
+                                       saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer,
+                                       point_size=point_size)
         files, repeated = once_each(expand_inputs(paths, recursive))
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")

@@ -99,6 +99,10 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     store."""
     if pulse_width and not get_kind(kind).has_width:
         raise click.UsageError(width_refusal())
+    if get_kind(kind).measuring is None:       # a kind with a pipeline of its own: scan searches for lines
+        raise click.UsageError(f"scan searches scenes for lines (edges and bars), not for {kind} targets yet: "
+                               f"imgmtf measure --target {kind} SCENE finds and measures every one in a scene "
+                               "(--roi X,Y,W,H for one array)")
     if max_length < min_length:
         raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
     if edge_figures and not out_dir:

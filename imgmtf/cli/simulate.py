@@ -27,13 +27,16 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
 
 #: the options that describe one chip, and those that describe a campaign: each refused with the other
 CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std", "ground_noise", "oversampling",
-             "sensor_path", "out")
+             "sensor_path", "out", "point_size", "spacing")
+#: the options of a line target (an edge or a bar) that an array of points has no use for, and the reverse
+LINE_ONLY = ("angle", "pulse_width", "offset", "ground_noise", "oversampling")
+POINTS_ONLY = ("point_size", "spacing")
 CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
                  "band_name", "blur")
 CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says otherwise
 
 
-@click.command(short_help="Render an edge or bar chip through the sensor (GeoTIFF, PNG).")
+@click.command(short_help="Render an edge, bar or point-array chip through the sensor (GeoTIFF, PNG).")
 @click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
               help="angle of the edge's normal from the x (column) axis, degrees in (-90, 90], which "
@@ -46,6 +49,11 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width of a pulse target, at least 0.2 px and at most --size: 1.5 or 1.5px (pixels), "
                    "1.5m (metres on the ground)")
+@click.option("--point-size", type=FiniteFloat(0, 20), default=0.0, show_default=True,
+              help="--target points: each target's side, px (0: points of light; 1: Rauchmiller's 1 px squares)")
+@click.option("--spacing", type=FiniteFloat(2, 1000), default=12.0, show_default=True,
+              help="--target points: distance between the 4 x 4 targets' centres, px (each at its own quarter-pixel "
+                   "offset)")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
 @click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default="50; 320 with --campaign",
@@ -83,7 +91,7 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
 @click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
 @click.pass_context
-def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, noise_std,
+def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
              degradation, snr, fill, blur, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
@@ -124,6 +132,15 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
                                      "how the chip was made, or a PNG (.png, pixels only); "
                                      f"got {suffix or 'no suffix'}", param_hint="'--out'")
         target_kind = get_kind(kind)
+        drawn_apart = target_kind.renderer is not None       # no line: its own renderer (points)
+        clash = [name for name in (LINE_ONLY if drawn_apart else POINTS_ONLY) if name in given]
+        if clash:
+            raise click.UsageError(f"{_flag(ctx, clash[0])} does not apply to --target {kind}")
+        if drawn_apart:
+            check_output_file(out)
+            _points_chip(target_kind, out, suffix, load_sensor(sensor_path), gsd, size, int(bits), low, high,
+                         point_size, spacing, noise_std, seed)
+            return
         if target_kind.has_width and pulse_width is None:
             raise click.UsageError(f"a {kind} target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
         if not target_kind.has_width and pulse_width is not None:
@@ -161,6 +178,31 @@ def simulate(ctx, kind, angle, low, high, pulse_width, offset, size, gsd, bits, 
             click.echo(f"note: a PNG keeps the pixels only; the GSD and how the chip was made (which "
                        f"`measure` uses to draw the true MTF) are kept in a GeoTIFF: --out "
                        f"{Path(out).with_suffix('.tif')}")
+
+
+def _points_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, point_size, spacing, noise_std, seed):
+    """A 4 x 4 array of point targets (squares of ``point_size`` px) at
+    quarter-pixel offsets, rendered exactly; the truth across and along
+    track in the file's tags."""
+    from ..io import write_geotiff, write_png
+    from ..sensor.points import PointArray
+    gsd_m = sensor.gsd_m if gsd is None else gsd
+    with option_errors():
+        array = PointArray(4, 4, spacing_px=spacing, size_px=point_size, low_dn=low, high_dn=high)
+        chip = kind.load("renderer")(sensor, array, size, gsd_m=gsd_m, bits=bits, noise_std_dn=noise_std, seed=seed)
+    provenance = chip.provenance()
+    truth = {"TRUE_MTF_NYQUIST_ACROSS": f"{provenance['mtf_nyquist_across']:.6f}",
+             "TRUE_MTF_NYQUIST_ALONG": f"{provenance['mtf_nyquist_along']:.6f}",
+             "TARGET_SIZE_PX": f"{point_size:g}"}
+    if suffix == ".png":
+        write_png(out, chip.image)
+    else:
+        write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=provenance, tags=truth)
+    what = f"{point_size:g} px squares" if point_size else "points"
+    clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
+    click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, 4 x 4 {what} {spacing:g} px apart at quarter-pixel "
+               f"offsets, GSD {chip.gsd_m:g} m; true MTF at Nyquist across track "
+               f"{provenance['mtf_nyquist_across']:.4f}, along track {provenance['mtf_nyquist_along']:.4f}{clipped}")
 
 
 def _flag(ctx, name: str) -> str:

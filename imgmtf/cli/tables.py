@@ -50,7 +50,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
              f"{num_cell(record.get('tilt_deg'), 5, 1)} {direction:>7} "
              f"{snr_cell(record.get('snr'))} {num_cell(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
              f"{num_cell(record.get('mtf50_cy_px'), 7, 4)} {num_cell(record.get('fwhm_px'), 6, 3)} "
-             f"{num_cell(last, 6, 3)}"]
+             f"{num_cell(last, 6, 0 if isinstance(last, int) else 3)}"]
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")

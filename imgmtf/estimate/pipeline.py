@@ -211,15 +211,18 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
     """
     chip = prepare_chip(image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
                         track_azimuth_deg=track_azimuth_deg)
-    located = locate_target(kind, chip, force=settings.force)
-    samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
-    read, shape = read_profile(kind, samples, settings, located.checks)
-    noise = measure_noise(kind, samples, shape, chip.quantum_dn)
-    window = choose_window(kind, samples, shape, noise, settings, chip.quantum_dn)
-    profile = widen_profile(read, samples, shape, window, settings, kind.name)
-    lsf = blend_tails(kind, samples, profile, shape, window)
-    spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
-    checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings)
+    try:
+        located = locate_target(kind, chip, force=settings.force)
+        samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
+        read, shape = read_profile(kind, samples, settings, located.checks)
+        noise = measure_noise(kind, samples, shape, chip.quantum_dn)
+        window = choose_window(kind, samples, shape, noise, settings, chip.quantum_dn)
+        profile = widen_profile(read, samples, shape, window, settings, kind.name)
+        lsf = blend_tails(kind, samples, profile, shape, window)
+        spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
+        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings)
+    except ImgmtfError as exc:
+        raise _points_instead(exc, kind, chip, image) from None
     estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
                         kind.subtracts_background, kind.lsf, functools.partial(_resample_weighted, samples, settings),
                         kind.read_width(read.grid, shape), kind.name)
@@ -233,6 +236,24 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
               "dequantised": samples.dequantised, **chip.left_out_px}
     return Measurement(chip, located, shape, noise, estimate, found, tuple(checks), tuple(warnings), params,
                        settings.frequencies_cy_px)
+
+
+def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: ArrayLike) -> ImgmtfError:
+    """A chip refused as an edge or a bar that holds point targets instead
+    says so (reason ``points``); any other refusal stands as it was.  The
+    chip's own pixels have its outliers (points among them) left out: the
+    image as given is what is looked at."""
+    from .mtf2d.sources import points_seen
+    if exc.reason not in ("no-target", "two-targets", "not-straight", "unsuitable", "not-an-edge", "not-a-bar",
+                          "angle", "snr", "non-uniform"):
+        return exc
+    x0, y0 = chip.origin
+    rows, cols = chip.pixels.shape
+    pixels = np.asarray(image, float)
+    seen = points_seen(pixels[y0: y0 + rows, x0: x0 + cols]) if pixels.ndim == 2 else None
+    if seen is None:
+        return exc
+    return UnsuitableTargetError(f"no {kind.name} here: the chip holds {seen}, not a line", reason="points")
 
 
 def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Located:

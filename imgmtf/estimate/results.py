@@ -175,6 +175,11 @@ class MTFResult:
     def _specific(self) -> dict:
         return {}
 
+    def summaries(self, curves: bool = True) -> list[dict]:
+        """The records' figures: one summary (:meth:`to_dict`), as every
+        kind's result gives a list (points give one per direction)."""
+        return [self.to_dict(curves)]
+
     def to_dict(self, curves: bool = True) -> dict:
         """JSON-ready summary (units in the names); ``curves`` adds the MTF."""
         out = {

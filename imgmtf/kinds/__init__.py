@@ -4,8 +4,8 @@
 one dispatcher.  Nothing else in the package compares a kind's name: it
 asks :func:`get_kind` for the kind and reads its facts.
 
-Adding a kind (a point source, a Siemens star): a module beside
-:mod:`.edge` and :mod:`.pulse` defining its :class:`Kind`, and one entry
+Adding a kind (a Siemens star): a module beside :mod:`.edge`,
+:mod:`.pulse` and :mod:`.points` defining its :class:`Kind`, and one entry
 in :data:`KINDS`; docs/architecture.md says what its parts are.
 
 This package sits below :mod:`imgmtf.sensor` and imports nothing of the
@@ -17,12 +17,13 @@ from __future__ import annotations
 from ..errors import ParameterError
 from .edge import EDGE
 from .kind import Column, Kind
+from .points import POINTS
 from .pulse import PULSE
 
 __all__ = ["KINDS", "Column", "Kind", "get_kind", "kind_names", "kinds_with_width"]
 
 #: every kind of target, by name, in the order commands list them
-KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE)}
+KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS)}
 
 
 def kind_names() -> tuple[str, ...]:
@@ -36,7 +37,7 @@ def kind_names() -> tuple[str, ...]:
     Examples
     --------
     >>> kind_names()
-    ('edge', 'pulse')
+    ('edge', 'pulse', 'points')
     """
     return tuple(KINDS)
 
@@ -68,7 +69,7 @@ def get_kind(name: str, what: str = "target kind") -> Kind:
     'bar'
     >>> get_kind("star")
     Traceback (most recent call last):
-    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse'), got 'star'
+    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points'), got 'star'
     """
     kind = KINDS.get(name) if isinstance(name, str) else None
     if kind is None:

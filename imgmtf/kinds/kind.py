@@ -7,6 +7,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ..errors import ParameterError
+
 
 @dataclass(frozen=True)
 class Column:
@@ -44,14 +46,18 @@ class Kind:
     record_fields : tuple of str
         The result's figures the CSV holds for this kind
         (:data:`imgmtf.records.SUMMARY_COLUMNS`).
-    estimator, result, measuring : str
+    estimator, result : str
         "module:attribute" of its estimator class (configured once, called
-        per chip), its result type, and its part of the shared pipeline (a
-        :class:`imgmtf.estimate.kind.TargetKind`).
-    scene_response : callable
+        per chip) and of its result type.
+    measuring : str or None
+        "module:attribute" of its part of the shared 1-D pipeline (a
+        :class:`imgmtf.estimate.kind.TargetKind`); None for a kind with a
+        pipeline of its own (points: :mod:`imgmtf.estimate.mtf2d`).
+    scene_response : callable or None
         ``scene_response(d_px, esf, width_px)``: the target's image, 0 to 1,
         at signed distances ``d_px`` (px) from its line, seen through a
-        sensor whose edge response along the normal is ``esf``.
+        sensor whose edge response along the normal is ``esf``; None for a
+        target that is no line (its ``renderer`` draws it).
     profile_label : str
         The title of its profile's figure, formatted with ``width_px``.
     lsf_label, lsf_scale : str
@@ -68,6 +74,18 @@ class Kind:
     fits_sensor : bool
         Whether a scan fits the sensor model to its accepted candidates
         (:mod:`imgmtf.scene.targetfit`, which reads half-edges' ESFs).
+    size_keyword : str or None
+        The keyword its estimator takes for a known size of each target
+        (points: ``point_size_px``, ``--point-size``), or None.
+    renderer : str or None
+        "module:attribute" of its own renderer when it is no line (None:
+        :class:`imgmtf.Target` and :func:`imgmtf.render` draw it).
+    figure : str or None
+        "module:attribute" of its measurement figure when it is not
+        :func:`imgmtf.plot.plot_measurement`'s.
+    rows_per_result : str or None
+        Why one result gives several records (points: one per direction),
+        or None for one record per result.
 
     Examples
     --------
@@ -86,8 +104,8 @@ class Kind:
     record_fields: tuple[str, ...]
     estimator: str
     result: str
-    measuring: str
-    scene_response: Callable[[Any, Callable[[Any], Any], float], Any]
+    measuring: str | None
+    scene_response: Callable[[Any, Callable[[Any], Any], float], Any] | None
     profile_label: str
     lsf_label: str
     lsf_scale: str
@@ -95,6 +113,10 @@ class Kind:
     masked_by: str | None = None
     lone_line: tuple[str, str] | None = None
     fits_sensor: bool = False
+    size_keyword: str | None = None
+    renderer: str | None = None
+    figure: str | None = None
+    rows_per_result: str | None = None
 
     def load(self, part: str) -> Any:
         """The object one of the kind's "module:attribute" parts names,
@@ -102,7 +124,7 @@ class Kind:
 
         Parameters
         ----------
-        part : {"estimator", "result", "measuring"}
+        part : {"estimator", "result", "measuring", "renderer", "figure"}
             Which part.
 
         Returns
@@ -110,13 +132,22 @@ class Kind:
         object
             The class (or function) the part names.
 
+        Raises
+        ------
+        ParameterError
+            The kind has no such part (points have no part of the 1-D
+            pipeline).
+
         Examples
         --------
         >>> from imgmtf.kinds import get_kind
         >>> get_kind("edge").load("result").__name__
         'EdgeResult'
         """
-        module, _, attribute = getattr(self, part).partition(":")
+        name = getattr(self, part)
+        if name is None:
+            raise ParameterError(f"a {self.name} target has no {part} part")
+        module, _, attribute = name.partition(":")
         return getattr(importlib.import_module(module), attribute)
 
     def make_estimator(self, method: str = "msg", **settings: Any) -> Any:
@@ -144,20 +175,23 @@ class Kind:
         """
         return self.load("estimator")(method, **settings)
 
-    def estimator_keywords(self, width_px: float | None) -> dict[str, float | None]:
+    def estimator_keywords(self, width_px: float | None, size_px: float | None = None) -> dict[str, float | None]:
         """The keywords this kind's estimator takes beyond those every
         kind's takes: a width (px; None to estimate it) for a kind with
-        one, none otherwise.
+        one, a known size (px) for a kind that takes one, none otherwise.
 
         Parameters
         ----------
         width_px : float or None
             The target's width, px (None: unknown).
+        size_px : float or None, optional
+            Each target's known size, px (None: none given).
 
         Returns
         -------
         dict
-            ``{"width_px": width_px}`` or ``{}``.
+            ``{"width_px": width_px}``, ``{"point_size_px": size_px}`` or
+            ``{}``.
 
         Examples
         --------
@@ -165,4 +199,7 @@ class Kind:
         >>> get_kind("pulse").estimator_keywords(1.5), get_kind("edge").estimator_keywords(None)
         ({'width_px': 1.5}, {})
         """
-        return {"width_px": width_px} if self.has_width else {}
+        keywords: dict[str, float | None] = {"width_px": width_px} if self.has_width else {}
+        if self.size_keyword is not None:
+            keywords[self.size_keyword] = size_px
+        return keywords

@@ -77,6 +77,8 @@ class Target:
 
     def __post_init__(self):
         kind = get_kind(self.kind)
+        if kind.scene_response is None:
+            raise ParameterError(f"a {kind.name} target is no straight line: {kind.renderer} renders it")
         for name in ("angle_deg", "low_dn", "high_dn", "offset_px", "width_px"):
             value = getattr(self, name)
             if isinstance(value, (bool, np.bool_)) or not isinstance(
@@ -130,5 +132,7 @@ class Target:
         numpy.ndarray
             The target's values there, DN.
         """
-        inside = get_kind(self.kind).scene_response(d_px, esf, self.width_px)
+        response = get_kind(self.kind).scene_response
+        assert response is not None, "a target is a line (checked when it was made)"
+        inside = response(d_px, esf, self.width_px)
         return self.low_dn + (self.high_dn - self.low_dn) * inside

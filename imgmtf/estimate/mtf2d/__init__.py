@@ -1,7 +1,14 @@
 """What is two-dimensional about an MTF: the 2-D MTF from its measured
 1-D sections (:mod:`.sections`; the inversions in :mod:`.inversion`, the
-choice of assumption in :mod:`.assumptions`)."""
+choice of assumption in :mod:`.assumptions`), and the 2-D PSF and MTF of
+arrays of point targets stacked by their sub-pixel phases (:mod:`.points`,
+:func:`measure_points`), beside the 1-D pipeline of edges and bars
+(:mod:`imgmtf.estimate.pipeline`)."""
+from __future__ import annotations
+
+from .estimator import PointsEstimator
 from .inversion import EllipticalModel, SeparableModel, elliptical_model, separable_model
+from .points import DirectionMTF, PointsResult, measure_points
 from .sections import (
     ASSUMPTIONS,
     BRACKET,
@@ -19,10 +26,14 @@ __all__ = [
     "ELLIPTICAL",
     "MTF2D",
     "SEPARABLE",
+    "DirectionMTF",
     "EllipticalModel",
+    "PointsEstimator",
+    "PointsResult",
     "SeparableModel",
     "TrackSection",
     "elliptical_model",
+    "measure_points",
     "mtf2d_from_sections",
     "sd_from_nyquist",
     "separable_model",

@@ -1,0 +1,116 @@
+"""The point-target stack (imgmtf.estimate.mtf2d.points) against the exact
+renderer's truth: quarter-pixel arrays of bright points and of dark 1 px
+squares, a lone point, noise; and the refusals of what is not a usable
+point.  Coverage over many noisy rows: bench/points_accuracy.py."""
+import numpy as np
+import pytest
+
+import imgmtf as im
+from imgmtf.errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
+from imgmtf.estimate.mtf2d import measure_points
+from imgmtf.sensor.points import PointArray, render_points
+from imgmtf.sensor.stages import Detector, GaussianOptics
+
+SENSOR = im.Sensor(stages=[GaussianOptics(0.45, 0.55), Detector(1.0, 1.0)])
+ARRAY = PointArray(4, 4, spacing_px=12.0)
+
+
+def errors(result, chip):
+    return {d.direction: d.mtf_nyquist - float(chip.true_mtf(0.5, d.direction)) for d in result.directions}
+
+
+def test_bright_quarter_pixel_points_give_the_truth_noise_free():
+    chip = render_points(SENSOR, ARRAY, 64, bits=None)
+    result = measure_points(chip.image, intervals="none")
+    assert len(result.used) == 16 and not result.refused and result.polarity == "bright"
+    assert all(abs(e) < 0.01 for e in errors(result, chip).values()), errors(result, chip)
+    assert result.alias_weight < 1e-6                  # the quarter pixels tile the pixel evenly
+    across, along = result.directions
+    assert across.direction == "across-track" and along.direction == "along-track"
+    assert across.mtf50_cy_px == pytest.approx(chip.true_mtf50_cy_px("across"), abs=0.005)
+    assert along.mtf50_cy_px == pytest.approx(chip.true_mtf50_cy_px("along"), abs=0.005)
+    assert across.fwhm_px < along.fwhm_px              # the PSF is wider along track
+    assert result.psf.shape[0] == result.psf.shape[1]
+    assert result.psf.sum() * result.psf_step_px ** 2 == pytest.approx(1.0, abs=1e-6)
+    centre = len(result.frequencies2d_cy_px) // 2
+    assert result.mtf2d[centre, centre] == pytest.approx(1.0)
+    # the 2-D MTF off the axes: the Gaussian's ellipse times the pixel's sinc, exactly
+    f = result.frequencies2d_cy_px
+    truth = np.abs(SENSOR.transfer(f[None, :], f[:, None]))
+    band = (np.abs(f[None, :]) <= 0.6) & (np.abs(f[:, None]) <= 0.6)
+    assert np.abs(result.mtf2d - truth)[band].max() < 0.005
+
+
+def test_bright_points_at_snr_100_with_intervals():
+    clean = render_points(SENSOR, ARRAY, 64, bits=None)
+    peak = float(clean.image.max() - ARRAY.low_dn)
+    chip = render_points(SENSOR, ARRAY, 64, bits=None, noise_std_dn=peak / 100.0, seed=11)
+    result = measure_points(chip.image, intervals=im.Intervals("bootstrap", replicates=100))
+    assert all(abs(e) < 0.02 for e in errors(result, chip).values()), errors(result, chip)
+    for section in result.directions:
+        assert section.mtf_nyquist_ci.low < section.mtf_nyquist < section.mtf_nyquist_ci.high
+        assert section.mtf_nyquist_ci.width < 0.08
+
+
+def test_dark_one_pixel_squares_with_their_size_divided_out():
+    array = PointArray(4, 4, spacing_px=12.0, size_px=1.0, low_dn=1000.0, high_dn=100.0)
+    chip = render_points(SENSOR, array, 64, bits=None)
+    result = measure_points(chip.image, point_size_px=1.0, intervals="none")
+    assert result.polarity == "dark" and len(result.used) == 16
+    assert all(abs(e) < 0.01 for e in errors(result, chip).values()), errors(result, chip)
+    # without the size, the square's sinc (0.637 at Nyquist) stays in
+    plain = measure_points(chip.image, intervals="none")
+    assert plain.directions[0].mtf_nyquist == pytest.approx(0.637 * result.directions[0].mtf_nyquist, rel=0.02)
+
+
+def test_a_single_isolated_point_leans_on_its_model_and_says_so():
+    chip = render_points(SENSOR, PointArray(1, 1, offsets_px=((0.3, 0.15),)), 32, bits=None)
+    result = measure_points(chip.image, intervals="none")
+    assert len(result.used) == 1 and result.alias_weight == pytest.approx(1.0)
+    assert all(abs(e) < 0.01 for e in errors(result, chip).values()), errors(result, chip)
+    assert any("aliases" in w for w in result.warnings)
+
+
+def test_the_papers_sensor_through_the_stack():
+    chip = render_points(im.Sensor(), ARRAY, 64, bits=None)
+    result = measure_points(chip.image, intervals="none")
+    assert all(abs(e) < 0.01 for e in errors(result, chip).values()), errors(result, chip)
+
+
+def test_summaries_are_one_record_per_direction():
+    chip = render_points(SENSOR, ARRAY, 64, bits=16)
+    rows = measure_points(chip.image, intervals="none", gsd_m=2.0).summaries(curves=True)
+    assert [r["direction"] for r in rows] == ["across-track", "along-track"]
+    assert all(r["target"] == "points" and r["points_used"] == 16 and r["gsd_m"] == 2.0 for r in rows)
+    assert rows[0]["mtf"][0] == 1.0 and len(rows[0]["frequencies_cy_px"]) == 101
+
+
+def test_targets_at_the_edge_blended_or_clipped_are_refused_with_reasons():
+    chip = render_points(SENSOR, PointArray(2, 2, spacing_px=12.0), 40, bits=None)
+    image = chip.image.copy()
+    image[1:4, 1:4] += 500.0                     # a target touching the chip's corner
+    image[24:27, 19:22] += 400.0                 # a second target 7 px from the bottom-left point
+    image[13:17, 13:17] = 2000.0                 # one point clipped
+    result = measure_points(image, intervals="none", saturation=(0.0, 2000.0))
+    reasons = {s.status for s in result.refused}
+    assert reasons == {"edge", "clipped", "blended"}
+    assert len(result.used) == 1
+    assert all(s.message for s in result.refused)
+
+
+def test_an_edge_is_no_point():
+    chip = im.render(SENSOR, im.Target("edge", 6.0, 200.0, 1200.0), 60, noise_std_dn=2.0, seed=1)
+    with pytest.raises(UnsuitableTargetError, match="an edge or a bar, not point targets") as info:
+        measure_points(chip.image, intervals="none")
+    assert info.value.reason == "not-points"
+
+
+def test_a_flat_chip_has_no_target():
+    with pytest.raises(TargetNotFoundError, match="no compact target"):
+        measure_points(np.random.default_rng(0).normal(100.0, 1.0, (40, 40)), intervals="none")
+
+
+@pytest.mark.parametrize("settings", [dict(point_size_px=-1.0), dict(polarity="grey"), dict(stamp_radius_px=1)])
+def test_bad_settings_are_refused(settings):
+    with pytest.raises(ParameterError):
+        measure_points(np.zeros((20, 20)), **settings)
