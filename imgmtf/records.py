@@ -467,8 +467,27 @@ class JsonLinesWriter:
         self.stream = stream
 
     def write(self, record: Record) -> None:
-        self.stream.write(to_json(record) + "\n")
-        self.stream.flush()
+        write_whole(self.stream, to_json(record) + "\n")
+
+
+def write_whole(stream: IO[str], text: str) -> None:
+    """``text`` written to ``stream`` in full and flushed: to a file's
+    descriptor, each partial write followed by the rest.  Through Python's
+    buffered writer, a signal arriving while a long line waited on a full
+    pipe (a scan's rows, 10-20 KB each, read by a slow consumer) lost the
+    rest of that line, and the next line followed on it: a row cut in two
+    is a row lost."""
+    import os
+    try:
+        fd = stream.fileno()
+    except (AttributeError, OSError, ValueError):       # not a file (a StringIO, a test's runner)
+        stream.write(text)
+        stream.flush()
+        return
+    stream.flush()
+    view = memoryview(text.encode("utf-8"))
+    while view:
+        view = view[os.write(fd, view):]
 
 
 def write_csv(records, path: str, columns=CSV_COLUMNS) -> None:

@@ -117,9 +117,10 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     which prints every candidate) one line per rejection reason with its
     count and example ids, then the combined and fitted rows."""
     if fmt == "json":
-        from ..records import to_json
-        for r in (*records, *summaries):
-            click.echo(to_json(r))
+        import sys
+
+        from ..records import to_json, write_whole
+        write_whole(sys.stdout, "".join(to_json(r) + "\n" for r in (*records, *summaries)))
         return
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
