@@ -6,9 +6,9 @@ arrays of point targets stacked by their sub-pixel phases (:mod:`.points`,
 (:mod:`imgmtf.estimate.pipeline`)."""
 from __future__ import annotations
 
-from .estimator import PointsEstimator
+from typing import TYPE_CHECKING, Any
+
 from .inversion import EllipticalModel, SeparableModel, elliptical_model, separable_model
-from .points import DirectionMTF, PointsResult, measure_points
 from .sections import (
     ASSUMPTIONS,
     BRACKET,
@@ -19,6 +19,23 @@ from .sections import (
     mtf2d_from_sections,
     sd_from_nyquist,
 )
+
+if TYPE_CHECKING:
+    from .estimator import PointsEstimator
+    from .points import DirectionMTF, PointsResult, measure_points
+
+#: the point stack's names, loaded when first asked for: it needs SciPy, which the scan's workers (the
+#: sections' only users there) must not load
+_POINTS = {"PointsEstimator": ".estimator", "DirectionMTF": ".points", "PointsResult": ".points",
+           "measure_points": ".points"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _POINTS:
+        from importlib import import_module
+        return getattr(import_module(_POINTS[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "ASSUMPTIONS",
