@@ -160,17 +160,19 @@ def real(work: Path) -> None:
         imgmtf("scan", str(REAL / name), "--campaign", str(store), "--acquired", acquired, "--no-progress")
     run = imgmtf("report", str(store), "--out", str(report))
     print(f"\nreal chips through scan --campaign and report (exit {run.returncode}; {report / 'report.html'}):")
-    print(f"{'chip':<28} {'method':<8} {'dir':<13} {'normal':>7} {'MTF@Nyq':>7} {'interval':>17} {'MTF50':>7} "
-          f"{'FWHM':>6} misfit")
+    print(f"{'chip':<28} {'method':<22} {'dir':<13} {'normal':>7} {'MTF@Nyq':>7} {'interval':>17} {'MTF50':>7} "
+          f"{'FWHM':>6} misfit quoted")
     for row in store_rows(store, "targets"):
         if row["scope"] != "target":
             continue
         record = json.loads(row["record"])
         interval = f"[{row['mtf_nyquist_ci_low']:.4f},{row['mtf_nyquist_ci_high']:.4f}]"
-        print(f"{Path(record['path']).name:<28} {row['method']:<8} {row['direction']:<13} "
-              f"{row['normal_angle_deg']:7.2f} {row['mtf_nyquist']:7.4f} {interval:>17} "
-              f"{row['mtf50_cy_px'] or float('nan'):7.4f} {row['fwhm_px']:6.3f} "
-              f"{record.get('misfit', '') if row['method'] == 'fit' else ''}")
+        method = row["method"] + (f" ({row['assumption']})" if row.get("assumption") else "")
+        print(f"{Path(record['path']).name:<28} {method:<22} {row['direction']:<13} "
+              f"{row['normal_angle_deg'] or float('nan'):7.2f} {row['mtf_nyquist'] or float('nan'):7.4f} "
+              f"{interval:>17} {row['mtf50_cy_px'] or float('nan'):7.4f} {row['fwhm_px'] or float('nan'):6.3f} "
+              f"{str(record.get('misfit', '')) if row['method'] == 'fit' else '':>6} "
+              f"{'yes' if row.get('recommended') else ''}")
     for stages in OTHER_STAGES:
         for name in REAL_CHIPS:
             run = imgmtf("scan", str(REAL / name), "--fit-stages", stages, "--format", "json", "--no-progress")
