@@ -54,3 +54,16 @@ def test_auto_checks_its_held_names_against_every_candidate():
     with pytest.raises(ParameterError, match="cannot hold 'motion'"):
         im.fit_sensor(chips(REAL_LIKE)[:1], stages="auto", hold="motion")
     assert im.estimate.fit.check_names("auto", "lag") == ["auto"]
+
+
+def test_fit_auto_says_which_model_it_kept_and_what_it_tried(tmp_path):
+    from click.testing import CliRunner
+
+    from imgmtf.cli import main
+    runner = CliRunner()
+    for name, angle in (("across.tif", "6"), ("along.tif", "84")):
+        assert runner.invoke(main, ["simulate", "--angle", angle, "--size", "60",
+                                    "--out", str(tmp_path / name)]).exit_code == 0
+    result = runner.invoke(main, ["fit", str(tmp_path / "across.tif"), str(tmp_path / "along.tif"), "--stages", "auto"])
+    assert result.exit_code == 0, result.output
+    assert "stages auto: the simplest that fits (1 of 5 tried) (optics+detector: BIC" in result.output

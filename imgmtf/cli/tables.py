@@ -87,6 +87,11 @@ def print_fit(result) -> None:
     edges = result.edges
     click.echo(f"fit of {', '.join(s.name for s in result.sensor.stages)} to {len(edges)} edge(s), "
                f"GSD {result.sensor.gsd_m:g} m; reduced chi-square {result.reduced_chi_square:.3g}")
+    if result.choice is not None:
+        tried = "; ".join(f"{'+'.join(c.stages)}: BIC {c.bic:.0f}{', misfit' if c.misfit else ''}"
+                          for c in result.choice.candidates)
+        failed = "".join(f"; {'+'.join(stages)}: did not converge" for stages, _ in result.choice.failed)
+        click.echo(f"stages auto: {result.choice.reason} ({tried}{failed})")
     click.echo(f"{'parameter':<28} {'value':>11} {'std err':>10} {'unit':<5} status")
     for p in result.parameters:
         se = f"{p.standard_error:10.4g}" if p.status == "fitted" else f"{'-':>10}"
