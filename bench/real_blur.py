@@ -6,11 +6,14 @@ is known of them), the half-edges ``imgmtf scan`` accepts are fitted with
 each stage set of ``--fit-stages auto``'s candidates
 (:data:`imgmtf.estimate.fit.choice.AUTO_CANDIDATES`), and printed:
 
-* per candidate, the reduced chi-square, the BIC, the largest residual
-  structure (% of the step) and whether it misfits, the across- and
-  along-track MTF at Nyquist, and the model's MTF at Nyquist along each
-  half-edge's normal beside the model-free measurement's interval;
-* which candidate ``auto`` keeps and why.
+* per candidate (fitted as ``--stages NAMES`` fits it), the reduced
+  chi-square, the BIC, the largest residual structure (% of the step) and
+  whether it misfits, the across- and along-track MTF at Nyquist, and the
+  model's MTF at Nyquist along each half-edge's normal, beside the
+  model-free measurement's interval;
+* which candidate ``auto`` keeps and why, and what it reads (auto holds
+  nothing for want of need, so its figures differ a little from the
+  same stages named).
 
 With ``--figure FILE`` it draws the first chip's half-edges' LSFs on a log
 scale against the kept model and the Gaussian core (the figure of
@@ -66,7 +69,12 @@ def main() -> None:
                   f"{fit.directions['across']['mtf_nyquist']:7.4f} {fit.directions['along']['mtf_nyquist']:7.4f}"
                   f"  {along}")
         auto = im.fit_sensor(edges, stages="auto")
-        print(f"auto keeps {'+'.join(auto.choice.kept)}: {auto.choice.reason}")
+        print(f"auto keeps {'+'.join(auto.choice.kept)}: {auto.choice.reason}; fitted as auto fits it (nothing "
+              f"held for want of need): across {auto.directions['across']['mtf_nyquist']:.4f} "
+              f"{[round(v, 4) for v in auto.directions['across']['mtf_nyquist_ci']]}, along "
+              f"{auto.directions['along']['mtf_nyquist']:.4f} "
+              f"{[round(v, 4) for v in auto.directions['along']['mtf_nyquist_ci']]}; along each normal "
+              + " ".join(f"{e.mtf_nyquist:.3f}" for e in auto.edges))
         if args.figure is not None and name == CHIPS[0]:
             from matplotlib.figure import Figure
 
