@@ -84,7 +84,9 @@ def test_every_stage_round_trips_and_is_even(name):
     assert_allclose(t, stage.transfer(-fx, fy, 1.0)) and t[4, 4] == pytest.approx(1.0)
     # the fit's coordinates map back to the same stage
     back = stage.with_fit_coordinates(stage.fit_coordinates(2.0), 2.0)
-    assert back.to_dict(include_name=False) == pytest.approx(stage.to_dict(include_name=False), rel=1e-12)
+    fitted = [name for name in stage.fit_specs()]
+    assert [getattr(back, n) for n in fitted] == pytest.approx([getattr(stage, n) for n in fitted], rel=1e-12)
+    assert back.to_dict() == {**stage.to_dict(), **{n: getattr(back, n) for n in fitted}}
 
 
 def test_numpy_scalars_are_plain_floats():

@@ -25,8 +25,11 @@ def _odd_kernel(ctx, param, value):
 
 @click.command(short_help="Restore images to a target MTF (MTF compensation).")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
-@click.option("--sensor", "sensor_path", required=True, type=click.Path(dir_okay=False),
+@click.option("--sensor", "sensor_path", type=click.Path(dir_okay=False),
               help="the sensor to compensate: a TOML file (imgmtf fit --out)")
+@click.option("--measured", "measured_path", type=click.Path(dir_okay=False),
+              help="instead of --sensor: the 2-D MTF measured without a model, the across- and along-track "
+                   "rows of imgmtf scan --format json saved to this file (the assumption the scan chose)")
 @click.option("--target-nyquist", required=True, type=FiniteFloat(0, 1, min_open=True), metavar="V",
               help="restored MTF at Nyquist in both axes, by a smooth (Gaussian) target transfer never above 1")
 @click.option("--max-noise-gain", type=FiniteFloat(1), metavar="G",
@@ -61,8 +64,9 @@ def _odd_kernel(ctx, param, value):
               help="json: one object per image (JSON Lines)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @parallel_options
-def restore(paths, sensor_path, target_nyquist, max_noise_gain, allow_misfit, kernel_size, noise_std, signal_std, gsd,
-            out_path, kernel_path, plot_path, saturation, tile_px, recursive, fmt, progress, workers, scheduler):
+def restore(paths, sensor_path, measured_path, target_nyquist, max_noise_gain, allow_misfit, kernel_size, noise_std,
+            signal_std, gsd, out_path, kernel_path, plot_path, saturation, tile_px, recursive, fmt, progress, workers,
+            scheduler):
     """Design a regularised inverse (Wiener) filter from the sensor's 2-D
     transfer and each image's noise so that the restored MTF follows a target,
     apply it tile by tile (georeference, data type, nodata and tags kept),
@@ -71,7 +75,12 @@ def restore(paths, sensor_path, target_nyquist, max_noise_gain, allow_misfit, ke
     model does not fit is refused (--allow-misfit overrides), and so is a
     filter whose noise would dominate the result (--max-noise-gain sets
     the noise budget).  An image that cannot be restored gives an error
-    line and the rest go on (exit status 1 if any failed)."""
+    line and the rest go on (exit status 1 if any failed).  With
+    --measured the filter is designed from the MTF a scan measured without
+    a model, the rows to quote where the model misfits."""
+    if (sensor_path is None) == (measured_path is None):
+        raise click.UsageError("give the system to compensate: --sensor FILE (a fitted sensor) or --measured FILE "
+                               "(imgmtf scan --format json's rows), one of them")
     with reported_errors():
         from ..batch import expand_inputs
         files = expand_inputs(paths, recursive)
@@ -86,11 +95,15 @@ def restore(paths, sensor_path, target_nyquist, max_noise_gain, allow_misfit, ke
             check_output_file(kernel_path)
         if plot_path:
             check_figure_file(plot_path)
-        sensor = load_sensor(sensor_path)
-        from ..estimate.fit.record import read_fit_record
-        from ..restore.restoration import check_model_fits
-        fit = read_fit_record(sensor_path)
-        check_model_fits(fit, sensor_path, allow_misfit=allow_misfit)       # before any output is made
+        if measured_path is not None:
+            from ..restore.measured import measured_sensor, read_scan_rows
+            sensor, fit = measured_sensor(read_scan_rows(measured_path), measured_path), None
+        else:
+            sensor = load_sensor(sensor_path)
+            from ..estimate.fit.record import read_fit_record
+            from ..restore.restoration import check_model_fits
+            fit = read_fit_record(sensor_path)
+            check_model_fits(fit, sensor_path, allow_misfit=allow_misfit)       # before any output is made
         outputs = _output_paths(files, out_path)
     from ..records import utc_now
     from ..restore.restoration import restore_image
@@ -119,7 +132,7 @@ def restore(paths, sensor_path, target_nyquist, max_noise_gain, allow_misfit, ke
                 save_figure(plot_restoration(done.filter), plot_path)
                 written.append(plot_path)
             if fmt == "json":
-                click.echo(json.dumps({**done.to_dict(), "status": "ok", "sensor_file": sensor_path,
+                click.echo(json.dumps({**done.to_dict(), "status": "ok", "sensor_file": sensor_path or measured_path,
                                        "written": written, "imgmtf_version": __version__, "run_utc": run_utc}))
             else:
                 _print_text(done, written)

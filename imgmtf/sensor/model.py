@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -587,5 +587,12 @@ def _paper_stages(keywords: dict) -> list[Stage]:
     return [cls(**params) for cls, params in values.items() if any(params.values())]
 
 
-def _toml_number(value: float) -> str:
-    return "inf" if math.isinf(value) else repr(float(value))
+def _toml_number(value: float | str | Sequence[float]) -> str:
+    """A stage parameter in TOML: a number (``inf`` for infinity), a word
+    (a measured MTF's combination) or a list of numbers (its curves)."""
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_number(v) for v in value) + "]"
+    number = float(value)  # type: ignore[arg-type]
+    return "inf" if math.isinf(number) else repr(number)

@@ -58,6 +58,7 @@ from .jitter import Jitter
 from .diffusion import Diffusion
 from .halo import Halo
 from .lag import Lag
+from .measured import MeasuredMTF
 # isort: on
 
 __all__ = [
@@ -74,6 +75,7 @@ __all__ = [
            "Halo",
            "Jitter",
            "Lag",
+           "MeasuredMTF",
            "Motion",
            "Stage",
            "register",
