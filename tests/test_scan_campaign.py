@@ -188,9 +188,10 @@ def test_scenes_scanned_with_outputs_name_their_overviews_in_the_store(campaign,
         assert os.path.basename(os.path.dirname(overview)) == os.path.splitext(os.path.basename(row["path"]))[0]
 
 
-def test_a_scene_scanned_with_edge_figures_names_each_in_the_store(campaign, tmp_path):
-    # ... and each accepted half-edge's figure (one scene: a figure costs about 0.4 s)
-    _, paths, _ = campaign
+def test_a_scene_scanned_with_edge_figures_names_each_in_the_store(tmp_path):
+    # ... and each accepted half-edge's figure (a figure costs about 0.7 s: a target cut out of its
+    # scene, as an L0R chip is, has four half-edges where the whole target has twelve)
+    paths = write_campaign(tmp_path / "scenes", SyntheticCampaign(acquisitions=2, size_px=128, seed=5, fill=True))
     store, out = str(tmp_path / "site.gpkg"), tmp_path / "out"
     result = CliRunner().invoke(main, ["scan", str(paths[0]), "--campaign", store, "--out", str(out),
                                        "--edge-figures", "--fit-stages", "none", "--format", "json"])
