@@ -466,10 +466,12 @@ def check_read_size(path: str, size: tuple[int, int], windowed: bool = False) ->
     nothing."""
     width, height = size
     if width * height > MAX_READ_PIXELS:
-        what = "the window" if windowed else "the image"
+        what, advice = ("the window", "measure a smaller window") if windowed else ("the image",
+                                                                                    "measure a window of it")
+        # in millions of pixels, as a camera's megapixels are counted (2^20 made 36.0 million read 34.33)
         raise ImageReadError(
-            f"{path}: {what} is {width} x {height} px ({width * height / 2**20:.2f} Mpx), more than "
-            f"the {MAX_READ_PIXELS // 2**20} Mpx read at once; measure a window of it", reason="too-large")
+            f"{path}: {what} is {width} x {height} px ({width * height / 1e6:.1f} million pixels), more than "
+            f"the {MAX_READ_PIXELS / 1e6:.1f} million read at once; {advice}", reason="too-large")
 
 
 def check_regular_file(path: str) -> None:

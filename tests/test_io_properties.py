@@ -102,7 +102,11 @@ def test_huge_declared_image_is_refused_by_name_and_read_through_a_window(tmp_pa
     assert path.stat().st_size < 300
     outcome = read_outcome(path)
     assert outcome.reason == "too-large"
-    assert "200000 x 200000 px" in str(outcome) and "window" in str(outcome)
+    assert "200000 x 200000 px (40000.0 million pixels), more than the 16.8 million" in str(outcome)
+    assert str(outcome).endswith("measure a window of it")
+    from imgmtf.io import check_read_size
+    with pytest.raises(ImgmtfError, match=r"the window is 6000 x 6000 px \(36.0 million pixels\).*a smaller window"):
+        check_read_size("big.tif", (6000, 6000), windowed=True)
     from imgmtf.cli.hints import refusal_hint
     assert "--roi" in refusal_hint(outcome.reason, str(outcome))         # the CLI names the option
     info = raster_info(path)

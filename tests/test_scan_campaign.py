@@ -86,6 +86,10 @@ def test_campaign_options_need_a_store_and_one_time_fits_one_scene(campaign, tmp
     assert result.exit_code == 2 and "Traceback" not in result.output
     result = CliRunner().invoke(main, ["scan", str(folder), "--fit-stages", "optics,lens"])
     assert result.exit_code == 2 and "unknown stage 'lens'" in result.output
+    # measure refuses them alike: given without a store they were silently ignored (exit 0)
+    for given in (["--acquired", "2020-01-01"], ["--platform", "X", "--band-name", "B4"]):
+        result = CliRunner().invoke(main, ["measure", str(folder), *given])
+        assert result.exit_code == 2 and f"{given[0]} describes the acquisitions of a campaign store" in result.output
 
 
 def test_fit_rows_are_printed_and_written_beside_the_combined_ones(tmp_path):

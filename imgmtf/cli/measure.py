@@ -90,6 +90,10 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
         raise click.UsageError(width_refusal())
     if point_size and get_kind(kind).size_keyword is None:
         raise click.UsageError(f"--point-size applies to --target points only, not to a {kind}")
+    facts = {"acquired": acquired, "platform": platform, "instrument": instrument, "band_name": band_name}
+    if not campaign and any(v is not None for v in facts.values()):      # as scan refuses them: not ignored
+        flag = next(f"--{k.replace('_', '-')}" for k, v in facts.items() if v is not None)
+        raise click.UsageError(f"{flag} describes the acquisitions of a campaign store: give --campaign STORE.gpkg")
     with reported_errors():
         from ..parallel import InputOrder, prestart_workers, signals_deferred
         if scheduler is None and not plot_path:
