@@ -37,7 +37,7 @@ import numpy as np
 from ...errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ...version import __version__
 from ..intervals import Intervals, as_intervals
-from .sources import FoundSources, Source, find_sources
+from .sources import FoundSources, Source, SourceTally, find_sources
 from .stack import DirectionMTF, Stack
 
 #: the directions' names: across and along the ground track, or the image's axes when the track is unknown
@@ -46,7 +46,7 @@ IMAGE_X, IMAGE_Y = "image-x", "image-y"
 
 
 @dataclass(frozen=True, eq=False)
-class PointsResult:
+class PointsResult(SourceTally):
     """The 2-D PSF and MTF of a stack of point targets.
 
     Attributes
@@ -118,14 +118,6 @@ class PointsResult:
     target: str = "points"
     checks: tuple = ()
 
-    @property
-    def used(self) -> tuple[Source, ...]:
-        return tuple(s for s in self.sources if s.used)
-
-    @property
-    def refused(self) -> tuple[Source, ...]:
-        return tuple(s for s in self.sources if not s.used)
-
     def direction(self, name: str) -> DirectionMTF:
         """The section called ``name``.
 
@@ -162,9 +154,7 @@ class PointsResult:
         list of dict
             Keys with units in their names, as an edge's.
         """
-        refusals: dict[str, int] = {}
-        for source in self.refused:
-            refusals[source.status] = refusals.get(source.status, 0) + 1
+        refusals = self.refusal_counts()
         snr = float(np.median([s.peak_snr for s in self.used])) if self.used else math.nan
         out = []
         for section in self.directions:

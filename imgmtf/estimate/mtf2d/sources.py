@@ -72,8 +72,31 @@ class Source:
         return self.status == "used"
 
 
+class SourceTally:
+    """The targets a result holds (its ``sources``) sorted into used and
+    refused, and the refusals counted by reason: for the targets found and
+    for the measurement made of them alike."""
+
+    sources: tuple[Source, ...]
+
+    @property
+    def used(self) -> tuple[Source, ...]:
+        return tuple(s for s in self.sources if s.used)
+
+    @property
+    def refused(self) -> tuple[Source, ...]:
+        return tuple(s for s in self.sources if not s.used)
+
+    def refusal_counts(self) -> dict[str, int]:
+        """How many targets each reason refused."""
+        counts: dict[str, int] = {}
+        for source in self.refused:
+            counts[source.status] = counts.get(source.status, 0) + 1
+        return counts
+
+
 @dataclass(frozen=True, eq=False)
-class FoundSources:
+class FoundSources(SourceTally):
     """What :func:`find_sources` returns.
 
     Attributes
@@ -99,21 +122,6 @@ class FoundSources:
     polarity: str
     noise_dn: float
     stamp_radius_px: int
-
-    @property
-    def used(self) -> tuple[Source, ...]:
-        return tuple(s for s in self.sources if s.used)
-
-    @property
-    def refused(self) -> tuple[Source, ...]:
-        return tuple(s for s in self.sources if not s.used)
-
-    def refusal_counts(self) -> dict[str, int]:
-        """How many targets each reason refused."""
-        counts: dict[str, int] = {}
-        for source in self.refused:
-            counts[source.status] = counts.get(source.status, 0) + 1
-        return counts
 
 
 def background(image: np.ndarray, box_px: int = 32) -> np.ndarray:
