@@ -57,9 +57,7 @@ def plot_fit_edge(fit: SensorFit, index: int, ax: Axes | None = None,
     """
     expect(fit, "fit")
     check_truth(truth)
-    if not -len(fit.edges) <= index < len(fit.edges):
-        from ..errors import ParameterError
-        raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
+    check_edge_index(fit, index)
     fig, ax = figure_axes(ax)
     edge = fit.edges[index]
     m = edge.measurement
@@ -193,9 +191,7 @@ def plot_fit_lsf(fit: SensorFit, index: int, ax: Axes | None = None,
     expect(fit, "fit")
     for other in (others or {}).values():
         expect(other, "fit")
-    if not -len(fit.edges) <= index < len(fit.edges):
-        from ..errors import ParameterError
-        raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
+    check_edge_index(fit, index)
     fig, ax = figure_axes(ax)
     edge = fit.edges[index]
     m = edge.measurement
@@ -220,6 +216,13 @@ def plot_fit_lsf(fit: SensorFit, index: int, ax: Axes | None = None,
                  fontsize="medium")
     ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18), frameon=False)   # off the data
     return fig
+
+
+def check_edge_index(fit: SensorFit, index: int) -> None:
+    """Refuse an ``index`` outside the fit's edges (negative from the end)."""
+    if not -len(fit.edges) <= index < len(fit.edges):
+        from ..errors import ParameterError
+        raise ParameterError(f"edge index {index} is outside the fit's {len(fit.edges)} edge(s)")
 
 
 def _short(source: str, width: int = 26) -> str:
