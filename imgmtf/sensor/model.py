@@ -25,7 +25,9 @@ be absurd (a blur of thousands of pixels) is refused with a
 """
 from __future__ import annotations
 
+import json
 import math
+import os
 import tomllib
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, fields
@@ -478,14 +480,37 @@ class Sensor:
         """
         lines = [f"# {line}" for line in comment.splitlines()]
         lines += ["# imgmtf sensor: metres on the ground, cycles/metre for frequencies",
-                  f"# stages: {', '.join(STAGES)}", f"gsd_m = {_toml_number(self.gsd_m)}"]
+                  f"# stages: {', '.join(STAGES)}", *self.toml_lines()]
+        write_toml_lines(path, lines)
+
+    def toml_lines(self, table: str = "") -> list[str]:
+        """The sensor as lines of TOML: ``gsd_m`` and a ``[[stages]]``
+        table per stage; within ``table`` when given (``[table]``,
+        ``[[table.stages]]``), as a fitted sensor's file keeps it beside its
+        ``[fit]`` record.
+
+        Parameters
+        ----------
+        table : str, optional
+            The table holding the sensor (default none: the top level).
+
+        Returns
+        -------
+        list of str
+            The lines.
+
+        Examples
+        --------
+        >>> from imgmtf import Sensor
+        >>> Sensor(motion_m=0, electronics_cutoff_cy_m=0).toml_lines("sensor")[:4]
+        ['[sensor]', 'gsd_m = 1.0', '', '[[sensor.stages]]']
+        """
+        lines = [f"[{table}]"] if table else []
+        lines.append(f"gsd_m = {toml_value(self.gsd_m)}")
         for stage in self.stages:
-            lines += ["", "[[stages]]", f'stage = "{stage.name}"']
-            lines += [f"{k} = {_toml_number(v)}" for k, v in stage.to_dict(include_name=False).items()]
-        try:
-            Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
-        except OSError as exc:
-            raise FileWriteError(f"{path}: cannot write sensor file: {exc.strerror or exc}") from None
+            lines += ["", f"[[{table + '.' if table else ''}stages]]", f"stage = {toml_value(stage.name)}"]
+            lines += [f"{k} = {toml_value(v)}" for k, v in stage.to_dict(include_name=False).items()]
+        return lines
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Sensor:
@@ -587,12 +612,35 @@ def _paper_stages(keywords: dict) -> list[Stage]:
     return [cls(**params) for cls, params in values.items() if any(params.values())]
 
 
-def _toml_number(value: float | str | Sequence[float]) -> str:
-    """A stage parameter in TOML: a number (``inf`` for infinity), a word
-    (a measured MTF's combination) or a list of numbers (its curves)."""
+def toml_value(value: float | str | Sequence[float | str]) -> str:
+    """A value in TOML: a number (``nan``, ``inf`` and ``-inf`` included),
+    a string (JSON's escapes are TOML's basic string's, non-ASCII as
+    \\uXXXX) or an array of them (a measured MTF's curves, a fit's
+    sources).
+
+    Examples
+    --------
+    >>> toml_value(0.5), toml_value(float("-inf")), toml_value("B4"), toml_value([1, 2.5])
+    ('0.5', '-inf', '"B4"', '[1.0, 2.5]')
+    """
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return json.dumps(value)
     if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_number(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     number = float(value)  # type: ignore[arg-type]
-    return "inf" if math.isinf(number) else repr(number)
+    return "nan" if math.isnan(number) else "inf" if number == math.inf else "-inf" if number == -math.inf \
+        else repr(number)
+
+
+def write_toml_lines(path: str | os.PathLike, lines: list[str]) -> None:
+    """Write ``lines`` of TOML to ``path`` (replaced if it exists).
+
+    Raises
+    ------
+    FileWriteError
+        The file cannot be written.
+    """
+    try:
+        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise FileWriteError(f"{path}: cannot write sensor file: {exc.strerror or exc}") from None

@@ -12,7 +12,6 @@ by hand, by ``imgmtf sensor --save``) makes no claim either way.
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import tomllib
@@ -20,7 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ...errors import ConfigError, FileWriteError
+from ...errors import ConfigError
+from ...sensor.model import toml_value, write_toml_lines
 
 #: the keys of the ``[fit]`` table and the type each holds
 _FIELDS = {"misfit": bool, "reduced_chi_square": float, "misfit_p": float, "misfit_fraction": float,
@@ -109,11 +109,12 @@ class FitRecord:
     def toml_lines(self) -> list[str]:
         """The ``[fit]`` table, as lines of TOML."""
         return ["[fit]", f"misfit = {'true' if self.misfit else 'false'}",
-                f"reduced_chi_square = {_toml_number(self.reduced_chi_square)}",
-                f"misfit_p = {_toml_number(self.misfit_p)}",
-                f"misfit_fraction = {_toml_number(self.misfit_fraction)}",
-                f"stages = {_toml_strings(self.stages)}", f"sources = {_toml_strings(self.sources)}",
-                f"imgmtf_version = {json.dumps(self.imgmtf_version)}"]
+                f"reduced_chi_square = {toml_value(self.reduced_chi_square)}",
+                f"misfit_p = {toml_value(self.misfit_p)}",
+                f"misfit_fraction = {toml_value(self.misfit_fraction)}",
+                f"stages = {toml_value([str(s) for s in self.stages])}",
+                f"sources = {toml_value([str(s) for s in self.sources])}",
+                f"imgmtf_version = {toml_value(self.imgmtf_version)}"]
 
 
 def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
@@ -140,18 +141,11 @@ def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
         The file cannot be written.
     """
     record = FitRecord.of(fit, sources)
-    sensor = fit.sensor
     lines = [f"# {line}" for line in comment.splitlines()]
     lines += ["# imgmtf fitted sensor: metres on the ground, cycles/metre for frequencies",
               "# [fit] says whether the model fits the edges it was fitted to (imgmtf restore refuses a misfit)",
-              *record.toml_lines(), "", "[sensor]", f"gsd_m = {_toml_number(sensor.gsd_m)}"]
-    for stage in sensor.stages:
-        lines += ["", "[[sensor.stages]]", f"stage = {json.dumps(stage.name)}"]
-        lines += [f"{k} = {_toml_number(v)}" for k, v in stage.to_dict(include_name=False).items()]
-    try:
-        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise FileWriteError(f"{path}: cannot write sensor file: {exc.strerror or exc}") from None
+              *record.toml_lines(), "", *fit.sensor.toml_lines("sensor")]
+    write_toml_lines(path, lines)
 
 
 def read_fit_record(path: str | Path) -> FitRecord | None:
@@ -209,17 +203,6 @@ def read_fit_record(path: str | Path) -> FitRecord | None:
 
 
 _KIND_NAMES = {bool: "true or false", float: "a number", list: "an array of strings", str: "a string"}
-
-
-def _toml_number(value: float) -> str:
-    value = float(value)
-    return "nan" if math.isnan(value) else ("inf" if value == math.inf else
-                                            "-inf" if value == -math.inf else repr(value))
-
-
-def _toml_strings(values) -> str:
-    # JSON's string escapes are TOML's basic strings' (non-ASCII as \uXXXX)
-    return "[" + ", ".join(json.dumps(str(v)) for v in values) + "]"
 
 
 def _json(value: float) -> float | None:
