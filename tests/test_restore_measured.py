@@ -75,3 +75,14 @@ def test_restore_measured_brings_the_measured_mtf_to_the_target(tmp_path):
         refused = runner.invoke(main, ["restore", str(image), *given, "--target-nyquist", "0.3",
                                        "--out", str(tmp_path / "r2.tif")])
         assert refused.exit_code == 2 and "--sensor FILE" in refused.output
+
+
+def test_a_measured_sensor_is_listed_drawn_and_saved_by_imgmtf_sensor(tmp_path):
+    path, again = tmp_path / "measured.toml", tmp_path / "again.toml"
+    measured_sensor(rows()).to_toml(path)
+    result = CliRunner().invoke(main, ["sensor", "--sensor", str(path), "--plot", str(tmp_path / "s.png"),
+                                       "--save", str(again)])
+    assert result.exit_code == 0, result.output
+    assert "frequencies_cy_px [161 values, 0 to 0.8] cy/px, across [161 values, 1 to" in result.output
+    assert "combination separable" in result.output and (tmp_path / "s.png").is_file()
+    assert again.read_text().split("\n")[1:] == path.read_text().split("\n")[1:]

@@ -26,7 +26,7 @@ def sensor_command(sensor_path, plot_path, save_path):
                    f"({'the paper' + chr(39) + 's generic sensor' if sensor == Sensor() else sensor_path})")
         for stage in sensor.stages:
             units = stage.units()
-            values = ", ".join(f"{k} {v:.6g}{(' ' + units[k]) if units[k] else ''}"
+            values = ", ".join(f"{k} {_shown(v)}{(' ' + units[k]) if units[k] else ''}"
                                for k, v in stage.to_dict(include_name=False).items())
             click.echo(f"  {stage.name:<12} {stage.title}: {values}")
         click.echo(f"{'stage':<12} {'FWHM across (m)':>16} {'FWHM along (m)':>15} "
@@ -46,3 +46,13 @@ def sensor_command(sensor_path, plot_path, save_path):
             from ..plot import plot_sensor
             save_figure(plot_sensor(sensor), plot_path)
             click.echo(f"wrote {plot_path}")
+
+
+def _shown(value) -> str:
+    """A stage parameter in the listing: a number, a word (a measured MTF's
+    combination) or a tabulated curve, by its length and ends."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (list, tuple)):
+        return f"[{len(value)} values, {value[0]:.4g} to {value[-1]:.4g}]"
+    return f"{value:.6g}"
