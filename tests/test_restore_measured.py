@@ -86,3 +86,9 @@ def test_a_measured_sensor_is_listed_drawn_and_saved_by_imgmtf_sensor(tmp_path):
     assert "frequencies_cy_px [161 values, 0 to 0.8] cy/px, across [161 values, 1 to" in result.output
     assert "combination separable" in result.output and (tmp_path / "s.png").is_file()
     assert again.read_text().split("\n")[1:] == path.read_text().split("\n")[1:]
+
+
+def test_a_measured_mtf_is_no_stage_to_fit():
+    chip = im.render(TRUTH, im.Target("edge", 6.0), 60).image
+    with pytest.raises(ParameterError, match="stage 'measured' has no parameter to fit"):
+        im.fit_sensor([chip], stages="optics,measured")

@@ -61,6 +61,8 @@ def stage_names(names, start: Sensor | None) -> list[str]:
     for name in names:
         if name not in STAGES:
             raise ParameterError(f"unknown stage {name!r}; known: {', '.join(STAGES)}")
+        if not STAGES[name].fit_specs():        # a measured MTF: a table, not a model's parameters
+            raise ParameterError(f"stage {name!r} has no parameter to fit")
     if len(set(names)) != len(names):
         raise ParameterError(f"a stage is named twice in {', '.join(names)}")
     return names
