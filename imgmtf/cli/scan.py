@@ -114,7 +114,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     interrupted, outcomes = None, []
     with reported_errors():
         from ..batch import expand_inputs
-        from ..parallel import prestart_workers, signals_deferred
+        from ..parallel import prestart_workers
         from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
         with option_errors():           # a malformed option: exit 2, before any work
@@ -151,8 +151,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             with closing(completed):
                 for outcome in completed:
                     outcomes.append(outcome)
-                    with signals_deferred():    # a JSON line cut in two by Ctrl-C is a row lost
-                        _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
+                    # (scan_scenes yields each outcome with Ctrl-C held back until it is reported)
+                    _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
         except KeyboardInterrupt as exc:
             interrupted = exc
     _closing_notes(outcomes, paths, store, kind, fmt)
