@@ -9,7 +9,7 @@ from ..errors import ParameterError
 from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
-from .options import FiniteFloat, parse_pair, parse_rois
+from .options import FiniteFloat, parse_rois, reading_options
 from .tables import print_fit
 
 
@@ -34,12 +34,7 @@ from .tables import print_fit
 @click.option("--force", is_flag=True,
               help="measure an edge even where a quality check fails (fill, saturation, non-uniform "
                    "sides...): every failed check becomes a warning")
-@click.option("--saturation", callback=parse_pair, metavar="LO,HI",
-              help="DN range the sensor records (default: an integer file's type range); "
-                   "sides at or beyond it are saturated")
-@click.option("--transfer", default="linear", show_default=True, metavar="linear|srgb|gamma:G",
-              help="how the stored values relate to light: linearised before measuring (srgb: the sRGB "
-                   "curve, gamma:2.2 a power law; 8-bit camera images are usually sRGB)")
+@reading_options
 @click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True), default=0.95,
               show_default=True, help="confidence of the intervals")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), help="write the fitted sensor as TOML")

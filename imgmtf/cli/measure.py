@@ -20,8 +20,8 @@ from .options import (
     length_option,
     parallel_options,
     parse_band,
-    parse_pair,
     parse_roi,
+    reading_options,
     width_refusal,
 )
 from .tables import TextRows
@@ -59,15 +59,10 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--force", is_flag=True,
               help="measure even where a quality check fails (fill, saturation, a second target, "
                    "non-uniform sides...): every failed check becomes a warning")
-@click.option("--saturation", callback=parse_pair, metavar="LO,HI",
-              help="DN range the sensor records (default: an integer file's type range); "
-                   "sides at or beyond it are saturated")
+@reading_options
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
                    "rows along track, as in L0/L1 products; unknown for map-projected files)")
-@click.option("--transfer", default="linear", show_default=True, metavar="linear|srgb|gamma:G",
-              help="how the stored values relate to light: linearised before measuring (srgb: the sRGB "
-                   "curve, gamma:2.2 a power law; 8-bit camera images are usually sRGB)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options

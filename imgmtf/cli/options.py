@@ -187,6 +187,17 @@ def parallel_options(command):
                         help="parallel worker processes, each on one thread")(command)
 
 
+def reading_options(command):
+    """--saturation and --transfer: how a file's values are read, shared by
+    measure and fit (the same words in each one's help)."""
+    command = click.option("--transfer", default="linear", show_default=True, metavar="linear|srgb|gamma:G",
+                           help="how the stored values relate to light: linearised before measuring (srgb: the "
+                                "sRGB curve, gamma:2.2 a power law; 8-bit camera images are usually sRGB)")(command)
+    return click.option("--saturation", callback=parse_pair, metavar="LO,HI",
+                        help="DN range the sensor records (default: an integer file's type range); "
+                             "sides at or beyond it are saturated")(command)
+
+
 def interval_options(command):
     """--intervals, --bootstrap and --confidence, shared by measure and scan."""
     command = click.option("--confidence", type=FiniteFloat(0, 1, min_open=True, max_open=True),
