@@ -204,6 +204,13 @@ def stage_from_dict(values: dict) -> Stage:
     return STAGES[name].from_dict(values)
 
 
+def exponential_radius(length_x: float, length_y: float) -> float:
+    """Radius outside which an exponential tail per axis, exp(-|x| / L)
+    (two-sided or one-sided), leaves less than 1e-9 of its energy:
+    ln(1e9) lengths, the two axes' together."""
+    return math.log(1e9) * math.hypot(length_x, length_y)
+
+
 def gaussian_radius(sigma: float) -> float:
     """Radius outside which a 2-D Gaussian of largest standard deviation
     ``sigma`` holds less than 1e-9 of its energy: exp(-r^2 / 2 sigma^2)."""

@@ -2,17 +2,13 @@
 diffusion, an RC readout's symmetric part): see :mod:`imgmtf.sensor.stages`."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .base import FitSpec, Stage, param, register
-
-#: -ln of the energy an exponential LSF leaves beyond a support radius (1e-9)
-_TAIL_E_FOLDS = math.log(1e9)
+from .base import FitSpec, Stage, exponential_radius, param, register
 
 
 @register
@@ -65,5 +61,4 @@ class Diffusion(Stage):
         return 1.0 / ((1.0 + ax * fx * fx) * (1.0 + ay * fy * fy))
 
     def support_radius_m(self, gsd_m: float) -> float:
-        # each axis leaves exp(-r / L) of its energy beyond r
-        return _TAIL_E_FOLDS * math.hypot(self.length_x_m, self.length_y_m)
+        return exponential_radius(self.length_x_m, self.length_y_m)

@@ -2,17 +2,13 @@
 lag, a readout's RC tail): see :mod:`imgmtf.sensor.stages`."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .base import FitSpec, Stage, param, register
-
-#: -ln of the energy a one-sided exponential leaves beyond a support radius (1e-9)
-_TAIL_E_FOLDS = math.log(1e9)
+from .base import FitSpec, Stage, exponential_radius, param, register
 
 
 @register
@@ -64,4 +60,4 @@ class Lag(Stage):
         return 1.0 / ((1.0 + 2j * np.pi * self.length_x_m * fx) * (1.0 + 2j * np.pi * self.length_y_m * fy))
 
     def support_radius_m(self, gsd_m: float) -> float:
-        return _TAIL_E_FOLDS * math.hypot(self.length_x_m, self.length_y_m)
+        return exponential_radius(self.length_x_m, self.length_y_m)
