@@ -67,3 +67,20 @@ def test_fit_auto_says_which_model_it_kept_and_what_it_tried(tmp_path):
     result = runner.invoke(main, ["fit", str(tmp_path / "across.tif"), str(tmp_path / "along.tif"), "--stages", "auto"])
     assert result.exit_code == 0, result.output
     assert "stages auto: the simplest that fits (1 of 5 tried) (optics+detector: BIC" in result.output
+
+
+def test_auto_stops_when_the_wings_do_not_lower_the_criterion(monkeypatch):
+    # a structure the exponential wings do not touch (texture, a second target) is no blur's shape:
+    # the richer candidates, all with the wings, would only chase it (16 s on a textured scene's 20 edges)
+    from types import SimpleNamespace
+
+    from imgmtf.estimate.fit import fitting
+
+    def fit_of(names, bic):
+        return SimpleNamespace(sensor=SimpleNamespace(stages=[SimpleNamespace(name=n) for n in names]), bic=bic)
+    monkeypatch.setattr(fitting, "candidate_summary", lambda fit: fit)
+    core, wings = AUTO_CANDIDATES[:2]
+    assert fitting.wings_do_not_help([fit_of(core, 100.0), fit_of(wings, 100.5)])
+    assert not fitting.wings_do_not_help([fit_of(core, 100.0), fit_of(wings, 90.0)])
+    assert not fitting.wings_do_not_help([fit_of(wings, 100.0)])            # the core failed to converge
+    assert not fitting.wings_do_not_help([fit_of(core, 100.0)])

@@ -114,7 +114,7 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     with one_blas_thread():
         if not auto:
             return run_fit(new_model(gsd, initial_stages(names, start, gsd), data, start), hold, confidence)
-        fits, failed = [], []
+        fits, failed, stopped = [], [], False
         for candidate in AUTO_CANDIDATES:
             model = new_model(gsd, initial_stages(list(candidate), start, gsd), data, start)
             try:
@@ -127,13 +127,32 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
                 continue
             if not fits[-1].misfit:
                 break               # the simplest that fits
+            stopped = wings_do_not_help(fits)
+            if stopped:
+                break
     if not fits:
         raise ImgmtfError("no candidate sensor model could be fitted: "
                           + "; ".join(f"{'+'.join(c)}: {message}" for c, message in failed), reason="fit")
     index, reason = choose(fits, tried=len(fits) + len(failed))
+    if stopped:
+        reason += "; the exponential wings did not lower it, so no richer candidate was tried"
     kept = tuple(s.name for s in fits[index].sensor.stages)
     choice = ModelChoice(tuple(candidate_summary(f) for f in fits), kept, reason, tuple(failed))
     return replace(fits[index], choice=choice)
+
+
+def wings_do_not_help(fits: list[SensorFit]) -> bool:
+    """Whether the Gaussian core and its exponential wings are both fitted
+    and the wings lowered the information criterion by nothing: every later
+    candidate has the wings, and a structure they do not touch is no blur's
+    shape (texture, a second target in the half-edges' profiles), which
+    richer stages only chase.  On a textured 4096 px scene's 20 pooled
+    half-edges the five candidates' BICs rose 94338-94377 while their fits
+    took 16 s; on the real L0R chips the wings alone cut it by a third."""
+    if [tuple(s.name for s in f.sensor.stages) for f in fits] != list(AUTO_CANDIDATES[:2]):
+        return False
+    core, wings = (candidate_summary(f).bic for f in fits)
+    return wings >= core
 
 
 def new_model(gsd: float, stages: list, data: list, start: Sensor | None) -> Model:
