@@ -25,22 +25,21 @@ be absurd (a blur of thousands of pixels) is refused with a
 """
 from __future__ import annotations
 
-import json
 import math
-import os
 import tomllib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import ConfigError, FileWriteError, ParameterError
+from ..errors import ConfigError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing, fwhm
 from .lines import LineResponse, line_grid
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
+from .toml_text import sensor_toml_lines, write_toml_lines
 
 DIRECTIONS = ("across", "along")
 #: the GSDs a sensor is rendered or read at, m: a picometre to a light-year (beyond, the
@@ -480,37 +479,8 @@ class Sensor:
         """
         lines = [f"# {line}" for line in comment.splitlines()]
         lines += ["# imgmtf sensor: metres on the ground, cycles/metre for frequencies",
-                  f"# stages: {', '.join(STAGES)}", *self.toml_lines()]
+                  f"# stages: {', '.join(STAGES)}", *sensor_toml_lines(self.gsd_m, self.stages)]
         write_toml_lines(path, lines)
-
-    def toml_lines(self, table: str = "") -> list[str]:
-        """The sensor as lines of TOML: ``gsd_m`` and a ``[[stages]]``
-        table per stage; within ``table`` when given (``[table]``,
-        ``[[table.stages]]``), as a fitted sensor's file keeps it beside its
-        ``[fit]`` record.
-
-        Parameters
-        ----------
-        table : str, optional
-            The table holding the sensor (default none: the top level).
-
-        Returns
-        -------
-        list of str
-            The lines.
-
-        Examples
-        --------
-        >>> from imgmtf import Sensor
-        >>> Sensor(motion_m=0, electronics_cutoff_cy_m=0).toml_lines("sensor")[:4]
-        ['[sensor]', 'gsd_m = 1.0', '', '[[sensor.stages]]']
-        """
-        lines = [f"[{table}]"] if table else []
-        lines.append(f"gsd_m = {toml_value(self.gsd_m)}")
-        for stage in self.stages:
-            lines += ["", f"[[{table + '.' if table else ''}stages]]", f"stage = {toml_value(stage.name)}"]
-            lines += [f"{k} = {toml_value(v)}" for k, v in stage.to_dict(include_name=False).items()]
-        return lines
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Sensor:
@@ -610,37 +580,3 @@ def _paper_stages(keywords: dict) -> list[Stage]:
         default = {f.name: f.default for f in fields(cls)}[name]
         values.setdefault(cls, {})[name] = check_number(f"sensor parameter {key}", keywords.get(key, default))
     return [cls(**params) for cls, params in values.items() if any(params.values())]
-
-
-def toml_value(value: float | str | Sequence[float | str]) -> str:
-    """A value in TOML: a number (``nan``, ``inf`` and ``-inf`` included),
-    a string (JSON's escapes are TOML's basic string's, non-ASCII as
-    \\uXXXX) or an array of them (a measured MTF's curves, a fit's
-    sources).
-
-    Examples
-    --------
-    >>> toml_value(0.5), toml_value(float("-inf")), toml_value("B4"), toml_value([1, 2.5])
-    ('0.5', '-inf', '"B4"', '[1.0, 2.5]')
-    """
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(toml_value(v) for v in value) + "]"
-    number = float(value)  # type: ignore[arg-type]
-    return "nan" if math.isnan(number) else "inf" if number == math.inf else "-inf" if number == -math.inf \
-        else repr(number)
-
-
-def write_toml_lines(path: str | os.PathLike, lines: list[str]) -> None:
-    """Write ``lines`` of TOML to ``path`` (replaced if it exists).
-
-    Raises
-    ------
-    FileWriteError
-        The file cannot be written.
-    """
-    try:
-        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise FileWriteError(f"{path}: cannot write sensor file: {exc.strerror or exc}") from None

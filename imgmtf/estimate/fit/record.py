@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import ConfigError
-from ...sensor.model import toml_value, write_toml_lines
+from ...sensor.toml_text import sensor_toml_lines, toml_value, write_toml_lines
 
 #: the keys of the ``[fit]`` table and the type each holds
 _FIELDS = {"misfit": bool, "reduced_chi_square": float, "misfit_p": float, "misfit_fraction": float,
@@ -144,7 +144,7 @@ def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
     lines = [f"# {line}" for line in comment.splitlines()]
     lines += ["# imgmtf fitted sensor: metres on the ground, cycles/metre for frequencies",
               "# [fit] says whether the model fits the edges it was fitted to (imgmtf restore refuses a misfit)",
-              *record.toml_lines(), "", *fit.sensor.toml_lines("sensor")]
+              *record.toml_lines(), "", *sensor_toml_lines(fit.sensor.gsd_m, fit.sensor.stages, "sensor")]
     write_toml_lines(path, lines)
 
 
