@@ -140,7 +140,7 @@ def test_the_reported_misfit_test_is_the_samples_at_an_offset(exact_edge, bump_d
     distances before the offset, straddle those bins: their means binned
     so give another p-value (0.633 against the samples' 0.368 here, exact
     model), which the report gave before."""
-    from imgmtf.estimate.fit.model import parameter_covariance
+    from imgmtf.estimate.fit.covariance import parameter_covariance
     from imgmtf.estimate.fit.report import fit_report
     data, model, z, m = exact_edge
     x0 = z[model.n_free + 2]

@@ -14,6 +14,7 @@ from ...errors import ImgmtfError, ParameterError
 from ...inputs import check_number
 from ...sensor.model import Sensor
 from .choice import AUTO_CANDIDATES, ModelChoice, candidate_summary, choose
+from .covariance import parameter_covariance
 from .data import EdgeImage, edge_data
 from .model import (
     Model,
@@ -22,7 +23,6 @@ from .model import (
     initial_stages,
     is_auto,
     listed,
-    parameter_covariance,
     stage_names,
 )
 from .report import fit_report

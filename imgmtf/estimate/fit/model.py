@@ -541,16 +541,6 @@ def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
 
 
-def parameter_covariance(jacobian, reduced_chi_square: float) -> np.ndarray:
-    """Parameter covariance from the weighted (sparse) Jacobian, scaled up by
-    the reduced chi-square when the residuals exceed the noise (never down:
-    on noise-free integer chips the noise is the quantisation's, 1/sqrt(12)
-    DN, which flat plateaus do not show)."""
-    normal = jacobian.T @ jacobian
-    return np.linalg.pinv(normal.toarray() if hasattr(normal, "toarray") else normal) * max(reduced_chi_square, 1.0)
-
-
-
 def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
               gsd: float, confidence: float):
     sensor = model.sensor(u)
