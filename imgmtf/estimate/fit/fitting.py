@@ -202,7 +202,7 @@ def run_fit(model: Model, hold, confidence: float, hold_unneeded: bool = True,
     while True:
         z, jacobian = model.solve(z, max_iterations)
         scale = max(model.reduced_chi_square(z), 1.0)
-        covariance = parameter_covariance(jacobian, scale)
+        covariance = parameter_covariance(jacobian, scale, model.n_free, model.counts)
         undetermined = model.undetermined(z, covariance)
         if not undetermined:
             break
@@ -232,5 +232,5 @@ def run_fit(model: Model, hold, confidence: float, hold_unneeded: bool = True,
                                   f"< {LIKELIHOOD_RATIO:g}); held at {held_where(model, key)}")
             model, z = trial, z_held
             scale = max(model.reduced_chi_square(z), 1.0)
-            covariance = parameter_covariance(jacobian_held, scale)
+            covariance = parameter_covariance(jacobian_held, scale, model.n_free, model.counts)
     return fit_report(model, z, covariance, notes, confidence)
