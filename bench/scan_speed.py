@@ -52,7 +52,16 @@ children, not counted) and their ratios (budgets: ``imgmtf scan`` within 2 x LSD
 reason, how many of the 14 edges were accepted with their MTF at Nyquist
 against the truth, and how many of the chart's 16 edges each tool measured.
 
-usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH]
+With ``--scale``, instead (minutes): the dense chart of
+:mod:`charts` (2000 x 2000 px, 484 squares, 1936 edges) scanned with
+default options, with ``--fit-stages none`` and with ``--bootstrap 50``,
+and a batch of 20 four-square charts (seeds SEED to SEED + 19) in one
+``imgmtf scan`` command, each against MTF Mapper run on the same images
+(a process per chart), once each in turn; then the sweep of the scene
+fit's time against the half-edges fitted (16 to 1936, doubling: budget
+time(2n) / time(n) at most 2).
+
+usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH] [--scale]
 """
 from __future__ import annotations
 
@@ -72,6 +81,7 @@ from pathlib import Path
 
 import numpy as np
 from _installed import compile_package
+from charts import DENSE_GRID, DENSE_SIZE, FOUR_ANGLES, FOUR_SIZE, dense_chart, four_square_chart
 
 import imgmtf as im
 from imgmtf.sensor.scenes import texture
@@ -79,10 +89,6 @@ from imgmtf.sensor.scenes import texture
 SEED = 20240512
 SIZE = 4096
 N_EDGES = 14
-CHART_SIZE = 1400
-CHART_ANGLES = (4.0, 7.5, 11.0, 14.5)     # the squares' tilts, deg
-CHART_SQUARE_PX = 380.0
-CHART_DARK_DN, CHART_FIELD_DN, CHART_NOISE_DN = 8000.0, 40000.0, 40.0
 
 
 def _parcels(image: np.ndarray, rng: np.random.Generator, count: int = 600) -> None:
@@ -174,30 +180,6 @@ def lsd_only(path: Path) -> int:
     return found
 
 
-def build_chart(path: Path) -> None:
-    """Write the chart of four dark squares to ``path`` (GeoTIFF, no CRS)."""
-    from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
-    rng = np.random.default_rng(SEED)
-    cell = CHART_SIZE // 2
-    image = np.zeros((CHART_SIZE, CHART_SIZE), np.uint16)
-    for k, angle in enumerate(CHART_ANGLES):
-        row, col = divmod(k, 2)
-        centre = tuple(cell / 2 - 0.5 + rng.uniform(-3, 3, 2))
-        square = QuadrantTarget(centre, angle, (CHART_DARK_DN,) * 4, CHART_SQUARE_PX / 2)
-        image[row * cell:(row + 1) * cell, col * cell:(col + 1) * cell] = render_quadrants(
-            im.Sensor(), (cell, cell), square, field_dn=CHART_FIELD_DN, noise_std_dn=CHART_NOISE_DN,
-            seed=int(rng.integers(1 << 31))).image
-    im.write_geotiff(path, image, provenance={"seed": SEED, "angles_deg": list(CHART_ANGLES),
-                                              "imgmtf_version": im.__version__})
-
-
-def chart(cache: Path) -> Path:
-    path = cache / f"scan_speed_chart_{CHART_SIZE}_{SEED}.tif"
-    if not path.exists():
-        build_chart(path)
-    return path
-
-
 def mtf_mapper(given: str | None) -> str | None:
     """MTF Mapper's executable: ``given``, else $MTF_MAPPER, else on the PATH; None if none runs."""
     candidate = given or os.environ.get("MTF_MAPPER") or shutil.which("mtf_mapper")
@@ -268,6 +250,90 @@ def mtf_mapper_edges(out: str) -> int:
     return len(path.read_text().splitlines()) if path.exists() else 0
 
 
+#: half-edges of the fit sweep, doubling; then every half-edge of the dense chart
+SWEEP_EDGES = (16, 32, 64, 128, 256, 512, 1024)
+#: four-square charts in the batch
+BATCH = 20
+
+
+def fit_sweep(dense: Path, runs: int) -> None:
+    """The scene fit's time (``fit_edges``, stages "auto", from the scan's
+    own measurements, as ``imgmtf scan`` fits them) against the half-edges
+    fitted, the first n of the dense chart's, n doubling from 16 to all of
+    them; the ratio time(2n) / time(n) (per doubling for the last step)."""
+    from imgmtf.estimate.fit import fit_edges
+    from imgmtf.scene.measure import scan_scene
+    from imgmtf.scene.targetfit import _from_scan
+    halves = [_from_scan(r) for r in scan_scene(str(dense)) if r.ok and r.site.get("target_id") is not None]
+    fit_edges(halves[:16], stages="auto")                   # warm-up: SciPy's optimizer loaded
+    print(f"fit time against half-edges (stages auto, the dense chart's {len(halves)} half-edges):")
+    before = None
+    for n in [n for n in SWEEP_EDGES if n < len(halves)] + [len(halves)]:
+        best = Timing()
+        for _ in range(runs if n <= 256 else 1):
+            wall, cpu = time.perf_counter(), time.process_time()
+            fit = fit_edges(halves[:n], stages="auto")
+            best = Timing(min(best.wall_s, time.perf_counter() - wall), min(best.cpu_s, time.process_time() - cpu))
+        ratio = ""
+        if before is not None:
+            doublings = math.log2(n / before[0])
+            ratio = (f"   time(2n)/time(n) {(best.wall_s / before[1].wall_s) ** (1 / doublings):4.2f} "
+                     f"(CPU {(best.cpu_s / before[1].cpu_s) ** (1 / doublings):4.2f})   (budget 2)")
+        print(f"  {n:5d} half-edges: {best.wall_s:7.2f} s (CPU {best.cpu_s:7.2f} s), "
+              f"{'+'.join(fit.choice.kept)}{ratio}", flush=True)
+        before = (n, best)
+
+
+def scale(cache: Path, runs: int, peer: str | None) -> None:
+    """The dense chart (default options, no fits, --bootstrap 50) and a
+    batch of 20 four-square charts in one command, each against MTF
+    Mapper run on the same images (once per chart), timed in the same run;
+    then the fit sweep."""
+    dense = dense_chart(cache)
+    batch = [four_square_chart(cache, SEED + k) for k in range(BATCH)]
+    with tempfile.TemporaryDirectory() as work:
+        def peer_on(paths: list[Path]) -> int:
+            edges = 0
+            for k, p in enumerate(paths):
+                out = Path(work) / f"mtf_mapper_{k}"
+                out.mkdir(exist_ok=True)
+                run_quietly([peer, "-q", "-l", str(p), str(out)])
+                edges += mtf_mapper_edges(str(out))
+            return edges
+        jobs = {"dense": lambda: run_quietly(command("scan", str(dense), "--format", "json")),
+                "dense_nofit": lambda: run_quietly(command("scan", str(dense), "--format", "json",
+                                                           "--fit-stages", "none")),
+                "dense_bootstrap": lambda: run_quietly(command("scan", str(dense), "--format", "json",
+                                                               "--bootstrap", "50")),
+                "batch": lambda: run_quietly(command("scan", *map(str, batch), "--format", "json"))}
+        if peer:
+            jobs.update(dense_peer=lambda: peer_on([dense]), batch_peer=lambda: peer_on(batch))
+        times = timed_together(jobs, 1, warm=set())
+    peer_dense, peer_batch = times.get("dense_peer"), times.get("batch_peer")
+    print(f"dense chart {DENSE_SIZE} x {DENSE_SIZE}, {DENSE_GRID ** 2} squares, {4 * DENSE_GRID ** 2} edges:")
+    if peer_dense is None:
+        print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
+    else:
+        print(f"  {'mtf_mapper -q -l DENSE DIR:':52s} {peer_dense.wall_s:6.2f} s (CPU {peer_dense.cpu_s:6.2f} s)"
+              f"   {peer_dense.out} edges measured")
+    for name, label, budget in (("dense", "imgmtf scan DENSE (fits)", "   (budget 2 x, aim 1 x)"),
+                                ("dense_nofit", "imgmtf scan DENSE --fit-stages none", ""),
+                                ("dense_bootstrap", "imgmtf scan DENSE --bootstrap 50", "   (budget 60 s)")):
+        t = times[name]
+        against = f"   {t.ratio(peer_dense)} MTF Mapper" if peer_dense else ""
+        print(f"  {label + ':':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s){against}{budget}"
+              f", {accepted_edges(t.out)} edges accepted")
+    t = times["batch"]
+    print(f"batch of {BATCH} four-square charts ({4 * len(FOUR_ANGLES) * BATCH} edges):")
+    if peer_batch is not None:
+        print(f"  {'mtf_mapper on each:':52s} {peer_batch.wall_s:6.2f} s (CPU {peer_batch.cpu_s:6.2f} s)"
+              f"   {peer_batch.out} edges measured")
+    against = f"   {t.ratio(peer_batch)} MTF Mapper" if peer_batch else ""
+    print(f"  {'imgmtf scan CHART1 ... CHART20 (fits):':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s){against}"
+          f"   (budget 2 x), {accepted_edges(t.out)} edges accepted")
+    fit_sweep(dense, runs)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()))
@@ -275,12 +341,19 @@ def main() -> None:
     parser.add_argument("--no-cli", action="store_true", help="skip the imgmtf scan command (and the chart)")
     parser.add_argument("--mtfmapper", metavar="PATH",
                         help="MTF Mapper's mtf_mapper (default: $MTF_MAPPER, else on the PATH)")
+    parser.add_argument("--scale", action="store_true",
+                        help="only the dense chart, the batch of 20 charts and the fit sweep (minutes)")
     args = parser.parse_args()
     compile_package()       # the start-up of an installed imgmtf (see _installed.py)
+    if args.scale:
+        print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
+        scale(args.cache, args.runs, mtf_mapper(args.mtfmapper))
+        print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+        return
     from imgmtf.scene.measure import scan_scene
     path, truth = scene(args.cache)
     peer = None if args.no_cli else mtf_mapper(args.mtfmapper)
-    chart_path = None if args.no_cli else chart(args.cache)
+    chart_path = None if args.no_cli else four_square_chart(args.cache)
     print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
     with tempfile.TemporaryDirectory() as work:
         jobs = {"lsd": lambda: lsd_only(path), "scan_scene": lambda: scan_scene(str(path))}
@@ -318,8 +391,7 @@ def main() -> None:
                             ("cli_workers_nofit", "imgmtf scan SCENE --workers 2 --fit-stages none"),
                             ("cli_out", "imgmtf scan SCENE --out DIR (CSV, GeoJSON, PNG)")):
             line(label, times[name], lsd, "LSD", "   (budget 2 x, aim 1.5 x)" if name == "cli" else "")
-        print(f"chart {CHART_SIZE} x {CHART_SIZE}, {len(CHART_ANGLES)} dark squares, "
-              f"{4 * len(CHART_ANGLES)} edges:")
+        print(f"chart {FOUR_SIZE} x {FOUR_SIZE}, {len(FOUR_ANGLES)} dark squares, {4 * len(FOUR_ANGLES)} edges:")
         peer_timing = times.get("mtf_mapper")
         if peer_timing is not None:
             line("  mtf_mapper -q -l CHART DIR", peer_timing, more=f"{peer_timing.out[1]} edges measured")
