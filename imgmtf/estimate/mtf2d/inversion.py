@@ -175,7 +175,36 @@ class EllipticalProblem:
         targets = self.remainders(many)
         trials = near + np.linspace(-0.3, 0.3, 13)
         costs = np.array([self._fit(x, targets)[0] for x in trials])
-        return [self.model(_vertex(trials, costs[:, k]), targets[:, k]) for k in range(targets.shape[1])]
+        return self.each_model(np.array([_vertex(trials, costs[:, k]) for k in range(targets.shape[1])]), targets)
+
+    def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> list[EllipticalModel]:
+        """:meth:`model` of each column of ``targets`` (samples x draws) at
+        its own log aspect, solved together: each draw's design (its
+        stretch, its nodes) stacked, the normal equations of all of them
+        solved in one call (a call per draw cost a dense chart's scan,
+        484 targets of a hundred-odd draws each, a sixth of its time)."""
+        stretch = np.sqrt(self.c ** 2 + self.s ** 2 * np.exp(-2 * log_aspects)[:, None, None])
+        w = (self.f * stretch)[:, self.use]                                         # draws x samples
+        nodes = np.linspace(0.0, np.maximum(w.max(axis=1, initial=0.0), NODE_STEP_CY_PX), 33, axis=-1)
+        step = nodes[:, 1] - nodes[:, 0]
+        position = np.clip(w / step[:, None], 0, nodes.shape[1] - 1)
+        low = np.minimum(np.floor(position).astype(int), nodes.shape[1] - 2)
+        frac = position - low
+        hat = np.zeros((*w.shape, nodes.shape[1]))
+        draw, sample = np.indices(w.shape)
+        hat[draw, sample, low] = 1.0 - frac
+        hat[draw, sample, low + 1] = frac
+        design = hat[:, :, 1:]
+        weighted = design * self.weight[None, :, None]
+        size = nodes.shape[1]
+        normal = np.transpose(weighted, (0, 2, 1)) @ weighted + _penalty(1, size) + 1e-10 * np.eye(size - 1)
+        rhs = np.transpose(weighted, (0, 2, 1)) @ (targets.T * self.weight)[:, :, None]
+        solution = np.concatenate([np.zeros((w.shape[0], 1)), np.linalg.solve(normal, rhs)[:, :, 0]], axis=1)
+        touched = np.abs(design).sum(axis=1) > 0                                   # draws x (nodes - 1)
+        last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
+        reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
+        return [EllipticalModel(nodes[k], np.where(reach[k], solution[k], np.nan), math.exp(log_aspects[k]))
+                for k in range(w.shape[0])]
 
 
 def _vertex(trials: np.ndarray, costs: np.ndarray) -> float:
