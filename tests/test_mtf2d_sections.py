@@ -156,7 +156,7 @@ def test_sections_it_cannot_invert_are_refused():
 def test_the_draws_elliptical_models_solved_together_are_each_ones_own():
     """The redrawn sections' elliptical models, every draw's normal
     equations solved in one call, are those solved draw by draw (nodes,
-    reach and log g to 1e-12)."""
+    reach and log g to 1e-12), and so are the misfits of many aspects."""
     from imgmtf.estimate.mtf2d.inversion import EllipticalProblem, prepared
     f = np.linspace(0, 1, 101)
     normals = [16.8, -73.2, 40.0]
@@ -173,3 +173,7 @@ def test_the_draws_elliptical_models_solved_together_are_each_ones_own():
         assert np.allclose(together.nodes, alone.nodes, rtol=0, atol=1e-12)
         assert np.array_equal(np.isnan(together.log_g), np.isnan(alone.log_g))
         assert np.allclose(together.log_g, alone.log_g, rtol=0, atol=1e-12, equal_nan=True)
+    # and the misfits of many aspects at once, of one target and of many, are each aspect's own
+    for target in (problem.log_r, targets):
+        alone = np.array([problem._fit(a, target)[0] for a in log_aspects])
+        assert np.allclose(problem.costs(log_aspects, target), alone, rtol=1e-10, atol=0)

@@ -121,7 +121,7 @@ def overlay_test(inputs, model: EllipticalModel, seed: int, draws: int = 100) ->
     normals, f, m, sd = inputs
     problem = EllipticalProblem(*prepared(normals, f, m, sd))
     log_aspect = math.log(model.aspect)
-    observed = float(problem._fit(log_aspect, problem.log_r)[0])
+    observed = float(problem.costs(np.array([log_aspect]), problem.log_r)[0])
     theta = np.radians(normals)
     predicted = np.array([model.transfer(f * abs(math.cos(t)), f * abs(math.sin(t))) for t in theta])
     predicted = np.where(np.isfinite(predicted), predicted, m)
@@ -129,5 +129,5 @@ def overlay_test(inputs, model: EllipticalModel, seed: int, draws: int = 100) ->
     shifts = np.random.default_rng(seed + 2).standard_normal((draws, normals.size))
     null = EllipticalProblem(*prepared(normals, f, predicted, sd))
     targets = null.remainders(predicted[None] + shifts[:, :, None] * spread[None])
-    costs = np.min([null._fit(x, targets)[0] for x in log_aspect + np.linspace(-0.3, 0.3, 13)], axis=0)
+    costs = np.min(null.costs(log_aspect + np.linspace(-0.3, 0.3, 13), targets), axis=0)
     return float(np.mean(costs >= observed))

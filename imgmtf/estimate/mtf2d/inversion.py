@@ -162,7 +162,7 @@ class EllipticalProblem:
         about the best, and a parabola (to 1e-4 in log)."""
         trials = np.linspace(math.log(ASPECT_BOUNDS[0]), math.log(ASPECT_BOUNDS[1]), 25)
         for _ in range(4):
-            costs = np.array([float(self._fit(x, self.log_r)[0]) for x in trials])
+            costs = self.costs(trials, self.log_r)
             i = int(np.argmin(costs))
             if _ < 3:
                 trials = np.linspace(trials[max(i - 1, 0)], trials[min(i + 1, trials.size - 1)], 9)
@@ -174,8 +174,19 @@ class EllipticalProblem:
         for all of them at once, each refined by a parabola."""
         targets = self.remainders(many)
         trials = near + np.linspace(-0.3, 0.3, 13)
-        costs = np.array([self._fit(x, targets)[0] for x in trials])
+        costs = self.costs(trials, targets)
         return self.each_model(np.array([_vertex(trials, costs[:, k]) for k in range(targets.shape[1])]), targets)
+
+    def costs(self, log_aspects: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """The weighted misfit (:meth:`_fit`'s first value) of ``targets``
+        (samples, or samples x k) at each of ``log_aspects``, every
+        aspect's least squares solved in one call: (aspects,) or (aspects, k)."""
+        _, design = self._stacked(log_aspects)
+        columns = targets if targets.ndim == 2 else targets[:, None]
+        solution = self._solutions(design, np.broadcast_to(columns, (len(log_aspects), *columns.shape)))
+        misfit = self.weight[:, None] * (design @ solution - columns)
+        costs = np.sum(misfit ** 2, axis=1)
+        return costs if targets.ndim == 2 else costs[:, 0]
 
     def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> list[EllipticalModel]:
         """:meth:`model` of each column of ``targets`` (samples x draws) at
@@ -183,28 +194,40 @@ class EllipticalProblem:
         stretch, its nodes) stacked, the normal equations of all of them
         solved in one call (a call per draw cost a dense chart's scan,
         484 targets of a hundred-odd draws each, a sixth of its time)."""
-        stretch = np.sqrt(self.c ** 2 + self.s ** 2 * np.exp(-2 * log_aspects)[:, None, None])
-        w = (self.f * stretch)[:, self.use]                                         # draws x samples
+        nodes, design = self._stacked(log_aspects)
+        size = nodes.shape[1]
+        solution = np.concatenate([np.zeros((len(log_aspects), 1)),
+                                   self._solutions(design, targets.T[:, :, None])[:, :, 0]], axis=1)
+        touched = np.abs(design).sum(axis=1) > 0                                   # draws x (nodes - 1)
+        last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
+        reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
+        return [EllipticalModel(nodes[k], np.where(reach[k], solution[k], np.nan), math.exp(log_aspects[k]))
+                for k in range(len(log_aspects))]
+
+    def _stacked(self, log_aspects: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_fit`'s nodes and design at each of ``log_aspects``,
+        stacked: (aspects, 33) and (aspects, samples, 32)."""
+        stretch = np.sqrt(self.c ** 2 + self.s ** 2 * np.exp(-2 * np.asarray(log_aspects))[:, None, None])
+        w = (self.f * stretch)[:, self.use]                                         # aspects x samples
         nodes = np.linspace(0.0, np.maximum(w.max(axis=1, initial=0.0), NODE_STEP_CY_PX), 33, axis=-1)
         step = nodes[:, 1] - nodes[:, 0]
         position = np.clip(w / step[:, None], 0, nodes.shape[1] - 1)
         low = np.minimum(np.floor(position).astype(int), nodes.shape[1] - 2)
         frac = position - low
         hat = np.zeros((*w.shape, nodes.shape[1]))
-        draw, sample = np.indices(w.shape)
-        hat[draw, sample, low] = 1.0 - frac
-        hat[draw, sample, low + 1] = frac
-        design = hat[:, :, 1:]
+        row, sample = np.indices(w.shape)
+        hat[row, sample, low] = 1.0 - frac
+        hat[row, sample, low + 1] = frac
+        return nodes, hat[:, :, 1:]
+
+    def _solutions(self, design: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """:func:`_solve`'s node values (but the first, 0) for stacked
+        designs (aspects x samples x nodes) and their targets (aspects x
+        samples x k)."""
         weighted = design * self.weight[None, :, None]
-        size = nodes.shape[1]
+        size = design.shape[2] + 1
         normal = np.transpose(weighted, (0, 2, 1)) @ weighted + _penalty(1, size) + 1e-10 * np.eye(size - 1)
-        rhs = np.transpose(weighted, (0, 2, 1)) @ (targets.T * self.weight)[:, :, None]
-        solution = np.concatenate([np.zeros((w.shape[0], 1)), np.linalg.solve(normal, rhs)[:, :, 0]], axis=1)
-        touched = np.abs(design).sum(axis=1) > 0                                   # draws x (nodes - 1)
-        last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
-        reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
-        return [EllipticalModel(nodes[k], np.where(reach[k], solution[k], np.nan), math.exp(log_aspects[k]))
-                for k in range(w.shape[0])]
+        return np.linalg.solve(normal, np.transpose(weighted, (0, 2, 1)) @ (targets * self.weight[None, :, None]))
 
 
 def _vertex(trials: np.ndarray, costs: np.ndarray) -> float:
