@@ -61,7 +61,7 @@ and a batch of 20 four-square charts (seeds SEED to SEED + 19) in one
 fit's time against the half-edges fitted (16 to 1936, doubling: budget
 time(2n) / time(n) at most 2).
 
-usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH] [--scale]
+usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH] [--scale [PARTS]]
 """
 from __future__ import annotations
 
@@ -284,13 +284,16 @@ def fit_sweep(dense: Path, runs: int) -> None:
         before = (n, best)
 
 
-def scale(cache: Path, runs: int, peer: str | None) -> None:
-    """The dense chart (default options, no fits, --bootstrap 50) and a
-    batch of 20 four-square charts in one command, each against MTF
-    Mapper run on the same images (once per chart), timed in the same run;
-    then the fit sweep."""
-    dense = dense_chart(cache)
-    batch = [four_square_chart(cache, SEED + k) for k in range(BATCH)]
+SCALE_PARTS = ("dense", "bootstrap", "batch", "sweep")
+
+
+def scale(cache: Path, runs: int, peer: str | None, parts: set[str]) -> None:
+    """Of ``parts``: the dense chart (default options and no fits;
+    "bootstrap": with --bootstrap 50) and a batch of 20 four-square charts
+    in one command, each against MTF Mapper run on the same images (once
+    per chart), timed in the same run; then the fit sweep."""
+    dense = dense_chart(cache) if parts & {"dense", "bootstrap", "sweep"} else None
+    batch = [four_square_chart(cache, SEED + k) for k in range(BATCH)] if "batch" in parts else []
     with tempfile.TemporaryDirectory() as work:
         def peer_on(paths: list[Path]) -> int:
             edges = 0
@@ -308,30 +311,37 @@ def scale(cache: Path, runs: int, peer: str | None) -> None:
                 "batch": lambda: run_quietly(command("scan", *map(str, batch), "--format", "json"))}
         if peer:
             jobs.update(dense_peer=lambda: peer_on([dense]), batch_peer=lambda: peer_on(batch))
-        times = timed_together(jobs, 1, warm=set())
+        wanted = {"dense": {"dense"}, "dense_nofit": {"dense"}, "dense_peer": {"dense", "bootstrap"},
+                  "dense_bootstrap": {"bootstrap"}, "batch": {"batch"}, "batch_peer": {"batch"}}
+        times = timed_together({k: v for k, v in jobs.items() if wanted[k] & parts}, 1, warm=set())
     peer_dense, peer_batch = times.get("dense_peer"), times.get("batch_peer")
-    print(f"dense chart {DENSE_SIZE} x {DENSE_SIZE}, {DENSE_GRID ** 2} squares, {4 * DENSE_GRID ** 2} edges:")
-    if peer_dense is None:
+    if parts & {"dense", "bootstrap"}:
+        print(f"dense chart {DENSE_SIZE} x {DENSE_SIZE}, {DENSE_GRID ** 2} squares, {4 * DENSE_GRID ** 2} edges:")
+    if parts & {"dense", "bootstrap"} and peer_dense is None:
         print("  MTF Mapper not found (--mtfmapper PATH or MTF_MAPPER=PATH): no comparison")
-    else:
+    elif peer_dense is not None:
         print(f"  {'mtf_mapper -q -l DENSE DIR:':52s} {peer_dense.wall_s:6.2f} s (CPU {peer_dense.cpu_s:6.2f} s)"
               f"   {peer_dense.out} edges measured")
     for name, label, budget in (("dense", "imgmtf scan DENSE (fits)", "   (budget 2 x, aim 1 x)"),
                                 ("dense_nofit", "imgmtf scan DENSE --fit-stages none", ""),
                                 ("dense_bootstrap", "imgmtf scan DENSE --bootstrap 50", "   (budget 60 s)")):
+        if name not in times:
+            continue
         t = times[name]
         against = f"   {t.ratio(peer_dense)} MTF Mapper" if peer_dense else ""
         print(f"  {label + ':':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s){against}{budget}"
               f", {accepted_edges(t.out)} edges accepted")
-    t = times["batch"]
-    print(f"batch of {BATCH} four-square charts ({4 * len(FOUR_ANGLES) * BATCH} edges):")
-    if peer_batch is not None:
-        print(f"  {'mtf_mapper on each:':52s} {peer_batch.wall_s:6.2f} s (CPU {peer_batch.cpu_s:6.2f} s)"
-              f"   {peer_batch.out} edges measured")
-    against = f"   {t.ratio(peer_batch)} MTF Mapper" if peer_batch else ""
-    print(f"  {'imgmtf scan CHART1 ... CHART20 (fits):':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s){against}"
-          f"   (budget 2 x), {accepted_edges(t.out)} edges accepted")
-    fit_sweep(dense, runs)
+    if "batch" in parts:
+        t = times["batch"]
+        print(f"batch of {BATCH} four-square charts ({4 * len(FOUR_ANGLES) * BATCH} edges):")
+        if peer_batch is not None:
+            print(f"  {'mtf_mapper on each:':52s} {peer_batch.wall_s:6.2f} s (CPU {peer_batch.cpu_s:6.2f} s)"
+                  f"   {peer_batch.out} edges measured")
+        against = f"   {t.ratio(peer_batch)} MTF Mapper" if peer_batch else ""
+        print(f"  {'imgmtf scan CHART1 ... CHART20 (fits):':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s)"
+              f"{against}   (budget 2 x), {accepted_edges(t.out)} edges accepted")
+    if dense is not None and "sweep" in parts:
+        fit_sweep(dense, runs)
 
 
 def main() -> None:
@@ -341,13 +351,18 @@ def main() -> None:
     parser.add_argument("--no-cli", action="store_true", help="skip the imgmtf scan command (and the chart)")
     parser.add_argument("--mtfmapper", metavar="PATH",
                         help="MTF Mapper's mtf_mapper (default: $MTF_MAPPER, else on the PATH)")
-    parser.add_argument("--scale", action="store_true",
-                        help="only the dense chart, the batch of 20 charts and the fit sweep (minutes)")
+    parser.add_argument("--scale", nargs="?", const=",".join(SCALE_PARTS), metavar="PARTS",
+                        help="only the dense chart, its --bootstrap 50 run, the batch of 20 charts and the fit "
+                             f"sweep (minutes; or some of {','.join(SCALE_PARTS)}, comma-separated)")
     args = parser.parse_args()
     compile_package()       # the start-up of an installed imgmtf (see _installed.py)
     if args.scale:
         print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
-        scale(args.cache, args.runs, mtf_mapper(args.mtfmapper))
+        parts = {p.strip() for p in args.scale.split(",") if p.strip()}
+        if parts - set(SCALE_PARTS):
+            parser.error(f"--scale: unknown part {sorted(parts - set(SCALE_PARTS))[0]!r}; "
+                         f"known: {', '.join(SCALE_PARTS)}")
+        scale(args.cache, args.runs, mtf_mapper(args.mtfmapper), parts)
         print(f"load average after:  {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
         return
     from imgmtf.scene.measure import scan_scene
