@@ -40,6 +40,7 @@ RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpol
 ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
 ZERO_SET_STEP_CY_PX = 0.02       # ...on this grid (its crossings interpolated)
 MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
+ZERO_EVIDENCE_SD = 3.0          # the spectrum beyond a read zero must average this many sd below nil
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
@@ -162,7 +163,11 @@ class PulseKind(TargetKind):
                                       f"background, within the noise ({noise:.1f} DN)")
         prf01 = peak / height
         h10 = _half_width_at(grid, prf01, 0.1)
-        width = self.width_px if self.width_px is not None else check_width(estimate_width(grid, prf01))
+        if self.width_px is None:
+            density = d.size / (2.0 * half_range)           # samples per px along the normal
+            width = check_width(estimate_width(grid, prf01, noise / height / math.sqrt(density)))
+        else:
+            width = self.width_px
         if width / 2 + 2.0 > half_range:
             raise UnsuitableTargetError(
                 f"the bar ({width:.1f} px) is too wide for the chip: it needs "
@@ -389,27 +394,79 @@ def sinc_log_slope(f, width_px: float):
     return np.where(f == 0, 0.0, slope)
 
 
-def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
+def estimate_width(grid: np.ndarray, prf01: np.ndarray, noise_per_px: float = 0.0) -> float:
     """Bar width from the first zero of the PRF's spectrum: |FT(PRF)| =
     |sinc(f W)| MTF(f), so its first zero is at 1/W as long as the MTF is
     still above the noise there.  Zeros are only sought below
     ``MAX_ZERO_SEARCH_CY_PX``: the pixel aperture's own zero near 1 cy/px
     would otherwise pass for a bar's.  The zero is located as the sign change
     of the spectrum referenced to the bar's centre (real for a symmetric
-    bar)."""
+    bar).
+
+    A zero is read only where it stands out of the noise: beyond a bar's
+    zero its spectrum turns negative (the sinc's negative lobe), beyond a
+    zero the noise made where the spectrum has faded it stays about nil.
+    ``noise_per_px`` (the profile's noise over its peak's height, times the
+    square root of a pixel over the samples per pixel: the sd of a linear
+    functional sum(k * prf01) * step is noise_per_px * sqrt(sum(k^2) * step))
+    judges it: the spectrum's mean from the zero to ``MAX_ZERO_SEARCH_CY_PX``
+    must lie ``ZERO_EVIDENCE_SD`` of its sd below nil; 0 (the default) takes
+    any zero.
+
+    Raises
+    ------
+    UnsuitableTargetError
+        (reason ``bar-width``) no zero below ``MAX_ZERO_SEARCH_CY_PX``, or
+        none that stands out of the noise: the message says how wide the bar
+        may be and how far that moves the MTF at Nyquist.
+
+    Examples
+    --------
+    >>> x = np.arange(-10, 10.0001, 0.05)
+    >>> round(estimate_width(x, (np.abs(x) <= 1.25).astype(float)), 2)    # a bare 2.5 px box
+    2.5
+    """
     f = np.arange(0.005, MAX_ZERO_SEARCH_CY_PX, 0.0025)
     step = grid[1] - grid[0]
-    real = np.cos(2 * np.pi * f[:, None] * grid[None, :]) @ prf01 * step
+    cosines = np.cos(2 * np.pi * f[:, None] * grid[None, :])
+    real = cosines @ prf01 * step
     area = prf01.sum() * step
     change = np.nonzero(np.sign(real[:-1]) != np.sign(real[1:]))[0]
     if change.size == 0 or area <= 0:
         raise UnsuitableTargetError(
-            f"the bar width cannot be estimated from this profile (no zero in its spectrum below "
-            f"{MAX_ZERO_SEARCH_CY_PX} cy/px, so the bar is narrower than "
-            f"{1 / MAX_ZERO_SEARCH_CY_PX:.2f} px); give its width", reason="bar-width")
+            f"the bar width cannot be estimated from this profile: its spectrum has no zero below "
+            f"{MAX_ZERO_SEARCH_CY_PX} cy/px{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; "
+            "give its width", reason="bar-width")
     i = change[0]
     zero = f[i] - real[i] * (f[i + 1] - f[i]) / (real[i + 1] - real[i])
+    if noise_per_px > 0:
+        beyond = f > zero
+        lobe = float(real[beyond].mean())
+        lobe_sd = noise_per_px * math.sqrt(float(np.sum(cosines[beyond].mean(axis=0) ** 2)) * step)
+        if lobe > -ZERO_EVIDENCE_SD * lobe_sd:
+            raise UnsuitableTargetError(
+                f"the bar width cannot be told from the noise: its spectrum's zero at {zero:.3f} cy/px "
+                f"({1 / zero:.2f} px) has no negative lobe beyond it (its mean to {MAX_ZERO_SEARCH_CY_PX} cy/px "
+                f"is {lobe / lobe_sd:+.1f} sd, {-ZERO_EVIDENCE_SD:.0f} needed), so the zero may be the noise's"
+                f"{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; give its width", reason="bar-width")
     return float(1.0 / zero)
+
+
+def _width_range(grid: np.ndarray, prf01: np.ndarray, f: np.ndarray, real: np.ndarray, cosines: np.ndarray,
+                 noise_per_px: float) -> str:
+    """What a width that cannot be read leaves open, for a refusal: the
+    widest bar whose zero the noise could hide (1 / the frequency where
+    the spectrum ``real`` at ``f`` first falls within ``ZERO_EVIDENCE_SD``
+    sd of nil, at most ``MAX_ZERO_SEARCH_CY_PX``), and the MTF at Nyquist a
+    line and that bar would give (the profile's spectrum at Nyquist over
+    its area, unwindowed: about what the estimate would read)."""
+    step = float(grid[1] - grid[0])
+    sd = noise_per_px * np.sqrt(np.sum(cosines ** 2, axis=1) * step)
+    faded = np.nonzero(real <= ZERO_EVIDENCE_SD * sd)[0]
+    widest = 1.0 / (float(f[faded[0]]) if faded.size else MAX_ZERO_SEARCH_CY_PX)
+    line = float(np.cos(np.pi * grid) @ prf01) / float(prf01.sum())
+    return (f": the bar may be anything up to {widest:.2f} px wide, which puts the MTF at Nyquist anywhere from "
+            f"about {line:.2f} (a line) to {line / np.sinc(NYQUIST * widest):.2f} (a {widest:.2f} px bar)")
 
 
 def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_window: int = 12):
