@@ -45,6 +45,7 @@ SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
 OUTER_PX = 5                    # a row window's pixels this far from the centre are background
+LOCATE_HALF_WINDOW_PX = 12      # the bar is first followed in row windows reaching this far either side of its seed
 REACH_MARGIN_PX = 2             # a row window reaches this far beyond where the bar's profile fades to 5 %
 WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-width at 10 %
 BACKGROUND_FRACTION = 2.0 / 3.0  # a bar's background is read from the samples beyond this share of the range
@@ -469,7 +470,8 @@ def _width_range(grid: np.ndarray, prf01: np.ndarray, f: np.ndarray, real: np.nd
             f"about {line:.2f} (a line) to {line / np.sinc(NYQUIST * widest):.2f} (a {widest:.2f} px bar)")
 
 
-def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_window: int = 12):
+def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool,
+                 half_window: int = LOCATE_HALF_WINDOW_PX):
     """Per-row bar centres (centroids of the background-subtracted profile),
     re-centred on the fitted line: three times within ``half_window`` px,
     which finds the bar wherever the seed put it, then twice within the

@@ -37,7 +37,7 @@ from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments
 from .fill import fill_screen
-from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi
+from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
 from .segments import (
     BAR_MAX_SEPARATION_PX,
@@ -142,7 +142,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
-                                            settings.margin_px + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
+                                            roi_margin_px(settings) + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
     records: list[Record] = []
     plans: list[Plan] = []
     rounded = _rounded_ends([half.segment for half, _ in candidates])
