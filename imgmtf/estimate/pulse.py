@@ -410,8 +410,9 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray, noise_per_px: float = 0.
     ``noise_per_px`` (the profile's noise over its peak's height, times the
     square root of a pixel over the samples per pixel: the sd of a linear
     functional sum(k * prf01) * step is noise_per_px * sqrt(sum(k^2) * step))
-    judges it: the spectrum's mean from the zero to ``MAX_ZERO_SEARCH_CY_PX``
-    must lie ``ZERO_EVIDENCE_SD`` of its sd below nil; 0 (the default) takes
+    judges it: the spectrum's mean over the lobe, from the zero f0 to 2 f0
+    (or ``MAX_ZERO_SEARCH_CY_PX``), must lie ``ZERO_EVIDENCE_SD`` of its sd
+    below nil; 0 (the default) takes
     any zero.
 
     Raises
@@ -432,25 +433,38 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray, noise_per_px: float = 0.
     cosines = np.cos(2 * np.pi * f[:, None] * grid[None, :])
     real = cosines @ prf01 * step
     area = prf01.sum() * step
+    if area <= 0:
+        raise UnsuitableTargetError("the bar width cannot be estimated from this profile: it has no area above "
+                                    "its background; give its width", reason="bar-width")
     change = np.nonzero(np.sign(real[:-1]) != np.sign(real[1:]))[0]
-    if change.size == 0 or area <= 0:
+    if change.size == 0:
         raise UnsuitableTargetError(
             f"the bar width cannot be estimated from this profile: its spectrum has no zero below "
-            f"{MAX_ZERO_SEARCH_CY_PX} cy/px{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; "
+            f"{MAX_ZERO_SEARCH_CY_PX} cy/px, so {_width_range(grid, prf01, f, real, cosines, noise_per_px)}; "
             "give its width", reason="bar-width")
     i = change[0]
     zero = f[i] - real[i] * (f[i + 1] - f[i]) / (real[i + 1] - real[i])
-    if noise_per_px > 0:
-        beyond = f > zero
-        lobe = float(real[beyond].mean())
-        lobe_sd = noise_per_px * math.sqrt(float(np.sum(cosines[beyond].mean(axis=0) ** 2)) * step)
-        if lobe > -ZERO_EVIDENCE_SD * lobe_sd:
-            raise UnsuitableTargetError(
-                f"the bar width cannot be told from the noise: its spectrum's zero at {zero:.3f} cy/px "
-                f"({1 / zero:.2f} px) has no negative lobe beyond it (its mean to {MAX_ZERO_SEARCH_CY_PX} cy/px "
-                f"is {lobe / lobe_sd:+.1f} sd, {-ZERO_EVIDENCE_SD:.0f} needed), so the zero may be the noise's"
-                f"{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; give its width", reason="bar-width")
+    lobe_sd = _lobe_sd(f, real, cosines, step, zero, noise_per_px) if noise_per_px > 0 else -math.inf
+    if lobe_sd > -ZERO_EVIDENCE_SD:
+        raise UnsuitableTargetError(
+            f"the bar width cannot be told from the noise: its spectrum's zero at {zero:.3f} cy/px "
+            f"({1 / zero:.2f} px) has no negative lobe beyond it (its mean to "
+            f"{min(2 * zero, MAX_ZERO_SEARCH_CY_PX):.2f} cy/px is {lobe_sd:+.1f} sd, {-ZERO_EVIDENCE_SD:.0f} needed) and may be the noise's, so "
+            f"{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; give its width", reason="bar-width")
     return float(1.0 / zero)
+
+
+def _lobe_sd(f: np.ndarray, real: np.ndarray, cosines: np.ndarray, step: float, zero: float,
+             noise_per_px: float) -> float:
+    """The spectrum's mean over the sinc's first negative lobe beyond the
+    zero (f0 to 2 f0, below ``MAX_ZERO_SEARCH_CY_PX``), in sd of that mean
+    under white noise of ``noise_per_px``; 0 where the lobe holds no grid
+    frequency (nothing shows it)."""
+    beyond = (f > zero) & (f < 2.0 * zero)
+    if not beyond.any():
+        return 0.0
+    sd = noise_per_px * math.sqrt(float(np.sum(cosines[beyond].mean(axis=0) ** 2)) * step)
+    return float(real[beyond].mean()) / sd
 
 
 def _width_range(grid: np.ndarray, prf01: np.ndarray, f: np.ndarray, real: np.ndarray, cosines: np.ndarray,
@@ -458,15 +472,20 @@ def _width_range(grid: np.ndarray, prf01: np.ndarray, f: np.ndarray, real: np.nd
     """What a width that cannot be read leaves open, for a refusal: the
     widest bar whose zero the noise could hide (1 / the frequency where
     the spectrum ``real`` at ``f`` first falls within ``ZERO_EVIDENCE_SD``
-    sd of nil, at most ``MAX_ZERO_SEARCH_CY_PX``), and the MTF at Nyquist a
+    sd of nil, at most ``MAX_ZERO_SEARCH_CY_PX``; and no wider than the
+    profile's FWHM), and the MTF at Nyquist a
     line and that bar would give (the profile's spectrum at Nyquist over
     its area, unwindowed: about what the estimate would read)."""
     step = float(grid[1] - grid[0])
     sd = noise_per_px * np.sqrt(np.sum(cosines ** 2, axis=1) * step)
     faded = np.nonzero(real <= ZERO_EVIDENCE_SD * sd)[0]
-    widest = 1.0 / (float(f[faded[0]]) if faded.size else MAX_ZERO_SEARCH_CY_PX)
+    # a bar is no wider than its pulse response's FWHM (a symmetric, unimodal blur keeps its edges above half)
+    widest = min(1.0 / (float(f[faded[0]]) if faded.size else MAX_ZERO_SEARCH_CY_PX), fwhm(grid, prf01))
     line = float(np.cos(np.pi * grid) @ prf01) / float(prf01.sum())
-    return (f": the bar may be anything up to {widest:.2f} px wide, which puts the MTF at Nyquist anywhere from "
+    if NYQUIST * widest >= 1.0:
+        return (f"the bar may be anything up to {widest:.2f} px wide, which puts the MTF at Nyquist anywhere "
+                f"above about {line:.2f} (a line): a bar 2 px wide hides Nyquist in its sinc's zero")
+    return (f"the bar may be anything up to {widest:.2f} px wide, which puts the MTF at Nyquist anywhere from "
             f"about {line:.2f} (a line) to {line / np.sinc(NYQUIST * widest):.2f} (a {widest:.2f} px bar)")
 
 

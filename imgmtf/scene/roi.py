@@ -2,8 +2,9 @@
 and the stretch of it clear of what must not enter the estimate.
 
 The ROI spans ``margin_px`` either side of the candidate's line (plus half
-a bar; for a kind with a width at least ``BAR_BACKGROUND_PX``), stops ``JUNCTION_CLEARANCE_PX`` short of every segment it meets at
-a junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
+a bar; for a kind with a width, at least what the bar estimator needs:
+:func:`roi_margin_px`), stops ``JUNCTION_CLEARANCE_PX`` short of every
+segment it meets at a junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
 short of fill and nodata, and ``END_TRIM_PX`` short of a free end.
 """
 from __future__ import annotations
@@ -95,7 +96,8 @@ def roi_margin_px(settings: ScanSettings) -> float:
     """
     if not get_kind(settings.target).has_width:
         return settings.margin_px
-    from ..estimate.pulse import LOCATE_HALF_WINDOW_PX     # (here: the workers reading ROIs need not load it)
+    # (imported here: the workers reading ROIs need not load the estimator)
+    from ..estimate.pulse import LOCATE_HALF_WINDOW_PX
     return max(settings.margin_px, LOCATE_HALF_WINDOW_PX + SEED_SLACK_PX)
 
 
