@@ -449,7 +449,8 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray, noise_per_px: float = 0.
         raise UnsuitableTargetError(
             f"the bar width cannot be told from the noise: its spectrum's zero at {zero:.3f} cy/px "
             f"({1 / zero:.2f} px) has no negative lobe beyond it (its mean to "
-            f"{min(2 * zero, MAX_ZERO_SEARCH_CY_PX):.2f} cy/px is {lobe_sd:+.1f} sd, {-ZERO_EVIDENCE_SD:.0f} needed) and may be the noise's, so "
+            f"{min(2 * zero, MAX_ZERO_SEARCH_CY_PX):.2f} cy/px is {lobe_sd:+.1f} sd, "
+            f"{-ZERO_EVIDENCE_SD:.0f} needed) and may be the noise's, so "
             f"{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; give its width", reason="bar-width")
     return float(1.0 / zero)
 
