@@ -476,13 +476,17 @@ def _width_range(grid: np.ndarray, prf01: np.ndarray, f: np.ndarray, real: np.nd
     sd of nil, at most ``MAX_ZERO_SEARCH_CY_PX``; and no wider than the
     profile's FWHM), and the MTF at Nyquist a
     line and that bar would give (the profile's spectrum at Nyquist over
-    its area, unwindowed: about what the estimate would read)."""
+    its area within twice its half-width at 10 % and 2 px: about what
+    the estimate would read)."""
     step = float(grid[1] - grid[0])
     sd = noise_per_px * np.sqrt(np.sum(cosines ** 2, axis=1) * step)
     faded = np.nonzero(real <= ZERO_EVIDENCE_SD * sd)[0]
     # a bar is no wider than its pulse response's FWHM (a symmetric, unimodal blur keeps its edges above half)
     widest = min(1.0 / (float(f[faded[0]]) if faded.size else MAX_ZERO_SEARCH_CY_PX), fwhm(grid, prf01))
-    line = float(np.cos(np.pi * grid) @ prf01) / float(prf01.sum())
+    # the profile's spectrum at Nyquist over its area within a few of its widths: the far samples add only
+    # noise and the background's error
+    near = np.abs(grid) <= 2.0 * _half_width_at(grid, prf01, 0.1) + 2.0
+    line = float(np.cos(np.pi * grid[near]) @ prf01[near]) / float(prf01[near].sum())
     if NYQUIST * widest >= 1.0:
         return (f"the bar may be anything up to {widest:.2f} px wide, which puts the MTF at Nyquist anywhere "
                 f"above about {line:.2f} (a line): a bar 2 px wide hides Nyquist in its sinc's zero")
