@@ -30,6 +30,8 @@ _LAZY = {
     "render": "sensor.rendering",
     "measure_edge": "estimate.edge", "EdgeEstimator": "estimate.edge", "EdgeResult": "estimate.edge",
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
+    "measure_double_bar": "estimate.double_bar", "DoubleBarEstimator": "estimate.double_bar",
+    "DoubleBarResult": "estimate.double_bar",
     "measure_points": "estimate.mtf2d.points", "PointsResult": "estimate.mtf2d.points",
     "PointsEstimator": "estimate.mtf2d.estimator", "PointArray": "sensor.points", "render_points": "sensor.points",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",

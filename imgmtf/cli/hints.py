@@ -45,6 +45,7 @@ HINTS = (
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
+    Hint(CHIP, "double-bar", "--target double-bar --pulse-width W --gap G measures them"),
     Hint(CHIP, "fit", "--stages fits fewer, --hold holds some"),
     # a scene's half-edges: fit takes the ROIs scan prints, one per file named
     Hint(CHIP, "fill", "--roi X,Y,W,H once per file fits the edges imgmtf scan finds", only=frozenset({"fit"})),
@@ -57,6 +58,7 @@ HINTS = (
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
     Hint(SCAN, "not-an-edge", "--target pulse measures bars"),
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
+    Hint(SCAN, "double-bar", "imgmtf measure --target double-bar --pulse-width W --gap G measures them"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and
