@@ -279,7 +279,7 @@ class DoubleBarEstimator:
             samples = m.estimate.samples
             profile = BarProfile("the double bar", samples.distance_px - m.shape.centre, samples.values_dn,
                                  float(fields["normal_angle_deg"]), kind.width_px, kind.gap_px,
-                                 float(m.shape.low), float(m.shape.high))
+                                 float(m.shape.low), float(m.shape.high), m.chip.quantum_dn)
             fitted = fit_bars([profile], stages=self.stages, confidence=self.settings.intervals.confidence)
             fields.update(mtf_nyquist=fitted.mtf_nyquist[0], mtf_nyquist_ci=fitted.mtf_nyquist_ci[0])
             if not math.isfinite(fields["mtf50_cy_px"]):

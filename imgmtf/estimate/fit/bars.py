@@ -70,6 +70,9 @@ class BarProfile:
         A double bar's gap (edge to edge), px; None for a single bar.
     background_dn, peak_dn : float
         The levels measured (the fit's starting point), DN.
+    quantum_dn : float, optional
+        The values' step (1 for a file's integer DN, 0 for floats): the
+        noise is at least its rounding's, quantum / sqrt(12).
     """
 
     source: str
@@ -80,6 +83,7 @@ class BarProfile:
     gap_px: float | None
     background_dn: float
     peak_dn: float
+    quantum_dn: float = 0.0
     bins: ProfileBins = field(init=False)
     noise: float = field(init=False)
 
@@ -90,7 +94,8 @@ class BarProfile:
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "bins", bin_profile(x, y))
         contrast = abs(self.peak_dn - self.background_dn)
-        object.__setattr__(self, "noise", max(profile_noise(x, y), 1e-5 * contrast, 1e-12))
+        object.__setattr__(self, "noise", max(profile_noise(x, y), self.quantum_dn / math.sqrt(12.0),
+                                                 1e-5 * contrast, 1e-12))
 
     @property
     def centres_px(self) -> tuple[float, ...]:
@@ -112,9 +117,10 @@ class BarProfile:
         return area / (self.width_px * len(self.centres_px)) if area else self.peak_dn - self.background_dn
 
 
-def bar_profile(result: Any, source: str) -> BarProfile:
+def bar_profile(result: Any, source: str, quantum_dn: float = 0.0) -> BarProfile:
     """A measured bar (:class:`imgmtf.PulseResult`) or double bar
-    (:class:`imgmtf.DoubleBarResult`) as the fit takes it.
+    (:class:`imgmtf.DoubleBarResult`) as the fit takes it (``quantum_dn``
+    its values' step: 1 for a file's integer DN).
 
     Raises
     ------
@@ -126,7 +132,7 @@ def bar_profile(result: Any, source: str) -> BarProfile:
         raise ParameterError(f"{source}: a {type(result).__name__}; the bars' fit takes bars and double bars")
     return BarProfile(source, np.asarray(result.samples_x_px, float), np.asarray(result.samples_dn, float),
                       float(result.normal_angle_deg), float(width), getattr(result, "gap_px", None),
-                      float(result.background_dn), float(result.peak_dn))
+                      float(result.background_dn), float(result.peak_dn), quantum_dn)
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,8 +184,8 @@ class BarFit:
         """JSON-ready: the parameters, and per profile the model's figures."""
         return {"stages": self.stages, "reduced_chi_square": self.reduced_chi_square,
                 "confidence": self.confidence, "parameters": [p.to_dict() for p in self.parameters],
-                "profiles": [{"source": s, "normal_angle_deg": a, "mtf_nyquist": m, "mtf_nyquist_ci": list(ci),
-                              "mtf50_cy_px": f, "mtf50_ci_cy_px": list(fci)}
+                "profiles": [{"source": s, "normal_angle_deg": a, "mtf_nyquist": m, "mtf_nyquist_ci": [ci.low, ci.high],
+                              "mtf50_cy_px": f, "mtf50_ci_cy_px": [fci.low, fci.high]}
                              for s, a, m, ci, f, fci in zip(self.sources, self.normal_angles_deg, self.mtf_nyquist,
                                                             self.mtf_nyquist_ci, self.mtf50_cy_px,
                                                             self.mtf50_ci_cy_px)],
