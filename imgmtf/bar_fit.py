@@ -35,10 +35,20 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width=None, gap=No
         takes them (a bar's width is read off its profile when None).
     stages : str, optional
         The stages fitted (default "optics,detector").
-    band, roi, gsd_m, force, transfer, saturation
-        As for :func:`imgmtf.fit_sensor`.
+    band : int, optional
+        1-based band of multi-band files.
+    roi : (int, int, int, int), optional
+        (x, y, width, height) window read from every file, px.
+    gsd_m : float, optional
+        The pixel, m (default the files', else 1: parameters in px).
     confidence : float, optional
         Of the intervals, in (0, 1).
+    force : bool, optional
+        Measure a file's target even where a quality check fails.
+    transfer : str, optional
+        How the stored values relate to light ("linear", "srgb", "gamma:G").
+    saturation : (float, float), optional
+        DN the sensor records (default an integer file's type range).
 
     Returns
     -------

@@ -77,7 +77,7 @@ def test_the_same_chips_as_one_bar_give_no_number(width, gap):
 def test_one_bar_through_a_blur_is_never_two():
     x = np.linspace(-10.0, 10.0, 801)
     for sigma in (0.3, 0.6):
-        def esf(d):
+        def esf(d, sigma=sigma):
             return 0.5 * (1.0 + erf(d / (sigma * np.sqrt(2.0))))
         for width in (0.3, 1.0, 2.0, 4.0, 8.0):
             profile = bar_response(x, esf, width)

@@ -13,7 +13,6 @@ from .files import check_figure_file, check_output_file, save_figure
 from .options import FiniteFloat, length_option, parse_rois, reading_options
 from .tables import print_fit
 
-
 #: the kinds fit takes: those of the 1-D pipeline (points have their own)
 FIT_KINDS = tuple(name for name, kind in KINDS.items() if kind.measuring is not None)
 #: what fit does with edges only (bars' fit takes the stages, the files and how to read them)
@@ -56,8 +55,8 @@ EDGE_ONLY = ("sensor_path", "hold", "out_path", "plot_path", "campaign")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
 @campaign_options
-def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, recursive, force, saturation, transfer, confidence,
-        out_path, fmt, plot_path, campaign, acquired, platform, instrument, band_name):
+def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, recursive, force, saturation,
+        transfer, confidence, out_path, fmt, plot_path, campaign, acquired, platform, instrument, band_name):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model.  With
@@ -169,7 +168,8 @@ def _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, satu
     click.echo(f"stages: {result.stages}   reduced chi-square {result.reduced_chi_square:.2f}")
     for p in result.parameters:
         error = f" +- {p.standard_error:.4g}" if p.status == "fitted" else ""
-        click.echo(f"  {p.stage}.{p.name} = {p.value:.4g}{error} {p.unit}  ({p.status}{': ' + p.note if p.note else ''})")
+        note = f": {p.note}" if p.note else ""
+        click.echo(f"  {p.stage}.{p.name} = {p.value:.4g}{error} {p.unit}  ({p.status}{note})")
     confidence_pct = f"{100 * result.confidence:g} %"
     for source, angle, m, ci, f50 in zip(result.sources, result.normal_angles_deg, result.mtf_nyquist,
                                          result.mtf_nyquist_ci, result.mtf50_cy_px):

@@ -58,7 +58,6 @@ HINTS = (
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
     Hint(SCAN, "not-an-edge", "--target pulse measures bars"),
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
-    Hint(SCAN, "double-bar", "imgmtf measure --target double-bar --pulse-width W --gap G measures them"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and

@@ -161,13 +161,14 @@ class DoubleBarKind(PulseKind):
     profile = gate.BAR_PROFILE
 
     def __init__(self, width_px: float, gap_px: float):
-        self.width_px = check_width(width_px)
+        self.bar_px: float = check_width(width_px)
+        self.width_px = self.bar_px             # what the bar's seed reads
         self.gap_px = check_gap(gap_px)
 
     @property
     def span_px(self) -> float:
         """The pair's whole width, outer side to outer side, px."""
-        return 2.0 * self.width_px + self.gap_px
+        return 2.0 * self.bar_px + self.gap_px
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
         background_sides = outer_samples(d, half_range, BACKGROUND_FRACTION)
@@ -191,7 +192,7 @@ class DoubleBarKind(PulseKind):
         area = float(np.sum(prf01[np.abs(grid) <= self._core(h10)]) * (grid[1] - grid[0]))
         return Shape(0.0, h10, float(background), float(background + sign * height),
                      min(1.5 * h10 + 1.0, half_range - 1.0),
-                     {"width_px": self.width_px, "gap_px": self.gap_px, "width_estimated": False,
+                     {"width_px": self.bar_px, "gap_px": self.gap_px, "width_estimated": False,
                       "prf01": prf01, "sign": sign, "area_px": area, "h10": h10,
                       "background_sides": background_sides})
 
@@ -202,7 +203,7 @@ class DoubleBarKind(PulseKind):
         return self._core(shape.scale_px, factor)
 
     def divisor(self, step, transfer, shape):
-        return with_transfer(lambda f: pair_transfer(f, self.width_px, self.gap_px), transfer)
+        return with_transfer(lambda f: pair_transfer(f, self.bar_px, self.gap_px), transfer)
 
     def peak_mask(self, s, shape):
         return np.abs(s - shape.centre) <= max(0.5 * self.span_px, 0.5)
@@ -269,7 +270,7 @@ class DoubleBarEstimator:
             m = run(kind, image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
                     dtype=dtype, track_azimuth_deg=track_azimuth_deg)
         extra = m.shape.extra
-        transfer_nyquist = float(pair_transfer(NYQUIST, kind.width_px, kind.gap_px))
+        transfer_nyquist = float(pair_transfer(NYQUIST, kind.bar_px, kind.gap_px))
         fields = m.result_fields()
         warnings = list(m.warnings)
         measured = float(fields["mtf_nyquist"])
@@ -278,13 +279,13 @@ class DoubleBarEstimator:
             from .fit.bars import BarProfile, fit_bars
             samples = m.estimate.samples
             profile = BarProfile("the double bar", samples.distance_px - m.shape.centre, samples.values_dn,
-                                 float(fields["normal_angle_deg"]), kind.width_px, kind.gap_px,
+                                 float(fields["normal_angle_deg"]), kind.bar_px, kind.gap_px,
                                  float(m.shape.low), float(m.shape.high), m.chip.quantum_dn)
             fitted = fit_bars([profile], stages=self.stages, confidence=self.settings.intervals.confidence)
             fields.update(mtf_nyquist=fitted.mtf_nyquist[0], mtf_nyquist_ci=fitted.mtf_nyquist_ci[0])
             if not math.isfinite(fields["mtf50_cy_px"]):
                 fields.update(mtf50_cy_px=fitted.mtf50_cy_px[0], mtf50_ci_cy_px=fitted.mtf50_ci_cy_px[0])
-            warnings.append(f"the pair's transfer is {transfer_nyquist:+.2f} at Nyquist (below "
+            warnings.append(f"the pair's transfer at Nyquist is {abs(transfer_nyquist):.2f} in modulus (below "
                             f"{MODEL_BELOW_TRANSFER}): MTF at Nyquist read off the sensor model "
                             f"({fitted.stages}) fitted to the profile, as Storey did")
             warnings += fitted.warnings
@@ -292,9 +293,9 @@ class DoubleBarEstimator:
             warnings.append(f"the pair's transfer falls below {MIN_TRANSFER} near Nyquist: masked (NaN)")
         return DoubleBarResult(
             **fields, method=self.settings.method,
-            params={**m.params, "pulse_width_px": kind.width_px, "gap_px": kind.gap_px},
+            params={**m.params, "pulse_width_px": kind.bar_px, "gap_px": kind.gap_px},
             polarity="bright" if extra["sign"] > 0 else "dark", warnings=tuple(warnings),
-            pulse_width_px=kind.width_px, gap_px=kind.gap_px, pair_transfer_nyquist=transfer_nyquist,
+            pulse_width_px=kind.bar_px, gap_px=kind.gap_px, pair_transfer_nyquist=transfer_nyquist,
             model_fitted=fitted is not None, measured_mtf_nyquist=measured,
             model=fitted, prf_x_px=m.profile.grid, prf=extra["prf01"],
             prf_fwhm_px=fwhm(m.profile.grid, extra["prf01"]), background_dn=float(m.shape.low),
@@ -318,8 +319,24 @@ def measure_double_bar(image: ArrayLike, *, width_px: float, gap_px: float,
     gap_px : float
         The gap between the bars, their near sides' distance along the
         normal, px (their centres lie ``width_px + gap_px`` apart).
-    roi, mask, method, gsd_m, saturation, force, track_azimuth_deg, dtype
-        As for :func:`imgmtf.measure_pulse`.
+    roi : (int, int, int, int), optional
+        (x, y, width, height) crop, px.
+    mask : ndarray of bool, optional
+        Of the image's shape: True for the pixels that belong to the chip.
+    method : str, optional
+        "msg" (default), "sliding", "spline" or "iso".
+    gsd_m : float, optional
+        Ground sample distance (m), to report cycles/m and metres.
+    saturation : (float, float), optional
+        (low, high) DN the sensor records (default an integer image's type
+        range).
+    force : bool, optional
+        Measure even when a quality check fails, each failure a warning.
+    track_azimuth_deg : float or None, optional
+        The ground track's direction, degrees clockwise from the image's
+        up (0, the default: rows along track); None when unknown.
+    dtype : numpy dtype, optional
+        The type the values were stored as, when ``image`` is a copy.
     stages : str, optional
         The sensor model's stages fitted where the pair's transfer is near
         zero at Nyquist (default "optics,detector"; "auto" lets the data
