@@ -36,7 +36,7 @@ _LAZY = {
     "PointsEstimator": "estimate.mtf2d.estimator", "PointArray": "sensor.points", "render_points": "sensor.points",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
-    "fit_sensor": "sensor_fit", "SensorFit": "estimate.fit", "FitRecord": "estimate.fit.record",
+    "fit_sensor": "sensor_fit", "fit_bar_files": "bar_fit", "SensorFit": "estimate.fit", "FitRecord": "estimate.fit.record",
     "read_fit_record": "estimate.fit.record",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records", "measure_file": "batch", "MeasureSettings": "measure_settings",
