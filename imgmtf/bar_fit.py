@@ -18,7 +18,8 @@ from .kinds import get_kind
 Roi = tuple[int, int, int, int]
 
 
-def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width=None, gap=None,
+def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width: tuple[float, str] | float | str | None = None,
+                  gap: tuple[float, str] | float | str | None = None,
                   stages: str | None = "optics,detector", band: int | None = None, roi: Roi | None = None,
                   gsd_m: float | None = None, confidence: float = 0.95, force: bool = False,
                   transfer: str = "linear", saturation: tuple[float, float] | None = None) -> BarFit:
@@ -81,7 +82,10 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width=None, gap=No
         raise ParameterError(f"the bars' fit takes targets with a width, not a {target}")
     if not paths:
         raise ParameterError("no bars to fit")
-    settings = MeasureSettings(target, band=band, roi=roi, pulse_width=pulse_width, gap=gap,
+    from .inputs import parse_length
+    settings = MeasureSettings(target, band=band, roi=roi,
+                               pulse_width=None if pulse_width is None else parse_length(pulse_width),
+                               gap=None if gap is None else parse_length(gap),
                                intervals=Intervals("none"), force=force, saturation=saturation, transfer=transfer)
     profiles, gsd = [], gsd_m
     for path in paths:
