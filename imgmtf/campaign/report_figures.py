@@ -66,9 +66,9 @@ class Figures:
         # the page's copy is the file scaled down, not the figure drawn a
         # second time: drawing (layout, ticks) is most of a report's time
         with Image.open(path) as full:
-            size = tuple(round(n * EMBED_DPI / FILE_DPI) for n in full.size)
+            width, height = (round(n * EMBED_DPI / FILE_DPI) for n in full.size)
             buffer = io.BytesIO()
-            full.resize(size, Image.Resampling.LANCZOS).save(buffer, format="png", optimize=True)
+            full.resize((width, height), Image.Resampling.LANCZOS).save(buffer, format="png", optimize=True)
         return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii"), \
             path.relative_to(self.out_dir).as_posix()
 
