@@ -111,6 +111,9 @@ def test_narrow_bar_width_cannot_be_estimated():
 
 def test_a_zero_the_noise_made_is_no_width_and_the_refusal_says_what_it_leaves_open():
     from scipy.optimize import brentq
+
+    from imgmtf.estimate.pulse import ZERO_EVIDENCE_SD
+    assert ZERO_EVIDENCE_SD == 2.5
     x = np.arange(-16, 16.0001, 0.05)
     sigma, ripple, f_ripple, envelope, noise = 0.6, 0.0024, 0.85, 4.0, 0.002
 
@@ -125,8 +128,8 @@ def test_a_zero_the_noise_made_is_no_width_and_the_refusal_says_what_it_leaves_o
     with pytest.raises(UnsuitableTargetError, match="cannot be told from the noise") as info:
         estimate_width(x, prf, noise)
     assert info.value.reason == "bar-width"
-    # the widest bar the noise could hide: where the spectrum falls to 3 sd of its noise, noise * sqrt(L / 2)
-    f_low = brentq(lambda f: spectrum(f) - 3 * noise * math.sqrt(x.size * 0.05 / 2), 0.5, zero)
+    # the widest bar the noise could hide: where the spectrum falls to 2.5 sd of its noise, noise * sqrt(L / 2)
+    f_low = brentq(lambda f: spectrum(f) - ZERO_EVIDENCE_SD * noise * math.sqrt(x.size * 0.05 / 2), 0.5, zero)
     widest, line, top = (float(v) for v in re.search(
         r"up to ([\d.]+) px wide, which puts the MTF at Nyquist anywhere from about ([\d.]+) \(a line\) to "
         r"([\d.]+)", str(info.value)).groups())

@@ -41,7 +41,7 @@ RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpol
 ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
 ZERO_SET_STEP_CY_PX = 0.02       # ...on this grid (its crossings interpolated)
 MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
-ZERO_EVIDENCE_SD = 3.0          # the spectrum beyond a read zero must average this many sd below nil
+ZERO_EVIDENCE_SD = 2.5          # the spectrum beyond a read zero must average this many sd below nil
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
@@ -454,7 +454,7 @@ def estimate_width(grid: np.ndarray, prf01: np.ndarray, noise_per_px: float = 0.
             f"the bar width cannot be told from the noise: its spectrum's zero at {zero:.3f} cy/px "
             f"({1 / zero:.2f} px) has no negative lobe beyond it (its mean to "
             f"{min(2 * zero, MAX_ZERO_SEARCH_CY_PX):.2f} cy/px is {lobe_sd:+.1f} sd, "
-            f"{-ZERO_EVIDENCE_SD:.0f} needed) and may be the noise's, so "
+            f"{-ZERO_EVIDENCE_SD:g} needed) and may be the noise's, so "
             f"{_width_range(grid, prf01, f, real, cosines, noise_per_px)}; give its width", reason="bar-width")
     return float(1.0 / zero)
 
