@@ -58,7 +58,9 @@ def sharpened_edge(sigma, kernel, noise, seed=1, shape=(100, 100)):
     (0.5, laplacian_kernel(0.3), 10.0),              # 3 x 3, true peak 1.11
     (0.5, unsharp_kernel(5, 1.0, 1.0), 0.0),         # 5 x 5, true peak 1.18
     (0.4, unsharp_kernel(3, 1.0, 10.0), 0.0),        # 3 x 3 box, true peak 1.23 on a sharp edge: its rows'
-])                                                   # locations swing 0.3 px with their phase, and are straight
+                                                     # locations swing 0.3 px with their phase, and are straight
+    (0.4, unsharp_kernel(5, 0.8, 1.0), 0.0),         # 5 x 5, true peak 1.18 on a sharp edge: the rows' Fermi
+])                                                   # fits collapse to steps (their width is held)
 def test_a_sharpened_product_is_measured_with_its_peak_and_a_note(sigma, kernel, noise):
     chip, truth = sharpened_edge(sigma, kernel, noise)
     f = np.arange(0, 1, 0.001)
