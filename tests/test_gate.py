@@ -345,3 +345,16 @@ def test_block_jumps_are_told_from_the_locators_bias_with_the_phase():
     assert compression(1 / 24, 0.0).passed
     assert compression(1 / 24, blocks).failed
     assert compression(0.25, blocks, bias=0.0).failed
+
+
+def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
+    # an MTF that is nowhere finite is not below 1
+    check = gate.mtf_excess_check(lambda f: np.full(np.shape(f), np.nan), lambda f: np.zeros(np.shape(f)), 0.5)
+    assert check.outcome == "not-run" and not check.failed
+    # 30 samples each side spread 1 per 0.2 px over 6 px: no 1-px band holds 10, no second feature looked for
+    d = np.r_[-np.arange(3.0, 9.0, 0.2), np.arange(3.0, 9.0, 0.2)]
+    values = np.where(d < 0, 200.0, 1200.0)
+    checks = gate.side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
+    second = [c for c in checks if c.reason == "two-targets"]
+    assert len(second) == 2 and all(c.outcome == "not-run" for c in second)
+    assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")
