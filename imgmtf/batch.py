@@ -24,6 +24,7 @@ from .io import open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
 from .records import Record, utc_now
+from .vectors import Unplaced, VectorROIs
 
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
@@ -148,21 +149,51 @@ def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: s
     # what the file's reading adds to its first record's warnings (and to its figure's count of them)
     skipped_note = ([f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured"]
                     if skipped else [])
+    try:
+        windows = _windows(info, settings)
+    except Exception as exc:
+        return [settings.failed(path, settings.band, exc, run_utc)]
     records = []
     for index, band in enumerate(bands):
-        file_notes = skipped_note if index == 0 else []
-        try:
-            raster = file.read(band, window=settings.roi)
-            result = measure_raster(raster, settings)
-            # one record per result, or per direction of a kind that measures several (points)
-            summaries = result.summaries(curves=True)
-        except Exception as exc:
-            failed = settings.failed(path, band, exc, run_utc)
-            records.append(failed.with_(figures={"warnings": file_notes}) if file_notes else failed)
-            continue
-        records.extend(_band_records(file, band, len(bands), raster, result, summaries, file_notes, settings,
-                                     plot_path, run_utc))
+        for feature in windows:
+            file_notes = skipped_note if index == 0 and feature is windows[0] else []
+            records.extend(_window_records(file, band, len(bands), feature, file_notes, settings, plot_path,
+                                           run_utc))
     return records
+
+
+def _windows(info, settings: MeasureSettings) -> list:
+    """What is read of a file: the settings' pixel window (or the whole
+    image), or each feature of a vector layer's window on it, or why that
+    feature has none (an error, its record's)."""
+    if isinstance(settings.roi, VectorROIs):
+        return settings.roi.windows(info)
+    return [None]
+
+
+def _window_records(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc) -> list[Record]:
+    """The records of one band read through one window: the settings' own
+    (``feature`` None), or a vector feature's (with its attributes), or the
+    error of a feature with no window."""
+    path = file.path
+    fields = {} if feature is None else {"site": feature.record_fields()}
+    if isinstance(feature, Unplaced):
+        return [settings.failed(path, band, feature.error, run_utc, **fields)]
+    window = settings.roi if feature is None else feature.window
+    notes = [*file_notes, *(feature.notes() if feature is not None else [])]
+    try:
+        raster = file.read(band, window=window)
+        result = measure_raster(raster, settings)
+        # one record per result, or per direction of a kind that measures several (points)
+        summaries = result.summaries(curves=True)
+    except Exception as exc:
+        failed = settings.failed(path, band, exc, run_utc, **fields)
+        return [failed.with_(figures={"warnings": notes}) if notes else failed]
+    if feature is not None and plot_path:
+        plot_path = _feature_plot_path(plot_path, feature.fid)
+    return [r.with_(**fields) if fields else r
+            for r in _band_records(file, band, n_bands, raster, result, summaries, notes, settings, plot_path,
+                                   run_utc)]
 
 
 def _band_records(file, band, n_bands, raster, result, summaries, file_notes, settings, plot_path, run_utc):
@@ -250,6 +281,14 @@ def plot_paths(paths, plot_dir: str) -> list[str]:
         suffix = f"_{seen[stem]}" if seen[stem] > 1 else ""
         out.append(str(folder / f"{stem}{suffix}_mtf.png"))
     return out
+
+
+def _feature_plot_path(plot_path: str, fid: str) -> str:
+    """A feature's figure: the file's with ``_f<id>`` before its suffix."""
+    p = Path(plot_path)
+    stem = p.name[:-len("_mtf.png")] if p.name.endswith("_mtf.png") else p.stem
+    tail = "_mtf.png" if p.name.endswith("_mtf.png") else p.suffix
+    return str(p.with_name(f"{stem}_f{fid}{tail}"))
 
 
 def _band_plot_path(plot_path: str, band, n_bands: int) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .errors import ParameterError
 from .estimate.intervals import Intervals, as_intervals
@@ -14,6 +14,7 @@ from .inputs import check_width, parse_length
 from .kinds import get_kind
 from .records import Record
 from .transfer import parse_transfer
+from .vectors import VectorROIs, as_rois
 
 if TYPE_CHECKING:
     from .estimate.results import MTFResult
@@ -34,8 +35,12 @@ class MeasureSettings:
     band : int or str, optional
         1-based band, "all" for every band, None (default) for the only
         band or RGB luminance.
-    roi : (int, int, int, int), optional
-        (x, y, width, height) window read from every file, px.
+    roi : (int, int, int, int), str, os.PathLike or VectorROIs, optional
+        (x, y, width, height) window read from every file, px; or a vector
+        layer (a file any GDAL vector driver reads, or
+        :class:`imgmtf.vectors.VectorROIs`) whose polygons and lines,
+        reprojected onto each file, are measured one window each, their
+        attributes in the records (``feature_id``, ``feature``).
     pulse_width : (float, str), float or str, optional
         (value, "px" or "m"), a number of px, a string as the CLI takes it
         ("1.4", "1.4px", "18.3m"), or None (default) to estimate it.
@@ -77,7 +82,7 @@ class MeasureSettings:
     target: str = "edge"
     method: str = "msg"
     band: int | str | None = None
-    roi: tuple[int, int, int, int] | None = None
+    roi: tuple[int, int, int, int] | VectorROIs | None = None
     pulse_width: tuple[float, str] | None = None
     intervals: Intervals = field(default_factory=Intervals)
     force: bool = False
@@ -88,6 +93,7 @@ class MeasureSettings:
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
+        object.__setattr__(self, "roi", as_rois(self.roi))     # a vector file read once, here
         if self.pulse_width is not None:
             object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
         if not get_kind(self.target, "target").has_width and self.pulse_width is not None:
@@ -134,14 +140,15 @@ class MeasureSettings:
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
-        return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
+        roi = self.roi.source if isinstance(self.roi, VectorROIs) else list(self.roi) if self.roi else None
+        return {"intervals": self.intervals.as_dict(), "roi": roi,
                 "band": self.band, "force": self.force,
                 "saturation": list(self.saturation) if self.saturation else None,
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None,
                 **({"point_size": list(self.point_size)} if self.point_size else {})}
 
-    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
+    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str, **fields: Any) -> Record:
         """The error record of a file (or band) that could not be measured.
 
         Parameters
@@ -154,6 +161,9 @@ class MeasureSettings:
             What the measurement raised.
         run_utc : str
             The run's start, UTC, ISO 8601.
+        **fields
+            Other fields of the record (``site``: a vector feature's id and
+            attributes).
 
         Returns
         -------
@@ -161,7 +171,7 @@ class MeasureSettings:
             An error record with these settings, the reason and message.
         """
         return Record.failed(path, band, self.target, self.method, exc, params=self.params(),
-                             run_utc=run_utc)
+                             run_utc=run_utc, **fields)
 
 
 def pulse_width_px(width: tuple[float, str] | None, raster: Raster) -> float | None:

@@ -166,6 +166,26 @@ def parse_rois(ctx, param, values):
     return tuple(parse_roi(ctx, param, v) for v in values or ())
 
 
+def roi_file_option(command):
+    """--roi-file: the polygons or lines of a vector layer as ROIs, shared
+    by measure, scan and fit (the same words in each one's help)."""
+    return click.option("--roi-file", type=click.Path(), metavar="FILE",
+                        help="ROIs from a vector layer (shapefile, GeoJSON, GeoPackage, KML...: any format GDAL "
+                             "reads): each polygon's bounds, or each line widened by 12 px either side, "
+                             "reprojected onto the image; one measurement per feature, its attributes in the "
+                             "record")(command)
+
+
+def read_roi_file(path: str | None):
+    """The features of --roi-file (None without it), read once before any
+    image: a missing or unreadable file, or a layer without a CRS, is an
+    input's error (exit 1, one line naming the file)."""
+    if path is None:
+        return None
+    from ..vectors import VectorROIs
+    return VectorROIs.read(path)
+
+
 def parse_band(ctx, param, value):
     if value is None or value.lower() == "all":
         return value and "all"

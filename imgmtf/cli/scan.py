@@ -18,6 +18,8 @@ from .options import (
     length_option,
     parallel_options,
     parse_pair,
+    read_roi_file,
+    roi_file_option,
     width_refusal,
 )
 from .tables import print_scan
@@ -52,6 +54,7 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
                    "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
+@roi_file_option
 @click.option("--fit-stages", default=DEFAULT_STAGES, show_default=True, metavar="STAGES",
               help="the sensor model's stages fitted to each target's half-edges for its across- and "
                    "along-track MTF (imgmtf fit's names, comma-separated); 'auto' for the simplest of "
@@ -81,7 +84,7 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
+         roi_file, fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
          verbose, progress, interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,
@@ -117,11 +120,12 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         from ..parallel import prestart_workers
         from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
+        rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
         with option_errors():           # a malformed option: exit 2, before any work
             stages = _stages(fit_stages)
             settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
                                     pulse_width=pulse_width, saturation=saturation,
-                                    track_azimuth_deg=track_azimuth,
+                                    track_azimuth_deg=track_azimuth, roi=rois,
                                     intervals=interval_settings(interval_method, replicates, confidence))
             if acquired is not None:
                 from ..campaign.acquisitions import parse_time

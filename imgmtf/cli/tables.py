@@ -38,9 +38,10 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
         band = record["band"]
         first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
     indent = " " * len(first)
+    feature = feature_line(record, indent)
     if record["status"] == "error":
         hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
-        return f"{first} error: {record['error']}{hint}"
+        return f"{first} error: {record['error']}{hint}" + (f"\n{feature}" if feature else "")
     last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
@@ -51,6 +52,8 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
              f"{snr_cell(record.get('snr'))} {num_cell(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
              f"{num_cell(record.get('mtf50_cy_px'), 7, 4)} {num_cell(record.get('fwhm_px'), 6, 3)} "
              f"{num_cell(last, 6, 0 if isinstance(last, int) else 3)}"]
+    if feature:
+        cells.append(feature)
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
@@ -58,6 +61,17 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
         cells.append(f"{indent} error: {record['error']}")
     cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def feature_line(record: dict, indent: str) -> str:
+    """The vector feature a row measured (--roi-file): its id, window and
+    attributes; '' for a row of no feature."""
+    if record.get("feature_id") is None:
+        return ""
+    attributes = ", ".join(f"{k}={v}" for k, v in (record.get("feature") or {}).items())
+    window = record.get("roi")
+    where = f" (x {window[0]}, y {window[1]}, {window[2]} x {window[3]} px)" if window else ""
+    return f"{indent} feature {record['feature_id']}{where}" + (f": {attributes}" if attributes else "")
 
 
 def ground_cell(value) -> str:
@@ -130,6 +144,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
                f"{accepted} accepted")
+    print_features(records, kind)
     shown = records if verbose else [r for r in records if r.ok]
     if shown:
         click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
@@ -173,6 +188,22 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     print_recommended(sections + fitted)
     for path in written:
         click.echo(f"wrote {path}")
+
+
+def print_features(records, kind: str) -> None:
+    """With --roi-file: per feature, its attributes and how many of its
+    candidates were accepted (the scan measured only those crossing one)."""
+    counts: dict[str, list] = {}
+    for record in records:
+        fid = record.site.get("feature_id")
+        if fid is not None:
+            entry = counts.setdefault(fid, [record.site.get("feature") or {}, 0, 0])
+            entry[1] += 1
+            entry[2] += record.ok
+    for fid, (attributes, found, accepted) in counts.items():
+        shown = ", ".join(f"{k}={v}" for k, v in attributes.items())
+        click.echo(f"  feature {fid}{f' ({shown})' if shown else ''}: {plural(found, f'candidate {kind}')} "
+                   f"crossing it, {accepted} accepted")
 
 
 def print_target_fits(fitted) -> None:

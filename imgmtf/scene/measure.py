@@ -36,6 +36,7 @@ from ..parallel import run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments
+from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi
 from .screen import geometry_screen
@@ -139,6 +140,11 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     context = Context(path, info, settings, track, params, run_utc, figures_dir)
     candidates = [(half, verdict or fill_screen(half.fill_fraction) or geometry_screen(half, settings))
                   for half, verdict in _candidates(halves, settings)]
+    features: list = [None] * len(candidates)
+    if settings.roi is not None:        # a vector layer's sites: only the candidates crossing one of them
+        owners = crossing(segment_rows([half.segment for half, _ in candidates]), placed_windows(settings.roi, info))
+        candidates = [c for c, owner in zip(candidates, owners) if owner is not None]
+        features = [owner for owner in owners if owner is not None]
     unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
@@ -152,7 +158,8 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         if not verdict:
             partners = segment_rows(half.partners)
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
-        records.append(_candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict))
+        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
+        records.append(record.with_(site=features[k].record_fields()) if features[k] is not None else record)
     batches = _batches(plans, info, settings.tile_px)
     halves = [half for half, _ in candidates]
 

@@ -7,6 +7,7 @@ from ..errors import ParameterError
 from ..estimate.intervals import Intervals, as_intervals
 from ..inputs import check_number, parse_length
 from ..measure_settings import MeasureSettings
+from ..vectors import VectorROIs, as_rois
 
 MIN_TILE_PX = 256
 MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
@@ -49,6 +50,11 @@ class ScanSettings:
         The ground track's direction, degrees clockwise from up; without
         it, a scene in sensor geometry has its rows along track and a
         map-projected one (with a CRS) an unknown direction.
+    roi : VectorROIs, str or os.PathLike, optional
+        A vector layer (:class:`imgmtf.vectors.VectorROIs`, or a file any
+        GDAL vector driver reads): only the candidates that cross one of
+        its features' windows on the scene are measured, each carrying
+        that feature's id and attributes (``feature_id``, ``feature``).
 
     Raises
     ------
@@ -72,9 +78,13 @@ class ScanSettings:
     intervals: Intervals = field(default_factory=Intervals)
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
+    roi: VectorROIs | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
+        object.__setattr__(self, "roi", as_rois(self.roi))                      # a vector file, read once
+        if self.roi is not None and not isinstance(self.roi, VectorROIs):
+            raise ParameterError(f"a scan's roi is a vector layer (its file or a VectorROIs), got {self.roi!r}")
         if self.pulse_width is not None:
             object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))     # "1.5m", as --pulse-width
         for name in ("min_length_px", "max_length_px"):
@@ -104,4 +114,5 @@ class ScanSettings:
     def as_dict(self) -> dict:
         """The scan's own settings, as records carry them."""
         return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
-                "margin_px": self.margin_px, "tile_px": self.tile_px}
+                "margin_px": self.margin_px, "tile_px": self.tile_px,
+                **({"roi_file": self.roi.source} if self.roi is not None else {})}
