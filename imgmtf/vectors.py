@@ -211,6 +211,22 @@ class VectorROIs:
         "coordinates": ...}``, or objects with ``__geo_interface__``) in
         ``crs``, numbered from 0.
 
+        Parameters
+        ----------
+        geometries : iterable of mapping
+            Polygons, lines (and their multi- forms), GeoJSON-like.
+        crs : str
+            Their coordinate reference system (``"EPSG:4326"``, WKT...).
+        attributes : sequence of mapping, optional
+            One mapping per geometry (default: none).
+        line_buffer_px : float, optional
+            How far a line's window reaches either side of it, px.
+
+        Returns
+        -------
+        VectorROIs
+            The features, source ``"geometries"``.
+
         Raises
         ------
         ParameterError
