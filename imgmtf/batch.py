@@ -17,6 +17,7 @@ import numpy as np
 
 from .atomic import ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
+from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
 from .file_notes import file_notes as raster_notes
 from .inputs import saturation_levels
@@ -203,8 +204,11 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
     records: list[Record] = []
     # what the file says about every number in it, as a scan says it of each edge it accepts
     file_notes = [*file_notes, *raster_notes(raster, settings.transfer, bool(info.alpha_bands))]
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
     for summary in summaries:
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
+        if centre is not None and getattr(result, "geometry", None) is not None:
+            summary.update(field_position(*edge_centre_px(result), result.normal_angle_deg, centre))
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         record = _untrusted_when_forced(record, settings, result.checks)
         if plot_path and records and records[0].plot:
@@ -231,17 +235,42 @@ def _untrusted_when_forced(record: Record, settings: MeasureSettings, checks) ->
 
 def measure_raster(raster, settings: MeasureSettings):
     """The estimate of one raster (a window of the file when ``roi`` is
-    set), its ROI reported in the file's pixel coordinates."""
+    set), its ROI reported in the file's pixel coordinates, its direction
+    named by the image's axes when nothing places a track on it
+    (:func:`in_image_axes`)."""
     estimator = settings.estimator()
     track = settings.track_azimuth_deg
+    image_axes = in_image_axes(raster, track)
     if track is None and not raster.map_projected:
-        track = 0.0                          # sensor geometry: rows along track
+        track = 0.0                          # sensor geometry: rows along track (or the image's axes)
     common = dict(gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
                   saturation=settings.saturation or saturation_levels(raster.dtype))
     result = estimator(raster.data, **settings.target_keywords(raster), **common)
     x0, y0 = raster.origin
     x, y, w, h = result.roi
-    return replace(result, roi=(x + x0, y + y0, w, h))
+    result = replace(result, roi=(x + x0, y + y0, w, h))
+    if image_axes and isinstance(getattr(result, "direction", None), str):
+        from .estimate.geometry import image_axis_label
+        result = replace(result, direction=image_axis_label(result.direction))
+    return result
+
+
+def edge_centre_px(result) -> tuple[float, float]:
+    """The middle of a measured target's fitted line, in the file's pixels
+    (pixel centres at integers): the mean of the rows it was fitted on."""
+    geometry = result.geometry
+    along = float(np.mean(geometry.rows[geometry.kept]))
+    across = geometry.slope * along + geometry.intercept
+    x, y = (along, across) if geometry.transposed else (across, along)
+    return x + result.roi[0], y + result.roi[1]
+
+
+def in_image_axes(raster, track_azimuth_deg: float | None) -> bool:
+    """Whether a file's directions are named by its own axes (horizontal,
+    vertical): it has no georeference (no CRS, no pixel size) and no track
+    azimuth was given, so nothing says where a track lies (a camera's
+    photo; an L0 product says it with ``track_azimuth_deg=0``)."""
+    return track_azimuth_deg is None and not raster.map_projected and raster.gsd_m is None
 
 
 def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, scheduler: str | None = None,

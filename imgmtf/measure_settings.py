@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from .errors import ParameterError
+from .estimate.field import parse_centre
 from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
 from .inputs import check_width, parse_length
@@ -64,6 +65,11 @@ class MeasureSettings:
     point_size : (float, str), float or str, optional
         Each point target's known size (a square's side), as
         ``pulse_width`` takes it; for the kinds that take one (points).
+    optical_centre : (float, float) or str, optional
+        A lens's optical centre (x, y), px (pixel centres at integers), or
+        ``"centre"`` for the image's: each edge's record then says how far
+        from it the edge lies and whether it measures the sagittal or the
+        meridional MTF (:func:`imgmtf.estimate.field.field_position`).
 
     Raises
     ------
@@ -90,6 +96,7 @@ class MeasureSettings:
     track_azimuth_deg: float | None = None
     transfer: str = "linear"
     point_size: tuple[float, str] | None = None
+    optical_centre: tuple[float, float] | str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
@@ -106,6 +113,10 @@ class MeasureSettings:
                 raise ParameterError(f"a point size applies to point targets only, not to a {self.target}")
             if not 0.0 <= self.point_size[0] <= 20.0 and self.point_size[1] == "px":
                 raise ParameterError(f"a point size must be 0 to 20 px, got {self.point_size[0]:g}")
+        if self.optical_centre is not None:
+            centre = self.optical_centre
+            object.__setattr__(self, "optical_centre", parse_centre(centre if isinstance(centre, str)
+                                                                    else ",".join(map(str, centre))))
         check_method(self.method)   # an unknown method fails here, before any file is read
         object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
@@ -146,7 +157,9 @@ class MeasureSettings:
                 "saturation": list(self.saturation) if self.saturation else None,
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None,
-                **({"point_size": list(self.point_size)} if self.point_size else {})}
+                **({"point_size": list(self.point_size)} if self.point_size else {}),
+                **({"optical_centre": self.optical_centre if isinstance(self.optical_centre, str)
+                    else list(self.optical_centre)} if self.optical_centre is not None else {})}
 
     def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str, **fields: Any) -> Record:
         """The error record of a file (or band) that could not be measured.

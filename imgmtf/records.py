@@ -314,7 +314,9 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "mtf_peak", "mtf_peak_cy_px",
     "sharpened",
-    "pulse_width_px", "roi_px", "feature_id", "feature", "warnings", "plot", "params", "imgmtf_version", "run_utc",
+    "pulse_width_px", "roi_px", "feature_id", "feature",
+    "radial_distance_px", "radial_angle_deg", "field_direction",
+    "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
 # each kind of target's own figures (imgmtf.kinds.Kind.record_fields) are
 # columns too: the edge's and the bar's sit among the figures above, where

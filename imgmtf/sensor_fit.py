@@ -120,7 +120,41 @@ def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
     fit = fit_edges([m for m, _ in measured], stages=stages, start=start, hold=hold, gsd_m=gsd_m,
                     confidence=confidence)
     forced = [w for _, warnings in measured for w in warnings]
-    return replace(fit, warnings=(*notes, *forced, *fit.warnings)) if notes or forced else fit
+    fit = replace(fit, warnings=(*notes, *forced, *fit.warnings)) if notes or forced else fit
+    photos = gsd_m is None and all(isinstance(item, (str, os.PathLike)) for item in items) and not any(
+        getattr(getattr(m, "result", None), "gsd_m", 1.0) is not None for m, _ in measured)
+    return in_image_axes(fit) if photos else fit
+
+
+def in_image_axes(fit: SensorFit) -> SensorFit:
+    """A fit of images with no georeference (a camera's files: no CRS, no
+    pixel size) told in their own terms: lengths in px (the model's metres
+    at the 1 m GSD it takes), directions the image's axes (horizontal,
+    across its columns, for the model's across track; vertical for along).
+
+    Parameters
+    ----------
+    fit : SensorFit
+        The fit, with rows taken along track.
+
+    Returns
+    -------
+    SensorFit
+        The same fit, ``pixel_units`` True, its words and units the image's.
+    """
+    from .estimate.geometry import image_axis_label
+
+    def words(text: str) -> str:
+        for track, axis in (("across-track", "horizontal"), ("along-track", "vertical")):
+            text = text.replace(track, axis)
+        return text
+    gsd_note = next((w for w in fit.warnings if w.startswith("no GSD in the inputs")), None)
+    warnings = [words(w) for w in fit.warnings if w is not gsd_note]
+    warnings.append("no GSD in the inputs: lengths are in px and directions the image's axes (horizontal: across "
+                    "its columns); give the GSD for lengths on the ground")
+    parameters = tuple(replace(p, unit="px" if p.unit == "m" else p.unit, note=words(p.note)) for p in fit.parameters)
+    edges = tuple(replace(e, direction=image_axis_label(e.direction)) for e in fit.edges)
+    return replace(fit, parameters=parameters, edges=edges, warnings=tuple(warnings), pixel_units=True)
 
 
 def feature_edges(paths: Sequence[str | os.PathLike], rois: VectorROIs, band: int | None = None

@@ -18,6 +18,7 @@ from .options import (
     interval_options,
     interval_settings,
     length_option,
+    optical_centre_option,
     parallel_options,
     parse_band,
     parse_roi,
@@ -50,6 +51,7 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
 @roi_file_option
+@optical_centre_option
 @click.option("--band", callback=parse_band,
               help="1-based band, or 'all' for one result per band "
                    "(default: the only band, or the luminance of RGB)")
@@ -70,9 +72,9 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @interval_options
 @parallel_options
 @campaign_options
-def measure(paths, kind, pulse_width, point_size, method, roi, roi_file, band, fmt, csv_path, plot_path, plot_dir,
-            recursive, force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
-            workers, scheduler, campaign, acquired, platform, instrument, band_name):
+def measure(paths, kind, pulse_width, point_size, method, roi, roi_file, optical_centre, band, fmt, csv_path,
+            plot_path, plot_dir, recursive, force, saturation, track_azimuth, transfer, progress, interval_method,
+            replicates, confidence, workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder; with --target points, the 2-D PSF and MTF of the
     point targets on it, one row across and one along track.  With --format json, one JSON object per line (JSON
@@ -106,7 +108,7 @@ def measure(paths, kind, pulse_width, point_size, method, roi, roi_file, band, f
             settings = MeasureSettings(kind, method, band, rois, pulse_width,
                                        interval_settings(interval_method, replicates, confidence), force=force,
                                        saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer,
-                                       point_size=point_size)
+                                       point_size=point_size, optical_centre=optical_centre)
         files, repeated = once_each(expand_inputs(paths, recursive))
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")

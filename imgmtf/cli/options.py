@@ -176,6 +176,26 @@ def roi_file_option(command):
                              "record")(command)
 
 
+def parse_optical_centre(ctx, param, value):
+    """Click callback: "X,Y" (px) or "centre" (:func:`imgmtf.estimate.field.parse_centre`)."""
+    if value is None:
+        return None
+    from ..errors import ParameterError
+    from ..estimate.field import parse_centre
+    try:
+        return parse_centre(value)
+    except ParameterError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def optical_centre_option(command):
+    """--optical-centre: sagittal and meridional edges, shared by measure and scan."""
+    return click.option("--optical-centre", callback=parse_optical_centre, metavar="X,Y|centre",
+                        help="a lens's optical centre, px (pixel centres at integers), or 'centre' for the "
+                             "image's: each edge is said sagittal or meridional (its normal across or along "
+                             "the radius from it, as MTF Mapper reports them) with its distance from it")(command)
+
+
 def read_roi_file(path: str | None):
     """The features of --roi-file (None without it), read once before any
     image: a missing or unreadable file, or a layer without a CRS, is an

@@ -54,6 +54,9 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
              f"{num_cell(last, 6, 0 if isinstance(last, int) else 3)}"]
     if feature:
         cells.append(feature)
+    if record.get("radial_distance_px") is not None:
+        cells.append(f"{indent} {record.get('field_direction') or 'at the optical centre'}, "
+                     f"{record['radial_distance_px']:g} px from the optical centre")
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
@@ -99,8 +102,9 @@ def num_cell(value, width: int, decimals: int) -> str:
 
 def print_fit(result) -> None:
     edges = result.edges
+    scale = "no GSD: lengths in px" if result.pixel_units else f"GSD {result.sensor.gsd_m:g} m"
     click.echo(f"fit of {', '.join(s.name for s in result.sensor.stages)} to {len(edges)} edge(s), "
-               f"GSD {result.sensor.gsd_m:g} m; reduced chi-square {result.reduced_chi_square:.3g}")
+               f"{scale}; reduced chi-square {result.reduced_chi_square:.3g}")
     if result.choice is not None:
         tried = "; ".join(f"{'+'.join(c.stages)}: BIC {c.bic:.0f}{', misfit' if c.misfit else ''}"
                           for c in result.choice.candidates)
@@ -116,16 +120,19 @@ def print_fit(result) -> None:
     pct = f"{100 * result.confidence:g}%"
     click.echo(f"{'edge':<32} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
+    axes = {"across": "x", "along": "y"} if result.pixel_units else {}
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
         click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {SHORT_DIRECTIONS.get(e.direction, e.direction):>7} "
-                   f"{e.constrains:>6} {e.mtf_nyquist:7.4f} "
+                   f"{axes.get(e.constrains, e.constrains):>6} "
+                   f"{e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")
     click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
+    names = {"across": "horizontal", "along": "vertical"} if result.pixel_units else {}
     for name, d in result.directions.items():
         lo, hi = d["mtf_nyquist_ci"]
-        click.echo(f"{name:<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
+        click.echo(f"{names.get(name, name):<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
                    f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
     for warning in result.warnings:
         click.echo(f"warning: {warning}")
@@ -206,6 +213,20 @@ def print_features(records, kind: str) -> None:
                    f"crossing it, {accepted} accepted")
 
 
+def print_lens_profile(profile) -> None:
+    """A lens profile's rings: per direction and ring, its edges' median
+    MTF50 and MTF at the profile's frequencies."""
+    x, y = profile.centre_px
+    click.echo(f"lens profile about the optical centre ({x:g}, {y:g}) px: medians per ring of the field")
+    heads = "".join(f" {f'MTF@{f:g}':>9}" for f in profile.frequencies_cy_px)
+    click.echo(f"{'direction':<10} {'ring px':>11} {'edges':>5} {'MTF50':>7}{heads}")
+    click.echo(f"{'':<10} {'':>11} {'':>5} {'cy/px':>7}" + "".join(f" {'':>9}" for _ in profile.frequencies_cy_px))
+    for ring in profile.rings:
+        cells = "".join(f" {num_cell(v, 9, 4)}" for v in ring.mtf)
+        click.echo(f"{ring.field_direction:<10} {f'{ring.inner_px:.0f}-{ring.outer_px:.0f}':>11} {ring.n_edges:>5} "
+                   f"{num_cell(ring.mtf50_cy_px, 7, 4)}{cells}")
+
+
 def print_target_fits(fitted) -> None:
     """The sensor model fitted to each target's half-edges, across and along
     track, and why a fit is not to be trusted (its misfit) or failed."""
@@ -282,7 +303,7 @@ def _mark(row: dict) -> str:
     return "*" if row.get("recommended") else " "
 
 
-SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
+SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along", "horizontal": "horiz", "vertical": "vert"}
 
 MAX_EXAMPLE_IDS = 5
 

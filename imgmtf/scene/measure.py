@@ -28,6 +28,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..atomic import ensure_folder
 from ..errors import ImageContentError, ParameterError
+from ..estimate.field import field_position, resolve_centre
 from ..estimate.geometry import direction_label
 from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
@@ -61,6 +62,13 @@ def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
     if settings.track_azimuth_deg is not None:
         return settings.track_azimuth_deg
     return None if info.crs else 0.0
+
+
+def in_image_axes(info: RasterInfo, settings: ScanSettings) -> bool:
+    """Whether the scene's directions are named by its own axes
+    (horizontal, vertical): no CRS, no pixel size and no track azimuth
+    given (a camera's photo), as :func:`imgmtf.batch.in_image_axes`."""
+    return settings.track_azimuth_deg is None and not info.crs and info.gsd_m is None
 
 
 # -- the scan -------------------------------------------------------------------------
@@ -152,6 +160,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     records: list[Record] = []
     plans: list[Plan] = []
     rounded = _rounded_ends([half.segment for half, _ in candidates])
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
     mapped = _map_ends([half.segment for half, _ in candidates], info)
     for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
         verdict = verdict or _beside_screen(half, clearance)
@@ -159,7 +168,12 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             partners = segment_rows(half.partners)
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
         record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
-        records.append(record.with_(site=features[k].record_fields()) if features[k] is not None else record)
+        if features[k] is not None:
+            record = record.with_(site=features[k].record_fields())
+        if centre is not None:          # where the candidate lies in a lens's field
+            s = half.segment
+            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
+        records.append(record)
     batches = _batches(plans, info, settings.tile_px)
     halves = [half for half, _ in candidates]
 

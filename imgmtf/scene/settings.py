@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..errors import ParameterError
+from ..estimate.field import parse_centre
 from ..estimate.intervals import Intervals, as_intervals
 from ..inputs import check_number, parse_length
 from ..measure_settings import MeasureSettings
@@ -55,6 +56,12 @@ class ScanSettings:
         GDAL vector driver reads): only the candidates that cross one of
         its features' windows on the scene are measured, each carrying
         that feature's id and attributes (``feature_id``, ``feature``).
+    optical_centre : (float, float) or str, optional
+        A lens's optical centre (x, y), px, or ``"centre"`` for the
+        scene's: each candidate is then placed in the field (its distance
+        from the centre, sagittal or meridional:
+        :func:`imgmtf.estimate.field.field_position`), what a lens profile
+        (:func:`imgmtf.scene.lens_profile.lens_profile`) reads.
 
     Raises
     ------
@@ -79,10 +86,15 @@ class ScanSettings:
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
     roi: VectorROIs | None = None
+    optical_centre: tuple[float, float] | str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
         object.__setattr__(self, "roi", as_rois(self.roi))                      # a vector file, read once
+        if self.optical_centre is not None:
+            centre = self.optical_centre
+            object.__setattr__(self, "optical_centre", parse_centre(centre if isinstance(centre, str)
+                                                                    else ",".join(map(str, centre))))
         if self.roi is not None and not isinstance(self.roi, VectorROIs):
             raise ParameterError(f"a scan's roi is a vector layer (its file or a VectorROIs), got {self.roi!r}")
         if self.pulse_width is not None:
@@ -115,4 +127,5 @@ class ScanSettings:
         """The scan's own settings, as records carry them."""
         return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
                 "margin_px": self.margin_px, "tile_px": self.tile_px,
-                **({"roi_file": self.roi.source} if self.roi is not None else {})}
+                **({"roi_file": self.roi.source} if self.roi is not None else {}),
+                **({"optical_centre": self.optical_centre} if self.optical_centre is not None else {})}

@@ -1,0 +1,137 @@
+"""Camera conventions: an image with no georeference and no track is told
+in its own axes (horizontal, vertical) and in px; with an optical centre,
+each edge is sagittal or meridional, and a chart of tilted squares whose
+blur grows across the field gives a lens profile matching its truth."""
+import csv
+import math
+import warnings
+
+import numpy as np
+import pytest
+import rasterio
+from click.testing import CliRunner
+from rasterio.errors import NotGeoreferencedWarning
+
+import imgmtf as im
+from imgmtf.cli import main
+from imgmtf.estimate.field import field_position
+from imgmtf.scene.lens_profile import lens_profile
+from imgmtf.sensor.chart import FieldBlur, square_chart
+
+from conftest import exact_edge_chip, gaussian_pixel_transfer
+
+pytestmark = pytest.mark.filterwarnings(f"ignore::{NotGeoreferencedWarning.__module__}.NotGeoreferencedWarning")
+BLUR = FieldBlur(centre_sigma_px=0.6, sagittal_sigma_px=0.9, meridional_sigma_px=1.5, reference_px=150.0)
+
+
+@pytest.fixture(scope="module")
+def photos(tmp_path_factory):
+    """Two 8-bit PNGs (no georeference): a near-vertical and a near-horizontal edge."""
+    folder = tmp_path_factory.mktemp("photos")
+    paths = []
+    for angle in (6.0, 84.0):
+        chip = exact_edge_chip(gaussian_pixel_transfer(0.6, angle), angle, (64, 64), low=40.0, high=220.0,
+                               noise_std=1.0, seed=int(angle))
+        paths.append(folder / f"edge{angle:g}.png")
+        im.write_png(paths[-1], np.round(chip).astype(np.uint8))
+    return paths
+
+
+def test_a_photo_is_told_in_its_own_axes_and_a_track_azimuth_restores_the_track(photos, tmp_path):
+    vertical_edge, horizontal_edge = photos
+    [record] = im.measure_file(vertical_edge, intervals="none")
+    assert record.get("direction") == "horizontal" and record.get("orientation") == "vertical"
+    assert im.measure_file(horizontal_edge, intervals="none")[0].get("direction") == "vertical"
+    [l0] = im.measure_file(vertical_edge, intervals="none", track_azimuth_deg=0.0)
+    assert l0.get("direction") == "across-track"
+    # a file with a pixel size in metres (imgmtf's chips, L1 products) keeps the track's words
+    chip = tmp_path / "chip.tif"
+    im.write_geotiff(chip, np.round(exact_edge_chip(gaussian_pixel_transfer(0.6, 6.0), 6.0, (64, 64))).astype(
+        np.uint16), gsd_m=2.0)
+    assert im.measure_file(chip, intervals="none")[0].get("direction") == "across-track"
+    result = CliRunner().invoke(main, ["measure", str(vertical_edge), str(horizontal_edge), "--intervals", "none"])
+    assert "horiz" in result.output and "vert" in result.output and "across" not in result.output
+
+
+def test_a_fit_of_photos_is_in_px_and_image_axes(photos, capsys):
+    from imgmtf.cli.tables import print_fit
+    from imgmtf.plot import plot_fit
+    fit = im.fit_sensor(photos, stages="optics,detector", hold="detector")
+    assert fit.pixel_units and {p.unit for p in fit.parameters} == {"px"}
+    assert [e.direction for e in fit.edges] == ["horizontal", "vertical"]
+    assert not any("track" in w for w in fit.warnings)
+    psf = plot_fit(fit).axes[-2]          # the PSF panel (its colour bar is the last axes)
+    assert (psf.get_xlabel(), psf.get_ylabel()) == ("x (px)", "y (px)")
+    print_fit(fit)
+    printed = capsys.readouterr().out
+    assert "no GSD: lengths in px" in printed and "horizontal" in printed
+    assert " m     " not in printed          # no parameter in metres
+
+
+@pytest.mark.parametrize("x, y, normal_deg, expected", [
+    (500.0, 300.0, 0.0, "meridional"),        # right of the centre, normal radial
+    (500.0, 300.0, 90.0, "sagittal"),         # right of it, normal tangential
+    (300.0, 500.0, 95.0, "meridional"),       # below it, normal nearly radial
+    (441.4, 441.4, 45.0 + 44.0, "meridional"),   # on the diagonal, 44 deg off radial
+    (441.4, 441.4, 45.0 + 46.0, "sagittal"),
+])
+def test_sagittal_and_meridional_follow_the_normal_against_the_radius(x, y, normal_deg, expected):
+    place = field_position(x, y, normal_deg, (300.0, 300.0))
+    assert place["field_direction"] == expected
+    assert place["radial_distance_px"] == pytest.approx(math.hypot(x - 300.0, y - 300.0), abs=0.01)
+
+
+def test_measure_places_each_edge_about_the_optical_centre(photos):
+    vertical_edge, _ = photos
+    # the edge runs down the middle of the 64 px chip: (31.5, 31.5)
+    [left] = im.measure_file(vertical_edge, intervals="none", optical_centre=(0.0, 31.5))
+    [above] = im.measure_file(vertical_edge, intervals="none", optical_centre=(31.5, 0.0))
+    assert left.get("field_direction") == "meridional" and above.get("field_direction") == "sagittal"
+    assert left.get("radial_distance_px") == pytest.approx(31.5, abs=0.5)
+    [centred] = im.measure_file(vertical_edge, intervals="none", optical_centre="centre")
+    assert centred.get("field_direction") is None and centred.get("radial_distance_px") < 1.0
+
+
+@pytest.fixture(scope="module")
+def chart_scan(tmp_path_factory):
+    """A 2 x 3 chart of tilted squares, blurred more meridionally than sagittally away from its centre,
+    scanned with the image's centre as the optical centre."""
+    folder = tmp_path_factory.mktemp("chart")
+    chart = square_chart((200, 300), BLUR, grid=(2, 3), side_px=40.0, noise_dn=10.0, seed=1)
+    path = folder / "chart.tif"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, "w", driver="GTiff", width=300, height=200, count=1, dtype="uint16") as out:
+            out.write(np.round(chart).astype(np.uint16)[None])
+    result = CliRunner().invoke(main, ["scan", str(path), "--optical-centre", "centre", "--min-length", "30",
+                                       "--fit-stages", "none", "--intervals", "none", "--out", str(folder / "out")])
+    return result, folder / "out"
+
+
+def test_each_chart_edge_is_placed_and_measured_as_its_truth(chart_scan):
+    result, out = chart_scan
+    assert result.exit_code == 0, result.output
+    with open(out / "targets.csv", newline="") as f:
+        edges = [r for r in csv.DictReader(f) if r["scope"] == "edge"]
+    assert len(edges) == 24 and all(r["status"] == "accepted" for r in edges)
+    for row in edges:       # the generator blurs each edge by the sigma of its place and direction
+        truth = BLUR.mtf50_cy_px(float(row["radial_distance_px"]), row["field_direction"])
+        assert float(row["mtf50_cy_px"]) == pytest.approx(truth, rel=0.01)
+    assert {r["direction"] for r in edges} == {"horizontal", "vertical"}
+
+
+def test_the_chart_gives_a_lens_profile_table_and_figure(chart_scan):
+    result, out = chart_scan
+    assert "lens profile about the optical centre (149.5, 99.5) px" in result.output
+    with open(out / "lens_profile.csv", newline="") as f:
+        rings = list(csv.DictReader(f))
+    outer = {r["field_direction"]: r for r in rings if float(r["outer_px"]) > 120}
+    # far from the centre the meridional blur (1.5 px at 150 px) is wider than the sagittal (0.9 px)
+    assert float(outer["meridional"]["mtf50_cy_px"]) < float(outer["sagittal"]["mtf50_cy_px"]) - 0.05
+    assert float(outer["meridional"]["mtf_at_0.25_cy_px"]) < float(outer["sagittal"]["mtf_at_0.25_cy_px"])
+    assert (out / "lens_profile.png").stat().st_size > 10_000
+
+
+def test_a_lens_profile_needs_edges_placed_in_the_field():
+    with pytest.raises(im.ParameterError, match="optical centre"):
+        lens_profile([im.Record("a.tif", 1, "edge", "msg", "accepted", figures={"mtf50_cy_px": 0.3})])
