@@ -314,7 +314,7 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "mtf_peak", "mtf_peak_cy_px",
     "sharpened",
-    "pulse_width_px", "roi_px", "feature_id", "feature",
+    "pulse_width_px", "roi_px", "feature_id", "feature", "feature_window_px",
     "radial_distance_px", "radial_angle_deg", "field_direction",
     "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )

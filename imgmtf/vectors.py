@@ -83,9 +83,9 @@ class FeatureWindow:
     source: str = ""
 
     def record_fields(self) -> dict[str, Any]:
-        """What its records carry: ``feature_id`` and ``feature`` (the
-        attributes)."""
-        return {"feature_id": self.fid, "feature": dict(self.attributes)}
+        """What its records carry: ``feature_id``, ``feature`` (the
+        attributes) and ``feature_window_px`` (x, y, w, h on the raster)."""
+        return {"feature_id": self.fid, "feature": dict(self.attributes), "feature_window_px": list(self.window)}
 
     def notes(self) -> list[str]:
         """Warnings its measurement carries (a window clipped to the raster)."""

@@ -72,7 +72,7 @@ def feature_line(record: dict, indent: str) -> str:
     if record.get("feature_id") is None:
         return ""
     attributes = ", ".join(f"{k}={v}" for k, v in (record.get("feature") or {}).items())
-    window = record.get("roi")
+    window = record.get("feature_window_px")
     where = f" (x {window[0]}, y {window[1]}, {window[2]} x {window[3]} px)" if window else ""
     return f"{indent} feature {record['feature_id']}{where}" + (f": {attributes}" if attributes else "")
 
@@ -204,12 +204,14 @@ def print_features(records, kind: str) -> None:
     for record in records:
         fid = record.site.get("feature_id")
         if fid is not None:
-            entry = counts.setdefault(fid, [record.site.get("feature") or {}, 0, 0])
+            entry = counts.setdefault(fid, [record.site.get("feature") or {}, 0, 0,
+                                            record.site.get("feature_window_px")])
             entry[1] += 1
             entry[2] += record.ok
-    for fid, (attributes, found, accepted) in counts.items():
+    for fid, (attributes, found, accepted, window) in counts.items():
         shown = ", ".join(f"{k}={v}" for k, v in attributes.items())
-        click.echo(f"  feature {fid}{f' ({shown})' if shown else ''}: {plural(found, f'candidate {kind}')} "
+        where = f" (x {window[0]}, y {window[1]}, {window[2]} x {window[3]} px)" if window else ""
+        click.echo(f"  feature {fid}{where}{f' [{shown}]' if shown else ''}: {plural(found, f'candidate {kind}')} "
                    f"crossing it, {accepted} accepted")
 
 
