@@ -58,7 +58,9 @@ class MeasureSettings:
     track_azimuth_deg : float, optional
         The ground track's direction in the image, degrees clockwise from
         up; None: rows along track for images in sensor geometry, unknown
-        for map-projected ones.
+        for map-projected ones, and for an image with no georeference (no
+        CRS, no pixel size: a photo) its own axes, the directions named
+        "horizontal" and "vertical".
     transfer : str, optional
         How the stored values relate to light, "linear" (as stored), "srgb"
         or "gamma:G" (:mod:`imgmtf.transfer`): linearised before measuring.

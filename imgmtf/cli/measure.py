@@ -67,7 +67,9 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @reading_options
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
-                   "rows along track, as in L0/L1 products; unknown for map-projected files)")
+                   "rows along track for a file with a pixel size in metres, as L1 products; unknown for "
+                   "map-projected files; for an image with no georeference, a photo or an L0 product, its own "
+                   "axes: horizontal, vertical; 0 says its rows are along track)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options

@@ -54,7 +54,9 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
               help="DN range the sensor records (default: an integer file's type range)")
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
-                   "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
+                   "rows along track for a scene in sensor geometry with a pixel size in metres; unknown for a "
+                   "map-projected one; for an image with no georeference, a photo or an L0 product, its own "
+                   "axes: horizontal, vertical; 0 says its rows are along track)")
 @roi_file_option
 @optical_centre_option
 @click.option("--lens-frequencies", metavar="F1,F2,...", default="0.125,0.25", show_default=True,

@@ -233,7 +233,7 @@ def print_target_fits(fitted) -> None:
     """The sensor model fitted to each target's half-edges, across and along
     track, and why a fit is not to be trusted (its misfit) or failed."""
     stages: list[str] = next((r.figures["stages"] for r in fitted if r.figures.get("stages")), [])
-    click.echo(f"fitted per target, across and along track (sensor model: {', '.join(stages) or '-'}; "
+    click.echo(f"fitted per target, {axes_words(fitted)} (sensor model: {', '.join(stages) or '-'}; "
                "misfit p: the smallest p-value of structure in its half-edges' residuals):")
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
@@ -264,7 +264,7 @@ def print_target_fits(fitted) -> None:
 def print_sections(sections) -> None:
     """The 2-D MTF's across- and along-track sections from each target's
     combined directions, under each assumption, and why the chosen one."""
-    click.echo("across and along track without a model (the 2-D MTF's sections from the combined directions, "
+    click.echo(f"{axes_words(sections)} without a model (the 2-D MTF's sections from the combined directions, "
                "under each assumption):")
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'assumption':>10} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6}")
@@ -277,9 +277,18 @@ def print_sections(sections) -> None:
                    f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
                    f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
                    f"{num_cell(r.get('fwhm_px'), 6, 3)}")
-        if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] == "along-track":
+        if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] in ("along-track",
+                                                                                                     "vertical"):
             said.add(key)
             click.echo(f"{'':>11} {r['chosen_assumption']}: {r.get('assumption_because')}")
+
+
+def axes_words(rows) -> str:
+    """How a scan's summaries name their two directions: the image's axes
+    for a camera's image (horizontal, vertical), else the track's."""
+    if any(r.figures.get("direction") in ("horizontal", "vertical") for r in rows):
+        return "horizontal and vertical"
+    return "across and along track"
 
 
 def print_recommended(rows) -> None:
@@ -288,7 +297,8 @@ def print_recommended(rows) -> None:
     if not any(r.figures.get("recommended") is not None for r in rows):
         return
     if any(r.figures.get("recommended") for r in rows):
-        click.echo("* the across/along row to quote per target and direction: the model's fit when it fits and "
+        pair = "horizontal/vertical" if axes_words(rows).startswith("horizontal") else "across/along"
+        click.echo(f"* the {pair} row to quote per target and direction: the model's fit when it fits and "
                    "agrees with the sections, else the sections' assumption")
     directions: dict[tuple, list] = {}
     for r in rows:

@@ -49,8 +49,10 @@ class ScanSettings:
         range).
     track_azimuth_deg : float, optional
         The ground track's direction, degrees clockwise from up; without
-        it, a scene in sensor geometry has its rows along track and a
-        map-projected one (with a CRS) an unknown direction.
+        it, a scene in sensor geometry has its rows along track, a
+        map-projected one (with a CRS) an unknown direction, and one with
+        no georeference (no CRS, no pixel size: a photo) its own axes
+        ("horizontal", "vertical").
     roi : VectorROIs, str or os.PathLike, optional
         A vector layer (:class:`imgmtf.vectors.VectorROIs`, or a file any
         GDAL vector driver reads): only the candidates that cross one of
