@@ -257,11 +257,12 @@ class VectorROIs:
         Raises
         ------
         ParameterError
-            The raster has no CRS: the layer cannot be placed on it.
+            The raster has no CRS: the layer cannot be placed on it
+            (reason ``no-crs``).
         """
         if not info.crs:
             raise ParameterError(f"{info.path}: the image has no coordinate reference system, so the features "
-                                 f"of {self.source} cannot be placed on it (measure it with --roi X,Y,W,H)")
+                                 f"of {self.source} cannot be placed on it", reason="no-crs")
         from rasterio.warp import transform_geom
         to_pixels = ~info.transform
         out: list[FeatureWindow | Unplaced] = []

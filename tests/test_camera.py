@@ -118,6 +118,9 @@ def test_each_chart_edge_is_placed_and_measured_as_its_truth(chart_scan):
         truth = BLUR.mtf50_cy_px(float(row["radial_distance_px"]), row["field_direction"])
         assert float(row["mtf50_cy_px"]) == pytest.approx(truth, rel=0.01)
     assert {r["direction"] for r in edges} == {"horizontal", "vertical"}
+    # the tables' words are the image's too, the chosen assumption still said beneath its rows
+    assert "horizontal and vertical without a model" in result.output and "across and along" not in result.output
+    assert "bracket: two orientations cannot tell" in result.output
 
 
 def test_the_chart_gives_a_lens_profile_table_and_figure(chart_scan):

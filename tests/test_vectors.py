@@ -132,12 +132,16 @@ def test_a_layer_or_raster_that_cannot_be_matched_is_a_one_line_error(scene, tmp
     assert {"missing": "no such vector file", "not a layer": "cannot read it as a vector layer",
             "no CRS on the layer": "no coordinate reference system",
             "no CRS on the raster": "the image has no coordinate reference system"}[case] in message
+    if case == "no CRS on the raster":
+        assert "(--roi X,Y,W,H measures a window in pixels)" in message
 
 
 def test_roi_and_roi_file_together_are_a_usage_error(scene, tmp_path):
     layer = write_layer(tmp_path / "sites.geojson", SITES)
     result = CliRunner().invoke(main, ["measure", str(scene), "--roi", "0,0,64,64", "--roi-file", str(layer)])
     assert result.exit_code == 2 and "not both" in result.output
+    bars = CliRunner().invoke(main, ["fit", str(scene), "--target", "pulse", "--roi-file", str(layer)])
+    assert bars.exit_code == 2 and "--roi-file gives the windows of edges" in bars.output
 
 
 def test_scan_measures_only_the_candidates_crossing_a_feature(scene, tmp_path):

@@ -133,8 +133,8 @@ def lens_profile(records: Iterable[Record], frequencies_cy_px: Sequence[float] =
         raise ParameterError(f"a lens profile needs at least one ring, got {rings!r}")
     placed = [r for r in records if r.ok and r.get("field_direction") in (SAGITTAL, MERIDIONAL)]
     if not placed:
-        raise ParameterError("no accepted edge placed in the field: scan with an optical centre "
-                             "(optical_centre=..., --optical-centre) a chart whose edges are accepted")
+        raise ParameterError("no accepted edge has a place in a lens's field: the scan was given no optical "
+                             "centre, or accepted no edge")
     edges = tuple(sorted((_edge(r, frequencies) for r in placed), key=lambda e: e.radius_px))
     outer = max(e.radius_px for e in edges) * (1 + 1e-9)
     bounds = np.linspace(0.0, outer, rings + 1)
