@@ -187,6 +187,11 @@ def _window_records(file, band, n_bands, feature, file_notes, settings, plot_pat
         result = measure_raster(raster, settings)
         # one record per result, or per direction of a kind that measures several (points)
         summaries = result.summaries(curves=True)
+        if in_image_axes(raster, settings.track_azimuth_deg):       # each direction, a points record's too
+            from .estimate.geometry import image_axis_label
+            for summary in summaries:
+                if isinstance(summary.get("direction"), str):
+                    summary["direction"] = image_axis_label(summary["direction"])
     except Exception as exc:
         failed = settings.failed(path, band, exc, run_utc, **fields)
         return [failed.with_(figures={"warnings": notes}) if notes else failed]

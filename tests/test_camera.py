@@ -138,3 +138,13 @@ def test_the_chart_gives_a_lens_profile_table_and_figure(chart_scan):
 def test_a_lens_profile_needs_edges_placed_in_the_field():
     with pytest.raises(im.ParameterError, match="optical centre"):
         lens_profile([im.Record("a.tif", 1, "edge", "msg", "accepted", figures={"mtf50_cy_px": 0.3})])
+
+
+def test_a_photo_of_point_targets_gives_a_horizontal_and_a_vertical_record(tmp_path):
+    from imgmtf.sensor.points import PointArray, render_points
+    from imgmtf.sensor.stages import Detector, GaussianOptics
+    sensor = im.Sensor(stages=[GaussianOptics(0.45, 0.55), Detector(1.0, 1.0)])
+    chip = render_points(sensor, PointArray(3, 3, spacing_px=12.0), 40, noise_std_dn=3.0, seed=2)
+    im.write_png(tmp_path / "points.png", chip.image.astype(np.uint16))
+    records = im.measure_file(tmp_path / "points.png", target="points", intervals="none")
+    assert [r.get("direction") for r in records] == ["horizontal", "vertical"]
