@@ -220,7 +220,7 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
             record = record.with_(plot=records[0].plot)
         elif plot_path:
             record = with_figure(record, functools.partial(_measurement_figure, result, raster,
-                                                           summary["warnings"]),
+                                                           summary["warnings"], _place(summary)),
                                  _band_plot_path(plot_path, band, n_bands))
         records.append(record)
     return records
@@ -332,13 +332,24 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result, raster, warnings):
-    """The measurement figure, titled with the file (and band), counting
-    every warning its record carries (the file's own among them), with the
-    true MTF when the file is a chip imgmtf simulated."""
+def _place(summary: dict) -> str:
+    """Where an edge lies in a lens's field, as its figure's title says it
+    (``""`` without an optical centre)."""
+    if summary.get("radial_distance_px") is None:
+        return ""
+    return (f"{summary.get('field_direction') or 'at the optical centre'}, "
+            f"{summary['radial_distance_px']:g} px from the optical centre")
+
+
+def _measurement_figure(result, raster, warnings, place: str = ""):
+    """The measurement figure, titled with the file (and band) and the
+    edge's place in a lens's field when asked (``place``), counting every
+    warning its record carries (the file's own among them), with the true
+    MTF when the file is a chip imgmtf simulated."""
     from .kinds import get_kind
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
+    title += f": {place}" if place else ""
     kind = get_kind(result.target)
     if kind.figure is not None:             # a kind with a figure of its own (points: the 2-D PSF and MTF)
         return kind.load("figure")(result, raster.data, truth=kind_truth(raster), title=title, warnings=warnings)

@@ -148,3 +148,12 @@ def test_a_photo_of_point_targets_gives_a_horizontal_and_a_vertical_record(tmp_p
     im.write_png(tmp_path / "points.png", chip.image.astype(np.uint16))
     records = im.measure_file(tmp_path / "points.png", target="points", intervals="none")
     assert [r.get("direction") for r in records] == ["horizontal", "vertical"]
+
+
+def test_the_measurement_figure_says_where_the_edge_lies_in_the_field(photos, monkeypatch, tmp_path):
+    import imgmtf.batch
+    drawn = []
+    monkeypatch.setattr(imgmtf.batch, "with_figure", lambda record, draw, path: drawn.append(draw()) or record)
+    im.measure_file(photos[0], plot_path=str(tmp_path / "edge.png"), intervals="none", optical_centre=(0.0, 31.5))
+    title = drawn[0]._suptitle.get_text()
+    assert "meridional, 31.5 px from the optical centre" in title and "horizontal" in title
