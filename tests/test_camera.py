@@ -159,3 +159,12 @@ def test_the_measurement_figure_says_where_the_edge_lies_in_the_field(photos, mo
     im.measure_file(photos[0], plot_path=str(tmp_path / "edge.png"), intervals="none", optical_centre=(0.0, 31.5))
     title = drawn[0]._suptitle.get_text()
     assert "meridional, 31.5 px from the optical centre" in title and "horizontal" in title
+
+
+@pytest.mark.parametrize("args, words", [
+    (["measure", "--optical-centre", "1,x"], "expected X,Y (two numbers, px) or 'centre'"),
+    (["scan", "--optical-centre", "centre", "--lens-frequencies", "0,2"], "must lie in (0, 1] cy/px"),
+])
+def test_malformed_camera_options_are_usage_errors(args, words):
+    result = CliRunner().invoke(main, [*args, "data/edge_16bit.tif"])
+    assert result.exit_code == 2 and words in result.output
