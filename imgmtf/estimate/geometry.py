@@ -193,6 +193,8 @@ DIRECTION_TOLERANCE_DEG = 10.0
 #: own axes, which rows along track would call across and along track (the normal along x is
 #: "horizontal": the MTF across the image's columns, from a near-vertical edge)
 IMAGE_AXES = {"across-track": "horizontal", "along-track": "vertical"}
+#: the directions named by an axis (of the track or of the image), not by a normal's angle
+AXIS_DIRECTIONS = (*IMAGE_AXES, *IMAGE_AXES.values())
 
 
 def image_axis_label(label: str) -> str:
