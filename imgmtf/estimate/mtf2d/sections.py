@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._blas import one_blas_thread
 from ...errors import ParameterError
 from .assumptions import (
     ASSUMPTIONS,
@@ -221,6 +222,14 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
     """
     if assumption not in ("auto", BRACKET, *ASSUMPTIONS):
         raise ParameterError(f"assumption must be auto, separable, elliptical or bracket, got {assumption!r}")
+    # small matrices: BLAS threads cost more than they save (on a busy machine, a third of the time)
+    with one_blas_thread():
+        return _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption, draws, confidence, seed)
+
+
+def _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption: str, draws: int, confidence: float,
+              seed: int) -> MTF2D:
+    """:func:`mtf2d_from_sections`'s work, its arguments checked."""
     theta, f, m, _ = prepared(normals_deg, frequencies_cy_px, mtfs, sd)
     normals = np.degrees(theta)
     spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
