@@ -75,18 +75,20 @@ def transfers(models: Sequence[SeparableModel] | Sequence[EllipticalModel], u: n
     u, v = np.asarray(u, float), np.asarray(v, float)
     if not len(models):
         return np.empty((0, u.size))
-    if all(isinstance(m, SeparableModel) for m in models):
-        nodes = _shared_nodes(models)
-        log_x = np.array([m.log_x for m in models])
-        log_y = np.array([m.log_y for m in models])
-        rows = len(models)
+    separable = [m for m in models if isinstance(m, SeparableModel)]
+    elliptical = [m for m in models if isinstance(m, EllipticalModel)]
+    rows = len(models)
+    if len(separable) == rows:
+        nodes = _shared_nodes(separable)
+        log_x = np.array([m.log_x for m in separable])
+        log_y = np.array([m.log_y for m in separable])
         return np.exp(_interp_inside(np.broadcast_to(np.abs(u), (rows, u.size)), nodes, log_x)
                       + _interp_inside(np.broadcast_to(np.abs(v), (rows, v.size)), nodes, log_y))
-    if all(isinstance(m, EllipticalModel) for m in models):
-        aspects = np.array([m.aspect for m in models])[:, None]
+    if len(elliptical) == rows:
+        aspects = np.array([m.aspect for m in elliptical])[:, None]
         w = np.hypot(u, v / aspects)
-        nodes = np.array([m.nodes for m in models])
-        log_g = np.array([m.log_g for m in models])
+        nodes = np.array([m.nodes for m in elliptical])
+        log_g = np.array([m.log_g for m in elliptical])
         return np.sinc(u) * np.sinc(v) * np.exp(_interp_inside(w, nodes, log_g))
     raise TypeError("transfers takes models of one kind, separable or elliptical")
 
