@@ -32,6 +32,8 @@ _LAZY = {
     "measure_pulse": "estimate.pulse", "PulseEstimator": "estimate.pulse", "PulseResult": "estimate.pulse",
     "measure_points": "estimate.mtf2d.points", "PointsResult": "estimate.mtf2d.points",
     "PointsEstimator": "estimate.mtf2d.estimator", "PointArray": "sensor.points", "render_points": "sensor.points",
+    "measure_star": "estimate.star.measure", "StarResult": "estimate.star.result",
+    "StarEstimator": "estimate.star.estimator", "SiemensStar": "sensor.star", "render_star": "sensor.star",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "sensor_fit", "SensorFit": "estimate.fit", "FitRecord": "estimate.fit.record",
