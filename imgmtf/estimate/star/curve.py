@@ -2,13 +2,15 @@
 frequency (a Gaussian kernel of :data:`BANDWIDTH_CY_PX`, or of
 :data:`SPACINGS_PER_BANDWIDTH` times the rings' spacing where they are
 sparser, near the star's centre; each ring weighted
-by its inverse variance), anchored at 1 at zero frequency, with the
+by its inverse variance), with the
 standard error of every smoothed value from the rings' (the smoother is
 linear: ``var = sum l_j^2 se_j^2``), widened by the rings' scatter about
-the curve when it exceeds their errors."""
+the curve when it exceeds their errors; under the lowest ring, the full
+contrast's extrapolation to 1 at zero frequency."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,8 +70,8 @@ class Curve:
         return at, error / abs(slope) if slope < 0 else math.nan
 
 
-def smooth(frequencies: np.ndarray, values: np.ndarray, errors: np.ndarray, *, anchor_error: float,
-           top_cy_px: float | None = None) -> Curve:
+def smooth(frequencies: np.ndarray, values: np.ndarray, errors: np.ndarray, *,
+           below: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None) -> Curve:
     """The local quadratic regression of the rings' values (see the module).
 
     Parameters
@@ -77,10 +79,9 @@ def smooth(frequencies: np.ndarray, values: np.ndarray, errors: np.ndarray, *, a
     frequencies, values, errors : numpy.ndarray
         Each ring's frequency (cy/px), MTF and its standard error (NaN
         rings are left out).
-    anchor_error : float
-        The standard error of the anchor, 1 at zero frequency.
-    top_cy_px : float, optional
-        The curve's end (default: the highest ring's frequency).
+    below : callable, optional
+        ``below(f) -> (mtf, error)``: the curve under the lowest ring (the
+        full contrast's extrapolation); default 1 at zero, linear to it.
 
     Returns
     -------
@@ -90,16 +91,13 @@ def smooth(frequencies: np.ndarray, values: np.ndarray, errors: np.ndarray, *, a
     Examples
     --------
     >>> f = np.linspace(0.1, 0.7, 60)
-    >>> curve = smooth(f, np.exp(-4 * f ** 2), np.full(60, 1e-3), anchor_error=1e-3)
+    >>> curve = smooth(f, np.exp(-4 * f ** 2), np.full(60, 1e-3))
     >>> round(curve.at(0.5)[0], 4), round(float(np.exp(-1.0)), 4)
     (0.3679, 0.3679)
     """
     good = np.isfinite(values) & np.isfinite(errors) & (errors > 0)
-    fj = np.concatenate([[0.0], frequencies[good]])
-    yj = np.concatenate([[1.0], values[good]])
-    sj = np.concatenate([[max(anchor_error, 1e-6)], errors[good]])
-    top = float(fj.max()) if top_cy_px is None else top_cy_px
-    grid = np.round(np.arange(0.0, top + 1e-9, STEP_CY_PX), 10)
+    fj, yj, sj = frequencies[good], values[good], errors[good]
+    grid = np.round(np.arange(0.0, float(fj.max()) + 1e-9, STEP_CY_PX), 10)
     rows, usable = _smoother(grid, fj, sj)
     mtf = np.where(usable, rows @ yj, np.nan)
     # the rings' scatter about the curve (each ring's leverage taken out), beyond their errors, widens every value's
@@ -109,6 +107,14 @@ def smooth(frequencies: np.ndarray, values: np.ndarray, errors: np.ndarray, *, a
     scatter = float(residual @ residual) / dof if dof >= 1.0 else math.nan
     factor = math.sqrt(max(1.0, scatter)) if math.isfinite(scatter) else 1.0
     error = np.where(usable, np.sqrt((rows ** 2) @ (sj ** 2)) * factor, np.nan)
+    # under the lowest ring no ring speaks: the extrapolation the full contrast was read with
+    gap = grid < fj.min()
+    if below is not None:
+        mtf[gap], error[gap] = below(grid[gap])
+    else:
+        first = int(np.argmax(usable & ~gap)) if (usable & ~gap).any() else 0
+        mtf[gap] = 1.0 + (mtf[first] - 1.0) * grid[gap] / max(grid[first], 1e-9)
+        error[gap] = error[first] * grid[gap] / max(grid[first], 1e-9)
     return Curve(grid, mtf, error, scatter)
 
 

@@ -169,8 +169,12 @@ def _direction(rings: Rings, contrast: Contrast, k: int, name: str, z: float) ->
     rotated = rings.modulation[k] * np.exp(-1j * contrast.phase_rad) / contrast.modulation
     errors = rings.standard_error[k] / contrast.modulation
     relative = contrast.standard_error / contrast.modulation
-    real = smooth(rings.frequencies_cy_px, rotated.real, errors, anchor_error=relative)
-    imaginary = smooth(rings.frequencies_cy_px, rotated.imag, errors, anchor_error=relative)
+    a, b = contrast.curvature[k]
+
+    def below(f):                         # the extrapolation's curve; its error is the contrast's, added below
+        return np.exp(-a * f ** 2 - b * f ** 4), 0.0 * f
+    real = smooth(rings.frequencies_cy_px, rotated.real, errors, below=below)
+    imaginary = smooth(rings.frequencies_cy_px, rotated.imag, errors, below=lambda f: (0.0 * f, 0.0 * f))
     mtf = np.hypot(real.mtf, imaginary.mtf)
     # the full contrast's error is every value's in proportion
     error = np.sqrt(real.standard_error ** 2 + (mtf * relative) ** 2)
