@@ -26,7 +26,7 @@ from .rings import Rings
 #: the rings that enter the extrapolation: the fundamental below this, cy/px
 EXTRAPOLATION_TOP_CY_PX = 0.22
 #: a plateau pixel lies at least this far from a wedge's edge, px
-PLATEAU_CLEARANCE_PX = 3.0
+PLATEAU_CLEARANCE_PX = 2.5
 #: the least share of the star's radius a plateau pixel lies beyond
 PLATEAU_RADIUS_SHARE = 0.5
 
@@ -98,8 +98,9 @@ def wedge_levels(image: np.ndarray, x: float, y: float, cycles: int, phase_rad: 
     rows, cols = image.shape
     yy, xx = np.mgrid[0:rows, 0:cols]
     r = np.hypot(xx - x, yy - y)
-    wrapped = np.angle(np.exp(1j * (cycles * np.arctan2(yy - y, xx - x) - phase_rad)))
-    clearance = r * (math.pi / 2 - np.abs(math.pi / 2 - np.abs(wrapped))) / cycles
+    # the rings' modulation (a - i b) / D of a cos + b sin is |m| exp(i phase): the crests at N theta = -phase
+    wrapped = np.angle(np.exp(1j * (cycles * np.arctan2(yy - y, xx - x) + phase_rad)))
+    clearance = r * np.abs(math.pi / 2 - np.abs(wrapped)) / cycles          # arc to the nearest edge, px
     plateau = (r >= PLATEAU_RADIUS_SHARE * outer_px) & (r <= outer_px) & (clearance >= PLATEAU_CLEARANCE_PX)
     values = np.asarray(image, float)
     bright = values[plateau & (np.abs(wrapped) < math.pi / 2)]

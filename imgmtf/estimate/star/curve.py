@@ -20,11 +20,11 @@ from ...metrics import first_crossing
 #: the kernel's standard deviation, cy/px
 BANDWIDTH_CY_PX = 0.035
 #: where rings are sparse, the kernel's standard deviation is this many of their spacings
-SPACINGS_PER_BANDWIDTH = 1.25
+SPACINGS_PER_BANDWIDTH = 0.8
 #: the curve's frequency step, cy/px
 STEP_CY_PX = 0.01
 #: rings (by kernel weight) a smoothed value needs; fewer: NaN
-MIN_EFFECTIVE_RINGS = 3.0
+MIN_EFFECTIVE_RINGS = 2.5
 
 
 @dataclass(frozen=True, eq=False)
