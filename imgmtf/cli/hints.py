@@ -41,6 +41,7 @@ HINTS = (
     Hint(CHIP, "not-a-bar", "--target edge measures an edge"),
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
+    Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),

@@ -198,6 +198,22 @@ class StarChip:
                 "mtf_nyquist_along": float(self.true_mtf(0.5, 90.0))}
 
 
+def default_cycles(size_px: int, profile: str = "sinusoidal") -> int:
+    """The cycles (even) of a star filling a ``size_px`` chip whose
+    outermost ring reads about 0.1 cy/px (a sinusoidal star: low enough to
+    extrapolate its full contrast), or 0.075 cy/px (a binary star: wedges
+    wide enough at the rim to read their levels 2.5 px from any edge).
+
+    Examples
+    --------
+    >>> default_cycles(201), default_cycles(201, "binary")
+    (62, 46)
+    """
+    radius = (size_px - 1) / 2.0 - 2.0
+    f = 0.075 if profile == "binary" else 0.1
+    return max(8, 2 * round(math.pi * radius * f))
+
+
 def keep_frequency(sensor: Sensor, gsd_m: float) -> float:
     """The frequency (cy/px) beyond which the sensor's transfer stays below
     :data:`TRANSFER_TOLERANCE` in every direction, at most

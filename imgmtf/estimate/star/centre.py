@@ -116,7 +116,11 @@ def cycles_and_profile(image: np.ndarray, x: float, y: float, outer: float) -> t
     spectrum[:3] = 0.0                                     # the mean and illumination, not a star's cycles
     n = int(np.argmax(spectrum))
     share = spectrum[n] ** 2 / max(float(np.sum(spectrum ** 2)), 1e-300)
-    if n < 4 or share < MIN_FUNDAMENTAL_SHARE:
+    if n < 4:
+        raise UnsuitableTargetError(
+            f"no Siemens star about ({x:.1f}, {y:.1f}): the strongest angular variation around it has {n} cycles "
+            "(a star has at least 4): an edge, a bar or a uniform field", reason="not-a-star")
+    if share < MIN_FUNDAMENTAL_SHARE:
         raise UnsuitableTargetError(
             f"no Siemens star about ({x:.1f}, {y:.1f}): its strongest angular harmonic ({n} cycles) holds "
             f"{100 * share:.0f} % of the variance around the centre (a star's holds over "
