@@ -58,7 +58,7 @@ MIN_STAR_PX = 32
 TAPER = 1.5
 #: the binary star's square-wave table: samples a cycle and rows of local frequency
 WAVE_SAMPLES = 8192
-WAVE_ROWS = 512
+WAVE_ROWS = 384
 TILE_PX = 256
 BITS = (8, 16)
 
@@ -262,7 +262,7 @@ def _pattern(star: SiemensStar, x: np.ndarray, y: np.ndarray, keep: float) -> np
     rows = (np.log(base[inside]) - log_b[0]) / (log_b[1] - log_b[0])
     columns = np.mod(psi[inside], 2.0 * math.pi) * (WAVE_SAMPLES / (2.0 * math.pi))
     out = np.zeros_like(r)
-    out[inside] = map_coordinates(table, [rows, columns], order=3, mode="grid-wrap")
+    out[inside] = map_coordinates(table, [rows, columns], order=1, mode="grid-wrap")
     return out
 
 

@@ -107,10 +107,10 @@ def wedge_levels(image: np.ndarray, x: float, y: float, cycles: int, phase_rad: 
     dark = values[plateau & (np.abs(wrapped) > math.pi / 2)]
     if bright.size < 10 or dark.size < 10:
         return math.nan, math.nan, math.nan
-    high, low = float(np.median(bright)), float(np.median(dark))
-    # the medians' errors (1.25 sigma / sqrt n) carried through (H - L) / (H + L)
-    e_high = 1.25 * float(np.std(bright)) / math.sqrt(bright.size)
-    e_low = 1.25 * float(np.std(dark)) / math.sqrt(dark.size)
+    # means, not medians: the plateaus hold few pixels, and the clearance keeps the edges out
+    high, low = float(np.mean(bright)), float(np.mean(dark))
+    e_high = float(np.std(bright)) / math.sqrt(bright.size)
+    e_low = float(np.std(dark)) / math.sqrt(dark.size)
     total = high + low
     error = 2.0 * math.hypot(low * e_high, high * e_low) / total ** 2 if total > 0 else math.nan
     return high, low, error
