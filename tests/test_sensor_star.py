@@ -55,4 +55,4 @@ def test_bad_stars_and_chips_are_refused():
         SiemensStar(profile="square")
     with pytest.raises(ParameterError, match="at least 32 x 32"):
         render_star(SENSOR, SiemensStar(), 20)
-    assert default_cycles(201) == 62 and default_cycles(201, "binary") == 46
+    assert default_cycles(201) == 76 and default_cycles(201, "binary") == 46

@@ -57,8 +57,8 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
               help="--target points: distance between the 4 x 4 targets' centres, px (each at its own quarter-pixel "
                    "offset)")
 @click.option("--cycles", type=click.IntRange(4, 2000),
-              help="--target star: periods around the centre (default: the outermost ring at about 0.1 cy/px, 0.075 "
-                   "for a binary star, whose wedges' levels are read there)")
+              help="--target star: periods around the centre (default: the outermost ring at about 0.125 cy/px, "
+                   "0.075 for a binary star, whose wedges' levels are read there)")
 @click.option("--star-profile", type=click.Choice(["sinusoidal", "binary"]), default="sinusoidal", show_default=True,
               help="--target star: ISO 12233's sinusoidal star (s-SFR) or black and white wedges")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,

@@ -16,7 +16,7 @@ from .kind import Column, Kind
 
 STAR = Kind(
     name="star", noun="star", has_width=False,
-    column=Column("unresolved_radius_px", "Ru", "px"),
+    column=Column("star_cycles", "N", "cy"),
     record_fields=("direction_deg", "star_cycles", "star_profile", "centre_x_px", "centre_y_px",
                    "nyquist_radius_px", "unresolved_radius_px", "star_contrast", "contrast_method"),
     estimator="imgmtf.estimate.star.estimator:StarEstimator",

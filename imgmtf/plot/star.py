@@ -184,11 +184,11 @@ def plot_star_directions(result: StarResult, truth: Callable[[np.ndarray, float]
         ax.errorbar(angles, values, yerr=np.where(np.isfinite(spread), spread, 0.0), fmt="o-", color=colour,
                     capsize=3, ms=4, lw=1.0, label=label)
         if truth is not None:
-            fine = np.linspace(0.0, 180.0, 181)
+            fine = np.linspace(0.0, 180.0, 37)
             if key == "mtf_nyquist":
                 expected = np.array([float(truth(np.array(0.5), a)) for a in fine])
             else:
-                f = np.linspace(0.0, 1.0, 2001)
+                f = np.linspace(0.0, 1.0, 501)
                 from ..metrics import first_crossing
                 expected = np.array([float(first_crossing(f, truth(f, a), 0.5)) for a in fine])
             ax.plot(fine, expected, color=colour, ls="--", lw=0.9, label=f"truth, {label}")

@@ -200,17 +200,19 @@ class StarChip:
 
 def default_cycles(size_px: int, profile: str = "sinusoidal") -> int:
     """The cycles (even) of a star filling a ``size_px`` chip whose
-    outermost ring reads about 0.1 cy/px (a sinusoidal star: low enough to
-    extrapolate its full contrast), or 0.075 cy/px (a binary star: wedges
-    wide enough at the rim to read their levels 2.5 px from any edge).
+    outermost ring reads about 0.125 cy/px (a sinusoidal star: low enough to
+    extrapolate its full contrast, and its Nyquist radius far enough out
+    that its wavefronts' curvature leaves the MTF at Nyquist within 0.005),
+    or 0.075 cy/px (a binary star: wedges wide enough at the rim to read
+    their levels 2.5 px from any edge).
 
     Examples
     --------
     >>> default_cycles(201), default_cycles(201, "binary")
-    (62, 46)
+    (76, 46)
     """
     radius = (size_px - 1) / 2.0 - 2.0
-    f = 0.075 if profile == "binary" else 0.1
+    f = 0.075 if profile == "binary" else 0.125
     return max(8, 2 * round(math.pi * radius * f))
 
 
