@@ -10,8 +10,8 @@ from scipy.special import ndtr
 
 import imgmtf as im
 from imgmtf.errors import ParameterError
-from imgmtf.sensor.star import SiemensStar, default_cycles, render_star
 from imgmtf.sensor.stages import Detector, GaussianOptics
+from imgmtf.sensor.star import SiemensStar, default_cycles, render_star
 
 SENSOR = im.Sensor(stages=[GaussianOptics(0.45, 0.6), Detector(1.0, 1.0)])
 STEP = 0.005

