@@ -61,3 +61,11 @@ def test_star_options_apply_to_stars_only(tmp_path):
     assert result.exit_code == 2 and "--cycles does not apply to --target edge" in result.output
     result = run("simulate", "--target", "star", "--spacing", 20, "--out", tmp_path / "star.tif")
     assert result.exit_code == 2 and "--spacing does not apply to --target star" in result.output
+
+
+def test_a_star_measured_as_an_edge_is_refused_naming_the_star(star_chip):
+    result = run("measure", "--target", "edge", "--format", "json", star_chip)
+    assert result.exit_code == 1
+    row = json.loads(result.stdout.splitlines()[0])
+    assert row["reason"] == "star" and "sinusoidal Siemens star of 46 cycles" in row["error"]
+    assert "--target star" in run("measure", "--target", "edge", star_chip).output

@@ -26,6 +26,10 @@ MIN_FUNDAMENTAL_SHARE = 0.3
 #: a sinusoid spends 29 % of its period within a tenth of its range from its extremes, a square wave most of its
 #: period: the share on the outermost circle above which a star is binary
 BINARY_PLATEAU_SHARE = 0.45
+#: a chip refused as a line is said to hold a star when the same harmonic, of at least so many cycles, holds
+#: at least this share of the angular variance on its outer and its middle circles
+MIN_SEEN_CYCLES = 8
+MIN_SEEN_SHARE = 0.5
 #: the annulus the centre is refined on: the fundamental's local frequency between these, cy/px
 REFINE_BAND_CY_PX = (0.06, 0.3)
 #: at most so many of the annulus' pixels enter the centre's fit
@@ -206,6 +210,47 @@ def refine_centre(image: np.ndarray, x: float, y: float, cycles: int, profile: s
         rms = math.nan
     phase = float(np.arctan2(beta[4], beta[3]))              # cos(psi) and sin(psi) of the fundamental
     return cx, cy, rms, phase
+
+
+def star_seen(image: np.ndarray) -> str | None:
+    """What a chip refused as an edge or a bar shows if a Siemens star fills
+    it: "a sinusoidal Siemens star of 46 cycles about (60.3, 59.8)", or
+    None (its strongest angular harmonic about its centre of symmetry is
+    no star's: an edge's or a bar's has one or two cycles).
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        The chip, DN.
+
+    Returns
+    -------
+    str or None
+        The words naming what was seen.
+
+    Examples
+    --------
+    >>> star_seen(np.zeros((40, 40))) is None
+    True
+    """
+    data = np.asarray(image, float)
+    if data.ndim != 2 or min(data.shape) < 32 or not np.isfinite(data).all() or np.ptp(data) == 0:
+        return None
+    x, y = rough_centre(data)
+    outer = min(x, y, data.shape[1] - 1 - x, data.shape[0] - 1 - y) - 2.0
+    if outer < 12.0:
+        return None
+    try:
+        n, profile, _ = cycles_and_profile(data, x, y, outer)
+    except UnsuitableTargetError:
+        return None
+    # a star's cycles are the same on every circle, and hold most of its variance; a wide bar's are neither
+    inner = angular_spectrum(data, x, y, np.linspace(0.5 * outer, 0.6 * outer, 4))
+    inner[:3] = 0.0
+    share = inner[n] ** 2 / max(float(np.sum(inner ** 2)), 1e-300)
+    if n < MIN_SEEN_CYCLES or int(np.argmax(inner)) != n or share < MIN_SEEN_SHARE:
+        return None
+    return f"a {profile} Siemens star of {n} cycles about ({x:.1f}, {y:.1f})"
 
 
 def locate_star(image: np.ndarray, *, profile: str = "auto", cycles: int | None = None,
