@@ -15,6 +15,7 @@ imported when first used (:meth:`Kind.load`).
 from __future__ import annotations
 
 from ..errors import ParameterError
+from .double_bar import DOUBLE_BAR
 from .edge import EDGE
 from .kind import Column, Kind
 from .points import POINTS
@@ -24,7 +25,7 @@ from .star import STAR
 __all__ = ["KINDS", "Column", "Kind", "get_kind", "kind_names", "kinds_with_width"]
 
 #: every kind of target, by name, in the order commands list them
-KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS, STAR)}
+KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS, DOUBLE_BAR, STAR)}
 
 
 def kind_names() -> tuple[str, ...]:
@@ -38,7 +39,7 @@ def kind_names() -> tuple[str, ...]:
     Examples
     --------
     >>> kind_names()
-    ('edge', 'pulse', 'points', 'star')
+    ('edge', 'pulse', 'points', 'double-bar', 'star')
     """
     return tuple(KINDS)
 
@@ -70,7 +71,7 @@ def get_kind(name: str, what: str = "target kind") -> Kind:
     'bar'
     >>> get_kind("spoke")
     Traceback (most recent call last):
-    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points', 'star'), got 'spoke'
+    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points', 'double-bar', 'star'), got 'spoke'
     """
     kind = KINDS.get(name) if isinstance(name, str) else None
     if kind is None:
@@ -89,6 +90,6 @@ def kinds_with_width() -> tuple[Kind, ...]:
     Examples
     --------
     >>> [kind.name for kind in kinds_with_width()]
-    ['pulse']
+    ['pulse', 'double-bar']
     """
     return tuple(kind for kind in KINDS.values() if kind.has_width)
