@@ -71,7 +71,7 @@ def get_kind(name: str, what: str = "target kind") -> Kind:
     'bar'
     >>> get_kind("spoke")
     Traceback (most recent call last):
-    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points', 'double-bar', 'star'), got 'spoke'
+    imgmtf.errors.ParameterError: target kind must be one of ('edge', ..., 'star'), got 'spoke'
     """
     kind = KINDS.get(name) if isinstance(name, str) else None
     if kind is None:
