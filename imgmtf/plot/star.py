@@ -81,6 +81,9 @@ def plot_star_image(result: StarResult, image: np.ndarray, ax: Axes | None = Non
     if math.isfinite(result.unresolved_radius_px):
         circles.append((result.unresolved_radius_px, "tab:red", "-",
                         f"unresolved (MTF 0.1), r = {result.unresolved_radius_px:.1f} px"))
+    else:                                   # the MTF stays above 0.1 on every ring read: resolved to the inner one
+        ax.plot([], [], color="tab:red", lw=1.3, label=f"unresolved zone inside r = {result.inner_radius_px:.0f} px "
+                                                         "(MTF over 0.1 on every ring read)")
     for radius, colour, style, label in circles:
         ax.add_patch(Circle((x, y), radius, fill=False, color=colour, ls=style, lw=1.3, label=label))
     ax.add_patch(Circle((x, y), result.inner_radius_px, fill=False, color="tab:green", lw=0.8))

@@ -129,7 +129,18 @@ class SiemensStar:
         return self.cycles / math.pi
 
     def centre_px(self, shape: tuple[int, int]) -> tuple[float, float]:
-        """The centre (x, y), px, on a chip of ``shape`` (rows, cols)."""
+        """The centre (x, y), px, on a chip of ``shape``.
+
+        Parameters
+        ----------
+        shape : (int, int)
+            The chip's rows and columns.
+
+        Returns
+        -------
+        (float, float)
+            x and y, px (pixel centres at integers).
+        """
         return ((shape[1] - 1) / 2.0 + self.centre_offset_px[0], (shape[0] - 1) / 2.0 + self.centre_offset_px[1])
 
     def to_dict(self) -> dict:

@@ -98,6 +98,14 @@ class StarResult:
         "star": its own estimator, and the kind.
     checks : tuple
         Empty: a star has no gate of line checks.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render_star(imgmtf.Sensor(), imgmtf.SiemensStar(cycles=32), 101)
+    >>> result = imgmtf.measure_star(chip.image, intervals="none")
+    >>> len(result.directions), result.directions[4].direction, result.cycles
+    (8, 'along-track', 32)
     """
 
     directions: tuple[StarDirection, ...]
@@ -126,7 +134,18 @@ class StarResult:
         return self.cycles / math.pi
 
     def direction(self, name: str) -> StarDirection:
-        """The direction called ``name`` ("across-track", "22.5deg"...).
+        """The direction called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            "across-track", "along-track", "22.5deg"... (or "image-x",
+            "image-y" when the track is unknown).
+
+        Returns
+        -------
+        StarDirection
+            That direction's MTF and its figures.
 
         Raises
         ------
@@ -179,7 +198,18 @@ class StarResult:
         return out
 
     def to_dict(self, curves: bool = True) -> dict:
-        """The first direction's summary (:meth:`summaries` gives them all)."""
+        """The first direction's summary (:meth:`summaries` gives them all).
+
+        Parameters
+        ----------
+        curves : bool, optional
+            Include the MTF curve (default True).
+
+        Returns
+        -------
+        dict
+            The across-track (or image-x) summary.
+        """
         return self.summaries(curves)[0]
 
 
