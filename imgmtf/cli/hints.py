@@ -44,6 +44,7 @@ HINTS = (
     Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
     Hint(CHIP, "star", "--target star measures a Siemens star"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
+    Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
