@@ -33,6 +33,9 @@ DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it fo
 SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
                     "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial")
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
+# with several scenes each worker runs whole scans, the segment graph's SciPy included: loaded once by
+# the fork server rather than by every worker as its first scene starts
+WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 
 
 @click.command(short_help="Find, measure and combine every edge or bar in a scene.")
@@ -150,7 +153,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                                    "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
             fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ()))
+            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+                             + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
