@@ -113,6 +113,7 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
     assert rejected and not any(f"{SCENE}:" in line for line in rejected)
     assert "warning: the image is not in sensor geometry" in result.stdout
+    assert "give the track's azimuth to label it (--track-azimuth DEG gives it)" in result.stdout
     geo = json.loads((out / "targets.geojson").read_text())
     assert geo["imgmtf_coordinates"].startswith("longitude/latitude")
     first = geo["features"][0]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from ..kinds import get_kind
-from .hints import refusal_hint, rejection_hint
+from .hints import hinted_warning, refusal_hint, rejection_hint
 
 
 class TextRows:
@@ -56,7 +56,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
     if record["status"] == "untrusted":
         cells.append(f"{indent} error: {record['error']}")
-    cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
+    cells += [f"{indent} warning: {hinted_warning(w)}" for w in record.get("warnings") or []]
     return "\n".join(cells)
 
 
@@ -114,7 +114,7 @@ def print_fit(result) -> None:
         click.echo(f"{name:<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
                    f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
     for warning in result.warnings:
-        click.echo(f"warning: {warning}")
+        click.echo(f"warning: {hinted_warning(warning)}")
 
 
 def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: bool = False) -> None:
@@ -145,7 +145,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
             click.echo(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
                        f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
             for warning in r.get("warnings") or []:
-                click.echo(f"{'':>{len(head)}} warning: {warning}")
+                click.echo(f"{'':>{len(head)}} warning: {hinted_warning(warning)}")
         else:       # the scene's name heads the table: the message need not repeat it
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
     if not verbose:
@@ -200,7 +200,7 @@ def print_target_fits(fitted) -> None:
         for warning in r.get("warnings") or []:
             if warning not in warned:           # across and along share their fit's warnings
                 warned.add(warning)
-                click.echo(f"{'':>11} warning: {warning}")
+                click.echo(f"{'':>11} warning: {hinted_warning(warning)}")
                 if "does not fit" in warning and not hinted:
                     hinted = True
                     click.echo(f"{'':>11} (--fit-stages fits other stages; the combined and sections rows "
