@@ -317,8 +317,16 @@ def test_band_all_on_an_rgba_photo_measures_the_colours_and_skips_alpha(run, tmp
 def test_text_table_names_units_and_fits_long_paths(run, chip, tmp_path):
     long_name = tmp_path / ("a_rather_long_file_name_for_a_chip_" + "x" * 10 + ".tif")
     long_name.write_bytes(chip.read_bytes())
-    lines = run("measure", chip, long_name).stdout.splitlines()
-    header, units, first = lines[0], lines[1], lines[2]
+    deep = tmp_path / ("a_folder_with_a_long_name_" * 4)
+    deep.mkdir()
+    deeper = deep / long_name.name
+    deeper.write_bytes(chip.read_bytes())
+    lines = run("measure", chip, long_name, deeper).stdout.splitlines()
+    # paths shortened below the folder they share, each still told apart: the rows fit 120 columns
+    assert lines[0] == f"paths below {tmp_path}/" and all(len(line) <= 120 for line in lines)
+    assert [line.split()[0] for line in lines[3:] if not line.startswith(" ")] == [
+        "edge.tif", "a_rather_lo..._a_chip_xxxxxxxxxx.tif", "a_folder_wi..._a_chip_xxxxxxxxxx.tif"]
+    header, units, first = lines[1], lines[2], lines[3]
     assert "cy/px" in units and "deg" in units and "px" in units
     assert header.index("normal") == first.index("6.00") + len("6.00") - len("normal")   # columns line up
     assert "band" not in header                                   # no band asked for: no band column

@@ -1,4 +1,5 @@
 import json
+import re
 
 import numpy as np
 import pytest
@@ -183,6 +184,21 @@ def test_cli_json_contract_toml_and_plot(pair, tmp_path):
     assert {"parameters", "reduced_chi_square", "directions", "warnings", "sensor"} <= set(record)
     assert set(record["directions"]["across"]) >= {"mtf_nyquist", "mtf_nyquist_ci", "mtf50_cy_px"}
     assert png.stat().st_size > 20_000
+    # the text table: long paths shortened below the folder they share, its columns aligned within 120
+    deep = tmp_path / ("a_folder_with_a_long_name_" * 3)
+    deep.mkdir()
+    shown = [deep / f"a_long_file_name_for_an_edge_of_the_sensor_{k}.tif" for k in range(2)]
+    for path, long in zip(paths, shown):
+        long.write_bytes(path.read_bytes())
+    lines = CliRunner().invoke(main, ["fit", *map(str, shown), "--stages", "optics,detector", "--hold",
+                                      "detector"]).stdout.splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("edge "))
+    assert lines[header - 1] == f"edges below {deep}/"
+    rows = lines[header: header + 3]
+    assert all(len(line) <= 120 for line in rows) and rows[1].split()[0] != rows[2].split()[0]
+    for row in rows[1:]:                # right-aligned: the headings end where the figures do
+        assert rows[0].index("normal") + len("normal") == re.search(r" (-?\d+\.\d\d) ", row).end(1)
+        assert len(rows[0]) == len(row)
     fitted = im.Sensor.from_toml(out)
     assert fitted.mtf_nyquist("across") == pytest.approx(record["directions"]["across"]["mtf_nyquist"])
     text = CliRunner().invoke(main, ["sensor", "--sensor", str(out)])
