@@ -55,6 +55,12 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     wrong = im.fit_sensor(chip.image, stages="optics,detector", hold="detector")
     assert wrong.misfit and any("does not fit" in w for w in wrong.warnings)
     assert wrong.edges[0].misfit_p < 1e-3
+    # and its figure says so in its title, the right one does not
+    from imgmtf.plot import plot_fit
+    figure = plot_fit(wrong)
+    assert figure._suptitle.get_text().startswith("MISFIT: the model does not fit 1 of its 1 edges")
+    assert "MISFIT" in figure.axes[0].get_title()
+    assert "MISFIT" not in plot_fit(right)._suptitle.get_text()
     # the advice names stages the model lacks, never one it has
     from imgmtf.estimate.fit.model import other_stages as _other_stages
     assert _other_stages(wrong.sensor.stages) == ("try the stages real blur adds (diffusion, halo, lag; stages "
