@@ -6,8 +6,11 @@
   CLI (each ``$ imgmtf ...`` line, its exit status 0 unless the line ends
   with a ``# exit status N`` comment, and the output shown beneath it, where
   ``...`` stands for any text, as in a doctest; a command shown without
-  output has its output unchecked), ``python`` blocks as doctests sharing
-  the document's names, ``toml`` blocks read as sensor files.
+  output prints nothing; ``> FILE`` sends what it prints to FILE),
+  ``python`` blocks as doctests sharing the document's names, ``toml``
+  blocks read as sensor files.
+* No other block shows a command (``$ imgmtf ...``) but the few that
+  :data:`RECORDED` names with why the suite cannot run them.
 * The package's docstring examples, module by module, as doctests.
 
 When a change moves what a command prints, ``python tests/test_docs.py
@@ -34,8 +37,17 @@ ROOT = Path(__file__).parent.parent
 # method), and the generated reproduction report
 OTHERS = {"accuracy.md", "method.md"}
 # pages whose examples read the shared real scenes (never copied into the repository): linked into
-# the folder the examples run in, the page skipped where they are absent (conftest.real_scene)
-REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",)}
+# the folder the examples run in (under the name the page gives it), the page skipped where they are
+# absent (conftest.real_scene)
+REAL_SCENES_READ = {"docs/scan.md": {"baotou_l0r_checkerboard.tif": "baotou_l0r_checkerboard.tif"},
+                    "docs/restore.md": {"baotou.tif": "baotou_l0r_checkerboard.tif"}}
+# blocks that show commands the suite does not run, each (document, its first command) with why
+RECORDED = {
+    ("docs/campaign.md", "imgmtf simulate --campaign scenes"):
+        "six 320 px scenes scanned with fits take about a minute; bench/campaign.py runs them against the truth",
+    ("docs/campaign.md", "imgmtf report store.gpkg --out report --requirement 0.1"):
+        "a store of the two real chips bench/campaign.py makes",
+}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -64,14 +76,22 @@ def console_steps(body: str):
 
 def run_command(command: str, where: str) -> list[str]:
     """Run one ``$ imgmtf ...`` line, check its exit status, return its
-    output lines (stdout and stderr as a terminal shows them)."""
+    output lines (stdout and stderr as a terminal shows them; with
+    ``> FILE``, stderr's, stdout written to FILE)."""
     args = shlex.split(command, comments=True)
     assert args[0] == "imgmtf", f"{where}: console blocks run imgmtf only, got {command!r}"
+    redirect = None
+    if len(args) > 2 and args[-2] == ">":
+        args, redirect = args[:-2], args[-1]
     status = EXIT_STATUS.search(command)
     result = CliRunner().invoke(main, args[1:])
     assert result.exit_code == int(status[1] if status else 0), (
         f"{where}: `{command}` exited {result.exit_code}:\n{result.output}")
-    return [line.rstrip() for line in result.output.strip("\n").splitlines()]
+    shown = result.output
+    if redirect is not None:
+        Path(redirect).write_text(result.stdout)
+        shown = result.stderr
+    return [line.rstrip() for line in shown.strip("\n").splitlines()]
 
 
 def run_console(body: str, where: str) -> None:
@@ -83,6 +103,9 @@ def run_console(body: str, where: str) -> None:
             assert checker.check_output(want, "\n".join(got) + "\n", doctest.ELLIPSIS), (
                 f"{where}: `{command}` printed\n" + "\n".join(got) + f"\nthe document shows\n{want}"
                 + "(python tests/test_docs.py --update rewrites what the documents show)")
+        else:       # shown without output: it prints none (a reader would not expect a table)
+            assert not got, (f"{where}: `{command}` printed\n" + "\n".join(got) + "\nthe document shows "
+                             "nothing (python tests/test_docs.py --update writes it; ... stands for lines left out)")
 
 
 def run_python(body: str, globs: dict, where: str) -> None:
@@ -129,8 +152,18 @@ def test_every_example_of_the_document_runs(document, sample_folder):
 
 
 def link_real_scenes(document: str, folder: Path) -> None:
-    for name in REAL_SCENES_READ.get(document, ()):
-        (folder / name).symlink_to(real_scene(name))
+    for link, name in REAL_SCENES_READ.get(document, {}).items():
+        (folder / link).symlink_to(real_scene(name))
+
+
+def test_every_block_that_shows_a_command_runs_or_says_why_not():
+    shown = {}
+    for document in DOCUMENTS:
+        for language, body, line in fenced_blocks((ROOT / document).read_text()):
+            commands = [c for c, _ in console_steps(body)] if body.lstrip().startswith("$ ") else []
+            if commands and language != "console":
+                shown[(document, commands[0])] = line
+    assert sorted(set(shown) - set(RECORDED)) == [] and sorted(set(RECORDED) - set(shown)) == []
 
 
 def assert_ignored(folder: Path) -> None:
@@ -207,7 +240,10 @@ def update_console_outputs(document: str) -> None:
                     if any(shown) and len(shown) == len(got):
                         got = [e if checker.check_output(e + "\n", g + "\n", doctest.ELLIPSIS) else g
                                for e, g in zip(shown, got)]
-                    lines += [f"$ {command}", *(got if any(shown) else shown)]
+                    elif any(shown) and checker.check_output("\n".join(shown) + "\n", "\n".join(got) + "\n",
+                                                             doctest.ELLIPSIS):
+                        got = shown                 # an abbreviated output ("...") that still matches
+                    lines += [f"$ {command}", *got]
                 text = text.replace(body, "\n".join(lines) + "\n", 1)
         finally:
             os.chdir(here)
