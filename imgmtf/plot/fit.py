@@ -289,10 +289,14 @@ def plot_fit(fit: SensorFit, max_edges: int = 6,
     verdict = ""
     if misfit:
         verdict = (f"MISFIT: the model does not fit {len(misfit)} of its {len(fit.edges)} edges (residual structure "
-                   f"up to {100 * max(e.misfit_fraction for e in misfit):.2f} % of the step): its MTF may be biased\n")
+                   f"up to {100 * max(e.misfit_fraction for e in misfit):.2f} % of the step): its MTF may be biased")
     elif fit.misfit:
-        verdict = "MISFIT: a fitted parameter sits at the bound of its range: its MTF may be biased\n"
-    fig.suptitle(f"{verdict}Fit of {', '.join(s.name for s in fit.sensor.stages)}{more}: reduced chi-square "
-                 f"{fit.reduced_chi_square:.3g}" + (f"; held or tied: {', '.join(held)}" if held else ""),
+        verdict = "MISFIT: a fitted parameter sits at the bound of its range: its MTF may be biased"
+    import textwrap
+    lines = [*verdict.splitlines(), f"Fit of {', '.join(s.name for s in fit.sensor.stages)}{more}: reduced "
+             f"chi-square {fit.reduced_chi_square:.3g}", *([f"held or tied: {', '.join(held)}"] if held else [])]
+    # wrapped to the figure's width (about 12 characters an inch at this size), never cut at its edges
+    width = int(12 * fig.get_figwidth())
+    fig.suptitle("\n".join(textwrap.fill(line, width) for line in lines),
                  fontsize="large" if fit.misfit else "medium", color="C3" if fit.misfit else "black")
     return fig

@@ -26,12 +26,13 @@ def _expect_filter(restoration: object) -> None:
 
 
 def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
-                      ax: Axes | None = None) -> Figure | SubFigure:
+                      ax: Axes | None = None, gain_axis: bool | None = None) -> Figure | SubFigure:
     """Along one axis: the sensor's MTF, the filter's transfer, the restored
     MTF and the target, to twice Nyquist (the filter's transfer repeats
     every 1 cy/px), with the values at Nyquist in the legend.  A filter
-    whose gain rises above 1.5 is drawn against an axis of its own on the
-    right, so that a high gain leaves the MTF curves their full height.
+    whose gain rises above ``SHARED_AXIS_GAIN`` is drawn against an axis of
+    its own on the right, so that a high gain leaves the MTF curves their
+    full height.
 
     Parameters
     ----------
@@ -41,6 +42,10 @@ def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
         The axis: across track (x, the default) or along track (y).
     ax : matplotlib.axes.Axes, optional
         The axes to draw on (default a new figure's).
+    gain_axis : bool, optional
+        Draw the filter against an axis of its own (default: when its gain
+        rises above ``SHARED_AXIS_GAIN``); a figure of both axes decides
+        once for both.
 
     Returns
     -------
@@ -71,7 +76,7 @@ def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
     ax.plot(f[:201], c["target"][:201], color="C2", ls=":", lw=2.0, label=f"target: {at['target']:.3f}")
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
     low, high = float(c["filter"].min()), float(c["filter"].max())
-    gain_ax = ax.twinx() if high > SHARED_AXIS_GAIN else ax
+    gain_ax = ax.twinx() if (high > SHARED_AXIS_GAIN if gain_axis is None else gain_axis) else ax
     gain_ax.plot(f, c["filter"], color="C1", ls="--", label=f"filter: {at['filter']:.2f}"
                  + (" (right axis)" if gain_ax is not ax else ""))
     mtf_top = max(1.05, float(max(c["system"].max(), c["restored"].max(), c["target"].max())) * 1.05)
@@ -190,8 +195,12 @@ def plot_restoration(restoration: RestorationFilter) -> Figure:
     _expect_filter(restoration)
     fig = Figure(figsize=(14.0, 5.0), layout="constrained")
     axes = fig.subplots(1, 3)
-    plot_restored_mtf(restoration, "across", ax=axes[0])
-    plot_restored_mtf(restoration, "along", ax=axes[1])
+    from ..restore.report import axis_curves
+    f = np.linspace(0.0, 1.0, 401)
+    separate = max(float(axis_curves(restoration, d, f)["filter"].max()) for d in ("across", "along")) \
+        > SHARED_AXIS_GAIN                      # both panels alike
+    plot_restored_mtf(restoration, "across", ax=axes[0], gain_axis=separate)
+    plot_restored_mtf(restoration, "along", ax=axes[1], gain_axis=separate)
     plot_restored_edge(restoration, ax=axes[2])
     form = "FFT" if restoration.kernel_size is None else "spatial"
     fig.suptitle(f"Restoration to MTF {restoration.target_nyquist:g} at Nyquist: {form} form, "
