@@ -13,8 +13,18 @@ from click.testing import CliRunner
 
 import imgmtf
 from imgmtf.cli import main
-from imgmtf.cli.hints import (CHIP, HINTS, OPTION, SCAN, WARNING, Command, hinted_warning, option_hints, refusal_hint,
-                              rejection_hint)
+from imgmtf.cli.hints import (
+    CHIP,
+    HINTS,
+    OPTION,
+    SCAN,
+    WARNING,
+    Command,
+    hinted_warning,
+    option_hints,
+    refusal_hint,
+    rejection_hint,
+)
 from imgmtf.cli.main import COMMANDS
 
 PACKAGE = pathlib.Path(imgmtf.__file__).parent

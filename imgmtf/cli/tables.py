@@ -7,7 +7,6 @@ import click
 from ..kinds import get_kind
 from .hints import hinted_warning, refusal_hint, rejection_hint
 
-
 #: the widest a table's path column grows (characters), so that its rows fit 120 columns
 MAX_PATH_COLUMN = 36
 
@@ -27,8 +26,9 @@ def path_labels(paths, width: int = MAX_PATH_COLUMN) -> tuple[dict[str, str], st
     --------
     >>> path_labels(["a.tif", "data/b.tif"])
     ({'a.tif': 'a.tif', 'data/b.tif': 'data/b.tif'}, '')
-    >>> path_labels(["/archive/site/2021/scene_a.tif", "/archive/site/2022/scene_b.tif"], width=20)
-    ({'/archive/site/2021/scene_a.tif': '2021/scene_a.tif', '/archive/site/2022/scene_b.tif': '2022/scene_b.tif'}, '/archive/site')
+    >>> labels, folder = path_labels(["/archive/site/2021/scene_a.tif", "/archive/site/2022/b.tif"], width=20)
+    >>> list(labels.values()), folder
+    (['2021/scene_a.tif', '2022/b.tif'], '/archive/site')
     """
     import os
     paths = list(dict.fromkeys(paths))
@@ -153,7 +153,8 @@ def print_fit(result) -> None:
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
-        click.echo(f"{labels[e.source]:<{width}} {e.normal_angle_deg:6.2f} {SHORT_DIRECTIONS.get(e.direction, e.direction):>7} "
+        direction = SHORT_DIRECTIONS.get(e.direction, e.direction)
+        click.echo(f"{labels[e.source]:<{width}} {e.normal_angle_deg:6.2f} {direction:>7} "
                    f"{e.constrains:>6} {e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")

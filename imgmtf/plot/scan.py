@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -182,7 +182,7 @@ EDGE_POINT_COST = 400.0
 
 
 def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]],
-                         segments: list[list[tuple[float, float]]] = ()) -> None:
+                         segments: Sequence[Sequence[tuple[float, float]]] = ()) -> None:
     """Each target's label beside its centre where it covers no accepted
     half-edge (``segments``, whose junction is the target's centre), no
     label placed before it (nor an id) and stays inside the image: the
