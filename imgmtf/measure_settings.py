@@ -59,6 +59,10 @@ class MeasureSettings:
     point_size : (float, str), float or str, optional
         Each point target's known size (a square's side), as
         ``pulse_width`` takes it; for the kinds that take one (points).
+    gap : (float, str), float or str, optional
+        A double bar's gap between its bars (edge to edge), as
+        ``pulse_width`` takes it; for the kinds with one (double bars),
+        which need it.
 
     Raises
     ------
@@ -85,6 +89,7 @@ class MeasureSettings:
     track_azimuth_deg: float | None = None
     transfer: str = "linear"
     point_size: tuple[float, str] | None = None
+    gap: tuple[float, str] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
@@ -100,6 +105,17 @@ class MeasureSettings:
                 raise ParameterError(f"a point size applies to point targets only, not to a {self.target}")
             if not 0.0 <= self.point_size[0] <= 20.0 and self.point_size[1] == "px":
                 raise ParameterError(f"a point size must be 0 to 20 px, got {self.point_size[0]:g}")
+        if self.gap is not None:
+            object.__setattr__(self, "gap", parse_length(self.gap))
+            if get_kind(self.target, "target").gap_keyword is None:
+                raise ParameterError(f"a gap applies to double bars only, not to a {self.target}")
+            if not self.gap[0] > 0:
+                raise ParameterError(f"a double bar's gap must be > 0, got {self.gap[0]:g}")
+        elif get_kind(self.target, "target").gap_keyword is not None:
+            raise ParameterError(f"a {self.target} needs the gap between its bars (and their width): "
+                                 "neither can be read off its profile")
+        if get_kind(self.target, "target").gap_keyword is not None and self.pulse_width is None:
+            raise ParameterError(f"a {self.target} needs its bars' width: it cannot be read off two bars' profile")
         check_method(self.method)   # an unknown method fails here, before any file is read
         object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
@@ -130,7 +146,8 @@ class MeasureSettings:
             A width in metres on a raster without a GSD.
         """
         return get_kind(self.target).estimator_keywords(pulse_width_px(self.pulse_width, raster),
-                                                        point_size_px(self.point_size, raster))
+                                                        point_size_px(self.point_size, raster),
+                                                        gap_px(self.gap, raster))
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
@@ -139,7 +156,8 @@ class MeasureSettings:
                 "saturation": list(self.saturation) if self.saturation else None,
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None,
-                **({"point_size": list(self.point_size)} if self.point_size else {})}
+                **({"point_size": list(self.point_size)} if self.point_size else {}),
+                **({"gap": list(self.gap)} if self.gap else {})}
 
     def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
         """The error record of a file (or band) that could not be measured.
@@ -192,4 +210,18 @@ def point_size_px(size: tuple[float, str] | None, raster: Raster) -> float | Non
         value = value / raster.gsd_m
     if not 0.0 <= value <= 20.0:
         raise ParameterError(f"{raster.path}: a point size of {value:g} px: it must be 0 to 20 px")
+    return value
+
+
+def gap_px(gap: tuple[float, str] | None, raster: Raster) -> float | None:
+    """A double bar's gap (value, unit) in pixels for this raster (metres
+    need its GSD)."""
+    if gap is None:
+        return None
+    value, unit = gap
+    if unit == "m":
+        if raster.gsd_m is None:
+            raise ParameterError(f"{raster.path}: a gap in metres needs a georeferenced image "
+                                 "(its GSD is unknown); give the gap in px")
+        value = value / raster.gsd_m
     return value

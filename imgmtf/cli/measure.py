@@ -44,6 +44,9 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--point-size", callback=length_option("px"),
               help="--target points: each target's side when it is a square of known size, 0 to 20 px: 1 or "
                    "1px (pixels), 30m (metres, needs a GSD); its sinc is divided out of the MTF")
+@click.option("--gap", callback=length_option("px"),
+              help="--target double-bar: the gap between its two bars, edge to edge: 2 or 2px (pixels), 60m "
+                   "(metres, needs a GSD); with --pulse-width, each bar's width")
 @click.option("--method", cls=MethodOption)
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
@@ -67,7 +70,7 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @interval_options
 @parallel_options
 @campaign_options
-def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
+def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
             force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
             workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
@@ -85,6 +88,11 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
         raise click.UsageError(width_refusal())
     if point_size and get_kind(kind).size_keyword is None:
         raise click.UsageError(f"--point-size applies to --target points only, not to a {kind}")
+    if gap and get_kind(kind).gap_keyword is None:
+        raise click.UsageError(f"--gap applies to --target double-bar only, not to a {kind}")
+    if get_kind(kind).gap_keyword is not None and not (gap and pulse_width):
+        raise click.UsageError(f"--target {kind} needs --pulse-width (each bar's width) and --gap (the gap "
+                               "between them): neither can be read off two bars' profile")
     facts = {"acquired": acquired, "platform": platform, "instrument": instrument, "band_name": band_name}
     if not campaign and any(v is not None for v in facts.values()):      # as scan refuses them: not ignored
         flag = next(f"--{k.replace('_', '-')}" for k, v in facts.items() if v is not None)
@@ -100,7 +108,7 @@ def measure(paths, kind, pulse_width, point_size, method, roi, band, fmt, csv_pa
             settings = MeasureSettings(kind, method, band, roi, pulse_width,
                                        interval_settings(interval_method, replicates, confidence), force=force,
                                        saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer,
-                                       point_size=point_size)
+                                       point_size=point_size, gap=gap)
         files, repeated = once_each(expand_inputs(paths, recursive))
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")

@@ -99,6 +99,9 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     store."""
     if pulse_width and not get_kind(kind).has_width:
         raise click.UsageError(width_refusal())
+    if get_kind(kind).gap_keyword is not None:     # a pair is not yet among the lines a scan pairs up
+        raise click.UsageError(f"scan does not search for {kind} targets yet: imgmtf measure --target {kind} "
+                               "--pulse-width W --gap G --roi X,Y,W,H measures one")
     if get_kind(kind).measuring is None:       # a kind with a pipeline of its own: scan searches for lines
         raise click.UsageError(f"scan searches scenes for lines (edges and bars), not for {kind} targets yet: "
                                f"imgmtf measure --target {kind} SCENE finds and measures every one in a scene "

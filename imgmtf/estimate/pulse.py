@@ -25,6 +25,7 @@ from ..inputs import check_width
 from ..kinds.pulse import PULSE
 from ..metrics import fwhm
 from . import gate
+from .bar_pair import bar_pair
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
 from .intervals.width import WidthReading
@@ -161,6 +162,9 @@ class PulseKind(TargetKind):
             raise TargetNotFoundError(f"no bar found: the profile peaks {height:.1f} DN above its "
                                       f"background, within the noise ({noise:.1f} DN)")
         prf01 = peak / height
+        pair = bar_pair(grid, prf01, noise / height)
+        if pair is not None:        # measured as one bar, a pair's MTF would read times |cos(pi f s)|
+            raise UnsuitableTargetError(pair.message(), reason="double-bar")
         h10 = _half_width_at(grid, prf01, 0.1)
         width = self.width_px if self.width_px is not None else check_width(estimate_width(grid, prf01))
         if width / 2 + 2.0 > half_range:
