@@ -97,12 +97,6 @@ def test_sensor_command_prints_and_plots(run, tmp_path):
     assert run("sensor", "--sensor", tmp_path / "s.toml").exit_code == 0
 
 
-def test_selftest_passes(run):
-    result = run("selftest")
-    assert result.exit_code == 0, result.output
-    assert "PASS" in result.stdout and "FAIL" not in result.stdout
-
-
 def test_simulated_chip_describes_itself(run, tmp_path):
     from imgmtf.io import read_raster
     path = tmp_path / "p.tif"

@@ -190,14 +190,29 @@ def test_cli_json_contract_toml_and_plot(pair, tmp_path):
     assert {"parameters", "reduced_chi_square", "directions", "warnings", "sensor"} <= set(record)
     assert set(record["directions"]["across"]) >= {"mtf_nyquist", "mtf_nyquist_ci", "mtf50_cy_px"}
     assert png.stat().st_size > 20_000
-    # the text table: long paths shortened below the folder they share, its columns aligned within 120
-    deep = tmp_path / ("a_folder_with_a_long_name_" * 3)
-    deep.mkdir()
-    shown = [deep / f"a_long_file_name_for_an_edge_of_the_sensor_{k}.tif" for k in range(2)]
-    for path, long in zip(paths, shown):
-        long.write_bytes(path.read_bytes())
-    lines = CliRunner().invoke(main, ["fit", *map(str, shown), "--stages", "optics,detector", "--hold",
-                                      "detector"]).stdout.splitlines()
+    fitted = im.Sensor.from_toml(out)
+    assert fitted.mtf_nyquist("across") == pytest.approx(record["directions"]["across"]["mtf_nyquist"])
+    text = CliRunner().invoke(main, ["sensor", "--sensor", str(out)])
+    assert text.exit_code == 0 and "optics" in text.stdout
+    assert CliRunner().invoke(main, ["simulate", "--sensor", str(out), "--size", "20",
+                                     "--out", str(tmp_path / "again.tif")]).exit_code == 0
+
+
+def test_the_text_table_shortens_long_paths_and_keeps_its_columns_within_120(capsys):
+    from types import SimpleNamespace
+
+    from imgmtf.cli.tables import print_fit
+    deep = "/archive/" + "a_folder_with_a_long_name_" * 3
+    edges = [SimpleNamespace(source=f"{deep}/a_long_file_name_for_an_edge_of_the_sensor_{k}.tif[0,0,60,60]",
+                             normal_angle_deg=angle, direction=d, constrains=d, mtf_nyquist=0.27,
+                             mtf_nyquist_ci=(0.26, 0.28), measured_mtf_nyquist=0.27, reduced_chi_square=1.0,
+                             misfit_fraction=0.0) for k, (angle, d) in enumerate(((5.0, "across"), (-84.0, "along")))]
+    result = SimpleNamespace(edges=edges, sensor=TRUTH, reduced_chi_square=1.0, choice=None, parameters=[],
+                             correlations=[], confidence=0.95, warnings=[],
+                             directions={"across": {"mtf_nyquist": 0.27, "mtf_nyquist_ci": (0.26, 0.28),
+                                                    "mtf50_cy_px": 0.36, "constrained": True}})
+    print_fit(result)
+    lines = capsys.readouterr().out.splitlines()
     header = next(k for k, line in enumerate(lines) if line.startswith("edge "))
     assert lines[header - 1] == f"edges below {deep}/"
     rows = lines[header: header + 3]
@@ -205,12 +220,6 @@ def test_cli_json_contract_toml_and_plot(pair, tmp_path):
     for row in rows[1:]:                # right-aligned: the headings end where the figures do
         assert rows[0].index("normal") + len("normal") == re.search(r" (-?\d+\.\d\d) ", row).end(1)
         assert len(rows[0]) == len(row)
-    fitted = im.Sensor.from_toml(out)
-    assert fitted.mtf_nyquist("across") == pytest.approx(record["directions"]["across"]["mtf_nyquist"])
-    text = CliRunner().invoke(main, ["sensor", "--sensor", str(out)])
-    assert text.exit_code == 0 and "optics" in text.stdout
-    assert CliRunner().invoke(main, ["simulate", "--sensor", str(out), "--size", "20",
-                                     "--out", str(tmp_path / "again.tif")]).exit_code == 0
 
 
 @pytest.mark.parametrize("args, message", [
