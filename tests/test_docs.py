@@ -11,15 +11,14 @@
   blocks read as sensor files.
 * No other block shows a command (``$ imgmtf ...``) but the few that
   :data:`RECORDED` names with why the suite cannot run them.
-* The package's docstring examples, module by module, as doctests.
+* (The package's docstring examples: tests/test_docstring_examples.py, a
+  file of its own so that a parallel run spreads the two.)
 
 When a change moves what a command prints, ``python tests/test_docs.py
 --update`` rewrites the console outputs the documents show (lines with
 ``...`` kept where they still match); read the diff before committing it.
 """
 import doctest
-import importlib
-import pkgutil
 import re
 import shlex
 from pathlib import Path
@@ -200,20 +199,6 @@ def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
         assert command in first_screen
     ci = (ROOT / ".ci" / "run").read_text()
     assert '".[$extras]"' in ci and "run_suite .venv-ci test" in ci and "\n    pytest" in ci
-
-
-MODULES = sorted(m.name for m in pkgutil.walk_packages(imgmtf.__path__, "imgmtf."))
-
-
-@pytest.mark.parametrize("name", MODULES)
-def test_docstring_examples(name, tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)                       # examples may write files
-    module = importlib.import_module(name)
-    runner = doctest.DocTestRunner(optionflags=DOCTEST_FLAGS)
-    report: list[str] = []
-    for test in doctest.DocTestFinder().find(module, name):
-        runner.run(test, out=report.append)
-    assert not runner.failures, "".join(report)
 
 
 def update_console_outputs(document: str) -> None:
