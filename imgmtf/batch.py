@@ -180,18 +180,21 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
             record = record.with_(plot=records[0].plot)
         elif plot_path:
             record = with_figure(record, functools.partial(_measurement_figure, result, raster,
-                                                           summary["warnings"]),
+                                                           summary["warnings"], record.reason
+                                                           if record.status == "untrusted" else None),
                                  _band_plot_path(plot_path, band, n_bands))
         records.append(record)
     return records
 
 
 def _untrusted_when_forced(record: Record, settings: MeasureSettings, checks) -> Record:
-    """A forced number that no one should use: status ``untrusted``
-    (printed, and a failure)."""
+    """A number forced past a refusal: status ``untrusted`` (printed, and a
+    failure), its reason the check that makes it unusable where one does
+    (:func:`.estimate.gate.untrusted_when_forced`), else the first that
+    failed.  A forced chip that fails no check is a plain success."""
     if settings.force:
         from .estimate.gate import untrusted_when_forced
-        failed = untrusted_when_forced(checks)
+        failed = untrusted_when_forced(checks) or next((c for c in checks if c.failed), None)
         if failed is not None:
             record = record.with_(status="untrusted", reason=failed.reason,
                                   error=f"{record.path}: forced, but not to be trusted: {failed.message}")
@@ -259,13 +262,17 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result, raster, warnings):
+def _measurement_figure(result, raster, warnings, untrusted=None):
     """The measurement figure, titled with the file (and band), counting
     every warning its record carries (the file's own among them), with the
-    true MTF when the file is a chip imgmtf simulated."""
+    true MTF when the file is a chip imgmtf simulated; a number forced past
+    a refusal (``untrusted``: its reason) is said not to be trusted in the
+    title."""
     from .kinds import get_kind
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
+    if untrusted:
+        title = f"{title}: NOT TO BE TRUSTED (forced past the refusal {untrusted})"
     kind = get_kind(result.target)
     if kind.figure is not None:             # a kind with a figure of its own (points: the 2-D PSF and MTF)
         return kind.load("figure")(result, raster.data, truth=kind_truth(raster), title=title, warnings=warnings)

@@ -12,7 +12,9 @@ A row whose fitted width collapses below what a pixel grid resolves (a
 sharpened edge's overshoots pull a logistic to a step, whose location is
 then free anywhere between two samples) is refitted with its width held
 at ``MIN_WIDTH_PX``: a logistic that still interpolates between the two
-samples astride the edge, so that the row keeps a location.
+samples astride the edge, so that the row keeps a location (where its
+step is like the other rows': a collapse on something else, a second
+feature or texture, keeps its free fit).
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ import numpy as np
 # a 1-px pixel aperture alone gives a 10-90 % rise of 0.8 px, a Fermi width
 # of 0.18 px: a fitted width below this is a collapse to a step, not a blur
 MIN_WIDTH_PX = 0.15
+MAX_STEP_CHANGE = 0.5          # a held row's step within this share of the rows' median step
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,12 +76,18 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
     # the model is symmetric under (a, c) -> (-a, -c) with d shifted: keep c > 0
     flip = p[:, 2] < 0
     p[flip] = np.column_stack([-p[flip, 0], p[flip, 1], -p[flip, 2], p[flip, 3] + p[flip, 0]])
-    pinned = np.all(np.isfinite(p), axis=1) & (p[:, 2] < MIN_WIDTH_PX) & (p[:, 0] != 0)
+    finite = np.all(np.isfinite(p), axis=1)
+    pinned = finite & (p[:, 2] < MIN_WIDTH_PX) & (p[:, 0] != 0)
     if pinned.any():
         start = p[pinned].copy()
         start[:, 2] = MIN_WIDTH_PX
-        p[pinned] = _levenberg_marquardt(x[pinned] if x.ndim == 2 else x, y[pinned], w[pinned], start,
-                                         iterations, free=np.array([True, True, False, True]))
+        held = _levenberg_marquardt(x[pinned] if x.ndim == 2 else x, y[pinned], w[pinned], start,
+                                    iterations, free=np.array([True, True, False, True]))
+        # a row held so is the target's only where its step is the target's
+        step = float(np.median(np.abs(p[finite, 0])))
+        alike = np.abs(np.abs(held[:, 0]) / step - 1.0) <= MAX_STEP_CHANGE
+        pinned[pinned] = alike
+        p[pinned] = held[alike]
     used = w.sum(axis=1)
     xmin = np.where(w > 0, x, np.inf).min(axis=1)
     xmax = np.where(w > 0, x, -np.inf).max(axis=1)

@@ -142,6 +142,12 @@ class EdgeFit:
         :data:`MISFIT_FRACTION` of the step."""
         return self.misfit_p < MISFIT_P and self.misfit_fraction > MISFIT_FRACTION
 
+    @property
+    def misfit_tested(self) -> bool:
+        """Whether the misfit test ran (its residuals filled a bin): an
+        edge it could not test is neither a fit nor a misfit."""
+        return math.isfinite(self.misfit_p)
+
     def to_dict(self) -> dict:
         return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
                 "constrains": self.constrains, "gsd_m": self.gsd_m, "rows_used": self.rows_used,
@@ -150,8 +156,9 @@ class EdgeFit:
                 "mtf50_cy_px": json_value(self.mtf50_cy_px),
                 "measured_mtf_nyquist": json_value(self.measured_mtf_nyquist), "noise_dn": self.noise_dn,
                 "step_dn": self.step_dn, "levels_dn": list(self.levels_dn), "offset_px": self.offset_px,
-                "reduced_chi_square": self.reduced_chi_square, "misfit_p": self.misfit_p,
-                "misfit_fraction": self.misfit_fraction, "misfit": self.misfit}
+                "reduced_chi_square": self.reduced_chi_square, "misfit_p": json_value(self.misfit_p),
+                "misfit_fraction": json_value(self.misfit_fraction), "misfit": self.misfit,
+                "misfit_test": ("failed" if self.misfit else "passed") if self.misfit_tested else "not-run"}
 
 
 @dataclass(frozen=True, eq=False)
