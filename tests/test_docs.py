@@ -36,10 +36,13 @@ ROOT = Path(__file__).parent.parent
 # method), and the generated reproduction report
 OTHERS = {"accuracy.md", "method.md"}
 # pages whose examples read the shared real scenes (never copied into the repository): linked into
-# the folder the examples run in (under the name the page gives it), the page skipped where they are
-# absent (conftest.real_scene)
+# the folder the examples run in (under the name the page gives it; a shapefile's parts in their
+# folder), the page skipped where they are absent (conftest.real_scene)
 REAL_SCENES_READ = {"docs/scan.md": {"baotou_l0r_checkerboard.tif": "baotou_l0r_checkerboard.tif"},
-                    "docs/restore.md": {"baotou.tif": "baotou_l0r_checkerboard.tif"}}
+                    "docs/restore.md": {"baotou.tif": "baotou_l0r_checkerboard.tif"},
+                    "docs/regions.md": {name: name for name in (
+                        "sentinel2_b04_bagnolo.tif",
+                        *(f"bagnolo_roi/mtf_al_bagnolo.{e}" for e in ("shp", "shx", "dbf", "prj")))}}
 # blocks that show commands the suite does not run, each (document, its first command) with why
 RECORDED = {
     ("docs/campaign.md", "imgmtf simulate --campaign scenes"):
@@ -152,6 +155,7 @@ def test_every_example_of_the_document_runs(document, sample_folder):
 
 def link_real_scenes(document: str, folder: Path) -> None:
     for link, name in REAL_SCENES_READ.get(document, {}).items():
+        (folder / link).parent.mkdir(exist_ok=True)         # a shapefile's parts, in their folder
         (folder / link).symlink_to(real_scene(name))
 
 
@@ -170,7 +174,7 @@ def assert_ignored(folder: Path) -> None:
     root as a newcomer runs them, is one .gitignore covers."""
     import shutil
     import subprocess
-    linked = {name for names in REAL_SCENES_READ.values() for name in names}
+    linked = {name.split("/")[0] for names in REAL_SCENES_READ.values() for name in names}
     written = [p.name + "/" * p.is_dir() for p in folder.iterdir()
                if p.name != "data" and not p.name.startswith("block") and p.name not in linked]
     if not written or not shutil.which("git") or not (ROOT / ".git").exists():

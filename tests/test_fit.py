@@ -208,6 +208,7 @@ def test_the_text_table_shortens_long_paths_and_keeps_its_columns_within_120(cap
                              mtf_nyquist_ci=(0.26, 0.28), measured_mtf_nyquist=0.27, reduced_chi_square=1.0,
                              misfit_fraction=0.0) for k, (angle, d) in enumerate(((5.0, "across"), (-84.0, "along")))]
     result = SimpleNamespace(edges=edges, sensor=TRUTH, reduced_chi_square=1.0, choice=None, parameters=[],
+                             pixel_units=False,
                              correlations=[], confidence=0.95, warnings=[],
                              directions={"across": {"mtf_nyquist": 0.27, "mtf_nyquist_ci": (0.26, 0.28),
                                                     "mtf50_cy_px": 0.36, "constrained": True}})

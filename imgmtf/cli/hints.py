@@ -42,8 +42,11 @@ HINTS = (
     Hint(CHIP, "not-a-bar", "--target edge measures an edge"),
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
+    Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
+    Hint(CHIP, "star", "--target star measures a Siemens star"),
     # an image too large, not a window too large (which a smaller --roi answers, as its message says)
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window", words="measure a window of it"),
+    Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),

@@ -34,6 +34,7 @@ from ..inputs import check_number, check_width
 from ..kinds.double_bar import DOUBLE_BAR
 from ..metrics import fwhm
 from . import gate
+from .bar_width import half_width_at
 from .kind import Shape
 from .pipeline import run
 from .pulse import BACKGROUND_FRACTION, MIN_HEIGHT_NOISE, WINDOW_FACTOR, PulseKind
@@ -188,7 +189,7 @@ class DoubleBarKind(PulseKind):
                 f"the double bar ({self.span_px:.1f} px) is too wide for the chip: it needs "
                 f"{self.span_px / 2 + 2:.1f} px of background on each side of its centre", reason="border")
         prf01 = peak / height
-        h10 = _half_width_at(grid, prf01, 0.1)
+        h10 = half_width_at(grid, prf01, 0.1)
         area = float(np.sum(prf01[np.abs(grid) <= self._core(h10)]) * (grid[1] - grid[0]))
         return Shape(0.0, h10, float(background), float(background + sign * height),
                      min(1.5 * h10 + 1.0, half_range - 1.0),
@@ -369,12 +370,4 @@ def measure_double_bar(image: ArrayLike, *, width_px: float, gap_px: float,
     return DoubleBarEstimator(method, stages=stages, force=force, **options)(
         image, width_px=width_px, gap_px=gap_px, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
         dtype=dtype, track_azimuth_deg=track_azimuth_deg)
-
-
-def _half_width_at(grid: np.ndarray, prf01: np.ndarray, level: float) -> float:
-    """Half of the profile's width at ``level`` of its peak."""
-    above = np.nonzero(prf01 >= level)[0]
-    if above.size == 0:
-        return 0.0
-    return float(max(-grid[above[0]], grid[above[-1]]))
 
