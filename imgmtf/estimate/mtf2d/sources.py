@@ -6,9 +6,11 @@ A target is a local maximum of the background-subtracted chip (its sign
 turned for dark targets), smoothed by a 1 px Gaussian, above five times the
 smoothed noise.  Each is cut out as a square stamp and refused, with a
 reason code and a message, when its peak is under the SNR floor
-(``faint``), signal reaches its stamp's border (``extended``: an edge or a
-bar, not a point), its stamp touches the chip's edge (``edge``), another
-target lies within the separation (``blended``), a pixel of it is at the
+(``faint``), signal reaches its stamp's border beyond the plane fitted to
+the border (``extended``: an edge or a bar, not a point; the plane is a
+textured field's slope), its stamp touches the chip's edge (``edge``),
+another target of at least a tenth of its peak lies within the separation
+(``blended``; a faint bump of texture does not blend), a pixel of it is at the
 recorded range's end (``clipped``) or it is sharper than any optics
 (``hot-pixel``).
 The rest are located by a least-squares fit of an elliptical Gaussian
@@ -32,6 +34,8 @@ POLARITIES = ("auto", "bright", "dark")
 MIN_SIGMA_PX = 0.15
 #: the share of its peak a target's smoothed signal may keep on its stamp's border
 MAX_BORDER_FRACTION = 0.2
+#: a neighbour blends a target when its smoothed peak is at least this share of the target's
+BLEND_FRACTION = 0.1
 
 
 @dataclass(frozen=True)
@@ -224,9 +228,12 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     sources, stamps, phases = [], [], []
     padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
     peaks_xy = np.column_stack([ix, iy])
+    heights = smoothed[iy, ix]
     for k, (y, x) in enumerate(zip(iy, ix)):
         distance = np.hypot(ix - x, iy - y)
         distance[k] = np.inf
+        # a neighbour blends only if it is of some weight beside this target (a faint bump of texture is not)
+        distance[heights < BLEND_FRACTION * heights[k]] = np.inf
         source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
                                       radius, float(distance.min()),
                                       separation, noise, min_snr, saturation, polarity)
@@ -258,10 +265,10 @@ def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separati
     ry, rx = np.nonzero(ring)
     near = ((rx[:, None] + x - radius - others[None, :, 0]) ** 2
             + (ry[:, None] + y - radius - others[None, :, 1]) ** 2 <= 9).any(axis=1)
-    values = padded[ry + y, rx + x][~near]
-    border = float(np.nanmax(np.abs(values), initial=0.0)) if np.isfinite(values).any() else 0.0
-    if border > MAX_BORDER_FRACTION * float(smoothed[y, x]):
-        share = 100 * border / smoothed[y, x]
+    border, level = border_excess(padded[ry + y, rx + x][~near], rx[~near] - radius, ry[~near] - radius)
+    height = float(smoothed[y, x]) - level
+    if border > MAX_BORDER_FRACTION * height:
+        share = 100 * border / max(height, 1e-12)
         return refused("extended", f"its signal reaches {2 * radius + 1} px across ({share:.0f} % of its peak on "
                        "the border): an edge or a bar, not a point")
     if x - radius < 0 or y - radius < 0 or x + radius >= cols or y + radius >= rows:
@@ -285,6 +292,30 @@ def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separati
         return refused("fit", f"the fitted centre or width ({max(sx, sy):.2f} px) does not fit the stamp")
     source = Source(x + dx, y + dy, snr, "used", "", flux, sign * level, sx, sy)
     return source, (sign * stamp - level) / flux, (dx, dy)
+
+
+def border_excess(values: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """How far a stamp's border ``values`` (at offsets ``x``, ``y`` from its
+    centre; NaN off the chip) stray from the plane fitted to them (the
+    largest absolute residual), and that plane's level at the centre.  The
+    plane is the background under the target (a textured field's slope); an
+    edge's step or a bar's crossing stays in the residual, and a bump on a
+    plateau has no height above the plane.
+
+    Examples
+    --------
+    >>> x = np.array([-2, 0, 2, -2, 2, -2, 0, 2]); y = np.array([-2, -2, -2, 0, 0, 2, 2, 2])
+    >>> [round(v, 9) for v in border_excess(5.0 + 0.3 * x - 0.1 * y, x, y)]
+    [0.0, 5.0]
+    >>> [round(v, 3) for v in border_excess(np.where(x > 0, 1.0, 0.0), x, y)]     # a step: no plane
+    [0.375, 0.375]
+    """
+    keep = np.isfinite(values)
+    if keep.sum() < 4:
+        return (float(np.nanmax(np.abs(values), initial=0.0)) if keep.any() else 0.0), 0.0
+    design = np.column_stack([np.ones(keep.sum()), x[keep], y[keep]]).astype(float)
+    coefficients = np.linalg.lstsq(design, values[keep], rcond=None)[0]
+    return float(np.abs(values[keep] - design @ coefficients).max()), float(coefficients[0])
 
 
 def pixel_gaussian(params, n: np.ndarray) -> np.ndarray:
