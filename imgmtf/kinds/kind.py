@@ -86,6 +86,11 @@ class Kind:
     rows_per_result : str or None
         Why one result gives several records (points: one per direction),
         or None for one record per result.
+    scanner : str or None
+        "module:attribute" of its own scene scan when it is no line
+        (``scanner(path, settings)`` returning the records and the scene's
+        summaries; points: :func:`imgmtf.scene.points.scan_point_arrays`),
+        or None: ``imgmtf scan`` searches the scene for lines.
 
     Examples
     --------
@@ -117,6 +122,7 @@ class Kind:
     renderer: str | None = None
     figure: str | None = None
     rows_per_result: str | None = None
+    scanner: str | None = None
 
     def load(self, part: str) -> Any:
         """The object one of the kind's "module:attribute" parts names,
@@ -124,7 +130,7 @@ class Kind:
 
         Parameters
         ----------
-        part : {"estimator", "result", "measuring", "renderer", "figure"}
+        part : {"estimator", "result", "measuring", "renderer", "figure", "scanner"}
             Which part.
 
         Returns

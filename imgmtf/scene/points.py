@@ -247,7 +247,7 @@ def scan_points(path: str, settings: ScanSettings, track_azimuth_deg: float | No
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; a point array needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}")
     xy, snr, bright = find_peaks(path, info, settings)
-    spacing = getattr(settings, "point_spacing_px", None)
+    spacing = settings.point_spacing_px
     params = {**settings.measure_settings().params(), "track_azimuth_deg": track_azimuth_deg,
               "scan": settings.as_dict()}
     kind = get_kind(settings.target)
@@ -302,6 +302,33 @@ def _ranked(records: list[Record]) -> list[Record]:
     for k, r in enumerate(accepted + rejected, start=1):
         out.append(r.with_(site={"id": k, "rank": k if r.ok else None}))
     return out
+
+
+def scan_point_arrays(path: str, settings: ScanSettings) -> tuple[list[Record], list[Record]]:
+    """A scene's point arrays (:func:`scan_points`) and its rows per
+    direction (:func:`summarise_points`): what ``imgmtf scan --target
+    points`` reports and stores (the kind's ``scanner``).
+
+    Parameters
+    ----------
+    path : str
+        The scene.
+    settings : ScanSettings
+        How to scan; the track's direction as an edge scan takes it
+        (:func:`imgmtf.scene.measure.track_azimuth`).
+
+    Returns
+    -------
+    (list of Record, list of Record)
+        The arrays' records and the scene's summaries.
+
+    Examples
+    --------
+    >>> records, summaries = scan_point_arrays("mirrors.tif", ScanSettings("points"))   # doctest: +SKIP
+    """
+    from .measure import track_azimuth
+    records = scan_points(path, settings, track_azimuth(raster_info(path), settings))
+    return records, summarise_points(records)
 
 
 def summarise_points(records: list[Record]) -> list[Record]:

@@ -49,6 +49,10 @@ class ScanSettings:
         The ground track's direction, degrees clockwise from up; without
         it, a scene in sensor geometry has its rows along track and a
         map-projected one (with a CRS) an unknown direction.
+    point_spacing_px : float, optional
+        Point targets (``target`` "points"): neighbours of one array lie
+        within this distance, px; None (default) to group them by their
+        own spacing (:func:`imgmtf.scene.points.group_arrays`).
 
     Raises
     ------
@@ -72,6 +76,7 @@ class ScanSettings:
     intervals: Intervals = field(default_factory=Intervals)
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
+    point_spacing_px: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
@@ -90,6 +95,10 @@ class ScanSettings:
         if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
             raise ParameterError(f"max_length_px ({self.max_length_px:g} px) must lie between min_length_px "
                                  f"({self.min_length_px:g} px) and {MAX_LENGTH_PX} px")
+        if self.point_spacing_px is not None:
+            object.__setattr__(self, "point_spacing_px", check_number("point_spacing_px", self.point_spacing_px))
+            if not self.point_spacing_px >= 2:
+                raise ParameterError(f"point_spacing_px must be at least 2 px, got {self.point_spacing_px}")
         if self.margin_px < 6:
             raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")
         if not (isinstance(self.tile_px, int) and MIN_TILE_PX <= self.tile_px <= MAX_TILE_PX):
@@ -103,5 +112,8 @@ class ScanSettings:
 
     def as_dict(self) -> dict:
         """The scan's own settings, as records carry them."""
-        return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
-                "margin_px": self.margin_px, "tile_px": self.tile_px}
+        out = {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
+               "margin_px": self.margin_px, "tile_px": self.tile_px}
+        if self.point_spacing_px is not None:       # only when given: an edge scan's acquisition keeps its id
+            out["point_spacing_px"] = self.point_spacing_px
+        return out
