@@ -84,7 +84,8 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         fit_stages, point_spacing, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
+         fit_stages, point_spacing, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name,
+         fmt,
          verbose, progress, interval_method, replicates, confidence, workers, scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,

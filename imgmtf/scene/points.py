@@ -191,7 +191,7 @@ def find_peaks(path: str, info: RasterInfo, settings: ScanSettings) -> tuple[np.
             wx1, wy1 = min(x0 + tile + TILE_PAD_PX, info.width), min(y0 + tile + TILE_PAD_PX, info.height)
             data = read_raster(path, settings.band, window=(wx, wy, wx1 - wx, wy1 - wy)).data
             xy, snr, bright = compact_peaks(data)
-            xy = xy + [wx, wy]
+            xy = xy + np.array([wx, wy])
             core = (xy[:, 0] >= x0) & (xy[:, 0] < x0 + tile) & (xy[:, 1] >= y0) & (xy[:, 1] < y0 + tile)
             parts.append((xy[core], snr[core], bright[core]))
     xy, snr, bright = (np.concatenate(p) for p in zip(*parts))
@@ -246,7 +246,7 @@ def scan_points(path: str, settings: ScanSettings, track_azimuth_deg: float | No
     if min(info.width, info.height) < MIN_SIZE_PX:
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; a point array needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}")
-    xy, snr, bright = find_peaks(path, info, settings)
+    xy, _, bright = find_peaks(path, info, settings)
     spacing = settings.point_spacing_px
     params = {**settings.measure_settings().params(), "track_azimuth_deg": track_azimuth_deg,
               "scan": settings.as_dict()}
