@@ -106,9 +106,12 @@ class Stack:
 
     def model(self, fx: np.ndarray, fy: np.ndarray, sigmas: np.ndarray) -> np.ndarray:
         """The located targets' model transfer: a Gaussian of the median
-        widths, integrated over the pixel (1 at zero)."""
-        sx, sy = np.median(sigmas, axis=0)
-        return np.exp(-2 * np.pi ** 2 * ((sx * fx) ** 2 + (sy * fy) ** 2)) * np.sinc(fx) * np.sinc(fy)
+        widths, integrated over the pixel (1 at zero); ``sigmas`` (n, 2)
+        gives one model, (replicates, n, 2) one per replicate (a leading
+        axis on the result)."""
+        sx, sy = np.moveaxis(np.median(sigmas, axis=-2), -1, 0)
+        sx, sy = np.reshape(sx, np.shape(sx) + (1,) * fx.ndim), np.reshape(sy, np.shape(sy) + (1,) * fx.ndim)
+        return np.exp(-2 * np.pi ** 2 * ((sx * fx) ** 2 + (sy * fy) ** 2)) * (np.sinc(fx) * np.sinc(fy))
 
     def transfer(self, fx: np.ndarray, fy: np.ndarray, *, divide_size: bool = True) -> np.ndarray:
         """The stack's transfer at the pairs (``fx``, ``fy``), the model's
@@ -123,12 +126,19 @@ class Stack:
         (replicates, frequencies)."""
         fx0, fy0 = np.append(fx, 0.0), np.append(fy, 0.0)
         each = self.contributions(fx0, fy0)                                   # (targets, F)
+        picks = np.asarray(picks)
+        # each replicate's shares of the targets (a target picked twice counts twice): all replicates at once
+        counts = np.zeros((len(picks), len(self.stamps)))
+        np.add.at(counts, (np.repeat(np.arange(len(picks)), picks.shape[1]), picks.ravel()), 1.0)
+        shares = counts * self.weights[None, :]
+        shares /= shares.sum(axis=1, keepdims=True)
         out = np.empty((len(picks), len(fx0)), complex)
-        for r, pick in enumerate(picks):
-            aliased = self.model(fx0[:, None] + self.aliases[None, :, 0], fy0[:, None] + self.aliases[None, :, 1],
-                                 self.sigmas[pick])
-            share = self.weights[pick] / self.weights[pick].sum()
-            out[r] = share @ each[pick] - aliased @ (share @ self.alias_phasors[pick])
+        ax, ay = fx0[:, None] + self.aliases[None, :, 0], fy0[:, None] + self.aliases[None, :, 1]
+        for start in range(0, len(picks), 50):          # the aliases' models of 50 replicates at a time (memory)
+            block = slice(start, start + 50)
+            aliased = self.model(ax, ay, self.sigmas[picks[block]])              # (R, F, aliases)
+            out[block] = shares[block] @ each - np.einsum("rfa,ra->rf", aliased,
+                                                           shares[block] @ self.alias_phasors)
         t = out[:, :-1] / out[:, -1:].real
         if divide_size and self.size > 0:
             divisor = np.sinc(self.size * fx) * np.sinc(self.size * fy)
@@ -170,13 +180,17 @@ class Stack:
         few targets is drawn: Student's t over the normal quantile, times
         sqrt(n / (n - 1)) (the bootstrap's variance of a mean is (n - 1) / n
         of the truth), n the weights' effective count (Hesterberg's
-        expanded percentile interval); 1.09 x 1.03 for 16 targets."""
-        from scipy import stats
+        expanded percentile interval; the degrees of freedom rounded);
+        1.09 x 1.03 for 16 targets."""
+        from statistics import NormalDist
+
+        from ..._stats import t_quantile
         n = float(self.weights.sum() ** 2 / (self.weights ** 2).sum())
         if n <= 1.5:
             return math.inf
         q = 0.5 + confidence / 2
-        return float(stats.t.ppf(q, n - 1) / stats.norm.ppf(q) * math.sqrt(n / (n - 1)))
+        # (t's degrees of freedom rounded to an integer: the closed form, without SciPy's stats, 2 s to import)
+        return float(t_quantile(q, max(int(round(n - 1)), 1)) / NormalDist().inv_cdf(q) * math.sqrt(n / (n - 1)))
 
     def lsf(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """The line spread function along ``vector``: the inverse transform
