@@ -356,7 +356,9 @@ def summarise_points(records: list[Record]) -> list[Record]:
     """
     accepted = [r for r in records if r.ok and r.figures.get("mtf_nyquist") is not None]
     out = []
-    for direction in dict.fromkeys(r.figures["direction"] for r in accepted):
+    order = ("across-track", "along-track", "image-x", "image-y")
+    for direction in sorted({r.figures["direction"] for r in accepted}, key=lambda d: (d not in order, order.index(d)
+                                                                                       if d in order else d)):
         group = [r for r in accepted if r.figures["direction"] == direction]
         out.append(_scene_row(group))
     return out

@@ -283,7 +283,9 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
     directions = tuple(stack.direction(name, vector, settings) for name, vector in section_axes(track_azimuth_deg))
     psf, step = stack.psf()
     f2d = np.round(np.arange(-50, 51) * 0.02, 10)
-    mtf2d = stack.mtf(f2d[None, :], f2d[:, None])
+    # a real PSF's transfer is Hermitian: |T(-f)| = |T(f)|, so the half plane fy >= 0 gives the whole grid
+    upper = stack.mtf(f2d[None, :], f2d[f2d.size // 2:, None])
+    mtf2d = np.vstack([upper[:0:-1, ::-1], upper])
     warnings = []
     if stack.alias_weight > 0.3:
         warnings.append(f"the {len(found.used)} targets' phases leave aliases of weight {stack.alias_weight:.2f} "

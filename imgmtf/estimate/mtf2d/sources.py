@@ -9,8 +9,9 @@ reason code and a message, when its peak is under the SNR floor
 (``faint``), signal reaches its stamp's border beyond the plane fitted to
 the border (``extended``: an edge or a bar, not a point; the plane is a
 textured field's slope), its stamp touches the chip's edge (``edge``),
-another target of at least a tenth of its peak lies within the separation
-(``blended``; a faint bump of texture does not blend), a pixel of it is at the
+another target (above the SNR floor, and of at least a tenth of its peak)
+lies within the separation (``blended``; a faint bump of texture does not
+blend), a pixel of it is at the
 recorded range's end (``clipped``) or it is sharper than any optics
 (``hot-pixel``).
 The rest are located by a least-squares fit of an elliptical Gaussian
@@ -229,11 +230,12 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
     peaks_xy = np.column_stack([ix, iy])
     heights = smoothed[iy, ix]
+    faint = signal[iy, ix] < min_snr * noise
     for k, (y, x) in enumerate(zip(iy, ix)):
         distance = np.hypot(ix - x, iy - y)
         distance[k] = np.inf
-        # a neighbour blends only if it is of some weight beside this target (a faint bump of texture is not)
-        distance[heights < BLEND_FRACTION * heights[k]] = np.inf
+        # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture is not)
+        distance[faint | (heights < BLEND_FRACTION * heights[k])] = np.inf
         source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
                                       radius, float(distance.min()),
                                       separation, noise, min_snr, saturation, polarity)
