@@ -331,6 +331,39 @@ def pixel_gaussian(params, n: np.ndarray) -> np.ndarray:
     return flux * gy[:, None] * gx[None, :] + level
 
 
+def _pixel_profile(n: np.ndarray, shift: float, sigma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A Gaussian integrated over unit pixels along one axis, and its
+    derivatives by the shift and by sigma."""
+    root2 = math.sqrt(2.0)
+    high, low = (n + 0.5 - shift) / (root2 * sigma), (n - 0.5 - shift) / (root2 * sigma)
+    e_high, e_low = np.exp(-high ** 2), np.exp(-low ** 2)
+    g = 0.5 * (special.erf(high) - special.erf(low))
+    d_shift = -(e_high - e_low) / (math.sqrt(2.0 * math.pi) * sigma)
+    d_sigma = -(high * e_high - low * e_low) / (math.sqrt(math.pi) * sigma)
+    return g, d_shift, d_sigma
+
+
+def pixel_gaussian_jacobian(params, n: np.ndarray) -> np.ndarray:
+    """The derivatives of :func:`pixel_gaussian`'s pixels (raveled, rows
+    first) by its ``params`` (flux, dx, dy, sigma_x, sigma_y, level): shape
+    (pixels, 6); what its least-squares fit uses rather than differences.
+
+    Examples
+    --------
+    >>> n, p = np.arange(-3, 4.0), np.array([100.0, 0.2, -0.3, 0.6, 0.8, 5.0])
+    >>> step = 1e-6 * np.eye(6)[2]
+    >>> numeric = (pixel_gaussian(p + step, n) - pixel_gaussian(p - step, n)).ravel() / 2e-6
+    >>> bool(np.allclose(pixel_gaussian_jacobian(p, n)[:, 2], numeric, atol=1e-6))
+    True
+    """
+    flux, dx, dy, sx, sy, _ = params
+    gx, gx_shift, gx_sigma = _pixel_profile(n, dx, sx)
+    gy, gy_shift, gy_sigma = _pixel_profile(n, dy, sy)
+    columns = (np.outer(gy, gx), flux * np.outer(gy, gx_shift), flux * np.outer(gy_shift, gx),
+               flux * np.outer(gy, gx_sigma), flux * np.outer(gy_sigma, gx), np.ones((n.size, n.size)))
+    return np.column_stack([c.ravel() for c in columns])
+
+
 def fit_pixel_gaussian(stamp: np.ndarray):
     """(flux, dx, dy, sigma_x, sigma_y, level) of the pixel-integrated
     Gaussian fitted to a positive ``stamp`` (dx, dy from its centre pixel),
@@ -351,7 +384,8 @@ def fit_pixel_gaussian(stamp: np.ndarray):
     high = [np.inf, radius, radius, float(radius), float(radius), np.inf]
     try:
         fit = optimize.least_squares(lambda p: (pixel_gaussian(p, n) - stamp).ravel(), start, bounds=(low, high),
-                                     x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400)
+                                     jac=lambda p: pixel_gaussian_jacobian(p, n), x_scale="jac", xtol=1e-12,
+                                     ftol=1e-12, gtol=1e-12, max_nfev=400)
     except (ValueError, np.linalg.LinAlgError):
         return None
     if not fit.success or not np.isfinite(fit.x).all() or fit.x[0] <= 0:
