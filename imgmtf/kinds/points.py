@@ -19,7 +19,8 @@ from .kind import Column, Kind
 POINTS = Kind(
     name="points", noun="point", has_width=False,
     column=Column("points_used", "N", "pts"),
-    record_fields=("points_used", "points_refused", "point_size_px", "alias_weight"),
+    record_fields=("points_used", "points_refused", "point_size_px", "alias_weight", "phase_cells",
+                   "phase_uniform_p"),
     estimator="imgmtf.estimate.mtf2d.estimator:PointsEstimator",
     result="imgmtf.estimate.mtf2d.points:PointsResult",
     measuring=None,
