@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from .hints import rejection_hint
 from .tables import SHORT_DIRECTIONS, interval_cell, num_cell, plural, snr_cell
 
 
@@ -41,8 +42,9 @@ def print_point_scan(scene, info, records, summaries, written, fmt) -> None:
     for record in records:
         if not record.ok:
             r = record.to_dict()
+            message = r["error"].removeprefix(r["path"] + ": ")
             click.echo(f"array {r['target_id']} at ({r['x_px']:.0f}, {r['y_px']:.0f}), {r['points_found']} "
-                       f"points found: rejected, {r['reason']}: {r['error'].removeprefix(r['path'] + ': ')}")
+                       f"points found: rejected, {r['reason']}: {message}{rejection_hint(r['reason'], message)}")
     if summaries:
         click.echo("the scene per direction, its arrays combined by precision (* the row to quote):")
         for summary in summaries:

@@ -67,6 +67,8 @@ class DirectionMTF:
 def _widened(replicates: np.ndarray, estimate: float, tail: float, widen: float) -> Interval:
     """The percentile interval of ``replicates``, its ends moved ``widen``
     times as far from ``estimate``."""
+    if not math.isfinite(widen):            # one target's worth of weight: no spread to draw an interval from
+        return Interval.none()
     low, high = np.nanpercentile(replicates, [tail, 100 - tail])
     return Interval(estimate - widen * (estimate - low), estimate + widen * (high - estimate))
 
