@@ -311,6 +311,8 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
         warnings.append(f"the {len(found.used)} targets' phases {coverage} and leave aliases of weight "
                         f"{stack.alias_weight:.2f} (0: a pixel tiled evenly): the MTF near Nyquist leans on the "
                         "Gaussian model they were located with")
+    if stack.tail_note:
+        warnings.append(stack.tail_note)
     if len(found.used) < 8 and settings.method != "none":
         warnings.append(f"only {len(found.used)} targets: the bootstrap over them is rough")
     rows, cols = np.asarray(image).shape

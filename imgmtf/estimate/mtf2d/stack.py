@@ -16,6 +16,13 @@ from .sources import FoundSources
 #: the highest alias order the model correction covers, and the band (cy/px) the PSF is drawn from
 ALIAS_ORDER = 4
 BAND_CY_PX = 2.0
+#: the taper: each stamp is its data within TAPER_SIGMAS fitted sigmas (at least TAPER_CORE_PX) of its centre,
+#: eased over TAPER_WIDTH_PX into its fitted model beyond, unless the targets' tails hold more than MAX_TAIL_LIGHT
+#: of their light (or three standard errors) that the model has not
+TAPER_CORE_PX = 2.0
+TAPER_SIGMAS = 3.0
+TAPER_WIDTH_PX = 1.5
+MAX_TAIL_LIGHT = 0.005
 #: where a square's sinc is too small to divide out (NaN there)
 MIN_DIVISOR = 0.1
 SECTION_STEP_CY_PX = 0.01
@@ -77,13 +84,16 @@ class Stack:
     """The used targets' stamps and phases, and the transforms of their
     stack (see the module); built once, read for every frequency."""
 
-    def __init__(self, found: FoundSources, point_size_px: float):
+    def __init__(self, found: FoundSources, point_size_px: float, *, taper: bool = True):
         self.stamps, self.phases, self.size = found.stamps, found.phases_px, point_size_px
         radius = found.stamp_radius_px
         self.offsets = np.arange(-radius, radius + 1, dtype=float)
         self.radius = radius
         used = found.used
         self.sigmas = np.array([[s.sigma_x_px, s.sigma_y_px] for s in used])
+        self.tail_note = ""
+        if taper and len(used):
+            self.stamps, self.tail_note = self._tapered()
         # inverse variance: a stamp divided by its flux has noise / flux; capped at 3x the median flux so that
         # no one bright target (one phase) carries the stack alone
         flux = np.array([s.flux_dn for s in used])
@@ -97,6 +107,28 @@ class Stack:
         first = np.max(np.abs(self.aliases), axis=1) == 1
         share = self.weights / self.weights.sum()
         self.alias_weight = float(np.abs(share @ self.alias_phasors[:, first]).max())
+
+    def _tapered(self) -> tuple[np.ndarray, str]:
+        """The stamps with their far pixels eased into each target's fitted
+        model (see the module), or as they are, with the reason, when the
+        targets' tails hold light the model has not."""
+        from .sources import pixel_gaussian
+        core = max(TAPER_CORE_PX, TAPER_SIGMAS * float(np.median(self.sigmas, axis=0).max()) + 0.35)
+        outer = core + TAPER_WIDTH_PX
+        if outer > self.radius + 0.5:               # a core that fills the stamp: nothing to ease
+            return self.stamps, ""
+        n = self.offsets
+        models = np.array([pixel_gaussian((1.0, dx, dy, sx, sy, 0.0), n)
+                           for (dx, dy), (sx, sy) in zip(self.phases, self.sigmas)])
+        r = np.hypot(n[None, None, :] - self.phases[:, 0, None, None], n[None, :, None] - self.phases[:, 1, None, None])
+        tail = np.where(r > core, self.stamps - models, 0.0).sum(axis=(1, 2))      # light beyond the model's
+        spread = float(tail.std(ddof=1)) / math.sqrt(len(tail)) if len(tail) > 1 else math.inf
+        if abs(float(tail.mean())) > max(3.0 * spread, MAX_TAIL_LIGHT):
+            return self.stamps, (f"the targets hold {100 * float(tail.mean()):+.1f} % of their light beyond "
+                                 f"{core:.1f} px that their Gaussian model has not (a halo or wings): measured as "
+                                 "they are, not eased into the model, at the cost of precision")
+        weight = np.sin(0.5 * np.pi * np.clip((outer - r) / TAPER_WIDTH_PX, 0.0, 1.0)) ** 2
+        return weight * self.stamps + (1.0 - weight) * models, ""
 
     def contributions(self, fx: np.ndarray, fy: np.ndarray) -> np.ndarray:
         """Each target's phase-corrected transform at the frequency pairs
