@@ -158,7 +158,7 @@ def _settle(own: list[dict], reference: Mapping) -> None:
     seen = f"the point array's {_figure(reference)}"
     current = [r for r in own if r.get("recommended")]
     order = current + sorted((r for r in own if not r.get("recommended")),
-                             key=lambda r: _EDGE_PREFERENCE.get(r.get("method"), 3))
+                             key=lambda r: _EDGE_PREFERENCE.get(str(r.get("method")), 3))
     agreeing = [r for r in order if _agrees(r, reference)]
     if current and agreeing and agreeing[0] is current[0]:
         current[0]["recommended_because"] = f"{current[0].get('recommended_because')}; {seen} agrees"

@@ -101,7 +101,7 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
         ax.add_patch(Rectangle((x - 0.5, y - 0.5), w, h, fill=False, edgecolor=colour, linewidth=1.4, zorder=4))
         lines = [f"A{number}"]
         if ok:
-            lines += [f"{_SHORT.get(m.get('direction'), m.get('direction'))}: {_interval(m)}" for m in members]
+            lines += [f"{_short(m)}: {_interval(m)}" for m in members]
         else:
             lines.append(first.get("reason") or "rejected")
         ax.text(x - 0.5, y - 1.5, "\n".join(lines), fontsize=6, color="black", ha="left", va="bottom", zorder=6,
@@ -111,7 +111,7 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
     handles += [Line2D([], [], color=colours[reason], lw=2,
                        label=f"{reason} ({sum(1 for m in arrays.values() if m[0].get('reason') == reason)})")
                 for reason in reasons]
-    quoted = ", ".join(f"{'*' if s.get('recommended') else ''}{_SHORT.get(s.get('direction'), s.get('direction'))} "
+    quoted = ", ".join(f"{'*' if s.get('recommended') else ''}{_short(s)} "
                        f"{_interval(s)}" for s in scene_rows if s.get("mtf_nyquist") is not None)
     ax.set_title(f"{accepted} point array{'s' * (accepted != 1)} accepted, {len(arrays) - accepted} rejected; "
                  f"labels: MTF at Nyquist [interval] per direction" + (f"; scene: {quoted}" if quoted else ""),
@@ -126,3 +126,8 @@ def _interval(row: Mapping[str, Any]) -> str:
     low, high = row.get("mtf_nyquist_ci") or (None, None)
     text = "-" if value is None else f"{value:.3f}"
     return text + (f" [{low:.3f}, {high:.3f}]" if low is not None and high is not None else "")
+
+
+def _short(row: Mapping[str, Any]) -> str:
+    direction = str(row.get("direction"))
+    return _SHORT.get(direction, direction)
