@@ -69,3 +69,10 @@ def test_edges_that_all_disagree_with_the_point_array_keep_their_row_and_say_so(
     marked = mark_recommended([image_row("e", "fit", 0.160, 0.155, 0.165, 1),
                                image_row("p", "points", 0.130, 0.124, 0.136)])
     assert marked[0]["recommended"] and "disagrees at Nyquist" in marked[0]["recommended_because"]
+
+
+def test_a_photos_image_axes_are_directions_like_the_tracks():
+    # a file with no georeference is told in its own axes: its rows are one direction each, whatever their normals
+    rows = [row("fit", "horizontal", misfit=0), row("combined", "horizontal", normal_angle_deg=0.6),
+            row("combined", "vertical", normal_angle_deg=89.7)]
+    assert chosen(rows) == [("fit", "horizontal"), ("combined", "vertical")]

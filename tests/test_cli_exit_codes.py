@@ -97,14 +97,14 @@ def test_a_value_its_check_refuses_exits_2_naming_the_limit(command, option, val
 # options that contradict each other
 CONTRADICTIONS = [
     ("measure", ["a.tif", "--plot", "p.png", "--plot-dir", "plots"], "--plot or --plot-dir"),
-    ("measure", ["a.tif", "--pulse-width", "2"], "--target pulse only"),
+    ("measure", ["a.tif", "--pulse-width", "2"], "--target pulse or --target double-bar only"),
     ("measure", ["a.tif", "--intervals", "none", "--bootstrap", "200"], "give one"),
     ("measure", ["a.tif", "--intervals", "influence", "--bootstrap", "0"], "give one"),
-    ("scan", ["a.tif", "--pulse-width", "2"], "--target pulse only"),
+    ("scan", ["a.tif", "--pulse-width", "2"], "--target pulse or --target double-bar only"),
     ("scan", ["a.tif", "--min-length", "100", "--max-length", "50"], "below --min-length"),
     ("scan", ["a.tif", "--edge-figures"], "give --out DIR"),
     ("scan", ["a.tif", "--intervals", "bootstrap", "--bootstrap", "0"], "give one"),
-    ("simulate", ["--out", "a.tif", "--pulse-width", "2"], "--target pulse only"),
+    ("simulate", ["--out", "a.tif", "--pulse-width", "2"], "--target pulse or --target double-bar only"),
     ("simulate", ["--out", "a.tif", "--target", "pulse"], "needs --pulse-width"),
     ("restore", ["a.tif", "b.tif", "--sensor", "s.toml", "--target-nyquist", "0.4", "--out", "o.tif",
                  "--plot", "p.png"], "take a single image"),

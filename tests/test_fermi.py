@@ -1,6 +1,6 @@
 import numpy as np
 
-from imgmtf.estimate.fermi import fermi, fit_fermi
+from imgmtf.estimate.fermi import MIN_WIDTH_PX, fermi, fit_fermi
 
 
 def test_recovers_exact_parameters_for_every_row_at_once():
@@ -32,3 +32,16 @@ def test_flat_row_fails():
     x = np.tile(np.arange(-8.0, 9.0), (1, 1))
     fit = fit_fermi(x, np.full_like(x, 50.0) + np.linspace(0, 1e-9, x.size), np.ones_like(x), np.zeros(1))
     assert not fit.ok[0] or abs(fit.params[0, 0]) < 1e-3
+
+
+def test_a_row_collapsed_to_a_step_keeps_its_location():
+    # a sharpened edge's row: undershoot, step, overshoot, antisymmetric about
+    # 0.5 px; a free logistic collapses to a step that may sit anywhere
+    # between the samples 0 and 1, the pinned width puts it midway
+    x = np.tile(np.arange(-8.0, 10.0), (3, 1))
+    y = np.where(x < 0.5, 200.0, 1200.0)
+    y[:, [7, 8, 9, 10]] = [100.0, 210.0, 1190.0, 1300.0]
+    fit = fit_fermi(x, y, np.ones_like(y), np.array([0.2, 0.5, 0.8]))
+    assert fit.ok.all() and fit.pinned.all()
+    assert (fit.width == MIN_WIDTH_PX).all()
+    np.testing.assert_allclose(fit.location, 0.5, atol=1e-5)

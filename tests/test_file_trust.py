@@ -142,3 +142,20 @@ def test_scan_and_measure_give_one_edge_the_same_warnings(tmp_path, name, option
     assert scanned["warnings"] == measured.to_dict()["warnings"]
     assert any(w.startswith("8-bit values are measured as stored") for w in scanned["warnings"])
     assert any("JPEG compression" in w for w in scanned["warnings"]) == name.endswith(".jpg")
+
+
+def test_a_number_forced_past_any_refusal_is_untrusted_in_its_record_and_figure(tmp_path):
+    # SNR 5: refused (snr and others); forced, printed as untrusted with the refusal's reason, exit 1
+    chip = exact_edge_chip(H, 6.0, offset=0.2, noise_std=200.0, seed=2, shape=(40, 40))
+    im.write_geotiff(tmp_path / "noisy.tif", chip)
+    code, (row,) = measure("--force", "--intervals", "none", tmp_path / "noisy.tif")
+    assert code == 1 and row["status"] == "untrusted" and row["mtf_nyquist"] is not None
+    assert row["reason"] in {c["reason"] for c in row["checks"] if c["outcome"] == "failed"}
+    assert "forced, but not to be trusted" in row["error"]
+    import matplotlib.pyplot as plt
+
+    from imgmtf.batch import _measurement_figure
+    figure = _measurement_figure(im.measure_edge(chip, force=True, intervals=im.Intervals("none")),
+                                 read_raster(tmp_path / "noisy.tif"), [], row["reason"])
+    assert f"NOT TO BE TRUSTED (forced past the refusal {row['reason']})" in figure._suptitle.get_text()
+    plt.close(figure)

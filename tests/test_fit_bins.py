@@ -202,3 +202,21 @@ def test_the_residual_panel_draws_the_bins_means_over_their_samples():
     centres, means, _ = residual_means(edge.samples_x_px - edge.offset_px, edge.residuals_dn, edge.bin_counts, 6.0)
     np.testing.assert_allclose(line.get_xdata(), centres)
     np.testing.assert_allclose(line.get_ydata(), means * 100 / abs(edge.step_dn))
+
+
+def test_a_misfit_test_without_a_bin_is_not_run_and_no_pass():
+    """Samples all beyond the transition (no 0.25 px bin within reach holds
+    3): the test cannot run, says so with NaN, and a record of such a fit
+    says it could not be tested rather than that it fits."""
+    from imgmtf.estimate.fit.record import FitRecord
+    response = types.SimpleNamespace(esf=lambda x: (np.asarray(x) > 0).astype(float))
+    p, size = misfit_test(np.array([-9.0, -8.0, 8.0, 9.0]), np.zeros(4), 1.0, 1000.0, response)
+    assert math.isnan(p) and math.isnan(size)
+    untested = types.SimpleNamespace(misfit_p=math.nan, misfit_fraction=math.nan, source="a", misfit_tested=False)
+    fit = types.SimpleNamespace(misfit=False, reduced_chi_square=1.0, edges=[untested],
+                                sensor=types.SimpleNamespace(stages=[]))
+    record = FitRecord.of(fit)
+    assert math.isnan(record.misfit_p) and "could not be tested on" in record.summary()
+    tested = types.SimpleNamespace(misfit_p=0.4, misfit_fraction=0.001, source="b", misfit_tested=True)
+    for edges in ([untested, tested], [tested, untested]):       # the tested edge's p, in either order
+        assert FitRecord.of(types.SimpleNamespace(**{**vars(fit), "edges": edges})).misfit_p == 0.4

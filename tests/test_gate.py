@@ -319,3 +319,42 @@ def test_every_check_is_listed_with_its_outcome_and_one_that_cannot_run_says_why
     check = gate.not_run("varying-blur", "too few rows")
     assert (check.passed, check.failed, check.outcome) == (False, False, "not-run")
     assert gate.enforce([check], force=False) == ()
+
+
+def test_block_jumps_are_told_from_the_locators_bias_with_the_phase():
+    """Row locations about their line: a sharp edge's locator bias with the
+    sub-pixel phase, 0.2 px jumping where the phase wraps (every 24 rows at
+    2.39 deg: always at one phase of an 8-row grid), is no codec (it was
+    refused as one); 8-row jumps of 0.1 px beside it are.  At 14.04 deg the
+    phase repeats every 4 rows and could stand in for the blocks, so the
+    jumps are judged as they are."""
+    from types import SimpleNamespace
+
+    from imgmtf.estimate.blocks import block_boundaries
+    from imgmtf.estimate.geometry import TargetGeometry
+    rows = np.arange(100)
+    noise = np.random.default_rng(1).normal(0, 0.01, 100)
+
+    def compression(slope, offsets, bias=0.2):
+        line = slope * rows + 40.3
+        located = line + bias * (np.mod(line, 1.0) - 0.5) + offsets + noise
+        geometry = TargetGeometry(slope, 40.3, rows, located, np.ones(100, bool), False)
+        (check,), _ = block_boundaries(SimpleNamespace(geometry=geometry, name="edge"))
+        return check
+    blocks = 0.1 * (rows // 8)
+    assert compression(1 / 24, 0.0).passed
+    assert compression(1 / 24, blocks).failed
+    assert compression(0.25, blocks, bias=0.0).failed
+
+
+def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
+    # an MTF that is nowhere finite is not below 1
+    check = gate.mtf_excess_check(lambda f: np.full(np.shape(f), np.nan), lambda f: np.zeros(np.shape(f)), 0.5)
+    assert check.outcome == "not-run" and not check.failed
+    # 30 samples each side spread 1 per 0.2 px over 6 px: no 1-px band holds 10, no second feature looked for
+    d = np.r_[-np.arange(3.0, 9.0, 0.2), np.arange(3.0, 9.0, 0.2)]
+    values = np.where(d < 0, 200.0, 1200.0)
+    checks = gate.side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
+    second = [c for c in checks if c.reason == "two-targets"]
+    assert len(second) == 2 and all(c.outcome == "not-run" for c in second)
+    assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")

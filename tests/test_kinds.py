@@ -13,6 +13,7 @@ import pytest
 import imgmtf
 from imgmtf.errors import ParameterError
 from imgmtf.kinds import KINDS, Kind, get_kind, kind_names, kinds_with_width
+from imgmtf.kinds.double_bar import DOUBLE_BAR
 from imgmtf.kinds.edge import EDGE
 from imgmtf.kinds.points import POINTS
 from imgmtf.kinds.pulse import PULSE
@@ -55,15 +56,16 @@ def test_no_module_outside_the_registry_compares_a_kind_name():
 
 
 def test_lookup_returns_the_registered_kinds_in_order():
-    assert kind_names() == ("edge", "pulse", "points")
+    assert kind_names() == ("edge", "pulse", "points", "double-bar")
     assert get_kind("edge") is EDGE and get_kind("pulse") is PULSE and get_kind("points") is POINTS
     assert all(KINDS[name].name == name for name in KINDS)
-    assert kinds_with_width() == (PULSE,)
+    assert kinds_with_width() == (PULSE, DOUBLE_BAR)
 
 
 @pytest.mark.parametrize("name", ["star", "Edge", "", None, 3])
 def test_an_unknown_kind_is_refused_naming_the_kinds_there_are(name):
-    with pytest.raises(ParameterError, match=r"target kind must be one of \('edge', 'pulse', 'points'\), got ") as info:
+    kinds = r"\('edge', 'pulse', 'points', 'double-bar'\)"
+    with pytest.raises(ParameterError, match=rf"target kind must be one of {kinds}, got ") as info:
         get_kind(name)
     assert isinstance(info.value, ValueError)
     with pytest.raises(ParameterError, match=r"^target must be one of"):
@@ -111,13 +113,14 @@ def test_each_kinds_column_is_in_its_measurement():
     sensor = imgmtf.Sensor()
     for kind in KINDS.values():
         width = 1.5 if kind.has_width else 0.0
+        gap = 2.0 if kind.gap_keyword else 0.0
         if kind.renderer is not None:
             from imgmtf.sensor.points import PointArray
             chip = kind.load("renderer")(sensor, PointArray(2, 2), 60)
         else:
-            chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width), 60)
+            chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width, gap_px=gap), 60)
         result = kind.make_estimator("msg", intervals=imgmtf.Intervals("none"))(
-            chip.image, **kind.estimator_keywords(width or None))
+            chip.image, **kind.estimator_keywords(width or None, gap_px=gap or None))
         figures = result.to_dict(curves=False)
         assert figures["target"] == kind.name and figures[kind.column.field] is not None
 
@@ -137,8 +140,8 @@ def test_the_registry_loads_nothing_numerical_and_nothing_above_it():
     code = ("import sys, imgmtf.kinds; print(sorted(m for m in sys.modules if m.startswith('imgmtf') or "
             "m in ('numpy', 'scipy', 'cv2', 'matplotlib')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert eval(out.stdout) == ["imgmtf", "imgmtf.errors", "imgmtf.kinds", "imgmtf.kinds.edge",
-                                "imgmtf.kinds.kind", "imgmtf.kinds.points", "imgmtf.kinds.pulse"]
+    assert eval(out.stdout) == ["imgmtf", "imgmtf.errors", "imgmtf.kinds", "imgmtf.kinds.double_bar",
+                                "imgmtf.kinds.edge", "imgmtf.kinds.kind", "imgmtf.kinds.points", "imgmtf.kinds.pulse"]
 
 
 def test_the_facts_of_points():

@@ -71,6 +71,17 @@ def test_scan_measures_the_bar_as_a_pulse_target():
     assert abs(accepted[0]["mtf_nyquist"] - tile_of(accepted[0])["true_mtf_nyquist"]) < 0.006
 
 
+def test_cli_scan_accepts_a_lone_bar_at_its_default_margin(tmp_path):
+    # the self-test's 1.5 px bar: its ROI once fell a pixel short of the background the bar's rows need
+    chip = im.render(im.Sensor(), im.Target("pulse", 6.0, 200.0, 1200.0, 0.17, 1.5), 200)
+    im.write_geotiff(tmp_path / "bar.tif", chip.image)
+    result = CliRunner().invoke(main, ["scan", str(tmp_path / "bar.tif"), "--target", "pulse", "--format", "json"])
+    assert result.exit_code == 0, result.output
+    row = json.loads(result.stdout.splitlines()[0])
+    assert row["status"] == "accepted" and row["width_estimated"] is True
+    assert abs(row["mtf_nyquist"] - float(chip.true_mtf(0.5))) < 0.02
+
+
 def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_records):
     from matplotlib.collections import LineCollection, PolyCollection
 

@@ -90,10 +90,10 @@ def test_a_campaign_scene_point_array_settles_the_edges_across_along_choice(tmp_
     assert points.exit_code == 0, points.output
     rows = [json.loads(line) for line in points.stdout.splitlines()]
     assert [(r["scope"], r["direction"], r["method"]) for r in rows if r["scope"] == "scene"] == [
-        ("scene", "across-track", "points"), ("scene", "along-track", "points")]
+        ("scene", "horizontal", "points"), ("scene", "vertical", "points")]
     assert {p.name for p in out.iterdir()} == {"targets.csv", "targets.geojson", "overview.png"}
     marked = [r for r in mark_recommended(read_layer(store, "targets"))
-              if r["scope"] == "scene" and r["direction"] == "across-track" and r["recommended"]]
+              if r["scope"] == "scene" and r["direction"] == "horizontal" and r["recommended"]]
     assert {r["method"] for r in marked} == {"points", "sections"}
     quoted_points = next(r for r in marked if r["method"] == "points")
     quoted_edges = next(r for r in marked if r["method"] == "sections")

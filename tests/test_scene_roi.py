@@ -8,7 +8,7 @@ from affine import Affine
 
 from imgmtf.estimate import gate
 from imgmtf.io import RasterInfo
-from imgmtf.scene.roi import END_TRIM_PX, JUNCTION_CLEARANCE_PX, Roi, clear_extent, plan_roi
+from imgmtf.scene.roi import END_TRIM_PX, JUNCTION_CLEARANCE_PX, Roi, clear_extent, plan_roi, roi_margin_px
 from imgmtf.scene.segments import HalfEdge, Segment
 from imgmtf.scene.settings import ScanSettings
 
@@ -33,6 +33,16 @@ def test_free_ends_are_trimmed_and_a_junction_end_is_kept():
     # a segment running 15 px beside it narrows it to keep the clearance
     assert plan_roi(HalfEdge(Segment(0.0, 0.0, 0.0, 100.0), 100.0), settings, 15.0).half_width_px == pytest.approx(
         15.0 - JUNCTION_CLEARANCE_PX)
+
+
+def test_a_bars_roi_holds_the_background_its_row_windows_need():
+    from imgmtf.estimate.pulse import LOCATE_HALF_WINDOW_PX
+    bar = HalfEdge(Segment(0.0, 0.0, 0.0, 100.0, width_px=3.0), 100.0)
+    # the bar estimator's row windows about a seed on either side of the bar, and 2 px for rounding
+    assert plan_roi(bar, ScanSettings(target="pulse")).half_width_px == LOCATE_HALF_WINDOW_PX + 2 + 1.5
+    assert plan_roi(bar, ScanSettings(target="pulse", margin_px=20)).half_width_px == 20 + 1.5
+    assert plan_roi(bar, ScanSettings()).half_width_px == 12 + 1.5              # an edge scan keeps its margin
+    assert roi_margin_px(ScanSettings(target="pulse", margin_px=6)) == LOCATE_HALF_WINDOW_PX + 2
 
 
 def _pixels(roi, width, height):

@@ -1,6 +1,7 @@
 """Sharpened products measured, with their peak said; a rise above 1 no
 sharpening kernel explains refused.  Truth: the Gaussian + pixel transfer
 times the kernel's own transfer along the edge's normal, exact."""
+import dataclasses
 import math
 
 import numpy as np
@@ -58,7 +59,9 @@ def sharpened_edge(sigma, kernel, noise, seed=1, shape=(100, 100)):
     (0.5, laplacian_kernel(0.3), 10.0),              # 3 x 3, true peak 1.11
     (0.5, unsharp_kernel(5, 1.0, 1.0), 0.0),         # 5 x 5, true peak 1.18
     (0.4, unsharp_kernel(3, 1.0, 10.0), 0.0),        # 3 x 3 box, true peak 1.23 on a sharp edge: its rows'
-])                                                   # locations swing 0.3 px with their phase, and are straight
+                                                     # locations swing 0.3 px with their phase, and are straight
+    (0.4, unsharp_kernel(5, 0.8, 1.0), 0.0),         # 5 x 5, true peak 1.18 on a sharp edge: the rows' Fermi
+])                                                   # fits collapse to steps (their width is held)
 def test_a_sharpened_product_is_measured_with_its_peak_and_a_note(sigma, kernel, noise):
     chip, truth = sharpened_edge(sigma, kernel, noise)
     f = np.arange(0, 1, 0.001)
@@ -109,3 +112,14 @@ def test_the_peak_is_read_up_to_the_limit():
     peak = mtf_peak(lambda f: 1 + 0.2 * np.sin(np.pi * np.asarray(f) / 0.5) * (np.asarray(f) < 0.5), 0.8)
     assert (round(peak.mtf, 3), round(peak.cy_px, 3)) == (1.2, 0.25)
     assert mtf_peak(lambda f: np.exp(-np.asarray(f)), 0.3).cy_px == 0.0
+
+
+def test_a_consistency_along_the_target_that_cannot_be_compared_is_no_evidence():
+    from imgmtf.estimate.evidence import Evidence
+    from imgmtf.estimate.sharpening import _lobe_change
+    d = np.linspace(-6, 6, 400)
+    esf = np.where(d < 0, 200.0, 1200.0) + 50 * np.sign(d) * np.exp(-0.5 * (np.abs(d) - 1) ** 2)
+    ev = Evidence(d, esf, np.repeat(np.arange(2), 200), 0.0, 1.0, 2.0, 200.0, 1200.0, 1.0, 1.0, 1, "edge", "edge",
+                  ("dark", "bright"), None)
+    assert "could not be compared" in _lobe_change(ev)                         # two rows: no halves
+    assert _lobe_change(dataclasses.replace(ev, rows=np.tile(np.arange(8), 50))) is None      # alike halves

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-ACROSS_ALONG = ("across-track", "along-track")
+from ..estimate.geometry import AXIS_DIRECTIONS
+
 POINTS = "points"
 #: the order in which edges' rows are offered to a point array's verdict
 _EDGE_PREFERENCE = {"fit": 0, "sections": 1, "combined": 2}
@@ -55,7 +56,7 @@ def _place(row: Mapping) -> tuple:
     """Acquisition, scope, target and direction (an oblique one by its normal, to a degree)."""
     direction = row.get("direction")
     normal = row.get("normal_angle_deg")
-    if direction not in ACROSS_ALONG and normal is not None:
+    if direction not in AXIS_DIRECTIONS and normal is not None:
         direction = f"{direction} {round(float(normal)) % 180}"
     return row.get("acquisition_id"), row.get("scope"), row.get("target_id"), direction
 
@@ -137,7 +138,7 @@ def settle_with_points(rows: list[dict]) -> list[dict]:
     places: dict[tuple, list[dict]] = {}
     for row in rows:
         image = _image(row)
-        if image is not None and row.get("scope") == "scene" and row.get("direction") in ACROSS_ALONG \
+        if image is not None and row.get("scope") == "scene" and row.get("direction") in AXIS_DIRECTIONS \
                 and row.get("mtf_nyquist") is not None:
             places.setdefault((image, row["direction"]), []).append(row)
     for members in places.values():

@@ -1,4 +1,4 @@
-"""``imgmtf fit``: fit the sensor model's stages to edges."""
+"""``imgmtf fit``: fit the sensor model's stages to edges, bars or double bars."""
 from __future__ import annotations
 
 import json
@@ -6,15 +6,27 @@ import json
 import click
 
 from ..errors import ParameterError
+from ..kinds import KINDS, get_kind
 from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
-from .options import FiniteFloat, parse_rois, reading_options
+from .options import FiniteFloat, length_option, parse_rois, read_roi_file, reading_options, roi_file_option
 from .tables import print_fit
 
+#: the kinds fit takes: those of the 1-D pipeline (points have their own)
+FIT_KINDS = tuple(name for name, kind in KINDS.items() if kind.measuring is not None)
+#: what fit does with edges only (bars' fit takes the stages, the files and how to read them)
+EDGE_ONLY = ("sensor_path", "hold", "out_path", "plot_path", "campaign")
 
-@click.command(short_help="Fit the sensor model to edges: its MTF in every direction.")
+
+@click.command(short_help="Fit the sensor model to edges or bars: its MTF in every direction.")
 @click.argument("paths", nargs=-1, required=True, type=click.Path())
+@click.option("--target", "kind", type=click.Choice(FIT_KINDS), default="edge", show_default=True,
+              help="what each file holds: an edge, a bar (pulse) or a double bar (Storey's two spans)")
+@click.option("--pulse-width", callback=length_option("px"),
+              help="--target pulse or double-bar: each bar's width, 1.4 or 1.4px (pixels), 18.3m (metres)")
+@click.option("--gap", callback=length_option("px"),
+              help="--target double-bar: the gap between its two bars, edge to edge, px or m")
 @click.option("--stages", metavar="NAMES",
               help="comma-separated stages to fit: optics, detector, motion, electronics, diffraction, "
                    "defocus, olpf, jitter, diffusion, halo, lag; or auto: the simplest of optics+detector, "
@@ -30,6 +42,7 @@ from .tables import print_fit
 @click.option("--roi", multiple=True, callback=parse_rois, metavar="X,Y,W,H",
               help="X,Y,W,H window in pixels: once for every file, or once per file in their order (a file "
                    "named again with another window gives another edge; default: the whole image)")
+@roi_file_option
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--force", is_flag=True,
               help="measure an edge even where a quality check fails (fill, saturation, non-uniform "
@@ -43,8 +56,9 @@ from .tables import print_fit
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
 @campaign_options
-def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, force, saturation, transfer, confidence,
-        out_path, fmt, plot_path, campaign, acquired, platform, instrument, band_name):
+def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, roi_file, recursive, force,
+        saturation, transfer, confidence, out_path, fmt, plot_path, campaign, acquired, platform, instrument,
+        band_name):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model.  With
@@ -54,7 +68,21 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, force, satu
     imgmtf measure does (--roi, --band, --transfer, --force; nodata and
     fill as measure treats them); a file named twice with the same window
     is measured once.  --out writes the sensor with a [fit] table saying
-    whether the model fits (imgmtf restore refuses one that does not)."""
+    whether the model fits (imgmtf restore refuses one that does not).
+    With --target pulse or double-bar, the stages (default optics and
+    detector) are fitted to the bars' profiles (Storey's method: a pair's
+    transfer may hide a frequency the model carries across), each file's
+    bar measured as imgmtf measure does; --pulse-width and --gap as for
+    measure."""
+    if get_kind(kind).has_width:
+        if roi_file:
+            raise click.UsageError("--roi-file gives the windows of edges: fit bars with --roi X,Y,W,H")
+        _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, saturation, transfer, confidence,
+                  fmt, given={"sensor_path": sensor_path, "hold": hold, "out_path": out_path,
+                              "plot_path": plot_path, "campaign": campaign})
+        return
+    if pulse_width or gap:
+        raise click.UsageError("--pulse-width and --gap describe bars: give --target pulse or double-bar")
     from ..batch import expand_inputs
     from ..estimate.fit import check_names
     from ..sensor.model import Sensor
@@ -72,6 +100,13 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, force, satu
             raise click.UsageError(f"--roi given {len(roi)} times for {len(files)} file(s): give it once for "
                                    "every file, or once per file")
         rois = roi[0] if len(roi) == 1 else (list(roi) if roi else None)
+        features: dict[str, dict] = {}
+        if roi_file:            # every file's edge in each feature's window, its attributes in its record
+            if roi:
+                raise click.UsageError("give --roi or --roi-file, not both")
+            from ..sensor_fit import feature_edges
+            files, rois, fields = feature_edges(files, read_roi_file(roi_file), band)
+            features = dict(zip(edge_sources(files, rois), fields))
         if plot_path:
             check_figure_file(plot_path)
         if out_path:
@@ -100,15 +135,58 @@ def fit(paths, stages, sensor_path, hold, gsd, band, roi, recursive, force, satu
             written.append(plot_path)
         if store:
             settings = {"command": "fit", "stages": stages, "sensor": sensor_path, "hold": hold, "gsd_m": gsd,
-                        "band": band, "roi": rois, "confidence": confidence, "force": force, "transfer": transfer,
-                        "saturation": saturation}
+                        "band": band, "roi": roi_file or rois, "confidence": confidence, "force": force,
+                        "transfer": transfer, "saturation": saturation}
             store.add_fit(files, result, settings, band=band, plot=plot_path)
             store.summary()
     if fmt == "json":
         from ..records import json_safe
         # NaN as null, no -0.0: as measure's and scan's JSON
-        click.echo(json.dumps(json_safe({**result.to_dict(), "written": written})))
+        out = result.to_dict()
+        out["edges"] = [{**edge, **features.get(edge["path"], {})} for edge in out["edges"]]
+        click.echo(json.dumps(json_safe({**out, "written": written})))
         return
     print_fit(result)
     for path in written:
         click.echo(f"wrote {path}")
+
+
+def _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, saturation, transfer, confidence, fmt,
+              given):
+    """``fit --target pulse|double-bar``: the stages fitted to the bars' profiles."""
+    clash = [name for name in EDGE_ONLY if given.get(name)]
+    if clash:
+        flag = {"sensor_path": "--sensor", "hold": "--hold", "out_path": "--out", "plot_path": "--plot",
+                "campaign": "--campaign"}[clash[0]]
+        raise click.UsageError(f"{flag} is the edges' fit's: not with --target {kind}")
+    if len(roi) > 1:
+        raise click.UsageError("--target pulse or double-bar takes one --roi for every file")
+    from ..bar_fit import fit_bar_files
+    from ..batch import expand_inputs
+    with reported_errors():
+        files = expand_inputs(paths, False)
+        if not files:
+            raise ParameterError(f"no image files in {', '.join(paths)}")
+        with option_errors():
+            from ..measure_settings import MeasureSettings
+            MeasureSettings(kind, pulse_width=pulse_width, gap=gap)
+        result = fit_bar_files(files, target=kind, pulse_width=pulse_width, gap=gap,
+                               stages=stages or "optics,detector", band=band, roi=roi[0] if roi else None,
+                               gsd_m=gsd, confidence=confidence, force=force, transfer=transfer,
+                               saturation=saturation)
+    if fmt == "json":
+        from ..records import json_safe
+        click.echo(json.dumps(json_safe(result.to_dict())))
+        return
+    click.echo(f"stages: {result.stages}   reduced chi-square {result.reduced_chi_square:.2f}")
+    for p in result.parameters:
+        error = f" +- {p.standard_error:.4g}" if p.status == "fitted" else ""
+        note = f": {p.note}" if p.note else ""
+        click.echo(f"  {p.stage}.{p.name} = {p.value:.4g}{error} {p.unit}  ({p.status}{note})")
+    confidence_pct = f"{100 * result.confidence:g} %"
+    for source, angle, m, ci, f50 in zip(result.sources, result.normal_angles_deg, result.mtf_nyquist,
+                                         result.mtf_nyquist_ci, result.mtf50_cy_px):
+        click.echo(f"{source}: normal {angle:.2f} deg, model MTF at Nyquist {m:.4f} "
+                   f"[{ci.low:.4f}, {ci.high:.4f}] ({confidence_pct}), MTF50 {f50:.4f} cy/px")
+    for warning in result.warnings:
+        click.echo(f"  warning: {warning}")

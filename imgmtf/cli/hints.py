@@ -42,9 +42,11 @@ HINTS = (
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
+    Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
+    Hint(CHIP, "double-bar", "--target double-bar --pulse-width W --gap G measures them"),
     Hint(CHIP, "fit", "--stages fits fewer, --hold holds some"),
     # a scene's half-edges: fit takes the ROIs scan prints, one per file named
     Hint(CHIP, "fill", "--roi X,Y,W,H once per file fits the edges imgmtf scan finds", only=frozenset({"fit"})),

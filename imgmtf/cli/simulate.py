@@ -27,9 +27,9 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
 
 #: the options that describe one chip, and those that describe a campaign: each refused with the other
 CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std", "ground_noise", "oversampling",
-             "sensor_path", "out", "point_size", "spacing")
+             "sensor_path", "out", "point_size", "spacing", "gap")
 #: the options of a line target (an edge or a bar) that an array of points has no use for, and the reverse
-LINE_ONLY = ("angle", "pulse_width", "offset", "ground_noise", "oversampling")
+LINE_ONLY = ("angle", "pulse_width", "offset", "ground_noise", "oversampling", "gap")
 POINTS_ONLY = ("point_size", "spacing")
 CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
                  "band_name", "blur")
@@ -49,6 +49,9 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width of a pulse target, at least 0.2 px and at most --size: 1.5 or 1.5px (pixels), "
                    "1.5m (metres on the ground)")
+@click.option("--gap", callback=length_option("px"),
+              help="--target double-bar: the gap between its two bars, edge to edge: 2 or 2px (pixels), 2m "
+                   "(metres on the ground); --pulse-width each bar's width")
 @click.option("--point-size", type=FiniteFloat(0, 20), default=0.0, show_default=True,
               help="--target points: each target's side, px (0: points of light; 1: Rauchmiller's 1 px squares)")
 @click.option("--spacing", type=FiniteFloat(2, 1000), default=12.0, show_default=True,
@@ -91,7 +94,7 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
 @click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
 @click.pass_context
-def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offset, size, gsd, bits, noise_std,
+def simulate(ctx, kind, angle, low, high, pulse_width, gap, point_size, spacing, offset, size, gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
              degradation, snr, fill, blur, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
@@ -145,6 +148,9 @@ def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offs
             raise click.UsageError(f"a {kind} target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
         if not target_kind.has_width and pulse_width is not None:
             raise click.UsageError(width_refusal())
+        if (target_kind.gap_keyword is not None) != (gap is not None):
+            raise click.UsageError(f"a {kind} target needs --gap (2 or 2px: pixels; 2m: metres)"
+                                   if gap is None else f"--gap applies to --target double-bar only, not to a {kind}")
         check_output_file(out)
         sensor = load_sensor(sensor_path)
         gsd_m = sensor.gsd_m if gsd is None else gsd
@@ -161,7 +167,8 @@ def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offs
                 if width_px > size:
                     raise ParameterError(f"--pulse-width ({width_px:g} px) is wider than the chip "
                                          f"(--size {size} px)")
-            target = Target(kind, angle, low, high, offset, width_px)
+            gap_px = 0.0 if gap is None else (gap[0] if gap[1] == "px" else gap[0] / gsd_m)
+            target = Target(kind, angle, low, high, offset, width_px, gap_px)
             chip = render(sensor, target, size, gsd_m=gsd_m, oversampling=oversampling, bits=int(bits),
                           noise_std_dn=noise_std, ground_noise=GroundNoise() if ground_noise else None,
                           seed=seed)
@@ -171,6 +178,7 @@ def simulate(ctx, kind, angle, low, high, pulse_width, point_size, spacing, offs
             write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=chip.provenance())
         clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
         width = f" {width_px:g} px wide" if target_kind.has_width else ""
+        width += f", {gap_px:g} px apart" if gap is not None else ""
         click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {kind}{width} at {angle:g} deg, "
                    f"GSD {chip.gsd_m:g} m; true MTF at Nyquist along the normal "
                    f"{float(chip.true_mtf(0.5)):.4f}{clipped}")

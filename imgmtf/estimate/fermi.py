@@ -7,6 +7,14 @@ step (left level minus right level) and ``d`` the right-hand level.  All
 rows are solved together: each iteration builds every row's 4 x 4 normal
 equations with one matrix product and solves them in one batched call, with
 a damping factor per row.
+
+A row whose fitted width collapses below what a pixel grid resolves (a
+sharpened edge's overshoots pull a logistic to a step, whose location is
+then free anywhere between two samples) is refitted with its width held
+at ``MIN_WIDTH_PX``: a logistic that still interpolates between the two
+samples astride the edge, so that the row keeps a location (where its
+step is like the other rows': a collapse on something else, a second
+feature or texture, keeps its free fit).
 """
 from __future__ import annotations
 
@@ -14,18 +22,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# a 1-px pixel aperture alone gives a 10-90 % rise of 0.8 px, a Fermi width
+# of 0.18 px: a fitted width below this is a collapse to a step, not a blur
+MIN_WIDTH_PX = 0.15
+MAX_STEP_CHANGE = 0.5          # a held row's step within this share of the rows' median step
+
 
 @dataclass(frozen=True, eq=False)
 class FermiFit:
     """Per-row fit results; arrays of length n_rows.
 
     ``params`` is (n_rows, 4) holding a, b, c, d; ``rms`` the RMS residual
-    (DN); ``ok`` is False where the fit diverged or left the data.
+    (DN); ``ok`` is False where the fit diverged or left the data;
+    ``pinned`` is True where the width collapsed and was held at
+    ``MIN_WIDTH_PX``.
     """
 
     params: np.ndarray
     rms: np.ndarray
     ok: np.ndarray
+    pinned: np.ndarray | None = None
 
     @property
     def location(self) -> np.ndarray:
@@ -48,16 +64,50 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
 
     ``weight`` is 1 for samples to use and 0 for padding; ``b0`` is the
     starting edge location per row (px).  Level starting values come from
-    the outermost used samples on each side.
+    the outermost used samples on each side.  Rows whose width collapses
+    below ``MIN_WIDTH_PX`` are refitted with the width held there.
     """
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     w = np.asarray(weight, float)
     n = y.shape[0]
     left, right = _side_levels(y, w)
-    p = np.column_stack([left - right, b0, np.full(n, c0), right])
+    p = _levenberg_marquardt(x, y, w, np.column_stack([left - right, b0, np.full(n, c0), right]), iterations)
+    # the model is symmetric under (a, c) -> (-a, -c) with d shifted: keep c > 0
+    flip = p[:, 2] < 0
+    p[flip] = np.column_stack([-p[flip, 0], p[flip, 1], -p[flip, 2], p[flip, 3] + p[flip, 0]])
+    finite = np.all(np.isfinite(p), axis=1)
+    pinned = finite & (p[:, 2] < MIN_WIDTH_PX) & (p[:, 0] != 0)
+    if pinned.any():
+        start = p[pinned].copy()
+        start[:, 2] = MIN_WIDTH_PX
+        held = _levenberg_marquardt(x[pinned] if x.ndim == 2 else x, y[pinned], w[pinned], start,
+                                    iterations, free=np.array([True, True, False, True]))
+        # a row held so is the target's only where its step is the target's
+        step = float(np.median(np.abs(p[finite, 0])))
+        alike = np.abs(np.abs(held[:, 0]) / step - 1.0) <= MAX_STEP_CHANGE
+        pinned[pinned] = alike
+        p[pinned] = held[alike]
+    used = w.sum(axis=1)
+    xmin = np.where(w > 0, x, np.inf).min(axis=1)
+    xmax = np.where(w > 0, x, -np.inf).max(axis=1)
+    ok = (np.all(np.isfinite(p), axis=1) & (used >= 6)
+          & (p[:, 1] > xmin) & (p[:, 1] < xmax)
+          & (p[:, 2] > 1e-3) & (p[:, 2] < (xmax - xmin) / 2))
+    cost = np.einsum("rk,rk->r", *(2 * [(y - fermi(x, p)) * w]))
+    rms = np.sqrt(cost / np.maximum(used, 1))
+    return FermiFit(p, rms, ok, pinned)
+
+
+def _levenberg_marquardt(x, y, w, p, iterations, free=None):
+    """Every row's parameters from ``p`` on; ``free`` (4 bools) holds the
+    others at their start."""
+    n = y.shape[0]
     lam = np.full(n, 1e-2)
     cost, jac, resid = _evaluate(x, y, w, p)
+    held = None if free is None else np.asarray(free, float)
+    if held is not None:
+        jac = jac * held
     for _ in range(iterations):
         weighted = np.swapaxes(jac * w[..., None], 1, 2)
         jtj = weighted @ jac
@@ -70,6 +120,8 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
             step = np.stack([np.linalg.lstsq(m, v, rcond=None)[0] for m, v in zip(damped, jtr)])
         trial = p + step
         trial_cost, trial_jac, trial_resid = _evaluate(x, y, w, trial)
+        if held is not None:
+            trial_jac = trial_jac * held
         better = np.isfinite(trial_cost) & (trial_cost < cost)
         p = np.where(better[:, None], trial, p)
         cost = np.where(better, trial_cost, cost)
@@ -79,17 +131,7 @@ def fit_fermi(x: np.ndarray, y: np.ndarray, weight: np.ndarray, b0: np.ndarray,
         # converged: no row proposes to move its edge by more than 1e-5 px
         if np.all((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5)):
             break
-    # the model is symmetric under (a, c) -> (-a, -c) with d shifted: keep c > 0
-    flip = p[:, 2] < 0
-    p[flip] = np.column_stack([-p[flip, 0], p[flip, 1], -p[flip, 2], p[flip, 3] + p[flip, 0]])
-    used = w.sum(axis=1)
-    xmin = np.where(w > 0, x, np.inf).min(axis=1)
-    xmax = np.where(w > 0, x, -np.inf).max(axis=1)
-    ok = (np.all(np.isfinite(p), axis=1) & (used >= 6)
-          & (p[:, 1] > xmin) & (p[:, 1] < xmax)
-          & (p[:, 2] > 1e-3) & (p[:, 2] < (xmax - xmin) / 2))
-    rms = np.sqrt(cost / np.maximum(used, 1))
-    return FermiFit(p, rms, ok)
+    return p
 
 
 def _side_levels(y, w):

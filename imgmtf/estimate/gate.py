@@ -397,9 +397,6 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
         full = counts >= 10
         band_means = np.abs(sums[full] / counts[full])
         band_noise = np.sqrt(np.var(resid) / counts[full])
-        worst = int(np.argmax(band_means - 5 * band_noise)) if full.any() else 0
-        second = (float(band_means[worst]) / contrast
-                  if full.any() and band_means[worst] > 5 * band_noise[worst] else 0.0)
         checks += [
             Check("non-uniform", trend <= MAX_SIDE_TREND,
                   f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast {way} the target (at "
@@ -408,11 +405,16 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
                   f"the {name} side carries texture of {100 * texture:.0f} % of the contrast beyond the "
                   f"pixel noise (at most {100 * MAX_SIDE_TEXTURE:g} %): not a uniform field",
                   texture, MAX_SIDE_TEXTURE),
-            Check("two-targets", second <= MAX_SECOND_FEATURE,
-                  f"another feature lies on the {name} side, {np.nonzero(full)[0][worst] if full.any() else 0}"
-                  f" px from the target ({100 * second:.0f} % of the contrast)",
-                  second, MAX_SECOND_FEATURE),
         ]
+        if not full.any():
+            checks.append(not_run("two-targets", f"no 1-px band of the {name} side holds 10 samples: a second "
+                                  "feature there not looked for"))
+            continue
+        worst = int(np.argmax(band_means - 5 * band_noise))
+        second = float(band_means[worst]) / contrast if band_means[worst] > 5 * band_noise[worst] else 0.0
+        checks.append(Check("two-targets", second <= MAX_SECOND_FEATURE,
+                            f"another feature lies on the {name} side, {np.nonzero(full)[0][worst]} px from the "
+                            f"target ({100 * second:.0f} % of the contrast)", second, MAX_SECOND_FEATURE))
     return checks
 
 
@@ -438,8 +440,11 @@ def mtf_excess_check(mtf, noise_sd, limit_cy_px: float) -> Check:
         return not_run("mtf-above-one", f"the MTF falls into its noise below 0.01 cy/px ({limit_cy_px:.3f}): "
                        "nothing to compare with 1")
     excess = mtf(f) - 1.0 - 3.0 * noise_sd(f)
-    worst = int(np.nanargmax(excess)) if np.isfinite(excess).any() else 0
-    over = float(excess[worst]) if np.isfinite(excess).any() else -1.0
+    if not np.isfinite(excess).any():
+        return not_run("mtf-above-one", "the MTF or its noise is not finite at any frequency up to its noise "
+                       "limit: nothing to compare with 1")
+    worst = int(np.nanargmax(excess))
+    over = float(excess[worst])
     return Check("mtf-above-one", over <= MAX_MTF_EXCESS,
                  f"the MTF reaches {float(mtf(f[worst:worst + 1])[0]):.2f} at {f[worst]:.2f} cy/px, above 1 "
                  "beyond its noise: a sharpened image or not a clean target", over, MAX_MTF_EXCESS)

@@ -25,9 +25,10 @@ from ..inputs import check_width
 from ..kinds.pulse import PULSE
 from ..metrics import fwhm
 from . import gate
+from .bar_pair import bar_pair
+from .bar_width import estimate_width, half_width_at, width_reading
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
-from .intervals.width import WidthReading
 from .kind import Shape, TargetKind
 from .pipeline import run
 from .results import MTFResult, finite
@@ -37,13 +38,11 @@ from .tails import outer_samples
 from .window import TAPER_FACTOR
 
 RESTORE_MIN_SINC = 0.02         # below this |sinc| the LSF spectrum is interpolated
-ZERO_SET_SPAN = (0.5, 1.6)       # a read width's zero is judged over this span of f0 (W / 1.6 to 2 W)...
-ZERO_SET_STEP_CY_PX = 0.02       # ...on this grid (its crossings interpolated)
-MAX_ZERO_SEARCH_CY_PX = 0.9     # a pixel aperture has its first zero at 1 cy/px or above
 SNR_THRESHOLD = 100.0           # the paper's threshold for a confident estimate
 MIN_HEIGHT_NOISE = 5.0          # a bar must peak this many noise sd above its background
 BAR_SIDES_PX = 8.0              # a bar's two sides are found within this of each other
 OUTER_PX = 5                    # a row window's pixels this far from the centre are background
+LOCATE_HALF_WINDOW_PX = 12      # the bar is first followed in row windows reaching this far either side of its seed
 REACH_MARGIN_PX = 2             # a row window reaches this far beyond where the bar's profile fades to 5 %
 WINDOW_FACTOR = 1.6             # LSF window half-width / the bar's PRF half-width at 10 %
 BACKGROUND_FRACTION = 2.0 / 3.0  # a bar's background is read from the samples beyond this share of the range
@@ -161,8 +160,15 @@ class PulseKind(TargetKind):
             raise TargetNotFoundError(f"no bar found: the profile peaks {height:.1f} DN above its "
                                       f"background, within the noise ({noise:.1f} DN)")
         prf01 = peak / height
-        h10 = _half_width_at(grid, prf01, 0.1)
-        width = self.width_px if self.width_px is not None else check_width(estimate_width(grid, prf01))
+        pair = bar_pair(grid, prf01, noise / height)
+        if pair is not None:        # measured as one bar, a pair's MTF would read times |cos(pi f s)|
+            raise UnsuitableTargetError(pair.message(), reason="double-bar")
+        h10 = half_width_at(grid, prf01, 0.1)
+        if self.width_px is None:
+            density = d.size / (2.0 * half_range)           # samples per px along the normal
+            width = check_width(estimate_width(grid, prf01, noise / height / math.sqrt(density)))
+        else:
+            width = self.width_px
         if width / 2 + 2.0 > half_range:
             raise UnsuitableTargetError(
                 f"the bar ({width:.1f} px) is too wide for the chip: it needs "
@@ -347,72 +353,8 @@ def usable_band(width_px: float) -> float:
     return float(f[np.argmax(np.abs(np.sinc(f * width_px)) < MIN_TRANSFER)])
 
 
-def width_reading(grid: np.ndarray, prf01: np.ndarray, width_px: float, contrast_dn: float,
-                  background_sides: tuple[np.ndarray, ...] = ()) -> WidthReading:
-    """How :func:`estimate_width` read ``width_px`` off ``prf01``, the
-    profile normalised by ``contrast_dn`` (its values minus the background,
-    over the peak's height in DN): R(f) and its pull on the profile's
-    values and background at the zero f0 and over ``ZERO_SET_SPAN`` of f0
-    about it, for the intervals (:class:`imgmtf.estimate.intervals.width.WidthReading`);
-    ``background_sides`` the masks of the samples the background is the
-    mean of the two sides' means of.
-
-    Examples
-    --------
-    A 1.5 px bar through a Gaussian PSF (sigma 0.5 px), made 0.02 px wider:
-
-    >>> from scipy.special import erf
-    >>> x = np.arange(-400, 401) * 0.05
-    >>> def bar(w):
-    ...     return 0.5 * (erf((x + w / 2) / 0.7071) - erf((x - w / 2) / 0.7071))
-    >>> reading = width_reading(x, bar(1.5), estimate_width(x, bar(1.5)), 1.0)
-    >>> round(float(reading.width_change(reading.on_grid[0] @ (bar(1.52) - bar(1.5)))), 3)
-    0.02
-    """
-    f_zero = 1.0 / width_px
-    low, high = (f * f_zero for f in ZERO_SET_SPAN)
-    freqs = np.concatenate([[f_zero], np.arange(low, min(high, MAX_ZERO_SEARCH_CY_PX), ZERO_SET_STEP_CY_PX)])
-    step = float(grid[1] - grid[0])
-    cosines = np.cos(2 * np.pi * freqs[:, None] * grid[None, :]) * step
-    slope = -float(np.sum(2 * np.pi * grid * np.sin(2 * np.pi * f_zero * grid) * prf01)) * step
-    on_grid = cosines / contrast_dn             # prf01 = (values - background) / contrast
-    return WidthReading(width_px, freqs, on_grid, -on_grid.sum(axis=1), cosines @ prf01, slope,
-                        lambda f: sinc_log_slope(f, width_px), background_sides)
-
-
-def sinc_log_slope(f, width_px: float):
-    """d ln|sinc(f W)| / dW at ``f`` (cy/px) for a bar of width W (px):
-    pi f cot(pi f W) - 1 / W (0 at f = 0)."""
-    f = np.asarray(f, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.pi * f / np.tan(np.pi * f * width_px) - 1.0 / width_px
-    return np.where(f == 0, 0.0, slope)
-
-
-def estimate_width(grid: np.ndarray, prf01: np.ndarray) -> float:
-    """Bar width from the first zero of the PRF's spectrum: |FT(PRF)| =
-    |sinc(f W)| MTF(f), so its first zero is at 1/W as long as the MTF is
-    still above the noise there.  Zeros are only sought below
-    ``MAX_ZERO_SEARCH_CY_PX``: the pixel aperture's own zero near 1 cy/px
-    would otherwise pass for a bar's.  The zero is located as the sign change
-    of the spectrum referenced to the bar's centre (real for a symmetric
-    bar)."""
-    f = np.arange(0.005, MAX_ZERO_SEARCH_CY_PX, 0.0025)
-    step = grid[1] - grid[0]
-    real = np.cos(2 * np.pi * f[:, None] * grid[None, :]) @ prf01 * step
-    area = prf01.sum() * step
-    change = np.nonzero(np.sign(real[:-1]) != np.sign(real[1:]))[0]
-    if change.size == 0 or area <= 0:
-        raise UnsuitableTargetError(
-            f"the bar width cannot be estimated from this profile (no zero in its spectrum below "
-            f"{MAX_ZERO_SEARCH_CY_PX} cy/px, so the bar is narrower than "
-            f"{1 / MAX_ZERO_SEARCH_CY_PX:.2f} px); give its width", reason="bar-width")
-    i = change[0]
-    zero = f[i] - real[i] * (f[i + 1] - f[i]) / (real[i + 1] - real[i])
-    return float(1.0 / zero)
-
-
-def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool, half_window: int = 12):
+def locate_pulse(work: np.ndarray, seed_x: np.ndarray, transposed: bool,
+                 half_window: int = LOCATE_HALF_WINDOW_PX):
     """Per-row bar centres (centroids of the background-subtracted profile),
     re-centred on the fitted line: three times within ``half_window`` px,
     which finds the bar wherever the seed put it, then twice within the
@@ -469,11 +411,3 @@ def _core_px(h10: float, width_px: float, factor: float | None = None) -> float:
     least the bar's half-width and a pixel; the bar's area is measured over
     the same core."""
     return max((factor or WINDOW_FACTOR) * h10, width_px / 2 + 1.0)
-
-
-def _half_width_at(grid: np.ndarray, prf01: np.ndarray, level: float) -> float:
-    """Half of the PRF's width at ``level`` of its peak."""
-    above = np.nonzero(prf01 >= level)[0]
-    if above.size == 0:
-        return 0.0
-    return float(max(-grid[above[0]], grid[above[-1]]))

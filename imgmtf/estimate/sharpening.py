@@ -154,11 +154,16 @@ def _lobes(x: np.ndarray, lsf: np.ndarray) -> tuple[tuple[float, float], tuple[f
 def _lobe_change(ev: Evidence) -> str | None:
     """Where the overshoot beyond either level (an edge's sides; a bar's
     background dips) differs between the halves of the target's rows by
-    more than ``MAX_LOBE_CHANGE`` of it and its noise: what says so."""
+    more than ``MAX_LOBE_CHANGE`` of it and its noise: what says so.  Where
+    no side's overshoot can be compared (too few rows or samples), that is
+    said too: an unchecked consistency is no evidence of one kernel."""
     s = ev.distance_px - ev.centre_px
     rows = np.unique(ev.rows)
+    unchecked = ("its overshoot could not be compared between the halves of its rows (too few rows or samples "
+                 "near it): one kernel along it is not shown")
     if rows.size < 4:
-        return None
+        return unchecked
+    compared = False
     middle = rows[rows.size // 2]
     halves = (ev.rows < middle, ev.rows >= middle)
     near = np.abs(s) <= max(ev.plateau_px, 2.0)
@@ -180,12 +185,13 @@ def _lobe_change(ev: Evidence) -> str | None:
         if min(p.size for p in parts) < 3:
             continue
         a, b = (float(np.mean(p)) for p in parts)
+        compared = True
         sd = max(ev.pixel_noise, ev.quantum / math.sqrt(12.0)) * math.sqrt(sum(1.0 / p.size for p in parts))
         if abs(a - b) > max(MAX_LOBE_CHANGE * 0.5 * abs(a + b), SIGNIFICANCE * sd):
             return (f"the overshoot {(worst + 0.5) * LOBE_BAND_PX:.1f} px from the {ev.name} is "
                     f"{100 * a / ev.contrast:.1f} % of the contrast in one half of its rows and "
                     f"{100 * b / ev.contrast:.1f} % in the other: not one kernel along it")
-    return None
+    return None if compared else unchecked
 
 
 def _sides(ev: Evidence) -> list[tuple[int, float, float]]:

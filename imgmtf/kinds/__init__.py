@@ -15,6 +15,7 @@ imported when first used (:meth:`Kind.load`).
 from __future__ import annotations
 
 from ..errors import ParameterError
+from .double_bar import DOUBLE_BAR
 from .edge import EDGE
 from .kind import Column, Kind
 from .points import POINTS
@@ -23,7 +24,7 @@ from .pulse import PULSE
 __all__ = ["KINDS", "Column", "Kind", "get_kind", "kind_names", "kinds_with_width"]
 
 #: every kind of target, by name, in the order commands list them
-KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS)}
+KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS, DOUBLE_BAR)}
 
 
 def kind_names() -> tuple[str, ...]:
@@ -37,7 +38,7 @@ def kind_names() -> tuple[str, ...]:
     Examples
     --------
     >>> kind_names()
-    ('edge', 'pulse', 'points')
+    ('edge', 'pulse', 'points', 'double-bar')
     """
     return tuple(KINDS)
 
@@ -69,7 +70,7 @@ def get_kind(name: str, what: str = "target kind") -> Kind:
     'bar'
     >>> get_kind("star")
     Traceback (most recent call last):
-    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points'), got 'star'
+    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points', 'double-bar'), got 'star'
     """
     kind = KINDS.get(name) if isinstance(name, str) else None
     if kind is None:
@@ -88,6 +89,6 @@ def kinds_with_width() -> tuple[Kind, ...]:
     Examples
     --------
     >>> [kind.name for kind in kinds_with_width()]
-    ['pulse']
+    ['pulse', 'double-bar']
     """
     return tuple(kind for kind in KINDS.values() if kind.has_width)

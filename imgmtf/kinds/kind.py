@@ -86,6 +86,10 @@ class Kind:
     rows_per_result : str or None
         Why one result gives several records (points: one per direction),
         or None for one record per result.
+    gap_keyword : str or None
+        The keyword its estimator, its ``scene_response`` and
+        :class:`imgmtf.Target` take for the edge-to-edge gap between its
+        two bars (double bars: ``gap_px``, ``--gap``), or None.
     scanner : str or None
         "module:attribute" of its own scene scan when it is no line
         (``scanner(path, settings)`` returning the records and the scene's
@@ -122,6 +126,7 @@ class Kind:
     renderer: str | None = None
     figure: str | None = None
     rows_per_result: str | None = None
+    gap_keyword: str | None = None
     scanner: str | None = None
 
     def load(self, part: str) -> Any:
@@ -181,7 +186,8 @@ class Kind:
         """
         return self.load("estimator")(method, **settings)
 
-    def estimator_keywords(self, width_px: float | None, size_px: float | None = None) -> dict[str, float | None]:
+    def estimator_keywords(self, width_px: float | None, size_px: float | None = None,
+                           gap_px: float | None = None) -> dict[str, float | None]:
         """The keywords this kind's estimator takes beyond those every
         kind's takes: a width (px; None to estimate it) for a kind with
         one, a known size (px) for a kind that takes one, none otherwise.
@@ -192,6 +198,8 @@ class Kind:
             The target's width, px (None: unknown).
         size_px : float or None, optional
             Each target's known size, px (None: none given).
+        gap_px : float or None, optional
+            The gap between its two bars, px, for a kind with one.
 
         Returns
         -------
@@ -208,4 +216,6 @@ class Kind:
         keywords: dict[str, float | None] = {"width_px": width_px} if self.has_width else {}
         if self.size_keyword is not None:
             keywords[self.size_keyword] = size_px
+        if self.gap_keyword is not None:
+            keywords[self.gap_keyword] = gap_px
         return keywords

@@ -2,8 +2,9 @@
 and the stretch of it clear of what must not enter the estimate.
 
 The ROI spans ``margin_px`` either side of the candidate's line (plus half
-a bar), stops ``JUNCTION_CLEARANCE_PX`` short of every segment it meets at
-a junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
+a bar; for a kind with a width, at least what the bar estimator needs:
+:func:`roi_margin_px`), stops ``JUNCTION_CLEARANCE_PX`` short of every
+segment it meets at a junction (the other quadrants of a checkerboard), ``FILL_CLEARANCE_PX``
 short of fill and nodata, and ``END_TRIM_PX`` short of a free end.
 """
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 
 from ..estimate import gate
 from ..io import RasterInfo
+from ..kinds import get_kind
 from .fill import FILL_SIDE_PX, fill_screen, grown
 from .settings import ScanSettings
 
@@ -26,6 +28,7 @@ JUNCTION_CLEARANCE_PX = 4.0     # an ROI keeps this far from the segments its ta
 FILL_CLEARANCE_PX = 4           # ... this far from fill and nodata (the target was blurred with the ground beyond it)
 END_TRIM_PX = 3.0               # ... and stops this short of a free end (a corner LSD did not see)
 MIN_HALF_WIDTH_PX = 10.0        # an ROI narrower either side of its target holds too little of the sides
+SEED_SLACK_PX = 2               # a bar's row windows reach this much farther than their half-width (see roi_margin_px)
 
 
 @dataclass(frozen=True)
@@ -72,11 +75,37 @@ class Roi:
                 for t, d in ((t0, -h), (t1, -h), (t1, h), (t0, h))]
 
 
+def roi_margin_px(settings: ScanSettings) -> float:
+    """How far (px) a candidate's ROI reaches beyond its target's
+    half-width: the scan's ``margin_px``, and for a kind with a width (a
+    bar) at least the background its estimator needs.  That estimator
+    follows a bar row by row in windows reaching
+    :data:`imgmtf.estimate.pulse.LOCATE_HALF_WINDOW_PX` either side of a
+    seed line that may lie on either side of the bar (the seed's half-bar
+    offset is the half-width the ROI adds), plus ``SEED_SLACK_PX`` for the
+    windows' rounding to whole pixels and the seed's own error: with the
+    default 12 px margin every row of a lone 1.5 px bar fell a pixel short.
+
+    Examples
+    --------
+    >>> from imgmtf.scene.settings import ScanSettings
+    >>> roi_margin_px(ScanSettings()), roi_margin_px(ScanSettings(target="pulse"))
+    (12, 14)
+    >>> roi_margin_px(ScanSettings(target="pulse", margin_px=20))
+    20
+    """
+    if not get_kind(settings.target).has_width:
+        return settings.margin_px
+    # (imported here: the workers reading ROIs need not load the estimator)
+    from ..estimate.pulse import LOCATE_HALF_WINDOW_PX
+    return max(settings.margin_px, LOCATE_HALF_WINDOW_PX + SEED_SLACK_PX)
+
+
 def plan_roi(half: HalfEdge, settings: ScanSettings, beside_px: float = math.inf) -> Roi:
     """The largest ROI a candidate may have: along its segment (a free end
     trimmed by ``END_TRIM_PX``; a junction end reaching the junction, which
     the partners' clearance then keeps off), at most ``max_length_px`` of
-    its middle, ``margin_px`` (plus half a bar) either side, or less, to
+    its middle, :func:`roi_margin_px` (plus half a bar) either side, or less, to
     stay ``JUNCTION_CLEARANCE_PX`` clear of a segment running beside it
     ``beside_px`` away."""
     s = half.segment
@@ -87,7 +116,7 @@ def plan_roi(half: HalfEdge, settings: ScanSettings, beside_px: float = math.inf
     if t1 - t0 > settings.max_length_px:
         middle = (t0 + t1) / 2
         t0, t1 = middle - settings.max_length_px / 2, middle + settings.max_length_px / 2
-    half_width = min(settings.margin_px + s.width_px / 2, beside_px - JUNCTION_CLEARANCE_PX)
+    half_width = min(roi_margin_px(settings) + s.width_px / 2, beside_px - JUNCTION_CLEARANCE_PX)
     return Roi(s.x0, s.y0, ux, uy, t0, t1, half_width)
 
 

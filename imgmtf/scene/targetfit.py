@@ -263,7 +263,7 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
         "model_choice": fit.choice.reason if fit.choice is not None else None,
         "parameters": {p.key: finite(p.value) for p in fit.parameters if p.status == "fitted"},
         "reduced_chi_square": finite(fit.reduced_chi_square), "misfit": bool(fit.misfit),
-        "misfit_p": finite(min(e.misfit_p for e in fit.edges)),
+        "misfit_p": finite(min((e.misfit_p for e in fit.edges if e.misfit_tested), default=math.nan)),
         "rows_used": int(sum(r.figures.get("rows_used") or 0 for r in records)),
         "snr_min": finite(min((r.figures.get("snr") or math.inf) for r in records)),
         "gsd_m": first.figures.get("gsd_m"), "warnings": warnings,

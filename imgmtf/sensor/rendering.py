@@ -244,7 +244,7 @@ class Renderer:
         if abs(target.offset_px) > half_diagonal + target.width_px:
             raise ParameterError(f"a target offset of {target.offset_px:g} px puts the {target.kind} outside "
                                  f"the {rows} x {cols} px chip (at most {half_diagonal:.1f} px from its centre)")
-        reach = half_diagonal + abs(target.offset_px) + target.width_px + 2.0
+        reach = half_diagonal + abs(target.offset_px) + 2 * target.width_px + target.gap_px + 2.0
         kept = self._responses.get(target.angle_deg)
         if kept is None or kept[0] < reach:
             kept = (reach, self.sensor.line_response(target.angle_deg, self.gsd_m, reach_px=reach))

@@ -1,4 +1,4 @@
-"""Synthetic targets: a straight edge or a pulse (bar).
+"""Synthetic targets: a straight edge, a pulse (bar) or a double bar.
 
 Geometry, in output-pixel units with pixel centres at integer coordinates
 (x along columns, y along rows, origin at the centre of the top-left pixel):
@@ -12,8 +12,8 @@ track); swapping ``low_dn`` and ``high_dn`` flips the polarity.
 
 A target is a straight line (or two) of infinite length, so its image
 through any PSF depends on d alone: the edge's is the sensor's edge
-response along the normal, the pulse's the difference of two edges'
-(:meth:`Target.image_values`).
+response along the normal, the pulse's the difference of two edges',
+a double bar's the sum of two pulses' (:meth:`Target.image_values`).
 """
 from __future__ import annotations
 
@@ -50,7 +50,11 @@ class Target:
         Position along the normal from the chip's centre, px.
     width_px : float
         The bar's width along the normal, px (> 0 for a pulse, 0 for an
-        edge).
+        edge); each bar's, for a double bar.
+    gap_px : float
+        A double bar's gap between its two bars (edge to edge) along the
+        normal, px (> 0 for a double bar, 0 for the others); the pair is
+        centred on the target's line.
 
     Raises
     ------
@@ -63,6 +67,8 @@ class Target:
     >>> from imgmtf import Target
     >>> Target("pulse", angle_deg=84.0, width_px=1.5).kind
     'pulse'
+    >>> Target("double-bar", angle_deg=5.0, width_px=1.0, gap_px=2.0).gap_px
+    2.0
     >>> Target("edge", angle_deg=120.0)
     Traceback (most recent call last):
     imgmtf.errors.ParameterError: target angle must be in (-90, 90] degrees, got 120.0
@@ -74,12 +80,13 @@ class Target:
     high_dn: float = 1200.0
     offset_px: float = 0.0
     width_px: float = 0.0
+    gap_px: float = 0.0
 
     def __post_init__(self):
         kind = get_kind(self.kind)
         if kind.scene_response is None:
             raise ParameterError(f"a {kind.name} target is no straight line: {kind.renderer} renders it")
-        for name in ("angle_deg", "low_dn", "high_dn", "offset_px", "width_px"):
+        for name in ("angle_deg", "low_dn", "high_dn", "offset_px", "width_px", "gap_px"):
             value = getattr(self, name)
             if isinstance(value, (bool, np.bool_)) or not isinstance(
                     value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
@@ -92,6 +99,10 @@ class Target:
         if not kind.has_width and self.width_px != 0:
             wide = " or ".join(f"kind={other.name!r}" for other in kinds_with_width())
             raise ParameterError(f"an {kind.name} target has no width; use {wide}")
+        if kind.gap_keyword is not None and self.gap_px <= 0:
+            raise ParameterError(f"{kind.name} gap must be > 0 pixels, got {self.gap_px}")
+        if kind.gap_keyword is None and self.gap_px != 0:
+            raise ParameterError(f"a {kind.name} target has no gap; a gap is a double bar's")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -134,5 +145,6 @@ class Target:
         """
         response = get_kind(self.kind).scene_response
         assert response is not None, "a target is a line (checked when it was made)"
-        inside = response(d_px, esf, self.width_px)
+        gap = {kind.gap_keyword: self.gap_px} if (kind := get_kind(self.kind)).gap_keyword else {}
+        inside = response(d_px, esf, self.width_px, **gap)
         return self.low_dn + (self.high_dn - self.low_dn) * inside

@@ -40,9 +40,11 @@ class FitRecord:
         Of the samples' residuals (1 for a model that fits to the noise).
     misfit_p : float
         The smallest p-value of structure in an edge's residuals (small:
-        structure the noise does not explain).
+        structure the noise does not explain); NaN where the test could run
+        on no edge.
     misfit_fraction : float
-        The largest RMS of that structure, fraction of the edge's step.
+        The largest RMS of that structure, fraction of the edge's step
+        (over the edges tested).
     stages : tuple of str
         The fitted sensor's stages.
     sources : tuple of str
@@ -88,15 +90,17 @@ class FitRecord:
         """
         from ...version import __version__
         edges = fit.edges
+        tested = [e for e in edges if math.isfinite(e.misfit_p)]       # an untested edge is no pass
         return cls(bool(fit.misfit), float(fit.reduced_chi_square),
-                   min((float(e.misfit_p) for e in edges), default=math.nan),
-                   max((float(e.misfit_fraction) for e in edges), default=math.nan),
+                   min((float(e.misfit_p) for e in tested), default=math.nan),
+                   max((float(e.misfit_fraction) for e in tested), default=math.nan),
                    tuple(s.name for s in fit.sensor.stages),
                    tuple(sources) if sources is not None else tuple(e.source for e in edges), __version__)
 
     def summary(self) -> str:
         """One line: the verdict and its figures."""
-        verdict = "does not fit" if self.misfit else "fits"
+        verdict = ("does not fit" if self.misfit else "fits" if math.isfinite(self.misfit_p)
+                   else "could not be tested on")
         return (f"the model ({', '.join(self.stages)}) {verdict} the {len(self.sources)} edge(s) it was fitted to "
                 f"(reduced chi-square {self.reduced_chi_square:.3g}, misfit p {self.misfit_p:.2g}, "
                 f"structure {100 * self.misfit_fraction:.2f} % of the step)")

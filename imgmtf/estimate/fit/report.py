@@ -80,7 +80,11 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
                        (float(lo), float(hi)), float(x0), chi, p, fraction, bins.x, res, bins.count, measured)
         edges.append(edge)
-        if edge.misfit:
+        if not edge.misfit_tested:
+            warnings.append(f"{d.source}: the misfit test could not run on this edge (no {MISFIT_BIN_PX:g} px bin "
+                            "of its residuals over the transition holds 3 samples): whether the model fits it is "
+                            "not known")
+        elif edge.misfit:
             warnings.append(f"{d.source}: the model does not fit this edge: its residuals are structured "
                             f"along the normal ({100 * fraction:.2f} % of the step, p = {p:.1g}); its MTF may be "
                             f"biased: {other_stages(model.stages)}")
@@ -170,14 +174,16 @@ def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float,
     (:func:`residual_means`), over the transition (where the model's edge
     response is between 0.1 % and 99.9 %, and at least +-3 px).  On the
     samples, not the fit's bins: those are formed on the distances before
-    the fitted offset, so at an offset they straddle these bins' edges."""
+    the fitted offset, so at an offset they straddle these bins' edges.
+    (NaN, NaN) where no bin holds 3 samples: the test cannot run, which is
+    no pass."""
     grid = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
     esf = response.esf(grid)
     inside = grid[(esf > 1e-3) & (esf < 1 - 1e-3)]
     reach = max(3.0, float(np.abs(inside).max()) if inside.size else 3.0)
     _, means, count = residual_means(x, residuals, np.ones(x.size), reach)
     if not count.size:
-        return 1.0, 0.0
+        return math.nan, math.nan
     statistic = float(np.sum(count * means**2) / noise**2)
     from scipy.special import chdtrc  # (scipy.stats, for this one tail, costs most of a second to import)
     p = float(chdtrc(count.size, statistic))

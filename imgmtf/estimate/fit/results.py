@@ -142,6 +142,12 @@ class EdgeFit:
         :data:`MISFIT_FRACTION` of the step."""
         return self.misfit_p < MISFIT_P and self.misfit_fraction > MISFIT_FRACTION
 
+    @property
+    def misfit_tested(self) -> bool:
+        """Whether the misfit test ran (its residuals filled a bin): an
+        edge it could not test is neither a fit nor a misfit."""
+        return math.isfinite(self.misfit_p)
+
     def to_dict(self) -> dict:
         return {"path": self.source, "normal_angle_deg": self.normal_angle_deg, "direction": self.direction,
                 "constrains": self.constrains, "gsd_m": self.gsd_m, "rows_used": self.rows_used,
@@ -150,8 +156,9 @@ class EdgeFit:
                 "mtf50_cy_px": json_value(self.mtf50_cy_px),
                 "measured_mtf_nyquist": json_value(self.measured_mtf_nyquist), "noise_dn": self.noise_dn,
                 "step_dn": self.step_dn, "levels_dn": list(self.levels_dn), "offset_px": self.offset_px,
-                "reduced_chi_square": self.reduced_chi_square, "misfit_p": self.misfit_p,
-                "misfit_fraction": self.misfit_fraction, "misfit": self.misfit}
+                "reduced_chi_square": self.reduced_chi_square, "misfit_p": json_value(self.misfit_p),
+                "misfit_fraction": json_value(self.misfit_fraction), "misfit": self.misfit,
+                "misfit_test": ("failed" if self.misfit else "passed") if self.misfit_tested else "not-run"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,6 +196,11 @@ class SensorFit:
     choice : ModelChoice or None
         With ``stages="auto"``: the candidate stage sets fitted, their
         information criterion and verdicts, and why this one was kept.
+    pixel_units : bool
+        True when no input had a GSD (a camera's images): lengths are in
+        px (the model's metres at a 1 m GSD) and directions the image's
+        axes, "horizontal" (across its columns: ``directions["across"]``)
+        and "vertical" (``directions["along"]``).
 
     Examples
     --------
@@ -211,6 +223,7 @@ class SensorFit:
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
     choice: ModelChoice | None = None
+    pixel_units: bool = False
 
     @property
     def misfit(self) -> bool:
@@ -271,6 +284,9 @@ class SensorFit:
         from ...version import __version__
         return {"imgmtf_version": __version__, "method": "fit",
                 "stages": [s.name for s in self.sensor.stages], "gsd_m": self.sensor.gsd_m,
+                "length_unit": "px" if self.pixel_units else "m",
+                "direction_names": (dict(zip(("across", "along"), ("horizontal", "vertical"))) if self.pixel_units
+                                    else {"across": "across-track", "along": "along-track"}),
                 "confidence": self.confidence, "reduced_chi_square": self.reduced_chi_square,
                 "misfit": self.misfit,
                 "parameters": [p.to_dict() for p in self.parameters],
