@@ -61,6 +61,8 @@ HINTS = (
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
     Hint(SCAN, "not-an-edge", "--target pulse measures bars"),
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
+    Hint(SCAN, "few-points", "--point-spacing PX groups targets farther apart, a star field's whole frame with "
+                             "its size"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and
