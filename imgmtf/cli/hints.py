@@ -63,6 +63,8 @@ HINTS = (
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
     Hint(SCAN, "not-an-edge", "--target pulse measures bars"),
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
+    Hint(SCAN, "few-points", "--point-spacing PX groups targets farther apart, a star field's whole frame with "
+                             "its size"),
     Hint(WARNING, "", "--track-azimuth DEG gives it", words="give the track's azimuth"),
 )
 

@@ -99,7 +99,7 @@ def measured_sensor(rows: Sequence[Mapping[str, Any]], source: str = "the rows",
     for scope in SCOPES:
         mine = [r for r in sections if r.get("scope") == scope and r.get("assumption") == r.get("chosen_assumption")]
         # an image without track information names its axes instead (horizontal: across its columns)
-        by_direction = {TRACK_OF.get(r.get("direction"), r.get("direction")): r for r in mine}
+        by_direction = {TRACK_OF.get(str(r.get("direction")), r.get("direction")): r for r in mine}
         if {"across-track", "along-track"} <= set(by_direction):
             chosen = by_direction
             break
