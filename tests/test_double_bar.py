@@ -72,6 +72,11 @@ def test_the_same_chips_as_one_bar_give_no_number(width, gap):
         with pytest.raises(UnsuitableTargetError, match=rf"two parallel bars {width + gap:.1f} px apart") as info:
             imgmtf.measure_pulse(c.image, width_px=given)
         assert info.value.reason == "double-bar"
+    # asked for as an edge, the refusal names the two bars at once (not "a bar", then "two bars")
+    with pytest.raises(UnsuitableTargetError, match=rf"two parallel bars {width + gap:.1f} px apart .*not an edge"
+                       ) as info:
+        imgmtf.measure_edge(c.image)
+    assert info.value.reason == "double-bar"
 
 
 def test_one_bar_through_a_blur_is_never_two():
