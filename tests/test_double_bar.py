@@ -124,3 +124,25 @@ def test_the_command_line_simulates_measures_fits_and_refuses(tmp_path):
     assert "two parallel bars 3.0 px apart" in refused.output and "--target double-bar" in refused.output
     no_gap = runner.invoke(main, ["measure", "--target", "double-bar", "--pulse-width", "1", path])
     assert no_gap.exit_code == 2 and "--gap" in no_gap.output
+
+
+def test_where_the_pair_hides_the_mtf_the_model_curve_and_its_band_are_shown():
+    c = chip(1.0, 2.0, SNR_100_DN, seed=3, size=40)
+    result = imgmtf.measure_double_bar(c.image, width_px=1.0, gap_px=2.0)
+    f, model = result.frequencies_cy_px, result.model_mtf
+    nyquist = int(np.argmin(np.abs(f - 0.5)))
+    assert np.isnan(result.mtf[nyquist]) and result.model_figures == ("mtf_nyquist",)
+    assert np.array_equal(model.frequencies_cy_px, f) and np.isfinite(model.mtf).all()
+    assert model.mtf[nyquist] == pytest.approx(result.mtf_nyquist, abs=1e-9)
+    assert model.low[nyquist] == pytest.approx(result.mtf_nyquist_ci.low, abs=1e-9)
+    assert np.all(model.low <= model.mtf) and np.all(model.mtf <= model.high)
+    assert np.abs(model.mtf - c.true_mtf(f))[f <= 0.75].max() < 0.02
+    record = result.to_dict()
+    assert len(record["model_mtf"]) == len(record["mtf"]) == f.size and len(record["model_mtf_ci"]) == f.size
+    from imgmtf.plot import plot_mtf
+    labels = plot_mtf(result).axes[0].get_legend_handles_labels()[1]
+    assert any(label.startswith("sensor model (optics,detector) fitted") for label in labels)
+    assert any(label.startswith("MTF@Nyquist") and label.endswith("(model)") for label in labels)
+    # where the transfer is divided, nothing is the model's
+    divided = imgmtf.measure_double_bar(chip(0.6, 1.2, size=40).image, width_px=0.6, gap_px=1.2)
+    assert divided.model_mtf is None and "model_mtf" not in divided.to_dict()

@@ -30,7 +30,7 @@ under that form.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from statistics import NormalDist
 from typing import Any
@@ -136,6 +136,38 @@ def bar_profile(result: Any, source: str, quantum_dn: float = 0.0) -> BarProfile
 
 
 @dataclass(frozen=True, eq=False)
+class ModelMTF:
+    """The fitted model's MTF along one profile's normal, with its
+    delta-method band: what a figure draws where the profile's own
+    transform cannot be read (a pair's transfer zeros).
+
+    Attributes
+    ----------
+    frequencies_cy_px, mtf : numpy.ndarray
+        The model's MTF (1 at zero frequency) and its frequencies, cy/px.
+    low, high : numpy.ndarray
+        Its band at ``confidence``, clipped to [0, 1].
+    stages : str
+        The model's stages, comma-separated.
+    confidence : float
+        Of the band.
+    """
+
+    frequencies_cy_px: np.ndarray
+    mtf: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    stages: str
+    confidence: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the curve and its band, rounded to 6 decimals."""
+        return {"model_stages": self.stages, "model_confidence": self.confidence,
+                "model_mtf": [round(float(v), 6) for v in self.mtf],
+                "model_mtf_ci": [[round(float(a), 6), round(float(b), 6)] for a, b in zip(self.low, self.high)]}
+
+
+@dataclass(frozen=True, eq=False)
 class BarFit:
     """The sensor model fitted to bars' profiles.
 
@@ -179,6 +211,29 @@ class BarFit:
     mtf50_ci_cy_px: tuple[Interval, ...]
     confidence: float
     warnings: tuple[str, ...] = ()
+    #: ``band(f, angle_deg)``: the model's MTF along a normal at ``f`` and its band
+    band: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = field(
+        default=None, repr=False, compare=False)
+
+    def mtf_curve(self, frequencies_cy_px: np.ndarray, index: int = 0) -> ModelMTF:
+        """The model's MTF along the ``index``-th profile's normal at
+        ``frequencies_cy_px`` (cy/px), with its delta-method band at
+        ``confidence``.
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("double-bar", 5.0, width_px=1.0, gap_px=2.0), 40)
+        >>> r = imgmtf.measure_double_bar(chip.image, width_px=1.0, gap_px=2.0)
+        >>> curve = fit_bars([bar_profile(r, "chip")]).mtf_curve(np.array([0.0, 0.5]))
+        >>> float(curve.mtf[0]), bool(curve.low[1] <= curve.mtf[1] <= curve.high[1])
+        (1.0, True)
+        """
+        if self.band is None:
+            raise ParameterError("this fit carries no model to evaluate")
+        f = np.asarray(frequencies_cy_px, float)
+        value, low, high = self.band(f, self.normal_angles_deg[index])
+        return ModelMTF(f, value, low, high, self.stages, self.confidence)
 
     def to_dict(self) -> dict:
         """JSON-ready: the parameters, and per profile the model's figures."""
@@ -365,7 +420,8 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
                         "times their noise: its form may not be the sensor's, and its MTF not the truth")
     return BarFit(sensor, ",".join(names), _parameters(model, z, covariance), float(reduced),
                   tuple(p.source for p in model.profiles), tuple(p.normal_angle_deg for p in model.profiles),
-                  tuple(nyquist), tuple(nyquist_ci), tuple(mtf50), tuple(mtf50_ci), confidence, tuple(warnings))
+                  tuple(nyquist), tuple(nyquist_ci), tuple(mtf50), tuple(mtf50_ci), confidence, tuple(warnings),
+                  lambda f, angle_deg: _mtf_band(model, u, cov, f, angle_deg, quantile))
 
 
 def _mtf_band(model: _BarModel, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
