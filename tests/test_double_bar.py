@@ -146,3 +146,24 @@ def test_where_the_pair_hides_the_mtf_the_model_curve_and_its_band_are_shown():
     # where the transfer is divided, nothing is the model's
     divided = imgmtf.measure_double_bar(chip(0.6, 1.2, size=40).image, width_px=0.6, gap_px=1.2)
     assert divided.model_mtf is None and "model_mtf" not in divided.to_dict()
+
+
+def test_fit_of_bars_writes_the_sensor_starts_from_one_holds_and_refuses_what_is_the_edges(tmp_path):
+    runner = CliRunner()
+    path, toml = str(tmp_path / "pair.tif"), str(tmp_path / "fitted.toml")
+    imgmtf.write_geotiff(path, chip(1.0, 2.0, size=40).image, gsd_m=1.0)
+    bars = ["fit", "--target", "double-bar", "--pulse-width", "1", "--gap", "2", path]
+    written = runner.invoke(main, [*bars, "--out", toml])
+    assert written.exit_code == 0 and f"wrote {toml}" in written.output, written.output
+    record, sensor = imgmtf.read_fit_record(toml), imgmtf.Sensor.from_toml(toml)
+    assert record.misfit is False and record.sources == (path,) and [s.name for s in sensor.stages] == [
+        "optics", "detector"]
+    held = runner.invoke(main, [*bars, "--sensor", toml, "--hold", "detector", "--format", "json"])
+    assert held.exit_code == 0, held.output
+    parameters = {p["name"]: p for p in json.loads(held.output)["parameters"]}
+    assert parameters["width_x_m"]["status"] == "held" and parameters["sigma_x_m"]["status"] == "fitted"
+    assert parameters["width_x_m"]["value"] == pytest.approx(sensor.stages[1].width_x_m)
+    for flag, value, why in (("--plot", "fit.png", "imgmtf measure --plot"), ("--campaign", "store", "misfit test"),
+                             ("--hold", "motion", "cannot hold 'motion'")):
+        refused = runner.invoke(main, [*bars, flag, value])
+        assert refused.exit_code == 2 and why in refused.output, refused.output
