@@ -101,6 +101,12 @@ def test_selftest_passes(run):
     result = run("selftest")
     assert result.exit_code == 0, result.output
     assert "PASS" in result.stdout and "FAIL" not in result.stdout
+    # every kind has a case: a double bar whose MTF at Nyquist only the fitted model reads, and points
+    from imgmtf.estimate.double_bar import MODEL_BELOW_TRANSFER, pair_transfer
+    from imgmtf.selftest import CASES
+    pairs = [c.target for c in CASES if c.target.kind == "double-bar"]
+    assert pairs and abs(pair_transfer(0.5, pairs[0].width_px, pairs[0].gap_px)) < MODEL_BELOW_TRANSFER
+    assert "double bar 1 px, 2 px gap" in result.stdout and "4x4 points across-track" in result.stdout
 
 
 def test_simulated_chip_describes_itself(run, tmp_path):
