@@ -41,6 +41,7 @@ _LAZY = {
     "read_fit_record": "estimate.fit.record",
     "Raster": "io", "read_raster": "io", "write_geotiff": "io", "write_png": "io", "luminance": "inputs",
     "Record": "records", "measure_file": "batch", "MeasureSettings": "measure_settings",
+    "VectorROIs": "vectors",
     "scan_scene": "scene.measure", "ScanSettings": "scene.settings", "summarise_scan": "scene.combine",
     "fit_targets": "scene.targetfit", "scan_scenes": "scene.series",
     "mtf2d_from_sections": "estimate.mtf2d", "MTF2D": "estimate.mtf2d",

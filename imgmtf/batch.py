@@ -17,6 +17,7 @@ import numpy as np
 
 from .atomic import ensure_folder
 from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
+from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
 from .file_notes import file_notes as raster_notes
 from .inputs import saturation_levels
@@ -24,6 +25,7 @@ from .io import open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
 from .records import Record, utc_now
+from .vectors import Unplaced, VectorROIs
 
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
@@ -148,21 +150,56 @@ def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: s
     # what the file's reading adds to its first record's warnings (and to its figure's count of them)
     skipped_note = ([f"{path}: band {', '.join(map(str, skipped))} is alpha (transparency, not DN): not measured"]
                     if skipped else [])
+    try:
+        windows = _windows(info, settings)
+    except Exception as exc:
+        return [settings.failed(path, settings.band, exc, run_utc)]
     records = []
     for index, band in enumerate(bands):
-        file_notes = skipped_note if index == 0 else []
-        try:
-            raster = file.read(band, window=settings.roi)
-            result = measure_raster(raster, settings)
-            # one record per result, or per direction of a kind that measures several (points)
-            summaries = result.summaries(curves=True)
-        except Exception as exc:
-            failed = settings.failed(path, band, exc, run_utc)
-            records.append(failed.with_(figures={"warnings": file_notes}) if file_notes else failed)
-            continue
-        records.extend(_band_records(file, band, len(bands), raster, result, summaries, file_notes, settings,
-                                     plot_path, run_utc))
+        for feature in windows:
+            file_notes = skipped_note if index == 0 and feature is windows[0] else []
+            records.extend(_window_records(file, band, len(bands), feature, file_notes, settings, plot_path,
+                                           run_utc))
     return records
+
+
+def _windows(info, settings: MeasureSettings) -> list:
+    """What is read of a file: the settings' pixel window (or the whole
+    image), or each feature of a vector layer's window on it, or why that
+    feature has none (an error, its record's)."""
+    if isinstance(settings.roi, VectorROIs):
+        return settings.roi.windows(info)
+    return [None]
+
+
+def _window_records(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc) -> list[Record]:
+    """The records of one band read through one window: the settings' own
+    (``feature`` None), or a vector feature's (with its attributes), or the
+    error of a feature with no window."""
+    path = file.path
+    fields = {} if feature is None else {"site": feature.record_fields()}
+    if isinstance(feature, Unplaced):
+        return [settings.failed(path, band, feature.error, run_utc, **fields)]
+    window = settings.roi if feature is None else feature.window
+    notes = [*file_notes, *(feature.notes() if feature is not None else [])]
+    try:
+        raster = file.read(band, window=window)
+        result = measure_raster(raster, settings)
+        # one record per result, or per direction of a kind that measures several (points)
+        summaries = result.summaries(curves=True)
+        if in_image_axes(raster, settings.track_azimuth_deg):       # each direction, a points record's too
+            from .estimate.geometry import image_axis_label
+            for summary in summaries:
+                if isinstance(summary.get("direction"), str):
+                    summary["direction"] = image_axis_label(summary["direction"])
+    except Exception as exc:
+        failed = settings.failed(path, band, exc, run_utc, **fields)
+        return [failed.with_(figures={"warnings": notes}) if notes else failed]
+    if feature is not None and plot_path:
+        plot_path = _feature_plot_path(plot_path, feature.fid)
+    return [r.with_(**fields) if fields else r
+            for r in _band_records(file, band, n_bands, raster, result, summaries, notes, settings, plot_path,
+                                   run_utc)]
 
 
 def _band_records(file, band, n_bands, raster, result, summaries, file_notes, settings, plot_path, run_utc):
@@ -172,8 +209,11 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
     records: list[Record] = []
     # what the file says about every number in it, as a scan says it of each edge it accepts
     file_notes = [*file_notes, *raster_notes(raster, settings.transfer, bool(info.alpha_bands))]
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
     for summary in summaries:
         summary["warnings"] = [*summary.get("warnings", []), *file_notes]
+        if centre is not None and getattr(result, "geometry", None) is not None:
+            summary.update(field_position(*edge_centre_px(result), result.normal_angle_deg, centre))
         record = Record.measured(path, raster.band, summary, params=settings.params(), run_utc=run_utc)
         record = _untrusted_when_forced(record, settings, result.checks)
         if plot_path and records and records[0].plot:
@@ -181,7 +221,8 @@ def _band_records(file, band, n_bands, raster, result, summaries, file_notes, se
         elif plot_path:
             record = with_figure(record, functools.partial(_measurement_figure, result, raster,
                                                            summary["warnings"], record.reason
-                                                           if record.status == "untrusted" else None),
+                                                           if record.status == "untrusted" else None,
+                                                           _place(summary)),
                                  _band_plot_path(plot_path, band, n_bands))
         records.append(record)
     return records
@@ -203,17 +244,42 @@ def _untrusted_when_forced(record: Record, settings: MeasureSettings, checks) ->
 
 def measure_raster(raster, settings: MeasureSettings):
     """The estimate of one raster (a window of the file when ``roi`` is
-    set), its ROI reported in the file's pixel coordinates."""
+    set), its ROI reported in the file's pixel coordinates, its direction
+    named by the image's axes when nothing places a track on it
+    (:func:`in_image_axes`)."""
     estimator = settings.estimator()
     track = settings.track_azimuth_deg
+    image_axes = in_image_axes(raster, track)
     if track is None and not raster.map_projected:
-        track = 0.0                          # sensor geometry: rows along track
+        track = 0.0                          # sensor geometry: rows along track (or the image's axes)
     common = dict(gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
                   saturation=settings.saturation or saturation_levels(raster.dtype))
     result = estimator(raster.data, **settings.target_keywords(raster), **common)
     x0, y0 = raster.origin
     x, y, w, h = result.roi
-    return replace(result, roi=(x + x0, y + y0, w, h))
+    result = replace(result, roi=(x + x0, y + y0, w, h))
+    if image_axes and isinstance(getattr(result, "direction", None), str):
+        from .estimate.geometry import image_axis_label
+        result = replace(result, direction=image_axis_label(result.direction))
+    return result
+
+
+def edge_centre_px(result) -> tuple[float, float]:
+    """The middle of a measured target's fitted line, in the file's pixels
+    (pixel centres at integers): the mean of the rows it was fitted on."""
+    geometry = result.geometry
+    along = float(np.mean(geometry.rows[geometry.kept]))
+    across = geometry.slope * along + geometry.intercept
+    x, y = (along, across) if geometry.transposed else (across, along)
+    return x + result.roi[0], y + result.roi[1]
+
+
+def in_image_axes(raster, track_azimuth_deg: float | None) -> bool:
+    """Whether a file's directions are named by its own axes (horizontal,
+    vertical): it has no georeference (no CRS, no pixel size) and no track
+    azimuth was given, so nothing says where a track lies (a camera's
+    photo; an L0 product says it with ``track_azimuth_deg=0``)."""
+    return track_azimuth_deg is None and not raster.map_projected and raster.gsd_m is None
 
 
 def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, scheduler: str | None = None,
@@ -255,6 +321,14 @@ def plot_paths(paths, plot_dir: str) -> list[str]:
     return out
 
 
+def _feature_plot_path(plot_path: str, fid: str) -> str:
+    """A feature's figure: the file's with ``_f<id>`` before its suffix."""
+    p = Path(plot_path)
+    stem = p.name[:-len("_mtf.png")] if p.name.endswith("_mtf.png") else p.stem
+    tail = "_mtf.png" if p.name.endswith("_mtf.png") else p.suffix
+    return str(p.with_name(f"{stem}_f{fid}{tail}"))
+
+
 def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     if n_bands == 1:
         return plot_path
@@ -262,15 +336,26 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
 
 
-def _measurement_figure(result, raster, warnings, untrusted=None):
-    """The measurement figure, titled with the file (and band), counting
-    every warning its record carries (the file's own among them), with the
-    true MTF when the file is a chip imgmtf simulated; a number forced past
-    a refusal (``untrusted``: its reason) is said not to be trusted in the
+def _place(summary: dict) -> str:
+    """Where an edge lies in a lens's field, as its figure's title says it
+    (``""`` without an optical centre)."""
+    if summary.get("radial_distance_px") is None:
+        return ""
+    return (f"{summary.get('field_direction') or 'at the optical centre'}, "
+            f"{summary['radial_distance_px']:g} px from the optical centre")
+
+
+def _measurement_figure(result, raster, warnings, untrusted=None, place: str = ""):
+    """The measurement figure, titled with the file (and band) and the
+    edge's place in a lens's field when asked (``place``), counting every
+    warning its record carries (the file's own among them), with the true
+    MTF when the file is a chip imgmtf simulated; a number forced past a
+    refusal (``untrusted``: its reason) is said not to be trusted in the
     title."""
     from .kinds import get_kind
     from .plot import plot_measurement
     title = raster.path if raster.band in (1, "luminance") else f"{raster.path}, band {raster.band}"
+    title += f": {place}" if place else ""
     if untrusted:
         title = f"{title}: NOT TO BE TRUSTED (forced past the refusal {untrusted})"
     kind = get_kind(result.target)

@@ -5,15 +5,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .errors import ParameterError
+from .estimate.field import parse_centre
 from .estimate.intervals import Intervals, as_intervals
 from .estimate.resampling import check_method
 from .inputs import check_width, parse_length
 from .kinds import get_kind
 from .records import Record
 from .transfer import parse_transfer
+from .vectors import VectorROIs, as_rois
 
 if TYPE_CHECKING:
     from .estimate.results import MTFResult
@@ -34,8 +36,12 @@ class MeasureSettings:
     band : int or str, optional
         1-based band, "all" for every band, None (default) for the only
         band or RGB luminance.
-    roi : (int, int, int, int), optional
-        (x, y, width, height) window read from every file, px.
+    roi : (int, int, int, int), str, os.PathLike or VectorROIs, optional
+        (x, y, width, height) window read from every file, px; or a vector
+        layer (a file any GDAL vector driver reads, or
+        :class:`imgmtf.vectors.VectorROIs`) whose polygons and lines,
+        reprojected onto each file, are measured one window each, their
+        attributes in the records (``feature_id``, ``feature``).
     pulse_width : (float, str), float or str, optional
         (value, "px" or "m"), a number of px, a string as the CLI takes it
         ("1.4", "1.4px", "18.3m"), or None (default) to estimate it.
@@ -52,7 +58,9 @@ class MeasureSettings:
     track_azimuth_deg : float, optional
         The ground track's direction in the image, degrees clockwise from
         up; None: rows along track for images in sensor geometry, unknown
-        for map-projected ones.
+        for map-projected ones, and for an image with no georeference (no
+        CRS, no pixel size: a photo) its own axes, the directions named
+        "horizontal" and "vertical".
     transfer : str, optional
         How the stored values relate to light, "linear" (as stored), "srgb"
         or "gamma:G" (:mod:`imgmtf.transfer`): linearised before measuring.
@@ -63,6 +71,11 @@ class MeasureSettings:
         A double bar's gap between its bars (edge to edge), as
         ``pulse_width`` takes it; for the kinds with one (double bars),
         which need it.
+    optical_centre : (float, float) or str, optional
+        A lens's optical centre (x, y), px (pixel centres at integers), or
+        ``"centre"`` for the image's: each edge's record then says how far
+        from it the edge lies and whether it measures the sagittal or the
+        meridional MTF (:func:`imgmtf.estimate.field.field_position`).
 
     Raises
     ------
@@ -81,7 +94,7 @@ class MeasureSettings:
     target: str = "edge"
     method: str = "msg"
     band: int | str | None = None
-    roi: tuple[int, int, int, int] | None = None
+    roi: tuple[int, int, int, int] | VectorROIs | None = None
     pulse_width: tuple[float, str] | None = None
     intervals: Intervals = field(default_factory=Intervals)
     force: bool = False
@@ -90,9 +103,11 @@ class MeasureSettings:
     transfer: str = "linear"
     point_size: tuple[float, str] | None = None
     gap: tuple[float, str] | None = None
+    optical_centre: tuple[float, float] | str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))
+        object.__setattr__(self, "roi", as_rois(self.roi))     # a vector file read once, here
         if self.pulse_width is not None:
             object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))
         if not get_kind(self.target, "target").has_width and self.pulse_width is not None:
@@ -116,6 +131,10 @@ class MeasureSettings:
                                  "neither can be read off its profile")
         if get_kind(self.target, "target").gap_keyword is not None and self.pulse_width is None:
             raise ParameterError(f"a {self.target} needs its bars' width: it cannot be read off two bars' profile")
+        if self.optical_centre is not None:
+            centre = self.optical_centre
+            object.__setattr__(self, "optical_centre", parse_centre(centre if isinstance(centre, str)
+                                                                    else ",".join(map(str, centre))))
         check_method(self.method)   # an unknown method fails here, before any file is read
         object.__setattr__(self, "transfer", str(parse_transfer(self.transfer)))
 
@@ -151,15 +170,18 @@ class MeasureSettings:
 
     def params(self) -> dict:
         """The run's settings, as records carry them."""
-        return {"intervals": self.intervals.as_dict(), "roi": list(self.roi) if self.roi else None,
+        roi = self.roi.source if isinstance(self.roi, VectorROIs) else list(self.roi) if self.roi else None
+        return {"intervals": self.intervals.as_dict(), "roi": roi,
                 "band": self.band, "force": self.force,
                 "saturation": list(self.saturation) if self.saturation else None,
                 "track_azimuth_deg": self.track_azimuth_deg, "transfer": self.transfer,
                 "pulse_width": list(self.pulse_width) if self.pulse_width else None,
                 **({"point_size": list(self.point_size)} if self.point_size else {}),
-                **({"gap": list(self.gap)} if self.gap else {})}
+                **({"gap": list(self.gap)} if self.gap else {}),
+                **({"optical_centre": self.optical_centre if isinstance(self.optical_centre, str)
+                    else list(self.optical_centre)} if self.optical_centre is not None else {})}
 
-    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str) -> Record:
+    def failed(self, path: str, band: int | str | None, exc: BaseException, run_utc: str, **fields: Any) -> Record:
         """The error record of a file (or band) that could not be measured.
 
         Parameters
@@ -172,6 +194,9 @@ class MeasureSettings:
             What the measurement raised.
         run_utc : str
             The run's start, UTC, ISO 8601.
+        **fields
+            Other fields of the record (``site``: a vector feature's id and
+            attributes).
 
         Returns
         -------
@@ -179,7 +204,7 @@ class MeasureSettings:
             An error record with these settings, the reason and message.
         """
         return Record.failed(path, band, self.target, self.method, exc, params=self.params(),
-                             run_utc=run_utc)
+                             run_utc=run_utc, **fields)
 
 
 def pulse_width_px(width: tuple[float, str] | None, raster: Raster) -> float | None:

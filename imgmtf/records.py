@@ -82,8 +82,9 @@ class Record:
         ``fwhm_px``...), empty for a failure.
     site : mapping
         Where a scan candidate lies (``id``, ``rank``, ``scope``,
-        ``target_id``, ``x0_px``...), or what a scan summary covers; empty
-        for ``measure``.
+        ``target_id``, ``x0_px``...), or what a scan summary covers; for a
+        window from a vector layer (``--roi-file``), its ``feature_id`` and
+        ``feature`` (the attributes); else empty for ``measure``.
     plot : str or None
         The figure written for this record, if any.
     params : mapping
@@ -313,7 +314,9 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "mtf50_cy_px", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px",
     "fwhm_px", "mtfa", "rer", "gsd_m", "mtf50_cy_m", "fwhm_m", "noise_limit_cy_px", "mtf_peak", "mtf_peak_cy_px",
     "sharpened",
-    "pulse_width_px", "roi_px", "warnings", "plot", "params", "imgmtf_version", "run_utc",
+    "pulse_width_px", "roi_px", "feature_id", "feature", "feature_window_px",
+    "radial_distance_px", "radial_angle_deg", "field_direction",
+    "warnings", "plot", "params", "imgmtf_version", "run_utc",
 )
 # each kind of target's own figures (imgmtf.kinds.Kind.record_fields) are
 # columns too: the edge's and the bar's sit among the figures above, where

@@ -21,6 +21,7 @@ from .estimate.fit.model import listed
 from .estimate.fit.results import SensorFit
 from .inputs import check_roi
 from .sensor.model import Sensor
+from .vectors import VectorROIs, as_rois
 
 if TYPE_CHECKING:
     from .estimate.edge import EdgeResult
@@ -32,7 +33,7 @@ Roi = tuple[int, int, int, int]
 def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
                stages: str | Sequence[str] | None = None, start: Sensor | None = None,
                hold: str | Sequence[str] = (), gsd_m: float | None = None,
-               band: int | None = None, roi: Roi | Sequence[Roi | None] | None = None,
+               band: int | None = None, roi: Roi | Sequence[Roi | None] | VectorROIs | str | None = None,
                confidence: float = 0.95, force: bool = False, transfer: str = "linear",
                saturation: tuple[float, float] | None = None) -> SensorFit:
     """Fit a sensor's stages to the profiles of one or more edges.
@@ -59,10 +60,12 @@ def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
     band : int, optional
         1-based band of multi-band files (default: the only band or the
         luminance).
-    roi : (int, int, int, int) or sequence of them, optional
+    roi : (int, int, int, int), sequence of them, VectorROIs or str, optional
         (x, y, width, height) window, px, taken from every file or array
         (only it is read from a file), or one window per edge (None for
-        the whole image); not for EdgeResults.
+        the whole image); not for EdgeResults.  Or a vector layer (its
+        file, or a :class:`imgmtf.vectors.VectorROIs`): every file's edge
+        measured in each feature's window (:func:`feature_edges`).
     confidence : float, optional
         Of the intervals, in (0, 1) (default 0.95).
     force : bool, optional
@@ -108,6 +111,8 @@ def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
     if isinstance(edges, (str, Path, np.ndarray, EdgeResult)):
         edges = [edges]
     items = listed("edges", edges, "files, arrays or EdgeResults")
+    if isinstance(roi, (str, os.PathLike, VectorROIs)):
+        items, roi, _ = feature_edges(items, as_rois(roi), band)
     rois = _windows(roi, len(items))
     items, rois, notes = _distinct(items, rois)
     measured = [_read(item, k, band, window, gsd_m, force, transfer, saturation)
@@ -115,7 +120,71 @@ def fit_sensor(edges: Sequence[str | os.PathLike | np.ndarray | EdgeResult], *,
     fit = fit_edges([m for m, _ in measured], stages=stages, start=start, hold=hold, gsd_m=gsd_m,
                     confidence=confidence)
     forced = [w for _, warnings in measured for w in warnings]
-    return replace(fit, warnings=(*notes, *forced, *fit.warnings)) if notes or forced else fit
+    fit = replace(fit, warnings=(*notes, *forced, *fit.warnings)) if notes or forced else fit
+    photos = gsd_m is None and all(isinstance(item, (str, os.PathLike)) for item in items) and not any(
+        getattr(getattr(m, "result", None), "gsd_m", 1.0) is not None for m, _ in measured)
+    return in_image_axes(fit) if photos else fit
+
+
+def in_image_axes(fit: SensorFit) -> SensorFit:
+    """A fit of images with no georeference (a camera's files: no CRS, no
+    pixel size) told in their own terms: lengths in px (the model's metres
+    at the 1 m GSD it takes), directions the image's axes (horizontal,
+    across its columns, for the model's across track; vertical for along).
+
+    Parameters
+    ----------
+    fit : SensorFit
+        The fit, with rows taken along track.
+
+    Returns
+    -------
+    SensorFit
+        The same fit, ``pixel_units`` True, its words and units the image's.
+    """
+    from .estimate.geometry import image_axis_label
+
+    def words(text: str) -> str:
+        for track, axis in (("across-track", "horizontal"), ("along-track", "vertical")):
+            text = text.replace(track, axis)
+        return text
+    gsd_note = next((w for w in fit.warnings if w.startswith("no GSD in the inputs")), None)
+    warnings = [words(w) for w in fit.warnings if w is not gsd_note]
+    warnings.append("no GSD in the inputs: lengths are in px and directions the image's axes (horizontal: across "
+                    "its columns); give the GSD for lengths on the ground")
+    parameters = tuple(replace(p, unit="px" if p.unit == "m" else p.unit, note=words(p.note)) for p in fit.parameters)
+    edges = tuple(replace(e, direction=image_axis_label(e.direction)) for e in fit.edges)
+    return replace(fit, parameters=parameters, edges=edges, warnings=tuple(warnings), pixel_units=True)
+
+
+def feature_edges(paths: Sequence[str | os.PathLike], rois: VectorROIs, band: int | None = None
+                  ) -> tuple[list[str], list[Roi], list[dict[str, Any]]]:
+    """Every file once per feature of a vector layer: the files (repeated),
+    each feature's window on its file, and what each edge's record carries
+    of its feature (``feature_id``, ``feature``).
+
+    Raises
+    ------
+    ParameterError
+        A path that is not a file, a file without a CRS, or a feature
+        with no window on a file (outside it: a fit takes every edge it
+        is given).
+    ImgmtfError
+        A file that cannot be read.
+    """
+    from .io import raster_info
+    from .vectors import Unplaced
+    files, windows, fields = [], [], []
+    for path in paths:
+        if not isinstance(path, (str, os.PathLike)):
+            raise ParameterError(f"a vector layer's features are windows of files, not of {type(path).__name__}s")
+        for placed in rois.windows(raster_info(os.fspath(path))):
+            if isinstance(placed, Unplaced):
+                raise placed.error
+            files.append(os.fspath(path))
+            windows.append(placed.window)
+            fields.append(placed.record_fields())
+    return files, windows, fields
 
 
 def edge_sources(paths: Sequence[str], roi: Roi | Sequence[Roi | None] | None = None) -> list[str]:

@@ -41,3 +41,10 @@ def test_an_unnamed_platform_is_keyed_by_its_files_or_stands_alone():
     assert sensor_of({"platform": "Landsat 9", "sensor_key": "x"}) == "Landsat 9"
     assert sensor_of({"platform": None, "sensor_key": "80 x 80 px uint16"}) == "unnamed: 80 x 80 px uint16"
     assert sensor_of({"acquisition_id": "0123456789abcdef"}) != sensor_of({"acquisition_id": "fedcba9876543210"})
+
+
+def test_a_photos_image_axes_are_directions_like_the_tracks():
+    # a file with no georeference is told in its own axes: its rows are one direction each, whatever their normals
+    rows = [row("fit", "horizontal", misfit=0), row("combined", "horizontal", normal_angle_deg=0.6),
+            row("combined", "vertical", normal_angle_deg=89.7)]
+    assert chosen(rows) == [("fit", "horizontal"), ("combined", "vertical")]

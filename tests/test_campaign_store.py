@@ -224,7 +224,7 @@ def test_a_schema_1_store_gains_the_new_columns_and_keeps_its_rows(tmp_path, acq
     assert old["recommended"] is None and old["assumption"] is None and old["method"] == "fit"
     other = read_acquisition(acquisition.path, band=1, settings={"other": True})
     write_acquisition(store, other, [], [summary("scene", "along-track", "combined")])
-    assert schema_version(store) == SCHEMA_VERSION == 2
+    assert schema_version(store) == SCHEMA_VERSION == 3
     assert sorted(str(r["sensor_key"]) for r in read_layer(store, "targets")) == [
         "16 x 16 px uint16, GSD 15 m", "None"]
 

@@ -35,7 +35,9 @@ ROOT = Path(__file__).parent.parent
 OTHERS = {"accuracy.md", "method.md"}
 # pages whose examples read the shared real scenes (never copied into the repository): linked into
 # the folder the examples run in, the page skipped where they are absent (conftest.real_scene)
-REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",)}
+REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",),
+                    "docs/regions.md": ("sentinel2_b04_bagnolo.tif",
+                                        *(f"bagnolo_roi/mtf_al_bagnolo.{e}" for e in ("shp", "shx", "dbf", "prj")))}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -130,6 +132,7 @@ def test_every_example_of_the_document_runs(document, sample_folder):
 
 def link_real_scenes(document: str, folder: Path) -> None:
     for name in REAL_SCENES_READ.get(document, ()):
+        (folder / name).parent.mkdir(exist_ok=True)         # a shapefile's parts, in their folder
         (folder / name).symlink_to(real_scene(name))
 
 
@@ -138,7 +141,7 @@ def assert_ignored(folder: Path) -> None:
     root as a newcomer runs them, is one .gitignore covers."""
     import shutil
     import subprocess
-    linked = {name for names in REAL_SCENES_READ.values() for name in names}
+    linked = {name.split("/")[0] for names in REAL_SCENES_READ.values() for name in names}
     written = [p.name + "/" * p.is_dir() for p in folder.iterdir()
                if p.name != "data" and not p.name.startswith("block") and p.name not in linked]
     if not written or not shutil.which("git") or not (ROOT / ".git").exists():

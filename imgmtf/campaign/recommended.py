@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-ACROSS_ALONG = ("across-track", "along-track")
+from ..estimate.geometry import AXIS_DIRECTIONS
 
 
 def sensor_of(row: Mapping) -> str:
@@ -42,7 +42,7 @@ def _place(row: Mapping) -> tuple:
     """Acquisition, scope, target and direction (an oblique one by its normal, to a degree)."""
     direction = row.get("direction")
     normal = row.get("normal_angle_deg")
-    if direction not in ACROSS_ALONG and normal is not None:
+    if direction not in AXIS_DIRECTIONS and normal is not None:
         direction = f"{direction} {round(float(normal)) % 180}"
     return row.get("acquisition_id"), row.get("scope"), row.get("target_id"), direction
 

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from ..atomic import atomic_output, ensure_folder
 from ..errors import FileWriteError
+from ..estimate.geometry import AXIS_DIRECTIONS
 from ..records import utc_now
 from ..version import __version__
 from .report_figures import Figures
@@ -281,7 +282,7 @@ def _result(row: Mapping) -> dict:
     interval = (f" [{_mtf(row.get('mtf_nyquist_ci_low'))}, {_mtf(row.get('mtf_nyquist_ci_high'))}]"
                 if row.get("mtf_nyquist_ci_low") is not None else "")
     direction = _text(row.get("direction"))
-    if row.get("direction") not in ("across-track", "along-track") and row.get("normal_angle_deg") is not None:
+    if row.get("direction") not in AXIS_DIRECTIONS and row.get("normal_angle_deg") is not None:
         direction += f" {row['normal_angle_deg']:.1f} deg"
     how = _text(row.get("method")) + (f" ({row['assumption']})" if row.get("assumption") else "")
     return {"text": f"{where}, {direction}, {how}: {_mtf(row.get('mtf_nyquist'))}{interval}",

@@ -30,7 +30,10 @@ still finds them (:func:`figure_path`).
 
 Schema versions: 1 the first; 2 adds ``sensor_key`` (what identifies an
 unnamed platform's sensor), ``recommended``, ``recommended_because`` and
-``assumption``, and keeps figure paths relative to the store.  Older
+``assumption``, and keeps figure paths relative to the store; 3 adds the
+edges' ``feature_id`` and ``feature`` (the vector feature, with its
+attributes as JSON, whose window a chip or candidate was measured in:
+``--roi-file``).  Older
 stores read (their missing columns None) and are upgraded when written.
 
 Geometry is longitude/latitude (EPSG:4326, one CRS for scenes of any UTM
@@ -64,7 +67,7 @@ from .acquisitions import Acquisition
 if TYPE_CHECKING:
     from ..io import RasterInfo
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 LAYERS = ("acquisitions", "edges", "targets")
 BUSY_TIMEOUT_S = 30.0           # SQLite waits this long for another writer's lock...
 WRITE_ATTEMPTS = 5              # ...and a write is tried this many times before it fails
@@ -89,7 +92,7 @@ _FIGURES = {
 _EDGE_COLUMNS = {
     **_REPEATED, "edge_id": "str", "scope": "str", "target_id": "int", "status": "str", "reason": "str",
     **_FIGURES, "snr": "float", "rows_used": "int", "x0_px": "float", "y0_px": "float", "x1_px": "float",
-    "y1_px": "float", "roi_px": "str", "plot": "str", "record": "str",
+    "y1_px": "float", "roi_px": "str", "plot": "str", "record": "str", "feature_id": "str", "feature": "str",
 }
 _TARGET_COLUMNS = {
     **_REPEATED, "scope": "str", "target_id": "int", "method": "str", "status": "str", "reason": "str",
@@ -365,6 +368,9 @@ def _edge_row(acquisition: Acquisition, record: Record, geo: _Georeference, home
     row.update({key: flat.get(key) for key in ("status", "reason", "snr", "rows_used",
                                                "x0_px", "y0_px", "x1_px", "y1_px")})
     row["edge_id"] = None if flat.get("id") is None else str(flat["id"])
+    row["feature_id"] = flat.get("feature_id")
+    row["feature"] = (json.dumps(json_safe(flat["feature"]), sort_keys=True, default=_jsonable)
+                      if flat.get("feature") is not None else None)
     roi = flat.get("roi")
     row["roi_px"] = json.dumps(roi) if roi else None
     if flat.get("x0_px") is not None:               # a scan's half-edge: its segment (pixel centres)

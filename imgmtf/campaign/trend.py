@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike
 
 from ..atomic import atomic_output
 from ..errors import FileWriteError, ParameterError
+from ..estimate.geometry import AXIS_DIRECTIONS
 from ..records import CANDIDATE_SCOPE, SCENE_SCOPE
 
 YEAR_S = 365.25 * 86400.0
@@ -45,7 +46,6 @@ FIGURES = {
     "rer": None,
 }
 GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recommended", "misfit")
-ACROSS_ALONG = ("across-track", "along-track")
 TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
                  "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest",
                  "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low",
@@ -218,7 +218,7 @@ def _by_normal(rows: Sequence[Mapping]) -> list[Mapping]:
     trends, not one."""
     from ..scene.combine import normal_families
 
-    plain = [r for r in rows if r.get("direction") in ACROSS_ALONG or r.get("normal_angle_deg") is None]
+    plain = [r for r in rows if r.get("direction") in AXIS_DIRECTIONS or r.get("normal_angle_deg") is None]
     out = list(plain)
     rest: dict[tuple, list[Mapping]] = {}
     for row in rows:

@@ -10,7 +10,7 @@ from ..kinds import KINDS, get_kind
 from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
-from .options import FiniteFloat, length_option, parse_rois, reading_options
+from .options import FiniteFloat, length_option, parse_rois, read_roi_file, reading_options, roi_file_option
 from .tables import print_fit
 
 #: the kinds fit takes: those of the 1-D pipeline (points have their own)
@@ -47,6 +47,7 @@ EDGE_ONLY = {
 @click.option("--roi", multiple=True, callback=parse_rois, metavar="X,Y,W,H",
               help="X,Y,W,H window in pixels: once for every file, or once per file in their order (a file "
                    "named again with another window gives another edge; default: the whole image)")
+@roi_file_option
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--force", is_flag=True,
               help="measure an edge even where a quality check fails (fill, saturation, non-uniform "
@@ -60,8 +61,9 @@ EDGE_ONLY = {
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
               help="figure of measured against model MTF per edge, residuals and the fitted PSF (PNG)")
 @campaign_options
-def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, recursive, force, saturation,
-        transfer, confidence, out_path, fmt, plot_path, campaign, acquired, platform, instrument, band_name):
+def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, roi_file, recursive, force,
+        saturation, transfer, confidence, out_path, fmt, plot_path, campaign, acquired, platform, instrument,
+        band_name):
     """Fit the sensor's stages to the edges of one or more images (one edge
     each; across- and along-track edges together constrain both axes), and
     read the MTF in every direction off the fitted model.  With
@@ -78,6 +80,8 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
     bar measured as imgmtf measure does; --pulse-width and --gap as for
     measure."""
     if get_kind(kind).has_width:
+        if roi_file:
+            raise click.UsageError("--roi-file gives the windows of edges: fit bars with --roi X,Y,W,H")
         _fit_bars(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, force, saturation,
                   transfer, confidence, out_path, fmt, given={"plot_path": plot_path, "campaign": campaign})
         return
@@ -100,6 +104,13 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
             raise click.UsageError(f"--roi given {len(roi)} times for {len(files)} file(s): give it once for "
                                    "every file, or once per file")
         rois = roi[0] if len(roi) == 1 else (list(roi) if roi else None)
+        features: dict[str, dict] = {}
+        if roi_file:            # every file's edge in each feature's window, its attributes in its record
+            if roi:
+                raise click.UsageError("give --roi or --roi-file, not both")
+            from ..sensor_fit import feature_edges
+            files, rois, fields = feature_edges(files, read_roi_file(roi_file), band)
+            features = dict(zip(edge_sources(files, rois), fields))
         if plot_path:
             check_figure_file(plot_path)
         if out_path:
@@ -128,14 +139,16 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
             written.append(plot_path)
         if store:
             settings = {"command": "fit", "stages": stages, "sensor": sensor_path, "hold": hold, "gsd_m": gsd,
-                        "band": band, "roi": rois, "confidence": confidence, "force": force, "transfer": transfer,
-                        "saturation": saturation}
+                        "band": band, "roi": roi_file or rois, "confidence": confidence, "force": force,
+                        "transfer": transfer, "saturation": saturation}
             store.add_fit(files, result, settings, band=band, plot=plot_path)
             store.summary()
     if fmt == "json":
         from ..records import json_safe
         # NaN as null, no -0.0: as measure's and scan's JSON
-        click.echo(json.dumps(json_safe({**result.to_dict(), "written": written})))
+        out = result.to_dict()
+        out["edges"] = [{**edge, **features.get(edge["path"], {})} for edge in out["edges"]]
+        click.echo(json.dumps(json_safe({**out, "written": written})))
         return
     print_fit(result)
     for path in written:

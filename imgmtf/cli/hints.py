@@ -42,6 +42,7 @@ HINTS = (
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
+    Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),

@@ -18,10 +18,13 @@ from .options import (
     interval_options,
     interval_settings,
     length_option,
+    optical_centre_option,
     parallel_options,
     parse_band,
     parse_roi,
+    read_roi_file,
     reading_options,
+    roi_file_option,
     width_refusal,
 )
 from .tables import TextRows
@@ -50,6 +53,8 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--method", cls=MethodOption)
 @click.option("--roi", callback=parse_roi,
               help="X,Y,W,H window in pixels (only it is read; needed for images over 16 Mpx)")
+@roi_file_option
+@optical_centre_option
 @click.option("--band", callback=parse_band,
               help="1-based band, or 'all' for one result per band "
                    "(default: the only band, or the luminance of RGB)")
@@ -65,14 +70,16 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @reading_options
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
-                   "rows along track, as in L0/L1 products; unknown for map-projected files)")
+                   "rows along track for a file with a pixel size in metres, as L1 products; unknown for "
+                   "map-projected files; for an image with no georeference, a photo or an L0 product, its own "
+                   "axes: horizontal, vertical; 0 says its rows are along track)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
 @parallel_options
 @campaign_options
-def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, csv_path, plot_path, plot_dir, recursive,
-            force, saturation, track_azimuth, transfer, progress, interval_method, replicates, confidence,
-            workers, scheduler, campaign, acquired, platform, instrument, band_name):
+def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, optical_centre, band, fmt, csv_path,
+            plot_path, plot_dir, recursive, force, saturation, track_azimuth, transfer, progress, interval_method,
+            replicates, confidence, workers, scheduler, campaign, acquired, platform, instrument, band_name):
     """Measure the MTF of the edge (or bar) in each image file, or in every
     image of a folder; with --target points, the 2-D PSF and MTF of the
     point targets on it, one row across and one along track.  With --format json, one JSON object per line (JSON
@@ -84,6 +91,8 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, c
     the store with its chip's row as it completes."""
     if plot_path and plot_dir:
         raise click.UsageError("give --plot or --plot-dir, not both")
+    if roi and roi_file:
+        raise click.UsageError("give --roi or --roi-file, not both")
     if pulse_width and not get_kind(kind).has_width:
         raise click.UsageError(width_refusal())
     if point_size and get_kind(kind).size_keyword is None:
@@ -104,11 +113,12 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, c
         from ..batch import expand_inputs, measure_files, once_each
         from ..measure_settings import MeasureSettings
         from ..records import CsvWriter, JsonLinesWriter, utc_now
+        rois = read_roi_file(roi_file) or roi       # once, before any image: its errors are an input's (exit 1)
         with option_errors():
-            settings = MeasureSettings(kind, method, band, roi, pulse_width,
+            settings = MeasureSettings(kind, method, band, rois, pulse_width,
                                        interval_settings(interval_method, replicates, confidence), force=force,
                                        saturation=saturation, track_azimuth_deg=track_azimuth, transfer=transfer,
-                                       point_size=point_size, gap=gap)
+                                       point_size=point_size, gap=gap, optical_centre=optical_centre)
         files, repeated = once_each(expand_inputs(paths, recursive))
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
@@ -126,7 +136,8 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, c
                                       band_name=band_name, run_utc=run_utc)
         if store:
             from ..records import json_safe
-            campaign_settings = {"command": "measure", **json_safe(asdict(settings))}
+            campaign_settings = {"command": "measure", **json_safe(asdict(settings)),
+                                 "roi": settings.params()["roi"]}     # a vector file by its name
         if plot_path:
             from ..batch import measure_file
             completed = iter([(0, measure_file(files[0], settings, plot_path, run_utc=run_utc))])
@@ -151,8 +162,11 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, c
                             for writer in writers:
                                 writer.write(record)
                             counts["ok" if record.ok else "error"] += 1
-                            if store and record.ok:
-                                store.add(record.path, record.band, campaign_settings, edges=[record])
+                    if store:       # a file's (and band's) chips are one acquisition: its features together
+                        for path, band_read in dict.fromkeys((r.path, r.band) for r in batch if r.ok):
+                            with signals_deferred():
+                                store.add(path, band_read, campaign_settings,
+                                          edges=[r for r in batch if r.ok and (r.path, r.band) == (path, band_read)])
             try:
                 with closing(completed):
                     for index, batch in completed:
@@ -172,3 +186,4 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, band, fmt, c
         click.echo(f"{counts['ok']} measured, {counts['error']} failed"
                    + (f"; summary in {csv_path}" if csv_path else ""), err=True)
     sys.exit(1 if counts["error"] else 0)
+

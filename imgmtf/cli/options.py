@@ -166,6 +166,46 @@ def parse_rois(ctx, param, values):
     return tuple(parse_roi(ctx, param, v) for v in values or ())
 
 
+def roi_file_option(command):
+    """--roi-file: the polygons or lines of a vector layer as ROIs, shared
+    by measure, scan and fit (the same words in each one's help)."""
+    return click.option("--roi-file", type=click.Path(), metavar="FILE",
+                        help="ROIs from a vector layer (shapefile, GeoJSON, GeoPackage, KML...: any format GDAL "
+                             "reads): each polygon's bounds, or each line widened by 12 px either side, "
+                             "reprojected onto the image; one measurement per feature, its attributes in the "
+                             "record")(command)
+
+
+def parse_optical_centre(ctx, param, value):
+    """Click callback: "X,Y" (px) or "centre" (:func:`imgmtf.estimate.field.parse_centre`)."""
+    if value is None:
+        return None
+    from ..errors import ParameterError
+    from ..estimate.field import parse_centre
+    try:
+        return parse_centre(value)
+    except ParameterError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def optical_centre_option(command):
+    """--optical-centre: sagittal and meridional edges, shared by measure and scan."""
+    return click.option("--optical-centre", callback=parse_optical_centre, metavar="X,Y|centre",
+                        help="a lens's optical centre, px (pixel centres at integers), or 'centre' for the "
+                             "image's: each edge is said sagittal or meridional (its normal across or along "
+                             "the radius from it, as MTF Mapper reports them) with its distance from it")(command)
+
+
+def read_roi_file(path: str | None):
+    """The features of --roi-file (None without it), read once before any
+    image: a missing or unreadable file, or a layer without a CRS, is an
+    input's error (exit 1, one line naming the file)."""
+    if path is None:
+        return None
+    from ..vectors import VectorROIs
+    return VectorROIs.read(path)
+
+
 def parse_band(ctx, param, value):
     if value is None or value.lower() == "all":
         return value and "all"

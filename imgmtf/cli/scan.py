@@ -16,8 +16,11 @@ from .options import (
     interval_options,
     interval_settings,
     length_option,
+    optical_centre_option,
     parallel_options,
     parse_pair,
+    read_roi_file,
+    roi_file_option,
     width_refusal,
 )
 from .tables import print_scan
@@ -51,7 +54,14 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
               help="DN range the sensor records (default: an integer file's type range)")
 @click.option("--track-azimuth", "track_azimuth", type=FiniteFloat(-360, 360), metavar="DEG",
               help="the ground track's direction in the image, degrees clockwise from up (default: "
-                   "rows along track for a scene in sensor geometry; unknown for a map-projected one)")
+                   "rows along track for a scene in sensor geometry with a pixel size in metres; unknown for a "
+                   "map-projected one; for an image with no georeference, a photo or an L0 product, its own "
+                   "axes: horizontal, vertical; 0 says its rows are along track)")
+@roi_file_option
+@optical_centre_option
+@click.option("--lens-frequencies", metavar="F1,F2,...", default="0.125,0.25", show_default=True,
+              help="with --optical-centre: the frequencies (cy/px) the lens profile reads the MTF at, beside "
+                   "MTF50, against the distance from the centre")
 @click.option("--fit-stages", default=DEFAULT_STAGES, show_default=True, metavar="STAGES",
               help="the sensor model's stages fitted to each target's half-edges for its across- and "
                    "along-track MTF (imgmtf fit's names, comma-separated); 'auto' for the simplest of "
@@ -81,8 +91,9 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         fit_stages, recursive, out_dir, edge_figures, store, acquired, platform, instrument, band_name, fmt,
-         verbose, progress, interval_method, replicates, confidence, workers, scheduler):
+         roi_file, optical_centre, lens_frequencies, fit_stages, recursive, out_dir, edge_figures, store, acquired,
+         platform, instrument, band_name, fmt, verbose, progress, interval_method, replicates, confidence, workers,
+         scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
@@ -120,12 +131,14 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         from ..parallel import prestart_workers
         from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
+        rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
         with option_errors():           # a malformed option: exit 2, before any work
             stages = _stages(fit_stages)
             settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
                                     pulse_width=pulse_width, saturation=saturation,
-                                    track_azimuth_deg=track_azimuth,
+                                    track_azimuth_deg=track_azimuth, roi=rois, optical_centre=optical_centre,
                                     intervals=interval_settings(interval_method, replicates, confidence))
+            frequencies = _frequencies(lens_frequencies) if optical_centre is not None else None
             if acquired is not None:
                 from ..campaign.acquisitions import parse_time
                 parse_time(acquired, "--acquired")
@@ -156,6 +169,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                     outcomes.append(outcome)
                     # (scan_scenes yields each outcome with Ctrl-C held back until it is reported)
                     _report(outcome, kind, band, folders.get(outcome.path), fmt, verbose)
+                    if frequencies and fmt == "text" and not outcome.error:
+                        _lens_profile(outcome, frequencies, folders.get(outcome.path))
         except KeyboardInterrupt as exc:
             interrupted = exc
     _closing_notes(outcomes, paths, store, kind, fmt)
@@ -188,6 +203,38 @@ def _stages(text: str) -> str | None:
         raise ParameterError(f"--fit-stages: unknown stage {unknown[0] if unknown else text!r}; known: "
                              f"{', '.join(STAGES)}, or auto, or none")
     return ",".join(names)
+
+
+def _frequencies(text: str) -> tuple[float, ...]:
+    """--lens-frequencies: cy/px, each in (0, 1]."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise ParameterError(f"--lens-frequencies: expected numbers F1,F2,... (cy/px), got {text!r}") from None
+    if not values or not all(0.0 < v <= 1.0 for v in values):
+        raise ParameterError(f"--lens-frequencies: each frequency must lie in (0, 1] cy/px, got {text!r}")
+    return values
+
+
+def _lens_profile(outcome, frequencies, folder) -> None:
+    """The scene's lens profile printed (and with --out, its table and figure written)."""
+    from ..scene.lens_profile import lens_profile, write_lens_profile
+    from .tables import print_lens_profile
+    try:
+        profile = lens_profile(outcome.records, frequencies)
+    except ParameterError as exc:
+        click.echo(f"imgmtf: note: {outcome.path}: no lens profile: {exc}", err=True)
+        return
+    written = []
+    if folder:
+        from ..plot import plot_lens_profile
+        from .files import save_figure
+        written.append(write_lens_profile(profile, str(Path(folder) / "lens_profile.csv")))
+        save_figure(plot_lens_profile(profile, title=Path(outcome.path).name), str(Path(folder) / "lens_profile.png"))
+        written.append(str(Path(folder) / "lens_profile.png"))
+    print_lens_profile(profile)
+    for path in written:
+        click.echo(f"wrote {path}")
 
 
 def _report(outcome, kind, band, folder, fmt, verbose) -> None:

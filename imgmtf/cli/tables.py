@@ -38,9 +38,10 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
         band = record["band"]
         first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
     indent = " " * len(first)
+    feature = feature_line(record, indent)
     if record["status"] == "error":
         hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
-        return f"{first} error: {record['error']}{hint}"
+        return f"{first} error: {record['error']}{hint}" + (f"\n{feature}" if feature else "")
     last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
@@ -51,6 +52,11 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
              f"{snr_cell(record.get('snr'))} {num_cell(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
              f"{num_cell(record.get('mtf50_cy_px'), 7, 4)} {num_cell(record.get('fwhm_px'), 6, 3)} "
              f"{num_cell(last, 6, 0 if isinstance(last, int) else 3)}"]
+    if feature:
+        cells.append(feature)
+    if record.get("radial_distance_px") is not None:
+        cells.append(f"{indent} {record.get('field_direction') or 'at the optical centre'}, "
+                     f"{record['radial_distance_px']:g} px from the optical centre")
     if record.get("gsd_m"):
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
@@ -58,6 +64,17 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
         cells.append(f"{indent} error: {record['error']}")
     cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def feature_line(record: dict, indent: str) -> str:
+    """The vector feature a row measured (--roi-file): its id, window and
+    attributes; '' for a row of no feature."""
+    if record.get("feature_id") is None:
+        return ""
+    attributes = ", ".join(f"{k}={v}" for k, v in (record.get("feature") or {}).items())
+    window = record.get("feature_window_px")
+    where = f" (x {window[0]}, y {window[1]}, {window[2]} x {window[3]} px)" if window else ""
+    return f"{indent} feature {record['feature_id']}{where}" + (f": {attributes}" if attributes else "")
 
 
 def ground_cell(value) -> str:
@@ -85,8 +102,9 @@ def num_cell(value, width: int, decimals: int) -> str:
 
 def print_fit(result) -> None:
     edges = result.edges
+    scale = "no GSD: lengths in px" if result.pixel_units else f"GSD {result.sensor.gsd_m:g} m"
     click.echo(f"fit of {', '.join(s.name for s in result.sensor.stages)} to {len(edges)} edge(s), "
-               f"GSD {result.sensor.gsd_m:g} m; reduced chi-square {result.reduced_chi_square:.3g}")
+               f"{scale}; reduced chi-square {result.reduced_chi_square:.3g}")
     if result.choice is not None:
         tried = "; ".join(f"{'+'.join(c.stages)}: BIC {c.bic:.0f}{', misfit' if c.misfit else ''}"
                           for c in result.choice.candidates)
@@ -102,16 +120,19 @@ def print_fit(result) -> None:
     pct = f"{100 * result.confidence:g}%"
     click.echo(f"{'edge':<32} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
+    axes = {"across": "x", "along": "y"} if result.pixel_units else {}
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
         click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {SHORT_DIRECTIONS.get(e.direction, e.direction):>7} "
-                   f"{e.constrains:>6} {e.mtf_nyquist:7.4f} "
+                   f"{axes.get(e.constrains, e.constrains):>6} "
+                   f"{e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")
     click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
+    names = {"across": "horizontal", "along": "vertical"} if result.pixel_units else {}
     for name, d in result.directions.items():
         lo, hi = d["mtf_nyquist_ci"]
-        click.echo(f"{name:<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
+        click.echo(f"{names.get(name, name):<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
                    f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
     for warning in result.warnings:
         click.echo(f"warning: {warning}")
@@ -130,6 +151,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
                f"{accepted} accepted")
+    print_features(records, kind)
     shown = records if verbose else [r for r in records if r.ok]
     if shown:
         click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
@@ -175,11 +197,43 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
         click.echo(f"wrote {path}")
 
 
+def print_features(records, kind: str) -> None:
+    """With --roi-file: per feature, its attributes and how many of its
+    candidates were accepted (the scan measured only those crossing one)."""
+    counts: dict[str, list] = {}
+    for record in records:
+        fid = record.site.get("feature_id")
+        if fid is not None:
+            entry = counts.setdefault(fid, [record.site.get("feature") or {}, 0, 0,
+                                            record.site.get("feature_window_px")])
+            entry[1] += 1
+            entry[2] += record.ok
+    for fid, (attributes, found, accepted, window) in counts.items():
+        shown = ", ".join(f"{k}={v}" for k, v in attributes.items())
+        where = f" (x {window[0]}, y {window[1]}, {window[2]} x {window[3]} px)" if window else ""
+        click.echo(f"  feature {fid}{where}{f' [{shown}]' if shown else ''}: {plural(found, f'candidate {kind}')} "
+                   f"crossing it, {accepted} accepted")
+
+
+def print_lens_profile(profile) -> None:
+    """A lens profile's rings: per direction and ring, its edges' median
+    MTF50 and MTF at the profile's frequencies."""
+    x, y = profile.centre_px
+    click.echo(f"lens profile about the optical centre ({x:g}, {y:g}) px: medians per ring of the field")
+    heads = "".join(f" {f'MTF@{f:g}':>9}" for f in profile.frequencies_cy_px)
+    click.echo(f"{'direction':<10} {'ring px':>11} {'edges':>5} {'MTF50':>7}{heads}")
+    click.echo(f"{'':<10} {'':>11} {'':>5} {'cy/px':>7}" + "".join(f" {'':>9}" for _ in profile.frequencies_cy_px))
+    for ring in profile.rings:
+        cells = "".join(f" {num_cell(v, 9, 4)}" for v in ring.mtf)
+        click.echo(f"{ring.field_direction:<10} {f'{ring.inner_px:.0f}-{ring.outer_px:.0f}':>11} {ring.n_edges:>5} "
+                   f"{num_cell(ring.mtf50_cy_px, 7, 4)}{cells}")
+
+
 def print_target_fits(fitted) -> None:
     """The sensor model fitted to each target's half-edges, across and along
     track, and why a fit is not to be trusted (its misfit) or failed."""
     stages: list[str] = next((r.figures["stages"] for r in fitted if r.figures.get("stages")), [])
-    click.echo(f"fitted per target, across and along track (sensor model: {', '.join(stages) or '-'}; "
+    click.echo(f"fitted per target, {axes_words(fitted)} (sensor model: {', '.join(stages) or '-'}; "
                "misfit p: the smallest p-value of structure in its half-edges' residuals):")
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
@@ -210,7 +264,7 @@ def print_target_fits(fitted) -> None:
 def print_sections(sections) -> None:
     """The 2-D MTF's across- and along-track sections from each target's
     combined directions, under each assumption, and why the chosen one."""
-    click.echo("across and along track without a model (the 2-D MTF's sections from the combined directions, "
+    click.echo(f"{axes_words(sections)} without a model (the 2-D MTF's sections from the combined directions, "
                "under each assumption):")
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'assumption':>10} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6}")
@@ -223,9 +277,18 @@ def print_sections(sections) -> None:
                    f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
                    f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
                    f"{num_cell(r.get('fwhm_px'), 6, 3)}")
-        if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] == "along-track":
+        if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] in ("along-track",
+                                                                                                     "vertical"):
             said.add(key)
             click.echo(f"{'':>11} {r['chosen_assumption']}: {r.get('assumption_because')}")
+
+
+def axes_words(rows) -> str:
+    """How a scan's summaries name their two directions: the image's axes
+    for a camera's image (horizontal, vertical), else the track's."""
+    if any(r.figures.get("direction") in ("horizontal", "vertical") for r in rows):
+        return "horizontal and vertical"
+    return "across and along track"
 
 
 def print_recommended(rows) -> None:
@@ -234,7 +297,8 @@ def print_recommended(rows) -> None:
     if not any(r.figures.get("recommended") is not None for r in rows):
         return
     if any(r.figures.get("recommended") for r in rows):
-        click.echo("* the across/along row to quote per target and direction: the model's fit when it fits and "
+        pair = "horizontal/vertical" if axes_words(rows).startswith("horizontal") else "across/along"
+        click.echo(f"* the {pair} row to quote per target and direction: the model's fit when it fits and "
                    "agrees with the sections, else the sections' assumption")
     directions: dict[tuple, list] = {}
     for r in rows:
@@ -251,7 +315,7 @@ def _mark(row: dict) -> str:
     return "*" if row.get("recommended") else " "
 
 
-SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along"}
+SHORT_DIRECTIONS = {"across-track": "across", "along-track": "along", "horizontal": "horiz", "vertical": "vert"}
 
 MAX_EXAMPLE_IDS = 5
 

@@ -189,6 +189,26 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry,
 DIRECTION_TOLERANCE_DEG = 10.0
 
 
+#: the directions of an image with no georeference and no track information (a camera's photo): its
+#: own axes, which rows along track would call across and along track (the normal along x is
+#: "horizontal": the MTF across the image's columns, from a near-vertical edge)
+IMAGE_AXES = {"across-track": "horizontal", "along-track": "vertical"}
+#: the directions named by an axis (of the track or of the image), not by a normal's angle
+AXIS_DIRECTIONS = (*IMAGE_AXES, *IMAGE_AXES.values())
+
+
+def image_axis_label(label: str) -> str:
+    """A direction measured with rows taken along track, named by the
+    image's axes instead ("horizontal", "vertical"; "oblique" stays).
+
+    Examples
+    --------
+    >>> image_axis_label(direction_label(5.0, 0.0)), image_axis_label("oblique")
+    ('horizontal', 'oblique')
+    """
+    return IMAGE_AXES.get(label, label)
+
+
 def direction_label(normal_angle_deg: float, track_azimuth_deg: float | None) -> str:
     """"along-track" when the normal lies within 10 deg of the ground
     track, "across-track" within 10 deg of its perpendicular, "oblique"

@@ -277,7 +277,7 @@ def plot_fit(fit: SensorFit, max_edges: int = 6,
     for i in range(shown):
         plot_fit_edge(fit, i, axes[i], truth=truths[i])
     plot_fit_residuals(fit, axes[shown])
-    plot_psf(fit.sensor, axes[shown + 1])
+    plot_psf(fit.sensor, axes[shown + 1], pixel_units=fit.pixel_units)
     axes[shown + 1].set_title("Fitted system PSF (peak = 1)")
     for ax in axes[panels:]:
         ax.set_visible(False)

@@ -19,7 +19,8 @@ def _view_radius_m(sensor: Sensor) -> float:
     return 1.5 * max(sensor.fwhm_m("across"), sensor.fwhm_m("along"), sensor.gsd_m)
 
 
-def plot_psf(sensor: Sensor, ax: Axes | None = None, oversampling: int = 20) -> Figure | SubFigure:
+def plot_psf(sensor: Sensor, ax: Axes | None = None, oversampling: int = 20,
+             pixel_units: bool = False) -> Figure | SubFigure:
     """The system PSF image (paper Fig. 2a), axes in metres, its core and
     shoulders shown in a square of 3 FWHM.
 
@@ -31,6 +32,10 @@ def plot_psf(sensor: Sensor, ax: Axes | None = None, oversampling: int = 20) -> 
         The axes to draw on (default a new figure's).
     oversampling : int, optional
         PSF samples per GSD in each axis (default 20).
+    pixel_units : bool, optional
+        The sensor's GSD is a pixel, not a length on the ground (a camera's
+        fit, no GSD known): axes "x (px)", "y (px)" (default: across and
+        along track, m).
 
     Returns
     -------
@@ -56,8 +61,8 @@ def plot_psf(sensor: Sensor, ax: Axes | None = None, oversampling: int = 20) -> 
     image = ax.imshow(psf.data / psf.data.max(), extent=(-half, half, half, -half), cmap="magma",
                       interpolation="nearest")
     r = _view_radius_m(sensor)
-    ax.set(xlim=(-r, r), ylim=(r, -r), title="System PSF (peak = 1)", xlabel="across track x (m)",
-           ylabel="along track y (m)")
+    names = ("x (px)", "y (px)") if pixel_units else ("across track x (m)", "along track y (m)")
+    ax.set(xlim=(-r, r), ylim=(r, -r), title="System PSF (peak = 1)", xlabel=names[0], ylabel=names[1])
     fig.colorbar(image, ax=ax, shrink=0.8)
     return fig
 

@@ -28,6 +28,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..atomic import ensure_folder
 from ..errors import ImageContentError, ParameterError
+from ..estimate.field import field_position, resolve_centre
 from ..estimate.geometry import direction_label
 from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
@@ -36,6 +37,7 @@ from ..parallel import run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments
+from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
@@ -60,6 +62,13 @@ def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
     if settings.track_azimuth_deg is not None:
         return settings.track_azimuth_deg
     return None if info.crs else 0.0
+
+
+def in_image_axes(info: RasterInfo, settings: ScanSettings) -> bool:
+    """Whether the scene's directions are named by its own axes
+    (horizontal, vertical): no CRS, no pixel size and no track azimuth
+    given (a camera's photo), as :func:`imgmtf.batch.in_image_axes`."""
+    return settings.track_azimuth_deg is None and not info.crs and info.gsd_m is None
 
 
 # -- the scan -------------------------------------------------------------------------
@@ -139,6 +148,11 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     context = Context(path, info, settings, track, params, run_utc, figures_dir)
     candidates = [(half, verdict or fill_screen(half.fill_fraction) or geometry_screen(half, settings))
                   for half, verdict in _candidates(halves, settings)]
+    features: list = [None] * len(candidates)
+    if settings.roi is not None:        # a vector layer's sites: only the candidates crossing one of them
+        owners = crossing(segment_rows([half.segment for half, _ in candidates]), placed_windows(settings.roi, info))
+        candidates = [c for c, owner in zip(candidates, owners) if owner is not None]
+        features = [owner for owner in owners if owner is not None]
     unscreened = [i for i, (_, verdict) in enumerate(candidates) if verdict is None]
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
@@ -146,13 +160,20 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     records: list[Record] = []
     plans: list[Plan] = []
     rounded = _rounded_ends([half.segment for half, _ in candidates])
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
     mapped = _map_ends([half.segment for half, _ in candidates], info)
     for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
         verdict = verdict or _beside_screen(half, clearance)
         if not verdict:
             partners = segment_rows(half.partners)
             plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
-        records.append(_candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict))
+        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
+        if features[k] is not None:
+            record = record.with_(site=features[k].record_fields())
+        if centre is not None:          # where the candidate lies in a lens's field
+            s = half.segment
+            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
+        records.append(record)
     batches = _batches(plans, info, settings.tile_px)
     halves = [half for half, _ in candidates]
 

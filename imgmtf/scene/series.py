@@ -177,8 +177,9 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
     ``overview`` figure (an absolute path) when one is to be written; an outcome
     with the error when the scene cannot be scanned, ``interrupted`` with
     the records so far on Ctrl-C."""
+    from ..io import raster_info
     from .combine import summarise_scan
-    from .measure import scan_scene
+    from .measure import in_image_axes, scan_scene
     from .sections import recommend, section_rows
     from .targetfit import fit_targets
     try:
@@ -202,11 +203,23 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         if get_kind(settings.target).fits_sensor and stages:
             summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
         summaries = recommend(summaries)
+        if in_image_axes(raster_info(path), settings):
+            records, summaries = _image_axes(records), _image_axes(summaries)
     except ImgmtfError as exc:
         message = " ".join(str(exc).split())
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
                             reason=exc.reason)
     return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
+
+
+def _image_axes(records) -> list[Record]:
+    """Records whose directions, worked out with rows along track, are
+    named by the image's axes (horizontal, vertical): the same directions."""
+    from ..estimate.geometry import image_axis_label
+
+    def named(fields):
+        return {"direction": image_axis_label(fields["direction"])} if "direction" in fields else {}
+    return [r.with_(figures=named(r.figures), site=named(r.site)) for r in records]
 
 
 def _reported(records) -> tuple[Record, ...]:

@@ -4,9 +4,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..errors import ParameterError
+from ..estimate.field import parse_centre
 from ..estimate.intervals import Intervals, as_intervals
 from ..inputs import check_number, parse_length
 from ..measure_settings import MeasureSettings
+from ..vectors import VectorROIs, as_rois
 
 MIN_TILE_PX = 256
 MAX_TILE_PX = 2048      # a batch of candidates reads its tile and their ROIs beyond it: well under one read's limit
@@ -47,8 +49,21 @@ class ScanSettings:
         range).
     track_azimuth_deg : float, optional
         The ground track's direction, degrees clockwise from up; without
-        it, a scene in sensor geometry has its rows along track and a
-        map-projected one (with a CRS) an unknown direction.
+        it, a scene in sensor geometry has its rows along track, a
+        map-projected one (with a CRS) an unknown direction, and one with
+        no georeference (no CRS, no pixel size: a photo) its own axes
+        ("horizontal", "vertical").
+    roi : VectorROIs, str or os.PathLike, optional
+        A vector layer (:class:`imgmtf.vectors.VectorROIs`, or a file any
+        GDAL vector driver reads): only the candidates that cross one of
+        its features' windows on the scene are measured, each carrying
+        that feature's id and attributes (``feature_id``, ``feature``).
+    optical_centre : (float, float) or str, optional
+        A lens's optical centre (x, y), px, or ``"centre"`` for the
+        scene's: each candidate is then placed in the field (its distance
+        from the centre, sagittal or meridional:
+        :func:`imgmtf.estimate.field.field_position`), what a lens profile
+        (:func:`imgmtf.scene.lens_profile.lens_profile`) reads.
 
     Raises
     ------
@@ -72,9 +87,18 @@ class ScanSettings:
     intervals: Intervals = field(default_factory=Intervals)
     saturation: tuple[float, float] | None = None
     track_azimuth_deg: float | None = None
+    roi: VectorROIs | None = None
+    optical_centre: tuple[float, float] | str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
+        object.__setattr__(self, "roi", as_rois(self.roi))                      # a vector file, read once
+        if self.optical_centre is not None:
+            centre = self.optical_centre
+            object.__setattr__(self, "optical_centre", parse_centre(centre if isinstance(centre, str)
+                                                                    else ",".join(map(str, centre))))
+        if self.roi is not None and not isinstance(self.roi, VectorROIs):
+            raise ParameterError(f"a scan's roi is a vector layer (its file or a VectorROIs), got {self.roi!r}")
         if self.pulse_width is not None:
             object.__setattr__(self, "pulse_width", parse_length(self.pulse_width))     # "1.5m", as --pulse-width
         for name in ("min_length_px", "max_length_px"):
@@ -104,4 +128,6 @@ class ScanSettings:
     def as_dict(self) -> dict:
         """The scan's own settings, as records carry them."""
         return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
-                "margin_px": self.margin_px, "tile_px": self.tile_px}
+                "margin_px": self.margin_px, "tile_px": self.tile_px,
+                **({"roi_file": self.roi.source} if self.roi is not None else {}),
+                **({"optical_centre": self.optical_centre} if self.optical_centre is not None else {})}

@@ -196,6 +196,11 @@ class SensorFit:
     choice : ModelChoice or None
         With ``stages="auto"``: the candidate stage sets fitted, their
         information criterion and verdicts, and why this one was kept.
+    pixel_units : bool
+        True when no input had a GSD (a camera's images): lengths are in
+        px (the model's metres at a 1 m GSD) and directions the image's
+        axes, "horizontal" (across its columns: ``directions["across"]``)
+        and "vertical" (``directions["along"]``).
 
     Examples
     --------
@@ -218,6 +223,7 @@ class SensorFit:
     _u: np.ndarray = field(repr=False)
     _covariance: np.ndarray = field(repr=False)
     choice: ModelChoice | None = None
+    pixel_units: bool = False
 
     @property
     def misfit(self) -> bool:
@@ -278,6 +284,9 @@ class SensorFit:
         from ...version import __version__
         return {"imgmtf_version": __version__, "method": "fit",
                 "stages": [s.name for s in self.sensor.stages], "gsd_m": self.sensor.gsd_m,
+                "length_unit": "px" if self.pixel_units else "m",
+                "direction_names": (dict(zip(("across", "along"), ("horizontal", "vertical"))) if self.pixel_units
+                                    else {"across": "across-track", "along": "along-track"}),
                 "confidence": self.confidence, "reduced_chi_square": self.reduced_chi_square,
                 "misfit": self.misfit,
                 "parameters": [p.to_dict() for p in self.parameters],
