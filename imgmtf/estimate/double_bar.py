@@ -161,9 +161,21 @@ class DoubleBarResult(MTFResult):
                 "peak_dn": finite(self.peak_dn), "model_figures": list(self.model_figures)}
 
     def to_dict(self, curves: bool = True) -> dict:
-        """As :meth:`MTFResult.to_dict`; with ``curves`` and a fitted model,
-        also the model's MTF on the same frequencies and its band
-        (``model_mtf``, ``model_mtf_ci``), apart from the measured ``mtf``."""
+        """JSON-ready summary, as :meth:`MTFResult.to_dict`; with ``curves``
+        and a fitted model, also the model's MTF on the same frequencies and
+        its band (``model_mtf``, ``model_mtf_ci``), apart from the measured
+        ``mtf``.
+
+        Parameters
+        ----------
+        curves : bool, optional
+            Add the curves (default True).
+
+        Returns
+        -------
+        dict
+            The record's figures (units in the names).
+        """
         out = super().to_dict(curves)
         if curves and self.model_mtf is not None:
             out.update(self.model_mtf.to_dict())
