@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: the reason code of a bar refused as two (the double-bar kind's name too: the kind that measures it)
+PAIR_REASON = "double-bar"
 #: a dip between two peaks counts when it falls below this share of the lower
 #: peak (a sharpened wide bar's overshoots at its sides dip to 0.85-0.9 of them;
 #: two 0.6 px bars 1.2 px apart through sigma 0.39 px + pixel to 0.47)

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
-from .bar_pair import pair_in_profile
+from .bar_pair import PAIR_REASON, pair_in_profile
 from .phase import without_phase_bias
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
@@ -371,7 +371,7 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None, grid: n
     if wanted == STEP_PROFILE and values is not None and grid is not None:
         pair = pair_in_profile(grid, values, noise_dn)
         if pair is not None:
-            return Check("double-bar", False, pair.message("an edge"))
+            return Check(PAIR_REASON, False, pair.message("an edge"))
     return Check(reason, False, message)
 
 

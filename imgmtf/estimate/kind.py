@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import UnsuitableTargetError
 from ..kinds import Kind
 from . import gate
+from .bar_pair import PAIR_REASON
 from .detection import Line
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
 from .intervals.width import WidthReading
@@ -162,7 +163,7 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
                 # whole pixels blur two close bars into one: their sub-pixel phases part them
                 grid, fine, noise_dn = seed_profile(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
                 pair = gate.kind_check(gate.classify_profile(mean), kind.profile, fine, grid, noise_dn)
-                check = pair if pair.reason == "double-bar" else check
+                check = pair if pair.reason == PAIR_REASON else check
             raise UnsuitableTargetError(check.message, reason=check.reason) from None
 
 
