@@ -34,6 +34,8 @@ _LAZY = {
     "DoubleBarResult": "estimate.double_bar",
     "measure_points": "estimate.mtf2d.points", "PointsResult": "estimate.mtf2d.points",
     "PointsEstimator": "estimate.mtf2d.estimator", "PointArray": "sensor.points", "render_points": "sensor.points",
+    "measure_star": "estimate.star.measure", "StarResult": "estimate.star.result",
+    "StarEstimator": "estimate.star.estimator", "SiemensStar": "sensor.star", "render_star": "sensor.star",
     "METHODS": "estimate.resampling", "resample_profile": "estimate.resampling",
     "Bootstrap": "estimate.intervals", "Interval": "estimate.intervals", "Intervals": "estimate.intervals",
     "fit_sensor": "sensor_fit", "fit_bar_files": "bar_fit",

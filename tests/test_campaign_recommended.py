@@ -43,6 +43,34 @@ def test_an_unnamed_platform_is_keyed_by_its_files_or_stands_alone():
     assert sensor_of({"acquisition_id": "0123456789abcdef"}) != sensor_of({"acquisition_id": "fedcba9876543210"})
 
 
+def image_row(acquisition, method, value, low, high, recommended=None, assumption=None):
+    return {"acquisition_id": acquisition, "scope": "scene", "target_id": None, "direction": "along-track",
+            "method": method, "assumption": assumption, "mtf_nyquist": value, "mtf_nyquist_ci_low": low,
+            "mtf_nyquist_ci_high": high, "recommended": recommended, "acquired_utc": "2024-01-01",
+            "platform": "Sim", "band_name": "pan"}
+
+
+def test_a_point_array_of_the_same_image_settles_the_edges_choice():
+    edges = [image_row("e", "sections", 0.150, 0.145, 0.155, 1, "separable"),
+             image_row("e", "sections", 0.132, 0.127, 0.137, 0, "elliptical")]
+    points = image_row("p", "points", 0.130, 0.124, 0.136)
+    marked = mark_recommended([*edges, points])
+    assert [r["recommended"] for r in marked] == [False, True, True]
+    assert marked[1]["recommended_because"].startswith("settled by a point array of the image")
+    assert "disagrees" in marked[0]["recommended_because"]
+    # agreeing: kept, and said so; another image (another time) is not judged by it
+    agreeing = mark_recommended([image_row("e", "sections", 0.131, 0.126, 0.136, 1, "separable"), points])
+    assert agreeing[0]["recommended"] and agreeing[0]["recommended_because"].endswith("agrees")
+    elsewhere = mark_recommended([edges[0], {**points, "acquired_utc": "2024-02-01"}])
+    assert elsewhere[0]["recommended"] and "point array" not in (elsewhere[0].get("recommended_because") or "")
+
+
+def test_edges_that_all_disagree_with_the_point_array_keep_their_row_and_say_so():
+    marked = mark_recommended([image_row("e", "fit", 0.160, 0.155, 0.165, 1),
+                               image_row("p", "points", 0.130, 0.124, 0.136)])
+    assert marked[0]["recommended"] and "disagrees at Nyquist" in marked[0]["recommended_because"]
+
+
 def test_a_photos_image_axes_are_directions_like_the_tracks():
     # a file with no georeference is told in its own axes: its rows are one direction each, whatever their normals
     rows = [row("fit", "horizontal", misfit=0), row("combined", "horizontal", normal_angle_deg=0.6),

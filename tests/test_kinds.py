@@ -17,6 +17,7 @@ from imgmtf.kinds.double_bar import DOUBLE_BAR
 from imgmtf.kinds.edge import EDGE
 from imgmtf.kinds.points import POINTS
 from imgmtf.kinds.pulse import PULSE
+from imgmtf.kinds.star import STAR
 from imgmtf.records import SUMMARY_COLUMNS
 
 PACKAGE = Path(imgmtf.__file__).parent
@@ -56,15 +57,16 @@ def test_no_module_outside_the_registry_compares_a_kind_name():
 
 
 def test_lookup_returns_the_registered_kinds_in_order():
-    assert kind_names() == ("edge", "pulse", "points", "double-bar")
+    assert kind_names() == ("edge", "pulse", "points", "double-bar", "star")
     assert get_kind("edge") is EDGE and get_kind("pulse") is PULSE and get_kind("points") is POINTS
+    assert get_kind("star") is STAR
     assert all(KINDS[name].name == name for name in KINDS)
     assert kinds_with_width() == (PULSE, DOUBLE_BAR)
 
 
-@pytest.mark.parametrize("name", ["star", "Edge", "", None, 3])
+@pytest.mark.parametrize("name", ["spoke", "Edge", "", None, 3])
 def test_an_unknown_kind_is_refused_naming_the_kinds_there_are(name):
-    kinds = r"\('edge', 'pulse', 'points', 'double-bar'\)"
+    kinds = r"\('edge', 'pulse', 'points', 'double-bar', 'star'\)"
     with pytest.raises(ParameterError, match=rf"target kind must be one of {kinds}, got ") as info:
         get_kind(name)
     assert isinstance(info.value, ValueError)
@@ -116,7 +118,9 @@ def test_each_kinds_column_is_in_its_measurement():
         gap = 2.0 if kind.gap_keyword else 0.0
         if kind.renderer is not None:
             from imgmtf.sensor.points import PointArray
-            chip = kind.load("renderer")(sensor, PointArray(2, 2), 60)
+            from imgmtf.sensor.star import SiemensStar
+            target = {POINTS: PointArray(2, 2), STAR: SiemensStar(cycles=24)}[kind]
+            chip = kind.load("renderer")(sensor, target, 60 if kind is POINTS else 81)
         else:
             chip = imgmtf.render(sensor, imgmtf.Target(kind.name, 6.0, width_px=width, gap_px=gap), 60)
         result = kind.make_estimator("msg", intervals=imgmtf.Intervals("none"))(
@@ -141,7 +145,8 @@ def test_the_registry_loads_nothing_numerical_and_nothing_above_it():
             "m in ('numpy', 'scipy', 'cv2', 'matplotlib')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert eval(out.stdout) == ["imgmtf", "imgmtf.errors", "imgmtf.kinds", "imgmtf.kinds.double_bar",
-                                "imgmtf.kinds.edge", "imgmtf.kinds.kind", "imgmtf.kinds.points", "imgmtf.kinds.pulse"]
+                                "imgmtf.kinds.edge", "imgmtf.kinds.kind", "imgmtf.kinds.points", "imgmtf.kinds.pulse",
+                                "imgmtf.kinds.star"]
 
 
 def test_the_facts_of_points():
@@ -157,3 +162,12 @@ def test_kind_is_a_frozen_record_of_facts():
     with pytest.raises(AttributeError):
         EDGE.name = "step"              # type: ignore[misc]
     assert isinstance(EDGE, Kind)
+
+
+def test_the_facts_of_a_star():
+    assert (STAR.noun, STAR.has_width, STAR.column.field) == ("star", False, "star_cycles")
+    assert STAR.measuring is None and STAR.scene_response is None and not STAR.fits_sensor
+    assert STAR.estimator_keywords(None, 1.0) == {} and STAR.lone_line[0] == "not-a-star"
+    assert "direction_deg" in STAR.record_fields and STAR.load("figure").__name__ == "plot_star"
+    with pytest.raises(ParameterError, match="a star target is no straight line"):
+        imgmtf.Target("star")

@@ -38,7 +38,7 @@ def test_pulse_width_px_converts_metres_with_the_gsd_and_checks_the_result():
 
 
 @pytest.mark.parametrize("options, words", [
-    (dict(target="star"), "target must be one of ('edge', 'pulse', 'points', 'double-bar'), got 'star'"),
+    (dict(target="spoke"), "target must be one of ('edge', 'pulse', 'points', 'double-bar', 'star'), got 'spoke'"),
     (dict(pulse_width="2px"), "a pulse width applies to pulse targets only"),
     (dict(target="pulse", pulse_width="-1px"), "width"),
     (dict(method="cubic"), "cubic"),

@@ -8,7 +8,7 @@ import pytest
 import imgmtf as im
 from imgmtf.errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from imgmtf.estimate.mtf2d import measure_points
-from imgmtf.sensor.points import PointArray, render_points
+from imgmtf.sensor.points import PointArray, quarter_pixel_offsets, render_points
 from imgmtf.sensor.stages import Detector, GaussianOptics
 
 SENSOR = im.Sensor(stages=[GaussianOptics(0.45, 0.55), Detector(1.0, 1.0)])
@@ -114,3 +114,18 @@ def test_a_flat_chip_has_no_target():
 def test_bad_settings_are_refused(settings):
     with pytest.raises(ParameterError):
         measure_points(np.zeros((20, 20)), **settings)
+
+
+def test_wings_the_gaussian_model_lacks_are_measured_not_eased_away():
+    # 16 points whose PSF is a pixel Gaussian plus 10 % of their light in wings (sigma 1.5 px)
+    from imgmtf.estimate.mtf2d.sources import pixel_gaussian
+    n = np.arange(-6, 7.0)
+    image = np.full((72, 72), 100.0)
+    for k, (dx, dy) in enumerate(quarter_pixel_offsets()):
+        y, x = 12 + 16 * (k // 4), 12 + 16 * (k % 4)
+        image[y - 6: y + 7, x - 6: x + 7] += (pixel_gaussian((900.0, dx, dy, 0.5, 0.5, 0.0), n)
+                                              + pixel_gaussian((100.0, dx, dy, 1.5, 1.5, 0.0), n))
+    result = measure_points(np.random.default_rng(0).normal(image, 0.5), intervals="none")
+    assert any("of their light beyond" in w for w in result.warnings)
+    truth = 0.9 * np.exp(-2 * np.pi ** 2 * 0.25 * 0.25) + 0.1 * np.exp(-2 * np.pi ** 2 * 2.25 * 0.25)
+    assert abs(result.directions[0].mtf_nyquist - truth * 2 / np.pi) < 0.005

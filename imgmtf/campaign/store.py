@@ -15,7 +15,8 @@ Layers
     The summaries per target or scene and direction, combined (``method``
     ``combined``), model-free across/along-track sections of the 2-D MTF
     (``sections``, under the named ``assumption``: separable, elliptical
-    or the bracket of both) or fitted (``fit``): MTF at Nyquist, MTF50,
+    or the bracket of both), fitted (``fit``) or a point array's (``points``:
+    across and along measured directly): MTF at Nyquist, MTF50,
     FWHM and RER with intervals (a Point at the target's centre); a fit's
     ``constrained`` (0 when no edge lay near that axis: the value is the
     other axis's, tied) and ``misfit``; ``recommended`` (1 on the row to
@@ -71,7 +72,7 @@ SCHEMA_VERSION = 3
 LAYERS = ("acquisitions", "edges", "targets")
 BUSY_TIMEOUT_S = 30.0           # SQLite waits this long for another writer's lock...
 WRITE_ATTEMPTS = 5              # ...and a write is tried this many times before it fails
-SUMMARY_METHODS = ("combined", "sections", "fit")
+SUMMARY_METHODS = ("combined", "sections", "fit", "points")
 
 # column -> type ("str", "float", "int"); the acquisition's facts repeat in
 # edges and targets so that each layer reads on its own in QGIS

@@ -41,6 +41,8 @@ HINTS = (
     Hint(CHIP, "not-a-bar", "--target edge measures an edge"),
     Hint(CHIP, "points", "--target points measures point targets"),
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
+    Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
+    Hint(CHIP, "star", "--target star measures a Siemens star"),
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
     Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
@@ -59,6 +61,8 @@ HINTS = (
     Hint(SCAN, "two-targets", "--margin sets the ROI's reach"),
     Hint(SCAN, "not-an-edge", "--target pulse measures bars"),
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
+    Hint(SCAN, "few-points", "--point-spacing PX groups targets farther apart, a star field's whole frame with "
+                             "its size"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and

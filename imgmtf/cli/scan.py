@@ -33,9 +33,12 @@ DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it fo
 SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
                     "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial")
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
+# with several scenes each worker runs whole scans, the segment graph's SciPy included: loaded once by
+# the fork server rather than by every worker as its first scene starts
+WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 
 
-@click.command(short_help="Find, measure and combine every edge or bar in a scene.")
+@click.command(short_help="Find, measure and combine every edge, bar or point array in a scene.")
 @click.argument("scenes", nargs=-1, required=True, type=click.Path())
 @click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--min-length", type=FiniteFloat(16), default=40.0, show_default=True,
@@ -66,6 +69,9 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
               help="the sensor model's stages fitted to each target's half-edges for its across- and "
                    "along-track MTF (imgmtf fit's names, comma-separated); 'auto' for the simplest of "
                    "optics+detector, +diffusion, +lag, +halo that fits; 'none' for no fit")
+@click.option("--point-spacing", "point_spacing", type=FiniteFloat(2, 100000), metavar="PX",
+              help="--target points: neighbouring points of one array lie within this distance, px (default: "
+                   "grouped by their own spacing, each within 1.5 times its nearest neighbour's distance)")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False),
               help="write targets.csv, targets.geojson and overview.png here (with several scenes, in a "
@@ -91,9 +97,9 @@ FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 @interval_options
 @parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
-         roi_file, optical_centre, lens_frequencies, fit_stages, recursive, out_dir, edge_figures, store, acquired,
-         platform, instrument, band_name, fmt, verbose, progress, interval_method, replicates, confidence, workers,
-         scheduler):
+         roi_file, optical_centre, lens_frequencies, fit_stages, point_spacing, recursive, out_dir, edge_figures, store,
+         acquired, platform, instrument, band_name, fmt, verbose, progress, interval_method, replicates, confidence,
+         workers, scheduler):
     """Find every straight edge (or bar) in each SCENE (files, or folders of
     images), split at junctions into half-edges (checkerboards,
     four-quadrant and cross targets), measure each on its own ROI, say why
@@ -107,16 +113,25 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     campaign store as it completes.  Exit status 1 when a scene cannot be
     scanned or has no usable target; on Ctrl-C or SIGTERM the results so
     far are reported and kept (130 or 143): every scene finished is in the
-    store."""
+    store.  With --target points, it finds the arrays of compact targets
+    (mirrors, lamps, stars) and measures each by the point stack: the
+    across- and along-track MTF directly, without a separability
+    assumption."""
     if pulse_width and not get_kind(kind).has_width:
         raise click.UsageError(width_refusal())
     if get_kind(kind).gap_keyword is not None:     # a pair is not yet among the lines a scan pairs up
         raise click.UsageError(f"scan does not search for {kind} targets yet: imgmtf measure --target {kind} "
                                "--pulse-width W --gap G --roi X,Y,W,H measures one")
-    if get_kind(kind).measuring is None:       # a kind with a pipeline of its own: scan searches for lines
+    scanner = get_kind(kind).scanner
+    if get_kind(kind).measuring is None and scanner is None:   # a pipeline of its own and no scan of its own
         raise click.UsageError(f"scan searches scenes for lines (edges and bars), not for {kind} targets yet: "
                                f"imgmtf measure --target {kind} SCENE finds and measures every one in a scene "
                                "(--roi X,Y,W,H for one array)")
+    if point_spacing is not None and scanner is None:
+        raise click.UsageError("--point-spacing groups point targets into arrays: give --target points")
+    if edge_figures and scanner is not None:
+        raise click.UsageError(f"--edge-figures draws half-edges; a {kind} scan draws its arrays in --out's "
+                               "overview.png (imgmtf measure --target points --roi X,Y,W,H --plot for one array)")
     if max_length < min_length:
         raise click.UsageError(f"--max-length ({max_length:g} px) is below --min-length ({min_length:g} px)")
     if edge_figures and not out_dir:
@@ -137,6 +152,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
             settings = ScanSettings(kind, min_length, max_length, margin, method=method, band=band,
                                     pulse_width=pulse_width, saturation=saturation,
                                     track_azimuth_deg=track_azimuth, roi=rois, optical_centre=optical_centre,
+                                    point_spacing_px=point_spacing,
                                     intervals=interval_settings(interval_method, replicates, confidence))
             frequencies = _frequencies(lens_frequencies) if optical_centre is not None else None
             if acquired is not None:
@@ -150,7 +166,8 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                                    "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
             fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ()))
+            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+                             + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
@@ -246,7 +263,11 @@ def _report(outcome, kind, band, folder, fmt, verbose) -> None:
     from ..scene.export import write_outputs
     info = raster_info(outcome.path)
     written = write_outputs(outcome.records, info, folder, band, outcome.summaries) if folder else []
-    print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt, verbose)
+    if get_kind(kind).scanner is not None:      # arrays, not lines: a table of their own
+        from .point_tables import print_point_scan
+        print_point_scan(outcome.path, info, outcome.records, outcome.summaries, written, fmt)
+    else:
+        print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt, verbose)
     if not any(r.ok for r in outcome.records) and not outcome.interrupted:
         click.echo(f"imgmtf: error: {outcome.path}: no usable {kind} found "
                    f"({len(outcome.records)} candidates, all rejected)", err=True)

@@ -9,6 +9,7 @@ command list's column keeps every short help on one line (a name as long as
 refused beside ``--campaign``, and the campaign's without it."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import click
@@ -27,16 +28,18 @@ MAX_OVERSAMPLING = 100              # simulate --oversampling
 
 #: the options that describe one chip, and those that describe a campaign: each refused with the other
 CHIP_ONLY = ("kind", "angle", "low", "high", "pulse_width", "offset", "noise_std", "ground_noise", "oversampling",
-             "sensor_path", "out", "point_size", "spacing", "gap")
+             "sensor_path", "out", "point_size", "spacing", "gap", "cycles", "star_profile")
 #: the options of a line target (an edge or a bar) that an array of points has no use for, and the reverse
 LINE_ONLY = ("angle", "pulse_width", "offset", "ground_noise", "oversampling", "gap")
 POINTS_ONLY = ("point_size", "spacing")
+STAR_ONLY = ("cycles", "star_profile")
+STAR_SIZE_PX = 201                  # a star chip's side unless --size says otherwise
 CAMPAIGN_ONLY = ("acquisitions", "start", "interval_days", "degradation", "snr", "fill", "platform", "instrument",
                  "band_name", "blur")
 CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says otherwise
 
 
-@click.command(short_help="Render an edge, bar or point-array chip through the sensor (GeoTIFF, PNG).")
+@click.command(short_help="Render an edge, bar, point or star chip through the sensor.")
 @click.option("--target", "kind", type=click.Choice(kind_names()), default="edge", show_default=True)
 @click.option("--angle", type=FiniteFloat(-90, 90, min_open=True), default=6.0, show_default=True,
               help="angle of the edge's normal from the x (column) axis, degrees in (-90, 90], which "
@@ -57,9 +60,15 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--spacing", type=FiniteFloat(2, 1000), default=12.0, show_default=True,
               help="--target points: distance between the 4 x 4 targets' centres, px (each at its own quarter-pixel "
                    "offset)")
+@click.option("--cycles", type=click.IntRange(4, 2000),
+              help="--target star: periods around the centre (default: the outermost ring at about 0.125 cy/px, "
+                   "0.075 for a binary star, whose wedges' levels are read there)")
+@click.option("--star-profile", type=click.Choice(["sinusoidal", "binary"]), default="sinusoidal", show_default=True,
+              help="--target star: ISO 12233's sinusoidal star (s-SFR) or black and white wedges")
 @click.option("--offset", type=FiniteFloat(), default=0.0, show_default=True,
               help="sub-pixel position of the edge along its normal from the chip centre, px")
-@click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50, show_default="50; 320 with --campaign",
+@click.option("--size", type=click.IntRange(2, MAX_CHIP_PX), default=50,
+              show_default="50; 201 for a star; 320 with --campaign",
               help="chip (or campaign scene) side, pixels")
 @click.option("--gsd", type=FiniteFloat(0, min_open=True), help="output GSD in metres (default: the sensor's)")
 @click.option("--bits", type=click.Choice(["8", "16"]), default="16", show_default=True)
@@ -94,7 +103,8 @@ CAMPAIGN_SIZE_PX = 320              # a campaign scene's side unless --size says
 @click.option("--instrument", default="PAN", show_default=True, help="campaign: INSTRUMENT tag")
 @click.option("--band-name", default="PAN", show_default=True, help="campaign: BAND_NAME tag")
 @click.pass_context
-def simulate(ctx, kind, angle, low, high, pulse_width, gap, point_size, spacing, offset, size, gsd, bits, noise_std,
+def simulate(ctx, kind, angle, low, high, pulse_width, gap, point_size, spacing, cycles, star_profile, offset, size,
+             gsd, bits, noise_std,
              ground_noise, oversampling, sensor_path, seed, out, campaign_dir, acquisitions, start, interval_days,
              degradation, snr, fill, blur, platform, instrument, band_name):
     """Render an edge or pulse chip through the generic sensor to a GeoTIFF
@@ -135,14 +145,17 @@ def simulate(ctx, kind, angle, low, high, pulse_width, gap, point_size, spacing,
                                      "how the chip was made, or a PNG (.png, pixels only); "
                                      f"got {suffix or 'no suffix'}", param_hint="'--out'")
         target_kind = get_kind(kind)
-        drawn_apart = target_kind.renderer is not None       # no line: its own renderer (points)
-        clash = [name for name in (LINE_ONLY if drawn_apart else POINTS_ONLY) if name in given]
+        drawn_apart = target_kind.renderer is not None       # no line: its own renderer (points, stars)
+        own = DRAWN_APART[target_kind.renderer][1] if drawn_apart else ()
+        refused = (LINE_ONLY + POINTS_ONLY + STAR_ONLY) if drawn_apart else POINTS_ONLY + STAR_ONLY
+        clash = [name for name in refused if name in given and name not in own]
         if clash:
             raise click.UsageError(f"{_flag(ctx, clash[0])} does not apply to --target {kind}")
         if drawn_apart:
             check_output_file(out)
-            _points_chip(target_kind, out, suffix, load_sensor(sensor_path), gsd, size, int(bits), low, high,
-                         point_size, spacing, noise_std, seed)
+            maker, _, default_size = DRAWN_APART[target_kind.renderer]
+            maker(target_kind, out, suffix, load_sensor(sensor_path), gsd, size if "size" in given else default_size,
+                  int(bits), low, high, noise_std, seed, **{name: ctx.params[name] for name in own})
             return
         if target_kind.has_width and pulse_width is None:
             raise click.UsageError(f"a {kind} target needs --pulse-width (1.5 or 1.5px: pixels; 1.5m: metres)")
@@ -188,7 +201,7 @@ def simulate(ctx, kind, angle, low, high, pulse_width, gap, point_size, spacing,
                        f"{Path(out).with_suffix('.tif')}")
 
 
-def _points_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, point_size, spacing, noise_std, seed):
+def _points_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, noise_std, seed, *, point_size, spacing):
     """A 4 x 4 array of point targets (squares of ``point_size`` px) at
     quarter-pixel offsets, rendered exactly; the truth across and along
     track in the file's tags."""
@@ -211,6 +224,40 @@ def _points_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, point_si
     click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, 4 x 4 {what} {spacing:g} px apart at quarter-pixel "
                f"offsets, GSD {chip.gsd_m:g} m; true MTF at Nyquist across track "
                f"{provenance['mtf_nyquist_across']:.4f}, along track {provenance['mtf_nyquist_along']:.4f}{clipped}")
+
+
+def _star_chip(kind, out, suffix, sensor, gsd, size, bits, low, high, noise_std, seed, *, cycles, star_profile):
+    """A Siemens star filling the chip, rendered exactly; the truth across
+    and along track in the file's tags."""
+    from ..io import write_geotiff, write_png
+    from ..sensor.star import SiemensStar, default_cycles
+    gsd_m = sensor.gsd_m if gsd is None else gsd
+    with option_errors():
+        profile = star_profile
+        n = default_cycles(size, profile) if cycles is None else cycles
+        star = SiemensStar(cycles=n, profile=profile, low_dn=low, high_dn=high)
+        chip = kind.load("renderer")(sensor, star, size, gsd_m=gsd_m, bits=bits, noise_std_dn=noise_std, seed=seed)
+    provenance = chip.provenance()
+    truth = {"TRUE_MTF_NYQUIST_ACROSS": f"{provenance['mtf_nyquist_across']:.6f}",
+             "TRUE_MTF_NYQUIST_ALONG": f"{provenance['mtf_nyquist_along']:.6f}",
+             "TRUE_MTF50_ACROSS_CY_PX": f"{chip.true_mtf50_cy_px(0.0):.6f}",
+             "TRUE_MTF50_ALONG_CY_PX": f"{chip.true_mtf50_cy_px(90.0):.6f}",
+             "STAR_CYCLES": str(n), "STAR_PROFILE": profile}
+    if suffix == ".png":
+        write_png(out, chip.image)
+    else:
+        write_geotiff(out, chip.image, gsd_m=chip.gsd_m, provenance=provenance, tags=truth)
+    clipped = f", {100 * chip.clipped_fraction:.1f} % of pixels clipped" if chip.clipped_fraction else ""
+    click.echo(f"wrote {out}: {size} x {size} px, {bits}-bit, {profile} Siemens star of {n} cycles (Nyquist at "
+               f"r = {star.nyquist_radius_px:.1f} px), GSD {chip.gsd_m:g} m; true MTF at Nyquist across track "
+               f"{provenance['mtf_nyquist_across']:.4f}, along track {provenance['mtf_nyquist_along']:.4f}{clipped}")
+
+
+#: the chips of kinds drawn apart from lines, by their renderer: how each is made, the options it takes and its
+#: side unless --size says otherwise
+DRAWN_APART: dict[str, tuple[Callable[..., None], tuple[str, ...], int]] = {
+    "imgmtf.sensor.points:render_points": (_points_chip, POINTS_ONLY, 50),
+    "imgmtf.sensor.star:render_star": (_star_chip, STAR_ONLY, STAR_SIZE_PX)}
 
 
 def _flag(ctx, name: str) -> str:

@@ -240,7 +240,8 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
 
 def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: ArrayLike) -> ImgmtfError:
     """A chip refused as an edge or a bar that holds point targets instead
-    says so (reason ``points``); any other refusal stands as it was.  The
+    says so (reason ``points``), or a Siemens star (reason ``star``); any
+    other refusal stands as it was.  The
     chip's own pixels have its outliers (points among them) left out: the
     image as given is what is looked at."""
     from .mtf2d.sources import points_seen
@@ -252,7 +253,11 @@ def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: Array
     pixels = np.asarray(image, float)
     seen = points_seen(pixels[y0: y0 + rows, x0: x0 + cols]) if pixels.ndim == 2 else None
     if seen is None:
-        return exc
+        from .star.centre import star_seen
+        star = star_seen(pixels[y0: y0 + rows, x0: x0 + cols]) if pixels.ndim == 2 else None
+        if star is None:
+            return exc
+        return UnsuitableTargetError(f"no {kind.name} here: the chip holds {star}, not a line", reason="star")
     return UnsuitableTargetError(f"no {kind.name} here: the chip holds {seen}, not a line", reason="points")
 
 

@@ -20,11 +20,12 @@ from .edge import EDGE
 from .kind import Column, Kind
 from .points import POINTS
 from .pulse import PULSE
+from .star import STAR
 
 __all__ = ["KINDS", "Column", "Kind", "get_kind", "kind_names", "kinds_with_width"]
 
 #: every kind of target, by name, in the order commands list them
-KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS, DOUBLE_BAR)}
+KINDS: dict[str, Kind] = {kind.name: kind for kind in (EDGE, PULSE, POINTS, DOUBLE_BAR, STAR)}
 
 
 def kind_names() -> tuple[str, ...]:
@@ -38,7 +39,7 @@ def kind_names() -> tuple[str, ...]:
     Examples
     --------
     >>> kind_names()
-    ('edge', 'pulse', 'points', 'double-bar')
+    ('edge', 'pulse', 'points', 'double-bar', 'star')
     """
     return tuple(KINDS)
 
@@ -68,9 +69,9 @@ def get_kind(name: str, what: str = "target kind") -> Kind:
     --------
     >>> get_kind("pulse").noun
     'bar'
-    >>> get_kind("star")
+    >>> get_kind("spoke")
     Traceback (most recent call last):
-    imgmtf.errors.ParameterError: target kind must be one of ('edge', 'pulse', 'points', 'double-bar'), got 'star'
+    imgmtf.errors.ParameterError: target kind must be one of ('edge', ..., 'star'), got 'spoke'
     """
     kind = KINDS.get(name) if isinstance(name, str) else None
     if kind is None:

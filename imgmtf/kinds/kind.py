@@ -90,6 +90,11 @@ class Kind:
         The keyword its estimator, its ``scene_response`` and
         :class:`imgmtf.Target` take for the edge-to-edge gap between its
         two bars (double bars: ``gap_px``, ``--gap``), or None.
+    scanner : str or None
+        "module:attribute" of its own scene scan when it is no line
+        (``scanner(path, settings)`` returning the records and the scene's
+        summaries; points: :func:`imgmtf.scene.points.scan_point_arrays`),
+        or None: ``imgmtf scan`` searches the scene for lines.
 
     Examples
     --------
@@ -122,6 +127,7 @@ class Kind:
     figure: str | None = None
     rows_per_result: str | None = None
     gap_keyword: str | None = None
+    scanner: str | None = None
 
     def load(self, part: str) -> Any:
         """The object one of the kind's "module:attribute" parts names,
@@ -129,7 +135,7 @@ class Kind:
 
         Parameters
         ----------
-        part : {"estimator", "result", "measuring", "renderer", "figure"}
+        part : {"estimator", "result", "measuring", "renderer", "figure", "scanner"}
             Which part.
 
         Returns

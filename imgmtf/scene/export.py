@@ -3,8 +3,8 @@
 ``targets.csv`` holds every candidate (``scope`` "edge"), then the
 per-target and per-scene summaries (``scope`` "target", "scene"), in the
 schema :data:`imgmtf.records.SCAN_CSV_COLUMNS`; ``targets.geojson`` the
-same records as features (a candidate a LineString, a target a Point at
-its centre, the scene's summaries without geometry); ``overview.png`` the
+same records as features (a candidate a LineString, a point array or a
+target a Point at its centre, the scene's summaries without geometry); ``overview.png`` the
 scene with its targets (:func:`imgmtf.plot.plot_scan`).
 """
 from __future__ import annotations
@@ -91,7 +91,7 @@ def write_outputs(records: Sequence[Record], info: RasterInfo, out_dir: str, ove
     FileWriteError
         An output cannot be written.
     """
-    from ..plot import plot_scan
+    from ..plot import plot_point_scan, plot_scan
     out = ensure_folder(out_dir)
     csv_path, json_path, png_path = (str(out / n) for n in ("targets.csv", "targets.geojson", "overview.png"))
     write_csv([*records, *summaries], csv_path, SCAN_CSV_COLUMNS)
@@ -105,5 +105,7 @@ def write_outputs(records: Sequence[Record], info: RasterInfo, out_dir: str, ove
     overview = read_raster(info.path, overview_band, out_shape=shape).data
     levels = display_levels(info.path, overview_band, info)
     rows, summary_rows = [r.to_dict() for r in records], [r.to_dict() for r in summaries]
-    save_figure(lambda: plot_scan(overview, info.width / shape[1], rows, summary_rows, levels), png_path)
+    # candidates without a segment are point arrays (imgmtf.scene.points): drawn as their ROIs
+    draw = plot_scan if not rows or any("x0_px" in r for r in rows) else plot_point_scan
+    save_figure(lambda: draw(overview, info.width / shape[1], rows, summary_rows, levels), png_path)
     return [csv_path, json_path, png_path]

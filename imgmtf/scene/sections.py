@@ -14,7 +14,9 @@ growing with frequency) for the sections' intervals.
 :func:`recommend` then marks, per scope, target and direction, the one
 across/along row to quote: the sensor model's fit when it fits and agrees
 with the sections within their intervals, else the sections' chosen
-assumption; a misfit fit is never recommended.
+assumption; a misfit fit is never recommended.  Where a point array
+measured the direction (``summary`` "points", :mod:`.points`), it is the
+reference instead of the sections: it needs no assumption.
 """
 from __future__ import annotations
 
@@ -31,6 +33,8 @@ from ..records import TARGET_SCOPE, Record
 
 ACROSS, ALONG = "across-track", "along-track"
 SECTIONS = "sections"
+#: a point array's rows (:mod:`.points`): across and along measured directly, no assumption to choose
+POINTS = "points"
 #: draws of the families' curves for the sections' intervals
 DRAWS = 100
 
@@ -181,7 +185,8 @@ def recommend(summaries: Sequence[Record]) -> list[Record]:
     marks: dict[int, tuple[bool, str]] = {}
     groups: dict[tuple, list[int]] = {}
     for k, r in enumerate(summaries):
-        if r.ok and r.figures.get("summary") in ("fit", SECTIONS) and r.figures.get("direction") in (ACROSS, ALONG):
+        if r.ok and r.figures.get("summary") in ("fit", SECTIONS, POINTS) and \
+                r.figures.get("direction") in (ACROSS, ALONG):
             groups.setdefault((r.site.get("scope"), r.site.get("target_id"), r.figures["direction"]), []).append(k)
     for members in groups.values():
         marks.update(_marks([summaries[k] for k in members], members))
@@ -195,6 +200,9 @@ def recommend(summaries: Sequence[Record]) -> list[Record]:
 
 
 def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]]:
+    points = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == POINTS]
+    if points:
+        return _point_marks(rows, indices, points[0])
     fits = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == "fit"]
     sections = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == SECTIONS
                 and r.figures.get("assumption") == r.figures.get("chosen_assumption")]
@@ -228,6 +236,30 @@ def _marks(rows: list[Record], indices: list[int]) -> dict[int, tuple[bool, str]
             marks[k] = (False, "the model fits and agrees with the sections")
         else:
             marks[k] = (False, f"{r.figures['chosen_assumption']} chosen: {r.figures.get('assumption_because')}")
+    return marks
+
+
+def _point_marks(rows: list[Record], indices: list[int], point: tuple[int, Record]) -> dict[int, tuple[bool, str]]:
+    """A direction a point array measures: its row, or the model's fit when
+    it fits and agrees with the array within their intervals; the sections
+    of edges never (the array needs no assumption)."""
+    k_point, reference = point
+    good_fits = [(k, r) for k, r in zip(indices, rows) if r.figures["summary"] == "fit" and not r.figures.get("misfit")
+                 and _interval(r.figures.get("mtf_nyquist_ci")) and _interval(reference.figures.get("mtf_nyquist_ci"))
+                 and _overlap(r.figures["mtf_nyquist_ci"], reference.figures["mtf_nyquist_ci"])]
+    pick, why = ((good_fits[0][0], "the model fits and agrees with the point array") if good_fits else
+                 (k_point, "the point array measures this direction directly (no separability assumption)"))
+    marks: dict[int, tuple[bool, str]] = {}
+    for k, r in zip(indices, rows):
+        if k == pick:
+            marks[k] = (True, why)
+        elif r.figures["summary"] == "fit":
+            marks[k] = (False, "the model does not fit" if r.figures.get("misfit") else
+                        "it disagrees with the point array at Nyquist")
+        elif r.figures["summary"] == POINTS:
+            marks[k] = (False, "the model fits and agrees with it" if good_fits else "another array's row is quoted")
+        else:
+            marks[k] = (False, "a point array measures this direction directly")
     return marks
 
 

@@ -190,6 +190,13 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                                            **facts)
             if overview:
                 acquisition = replace(acquisition, overview=str(Path(overview).resolve()))
+        scanner = get_kind(settings.target).scanner
+        if scanner is not None:             # a kind that is no line scans the scene its own way (points)
+            records, summaries = get_kind(settings.target).load("scanner")(path, settings)
+            summaries = recommend(summaries)
+            if in_image_axes(raster_info(path), settings):
+                records, summaries = _image_axes(records), _image_axes(summaries)
+            return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
         try:
             records = scan_scene(path, settings, workers=workers, scheduler=scheduler, progress=progress,
                                  figures_dir=figures_dir)

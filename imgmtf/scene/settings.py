@@ -64,6 +64,10 @@ class ScanSettings:
         from the centre, sagittal or meridional:
         :func:`imgmtf.estimate.field.field_position`), what a lens profile
         (:func:`imgmtf.scene.lens_profile.lens_profile`) reads.
+    point_spacing_px : float, optional
+        Point targets (``target`` "points"): neighbours of one array lie
+        within this distance, px; None (default) to group them by their
+        own spacing (:func:`imgmtf.scene.points.group_arrays`).
 
     Raises
     ------
@@ -89,6 +93,7 @@ class ScanSettings:
     track_azimuth_deg: float | None = None
     roi: VectorROIs | None = None
     optical_centre: tuple[float, float] | str | None = None
+    point_spacing_px: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "intervals", as_intervals(self.intervals))    # "bootstrap", as --intervals
@@ -114,6 +119,10 @@ class ScanSettings:
         if not self.min_length_px <= self.max_length_px <= MAX_LENGTH_PX:
             raise ParameterError(f"max_length_px ({self.max_length_px:g} px) must lie between min_length_px "
                                  f"({self.min_length_px:g} px) and {MAX_LENGTH_PX} px")
+        if self.point_spacing_px is not None:
+            object.__setattr__(self, "point_spacing_px", check_number("point_spacing_px", self.point_spacing_px))
+            if not self.point_spacing_px >= 2:
+                raise ParameterError(f"point_spacing_px must be at least 2 px, got {self.point_spacing_px}")
         if self.margin_px < 6:
             raise ParameterError(f"the ROI margin must be at least 6 px, got {self.margin_px}")
         if not (isinstance(self.tile_px, int) and MIN_TILE_PX <= self.tile_px <= MAX_TILE_PX):
@@ -130,4 +139,6 @@ class ScanSettings:
         return {"min_length_px": self.min_length_px, "max_length_px": self.max_length_px,
                 "margin_px": self.margin_px, "tile_px": self.tile_px,
                 **({"roi_file": self.roi.source} if self.roi is not None else {}),
-                **({"optical_centre": self.optical_centre} if self.optical_centre is not None else {})}
+                **({"optical_centre": self.optical_centre} if self.optical_centre is not None else {}),
+                # only when given: an edge scan's acquisition keeps its id
+                **({"point_spacing_px": self.point_spacing_px} if self.point_spacing_px is not None else {})}

@@ -40,6 +40,9 @@ from ..intervals import Intervals, as_intervals
 from .sources import FoundSources, Source, SourceTally, find_sources
 from .stack import DirectionMTF, Stack
 
+#: a uniformity of the targets' phases less likely than this is reported (pixel-locking), and the fewest targets tested
+PIXEL_LOCK_P = 0.01
+MIN_PHASE_TEST = 8
 #: the directions' names: across and along the ground track, or the image's axes when the track is unknown
 ACROSS, ALONG = "across-track", "along-track"
 IMAGE_X, IMAGE_Y = "image-x", "image-y"
@@ -89,6 +92,12 @@ class PointsResult(SourceTally):
     checks : tuple
         Empty: a point stack has no gate of line checks; its targets are
         refused one by one (``sources``).
+    phase_cells : int
+        The quarter-pixel cells (of 16) the used targets' phases fall in.
+    phase_uniform_p : float
+        The p-value of their phases being uniform over the pixel
+        (:func:`phase_coverage`); small: pixel-locked or few phases, which
+        a warning names.
 
     Examples
     --------
@@ -117,6 +126,8 @@ class PointsResult(SourceTally):
     method: str = "points"
     target: str = "points"
     checks: tuple = ()
+    phase_cells: int = 0
+    phase_uniform_p: float = math.nan
 
     def direction(self, name: str) -> DirectionMTF:
         """The section called ``name``.
@@ -171,7 +182,8 @@ class PointsResult(SourceTally):
                 "fwhm_m": _finite(section.fwhm_px * self.gsd_m) if self.gsd_m else None,
                 "points_used": len(self.used), "points_refused": len(self.refused),
                 "points_refused_by": refusals, "point_size_px": self.point_size_px,
-                "alias_weight": _finite(self.alias_weight),
+                "alias_weight": _finite(self.alias_weight), "phase_cells": int(self.phase_cells),
+                "phase_uniform_p": _finite(self.phase_uniform_p),
                 "roi": list(self.roi), "warnings": list(self.warnings), "params": dict(self.params),
                 "imgmtf_version": __version__,
             }
@@ -283,12 +295,24 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
     directions = tuple(stack.direction(name, vector, settings) for name, vector in section_axes(track_azimuth_deg))
     psf, step = stack.psf()
     f2d = np.round(np.arange(-50, 51) * 0.02, 10)
-    mtf2d = stack.mtf(f2d[None, :], f2d[:, None])
+    # a real PSF's transfer is Hermitian: |T(-f)| = |T(f)|, so the half plane fy >= 0 gives the whole grid
+    upper = stack.mtf(f2d[None, :], f2d[f2d.size // 2:, None])
+    mtf2d = np.vstack([upper[:0:-1, ::-1], upper])
     warnings = []
-    if stack.alias_weight > 0.3:
-        warnings.append(f"the {len(found.used)} targets' phases leave aliases of weight {stack.alias_weight:.2f} "
-                        "(0: a pixel tiled evenly): the MTF near Nyquist leans on the Gaussian model they were "
-                        "located with")
+    cells, uniform_p = phase_coverage(np.array([[s.x_px, s.y_px] for s in found.used]))
+    coverage = f"cover {cells} of the pixel's 16 quarter-pixel cells"
+    if uniform_p < PIXEL_LOCK_P:
+        warnings.append(f"the {len(found.used)} targets' sub-pixel phases are not spread evenly over the pixel (they "
+                        f"{coverage}; uniform phases p={uniform_p:.2g}): their locations may be pixel-locked (pulled "
+                        "towards pixel centres by a PSF the Gaussian fit does not match), which the stack cannot "
+                        f"undo, and the aliases they leave weigh {stack.alias_weight:.2f} (0: a pixel tiled evenly): "
+                        "the MTF near Nyquist leans on the Gaussian model they were located with")
+    elif stack.alias_weight > 0.3:
+        warnings.append(f"the {len(found.used)} targets' phases {coverage} and leave aliases of weight "
+                        f"{stack.alias_weight:.2f} (0: a pixel tiled evenly): the MTF near Nyquist leans on the "
+                        "Gaussian model they were located with")
+    if stack.tail_note:
+        warnings.append(stack.tail_note)
     if len(found.used) < 8 and settings.method != "none":
         warnings.append(f"only {len(found.used)} targets: the bootstrap over them is rough")
     rows, cols = np.asarray(image).shape
@@ -296,7 +320,53 @@ def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: s
               "min_snr": float(min_snr), "min_separation_px": min_separation_px,
               "intervals": settings.as_dict()}
     return PointsResult(directions, psf, step, mtf2d, f2d, found.sources, found.polarity, float(point_size_px),
-                        found.noise_dn, stack.alias_weight, gsd_m, (0, 0, cols, rows), params, tuple(warnings))
+                        found.noise_dn, stack.alias_weight, gsd_m, (0, 0, cols, rows), params, tuple(warnings),
+                        phase_cells=cells, phase_uniform_p=uniform_p)
+
+
+def phase_coverage(centres_px: np.ndarray) -> tuple[int, float]:
+    """How evenly targets at ``centres_px`` (x, y), px, sample the pixel:
+    the quarter-pixel cells (of 16) their sub-pixel phases fall in, and the
+    p-value of their phases being uniform (Rayleigh's test on each axis,
+    the smaller; NaN under ``MIN_PHASE_TEST`` targets).  Targets placed at
+    random give a large p; an array tiled by quarter pixels gives 1;
+    locations pixel-locked by a biased fit (real stars' phases crowding at
+    the pixel's centre) give a small one.
+
+    Parameters
+    ----------
+    centres_px : numpy.ndarray, shape (n, 2)
+        The targets' fitted centres, px (pixel centres at integers).
+
+    Returns
+    -------
+    (int, float)
+        The cells covered, and the p-value.
+
+    Examples
+    --------
+    >>> from imgmtf.sensor.points import quarter_pixel_offsets
+    >>> cells, p = phase_coverage(quarter_pixel_offsets() + 10.0)
+    >>> cells, round(p, 6)
+    (16, 1.0)
+    >>> rng = np.random.default_rng(0)
+    >>> cells, p = phase_coverage(np.round(rng.uniform(0, 50, (40, 2))) + rng.normal(0, 0.08, (40, 2)))
+    >>> cells, p < 1e-6                                     # crowding at the pixels' centres
+    (4, True)
+    """
+    centres = np.asarray(centres_px, float).reshape(-1, 2)
+    if not len(centres):
+        return 0, math.nan
+    phases = centres - np.floor(centres)                  # 0 to 1 from a pixel's centre
+    cells = len({(int(a), int(b)) for a, b in np.floor(phases * 4).clip(0, 3)})
+    if len(centres) < MIN_PHASE_TEST:
+        return cells, math.nan
+    n = len(centres)
+    r2 = np.abs(np.exp(2j * np.pi * phases).mean(axis=0)) ** 2
+    z = n * r2
+    # Rayleigh's p-value with its small-sample correction (Zar, Biostatistical Analysis, eq. 27.4)
+    p = np.exp(np.sqrt(1 + 4 * n + 4 * (n * n - (n * z))) - (1 + 2 * n))
+    return cells, float(np.clip(p, 0.0, 1.0).min())
 
 
 def section_axes(track_azimuth_deg: float | None) -> tuple[tuple[str, tuple[float, float]], ...]:

@@ -26,12 +26,14 @@ taken.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._blas import one_blas_thread
 from ...errors import ParameterError
 from .assumptions import (
     ASSUMPTIONS,
@@ -44,6 +46,7 @@ from .assumptions import (
     pair_decision,
     prediction_tests,
 )
+from .curves import mtf50_rows, transfers
 from .inversion import (
     REACH_CY_PX,
     drawn_models,
@@ -52,6 +55,7 @@ from .inversion import (
 )
 
 _GRID = np.round(np.arange(0.0, REACH_CY_PX + 1e-9, 0.01), 2)
+_FWHM_X = np.linspace(0.0, 4.0, 801)       # where the LSF is evaluated for its FWHM, px
 
 
 @dataclass(frozen=True)
@@ -218,6 +222,14 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
     """
     if assumption not in ("auto", BRACKET, *ASSUMPTIONS):
         raise ParameterError(f"assumption must be auto, separable, elliptical or bracket, got {assumption!r}")
+    # small matrices: BLAS threads cost more than they save (on a busy machine, a third of the time)
+    with one_blas_thread():
+        return _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption, draws, confidence, seed)
+
+
+def _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption: str, draws: int, confidence: float,
+              seed: int) -> MTF2D:
+    """:func:`mtf2d_from_sections`'s work, its arguments checked."""
     theta, f, m, _ = prepared(normals_deg, frequencies_cy_px, mtfs, sd)
     normals = np.degrees(theta)
     spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
@@ -250,12 +262,13 @@ def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tupl
     sections redrawn by ``shifts`` (draws x sections) and inverted again."""
     normals, f, m, sd = inputs
     curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
-    drawn = None
+    across = along = None
     if shifts is not None:
-        drawn = np.array([[again.transfer(_GRID, 0.0 * _GRID), again.transfer(0.0 * _GRID, _GRID)]
-                          for again in drawn_models(assumption, model, normals, f, m, sd, shifts)])
-    return (_section("across-track", curves[0], None if drawn is None else drawn[:, 0], confidence),
-            _section("along-track", curves[1], None if drawn is None else drawn[:, 1], confidence))
+        # every draw's sections in one pass (a call per draw was a third of a dense chart's sections)
+        again = drawn_models(assumption, model, normals, f, m, sd, shifts)
+        across, along = transfers(again, _GRID, 0.0 * _GRID), transfers(again, 0.0 * _GRID, _GRID)
+    return (_section("across-track", curves[0], across, confidence),
+            _section("along-track", curves[1], along, confidence))
 
 
 def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float) -> TrackSection:
@@ -268,7 +281,7 @@ def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confid
         low, high = np.quantile(drawn, [tail, 1 - tail], axis=0)
         low, high = np.minimum(low, curve), np.maximum(high, curve)
         nyquist = drawn[:, _GRID.searchsorted(0.5)]
-        fifty = np.array([_mtf50(c) for c in drawn])
+        fifty = mtf50_rows(_GRID, drawn)
         nyq_ci = _quantiles(nyquist, tail, curve[_GRID.searchsorted(0.5)])
         fifty_ci = _quantiles(fifty, tail, _mtf50(curve))
     return TrackSection(direction, _GRID.copy(), curve, low, high, float(curve[_GRID.searchsorted(0.5)]), nyq_ci,
@@ -319,15 +332,24 @@ def _fwhm(curve: np.ndarray) -> float:
     reach = int(np.argmin(finite)) if not finite.all() else curve.size
     if reach < 3 or curve[reach - 1] > 0.1:
         return math.nan
-    f, mtf = _GRID[:reach], curve[:reach]
-    x = np.linspace(0.0, 4.0, 801)
+    mtf = curve[:reach]
     weights = np.full(reach, 0.01)
     weights[[0, -1]] = 0.005
-    lsf = 2.0 * (np.cos(2 * np.pi * np.outer(x, f)) @ (mtf * weights))
+    lsf = 2.0 * (_cosines(reach) @ (mtf * weights))
     half = lsf[0] / 2
     below = np.flatnonzero(lsf < half)
     if not below.size:
         return math.nan
-    k = below[0]
+    k, x = below[0], _FWHM_X
     return float(2 * (x[k - 1] + (lsf[k - 1] - half) / (lsf[k - 1] - lsf[k]) * (x[k] - x[k - 1])))
+
+
+@functools.lru_cache(maxsize=16)
+def _cosines(reach: int) -> np.ndarray:
+    """The cosine transform's matrix from the first ``reach`` grid
+    frequencies to the LSF at ``_FWHM_X`` (px): the same few reaches recur
+    for every target of a scan."""
+    out = np.cos(2 * np.pi * np.outer(_FWHM_X, _GRID[:reach]))
+    out.flags.writeable = False
+    return out
 

@@ -6,9 +6,12 @@ A target is a local maximum of the background-subtracted chip (its sign
 turned for dark targets), smoothed by a 1 px Gaussian, above five times the
 smoothed noise.  Each is cut out as a square stamp and refused, with a
 reason code and a message, when its peak is under the SNR floor
-(``faint``), signal reaches its stamp's border (``extended``: an edge or a
-bar, not a point), its stamp touches the chip's edge (``edge``), another
-target lies within the separation (``blended``), a pixel of it is at the
+(``faint``), signal reaches its stamp's border beyond the plane fitted to
+the border (``extended``: an edge or a bar, not a point; the plane is a
+textured field's slope), its stamp touches the chip's edge (``edge``),
+another target (above the SNR floor, and of at least a tenth of its peak)
+lies within the separation (``blended``; a faint bump of texture does not
+blend), a pixel of it is at the
 recorded range's end (``clipped``) or it is sharper than any optics
 (``hot-pixel``).
 The rest are located by a least-squares fit of an elliptical Gaussian
@@ -32,6 +35,8 @@ POLARITIES = ("auto", "bright", "dark")
 MIN_SIGMA_PX = 0.15
 #: the share of its peak a target's smoothed signal may keep on its stamp's border
 MAX_BORDER_FRACTION = 0.2
+#: a neighbour blends a target when its smoothed peak is at least this share of the target's
+BLEND_FRACTION = 0.1
 
 
 @dataclass(frozen=True)
@@ -224,9 +229,13 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     sources, stamps, phases = [], [], []
     padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
     peaks_xy = np.column_stack([ix, iy])
+    heights = smoothed[iy, ix]
+    faint = signal[iy, ix] < min_snr * noise
     for k, (y, x) in enumerate(zip(iy, ix)):
         distance = np.hypot(ix - x, iy - y)
         distance[k] = np.inf
+        # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture is not)
+        distance[faint | (heights < BLEND_FRACTION * heights[k])] = np.inf
         source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
                                       radius, float(distance.min()),
                                       separation, noise, min_snr, saturation, polarity)
@@ -258,10 +267,10 @@ def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separati
     ry, rx = np.nonzero(ring)
     near = ((rx[:, None] + x - radius - others[None, :, 0]) ** 2
             + (ry[:, None] + y - radius - others[None, :, 1]) ** 2 <= 9).any(axis=1)
-    values = padded[ry + y, rx + x][~near]
-    border = float(np.nanmax(np.abs(values), initial=0.0)) if np.isfinite(values).any() else 0.0
-    if border > MAX_BORDER_FRACTION * float(smoothed[y, x]):
-        share = 100 * border / smoothed[y, x]
+    border, level = border_excess(padded[ry + y, rx + x][~near], rx[~near] - radius, ry[~near] - radius)
+    height = float(smoothed[y, x]) - level
+    if border > MAX_BORDER_FRACTION * height:
+        share = 100 * border / max(height, 1e-12)
         return refused("extended", f"its signal reaches {2 * radius + 1} px across ({share:.0f} % of its peak on "
                        "the border): an edge or a bar, not a point")
     if x - radius < 0 or y - radius < 0 or x + radius >= cols or y + radius >= rows:
@@ -287,6 +296,30 @@ def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separati
     return source, (sign * stamp - level) / flux, (dx, dy)
 
 
+def border_excess(values: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """How far a stamp's border ``values`` (at offsets ``x``, ``y`` from its
+    centre; NaN off the chip) stray from the plane fitted to them (the
+    largest absolute residual), and that plane's level at the centre.  The
+    plane is the background under the target (a textured field's slope); an
+    edge's step or a bar's crossing stays in the residual, and a bump on a
+    plateau has no height above the plane.
+
+    Examples
+    --------
+    >>> x = np.array([-2, 0, 2, -2, 2, -2, 0, 2]); y = np.array([-2, -2, -2, 0, 0, 2, 2, 2])
+    >>> [round(v, 9) for v in border_excess(5.0 + 0.3 * x - 0.1 * y, x, y)]
+    [0.0, 5.0]
+    >>> [round(v, 3) for v in border_excess(np.where(x > 0, 1.0, 0.0), x, y)]     # a step: no plane
+    [0.375, 0.375]
+    """
+    keep = np.isfinite(values)
+    if keep.sum() < 4:
+        return (float(np.nanmax(np.abs(values), initial=0.0)) if keep.any() else 0.0), 0.0
+    design = np.column_stack([np.ones(keep.sum()), x[keep], y[keep]]).astype(float)
+    coefficients = np.linalg.lstsq(design, values[keep], rcond=None)[0]
+    return float(np.abs(values[keep] - design @ coefficients).max()), float(coefficients[0])
+
+
 def pixel_gaussian(params, n: np.ndarray) -> np.ndarray:
     """An elliptical Gaussian integrated over unit pixels, plus a constant:
     ``params`` (flux, dx, dy, sigma_x, sigma_y, level), on a stamp whose
@@ -296,6 +329,39 @@ def pixel_gaussian(params, n: np.ndarray) -> np.ndarray:
     gx = 0.5 * (special.erf((n + 0.5 - dx) / (root2 * sx)) - special.erf((n - 0.5 - dx) / (root2 * sx)))
     gy = 0.5 * (special.erf((n + 0.5 - dy) / (root2 * sy)) - special.erf((n - 0.5 - dy) / (root2 * sy)))
     return flux * gy[:, None] * gx[None, :] + level
+
+
+def _pixel_profile(n: np.ndarray, shift: float, sigma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A Gaussian integrated over unit pixels along one axis, and its
+    derivatives by the shift and by sigma."""
+    root2 = math.sqrt(2.0)
+    high, low = (n + 0.5 - shift) / (root2 * sigma), (n - 0.5 - shift) / (root2 * sigma)
+    e_high, e_low = np.exp(-high ** 2), np.exp(-low ** 2)
+    g = 0.5 * (special.erf(high) - special.erf(low))
+    d_shift = -(e_high - e_low) / (math.sqrt(2.0 * math.pi) * sigma)
+    d_sigma = -(high * e_high - low * e_low) / (math.sqrt(math.pi) * sigma)
+    return g, d_shift, d_sigma
+
+
+def pixel_gaussian_jacobian(params, n: np.ndarray) -> np.ndarray:
+    """The derivatives of :func:`pixel_gaussian`'s pixels (raveled, rows
+    first) by its ``params`` (flux, dx, dy, sigma_x, sigma_y, level): shape
+    (pixels, 6); what its least-squares fit uses rather than differences.
+
+    Examples
+    --------
+    >>> n, p = np.arange(-3, 4.0), np.array([100.0, 0.2, -0.3, 0.6, 0.8, 5.0])
+    >>> step = 1e-6 * np.eye(6)[2]
+    >>> numeric = (pixel_gaussian(p + step, n) - pixel_gaussian(p - step, n)).ravel() / 2e-6
+    >>> bool(np.allclose(pixel_gaussian_jacobian(p, n)[:, 2], numeric, atol=1e-6))
+    True
+    """
+    flux, dx, dy, sx, sy, _ = params
+    gx, gx_shift, gx_sigma = _pixel_profile(n, dx, sx)
+    gy, gy_shift, gy_sigma = _pixel_profile(n, dy, sy)
+    columns = (np.outer(gy, gx), flux * np.outer(gy, gx_shift), flux * np.outer(gy_shift, gx),
+               flux * np.outer(gy, gx_sigma), flux * np.outer(gy_sigma, gx), np.ones((n.size, n.size)))
+    return np.column_stack([c.ravel() for c in columns])
 
 
 def fit_pixel_gaussian(stamp: np.ndarray):
@@ -318,7 +384,8 @@ def fit_pixel_gaussian(stamp: np.ndarray):
     high = [np.inf, radius, radius, float(radius), float(radius), np.inf]
     try:
         fit = optimize.least_squares(lambda p: (pixel_gaussian(p, n) - stamp).ravel(), start, bounds=(low, high),
-                                     x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400)
+                                     jac=lambda p: pixel_gaussian_jacobian(p, n), x_scale="jac", xtol=1e-12,
+                                     ftol=1e-12, gtol=1e-12, max_nfev=400)
     except (ValueError, np.linalg.LinAlgError):
         return None
     if not fit.success or not np.isfinite(fit.x).all() or fit.x[0] <= 0:

@@ -16,6 +16,13 @@ from .sources import FoundSources
 #: the highest alias order the model correction covers, and the band (cy/px) the PSF is drawn from
 ALIAS_ORDER = 4
 BAND_CY_PX = 2.0
+#: the taper: each stamp is its data within TAPER_SIGMAS fitted sigmas (at least TAPER_CORE_PX) of its centre,
+#: eased over TAPER_WIDTH_PX into its fitted model beyond, unless the targets' tails hold more than MAX_TAIL_LIGHT
+#: of their light (or three standard errors) that the model has not
+TAPER_CORE_PX = 2.0
+TAPER_SIGMAS = 3.0
+TAPER_WIDTH_PX = 1.5
+MAX_TAIL_LIGHT = 0.005
 #: where a square's sinc is too small to divide out (NaN there)
 MIN_DIVISOR = 0.1
 SECTION_STEP_CY_PX = 0.01
@@ -67,6 +74,8 @@ class DirectionMTF:
 def _widened(replicates: np.ndarray, estimate: float, tail: float, widen: float) -> Interval:
     """The percentile interval of ``replicates``, its ends moved ``widen``
     times as far from ``estimate``."""
+    if not math.isfinite(widen):            # one target's worth of weight: no spread to draw an interval from
+        return Interval.none()
     low, high = np.nanpercentile(replicates, [tail, 100 - tail])
     return Interval(estimate - widen * (estimate - low), estimate + widen * (high - estimate))
 
@@ -75,13 +84,16 @@ class Stack:
     """The used targets' stamps and phases, and the transforms of their
     stack (see the module); built once, read for every frequency."""
 
-    def __init__(self, found: FoundSources, point_size_px: float):
+    def __init__(self, found: FoundSources, point_size_px: float, *, taper: bool = True):
         self.stamps, self.phases, self.size = found.stamps, found.phases_px, point_size_px
         radius = found.stamp_radius_px
         self.offsets = np.arange(-radius, radius + 1, dtype=float)
         self.radius = radius
         used = found.used
         self.sigmas = np.array([[s.sigma_x_px, s.sigma_y_px] for s in used])
+        self.tail_note = ""
+        if taper and len(used):
+            self.stamps, self.tail_note = self._tapered()
         # inverse variance: a stamp divided by its flux has noise / flux; capped at 3x the median flux so that
         # no one bright target (one phase) carries the stack alone
         flux = np.array([s.flux_dn for s in used])
@@ -96,6 +108,28 @@ class Stack:
         share = self.weights / self.weights.sum()
         self.alias_weight = float(np.abs(share @ self.alias_phasors[:, first]).max())
 
+    def _tapered(self) -> tuple[np.ndarray, str]:
+        """The stamps with their far pixels eased into each target's fitted
+        model (see the module), or as they are, with the reason, when the
+        targets' tails hold light the model has not."""
+        from .sources import pixel_gaussian
+        core = max(TAPER_CORE_PX, TAPER_SIGMAS * float(np.median(self.sigmas, axis=0).max()) + 0.35)
+        outer = core + TAPER_WIDTH_PX
+        if outer > self.radius + 0.5:               # a core that fills the stamp: nothing to ease
+            return self.stamps, ""
+        n = self.offsets
+        models = np.array([pixel_gaussian((1.0, dx, dy, sx, sy, 0.0), n)
+                           for (dx, dy), (sx, sy) in zip(self.phases, self.sigmas)])
+        r = np.hypot(n[None, None, :] - self.phases[:, 0, None, None], n[None, :, None] - self.phases[:, 1, None, None])
+        tail = np.where(r > core, self.stamps - models, 0.0).sum(axis=(1, 2))      # light beyond the model's
+        spread = float(tail.std(ddof=1)) / math.sqrt(len(tail)) if len(tail) > 1 else math.inf
+        if abs(float(tail.mean())) > max(3.0 * spread, MAX_TAIL_LIGHT):
+            return self.stamps, (f"the targets hold {100 * float(tail.mean()):+.1f} % of their light beyond "
+                                 f"{core:.1f} px that their Gaussian model has not (a halo or wings): measured as "
+                                 "they are, not eased into the model, at the cost of precision")
+        weight = np.sin(0.5 * np.pi * np.clip((outer - r) / TAPER_WIDTH_PX, 0.0, 1.0)) ** 2
+        return weight * self.stamps + (1.0 - weight) * models, ""
+
     def contributions(self, fx: np.ndarray, fy: np.ndarray) -> np.ndarray:
         """Each target's phase-corrected transform at the frequency pairs
         (``fx``, ``fy``) (1-D, cy/px): shape (targets, frequencies)."""
@@ -106,9 +140,12 @@ class Stack:
 
     def model(self, fx: np.ndarray, fy: np.ndarray, sigmas: np.ndarray) -> np.ndarray:
         """The located targets' model transfer: a Gaussian of the median
-        widths, integrated over the pixel (1 at zero)."""
-        sx, sy = np.median(sigmas, axis=0)
-        return np.exp(-2 * np.pi ** 2 * ((sx * fx) ** 2 + (sy * fy) ** 2)) * np.sinc(fx) * np.sinc(fy)
+        widths, integrated over the pixel (1 at zero); ``sigmas`` (n, 2)
+        gives one model, (replicates, n, 2) one per replicate (a leading
+        axis on the result)."""
+        sx, sy = np.moveaxis(np.median(sigmas, axis=-2), -1, 0)
+        sx, sy = np.reshape(sx, np.shape(sx) + (1,) * fx.ndim), np.reshape(sy, np.shape(sy) + (1,) * fx.ndim)
+        return np.exp(-2 * np.pi ** 2 * ((sx * fx) ** 2 + (sy * fy) ** 2)) * (np.sinc(fx) * np.sinc(fy))
 
     def transfer(self, fx: np.ndarray, fy: np.ndarray, *, divide_size: bool = True) -> np.ndarray:
         """The stack's transfer at the pairs (``fx``, ``fy``), the model's
@@ -123,12 +160,19 @@ class Stack:
         (replicates, frequencies)."""
         fx0, fy0 = np.append(fx, 0.0), np.append(fy, 0.0)
         each = self.contributions(fx0, fy0)                                   # (targets, F)
+        picks = np.asarray(picks)
+        # each replicate's shares of the targets (a target picked twice counts twice): all replicates at once
+        counts = np.zeros((len(picks), len(self.stamps)))
+        np.add.at(counts, (np.repeat(np.arange(len(picks)), picks.shape[1]), picks.ravel()), 1.0)
+        shares = counts * self.weights[None, :]
+        shares /= shares.sum(axis=1, keepdims=True)
         out = np.empty((len(picks), len(fx0)), complex)
-        for r, pick in enumerate(picks):
-            aliased = self.model(fx0[:, None] + self.aliases[None, :, 0], fy0[:, None] + self.aliases[None, :, 1],
-                                 self.sigmas[pick])
-            share = self.weights[pick] / self.weights[pick].sum()
-            out[r] = share @ each[pick] - aliased @ (share @ self.alias_phasors[pick])
+        ax, ay = fx0[:, None] + self.aliases[None, :, 0], fy0[:, None] + self.aliases[None, :, 1]
+        for start in range(0, len(picks), 50):          # the aliases' models of 50 replicates at a time (memory)
+            block = slice(start, start + 50)
+            aliased = self.model(ax, ay, self.sigmas[picks[block]])              # (R, F, aliases)
+            out[block] = shares[block] @ each - np.einsum("rfa,ra->rf", aliased,
+                                                           shares[block] @ self.alias_phasors)
         t = out[:, :-1] / out[:, -1:].real
         if divide_size and self.size > 0:
             divisor = np.sinc(self.size * fx) * np.sinc(self.size * fy)
@@ -170,13 +214,17 @@ class Stack:
         few targets is drawn: Student's t over the normal quantile, times
         sqrt(n / (n - 1)) (the bootstrap's variance of a mean is (n - 1) / n
         of the truth), n the weights' effective count (Hesterberg's
-        expanded percentile interval); 1.09 x 1.03 for 16 targets."""
-        from scipy import stats
+        expanded percentile interval; the degrees of freedom rounded);
+        1.09 x 1.03 for 16 targets."""
+        from statistics import NormalDist
+
+        from ..._stats import t_quantile
         n = float(self.weights.sum() ** 2 / (self.weights ** 2).sum())
         if n <= 1.5:
             return math.inf
         q = 0.5 + confidence / 2
-        return float(stats.t.ppf(q, n - 1) / stats.norm.ppf(q) * math.sqrt(n / (n - 1)))
+        # (t's degrees of freedom rounded to an integer: the closed form, without SciPy's stats, 2 s to import)
+        return float(t_quantile(q, max(int(round(n - 1)), 1)) / NormalDist().inv_cdf(q) * math.sqrt(n / (n - 1)))
 
     def lsf(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """The line spread function along ``vector``: the inverse transform
