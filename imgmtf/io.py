@@ -422,7 +422,7 @@ def _read(src, info: RasterInfo, band, window, out_shape) -> Raster:
         data = luminance(np.stack([_band(src, i, region, out_shape) for i in (1, 2, 3)]), channel_axis=0)
     else:
         raise ParameterError(f"{path}: has {count} bands and no RGB colour interpretation; "
-                             "choose one band, or all", reason="bands")
+                             "choose one band", reason="bands")
     tags = src.tags()
     codec = lossy_codec(src)
     if data.size == 0:

@@ -227,12 +227,14 @@ class Record:
         return self.status in OK_STATUSES
 
     def get(self, key: str, default: Any = None) -> Any:
-        """A value of the flat JSON form (a field, a figure or a site key).
+        """A value of the flat JSON form (a field, a figure or a site key),
+        or of a CSV column (an interval's bound, ``mtf_nyquist_ci_low``; a
+        point of the curve, ``mtf_at_0.25_cy_px``) by the CSV's name.
 
         Parameters
         ----------
         key : str
-            The key (``mtf_nyquist``, ``status``, ``x0_px``...).
+            The key (``mtf_nyquist``, ``status``, ``x0_px``...) or CSV column.
         default : object, optional
             What a missing key gives (default None).
 
@@ -240,8 +242,26 @@ class Record:
         -------
         object
             The value.
+
+        Examples
+        --------
+        >>> r = Record("a.tif", 1, "edge", "msg", "ok", figures={"mtf_nyquist": 0.3, "mtf_nyquist_ci": [0.28, 0.32]})
+        >>> r.get("mtf_nyquist_ci"), r.get("mtf_nyquist_ci_low"), r.get("mtf50_ci_low_cy_px", "-")
+        ([0.28, 0.32], 0.28, '-')
         """
-        return self.to_dict().get(key, default)
+        flat = self.to_dict()
+        if key in flat:
+            return flat[key]
+        source = _CSV_SOURCES.get(key)
+        if isinstance(source, tuple):
+            pair = flat.get(source[0])
+            return default if pair is None else pair[source[1]]
+        if source is not None:
+            return flat.get(source, default)
+        if key in _CURVE_COLUMN_FREQUENCY:
+            value = curve_values(flat.get("frequencies_cy_px"), flat.get("mtf"))[key]
+            return default if value is None else value
+        return default
 
     def with_(self, **changes: Any) -> Record:
         """A copy with fields changed (``figures``/``site`` given as

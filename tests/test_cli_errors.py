@@ -13,7 +13,18 @@ from click.testing import CliRunner
 
 import imgmtf
 from imgmtf.cli import main
-from imgmtf.cli.hints import CHIP, HINTS, OPTION, SCAN, Command, option_hints, refusal_hint, rejection_hint
+from imgmtf.cli.hints import (
+    CHIP,
+    HINTS,
+    OPTION,
+    SCAN,
+    WARNING,
+    Command,
+    hinted_warning,
+    option_hints,
+    refusal_hint,
+    rejection_hint,
+)
 from imgmtf.cli.main import COMMANDS
 
 PACKAGE = pathlib.Path(imgmtf.__file__).parent
@@ -46,14 +57,29 @@ def test_no_library_message_names_a_command_line_option():
     ("too-large", "--roi"), ("bands", "--band"), ("bar-width", "--pulse-width"), ("fit", "--stages"),
 ])
 def test_the_cli_answers_a_reason_with_its_option(reason, option):
-    answers = option_hints(CHIP, reason)
+    message = "a message; " + next(h.words for h in HINTS if h.command == CHIP and h.reason == reason)
+    answers = option_hints(CHIP, reason, message)
     # one answer per refusal, per command ("--band all" only where --band takes it)
-    assert option in refusal_hint(reason, "a message") and option in answers[0]
+    assert option in refusal_hint(reason, message) and option in answers[0]
     assert len(answers) == len({h.only for h in HINTS if h.command == CHIP and h.reason == reason})
 
 
 def test_a_reason_no_option_answers_gets_no_option():
     assert refusal_hint("unreadable", "cannot read") == ""
+
+
+def test_a_window_too_large_is_not_told_to_give_a_window():
+    whole = "a.tif: the image is 6000 x 6000 px (36.0 million pixels), ...; measure a window of it"
+    window = "a.tif: the window is 5000 x 5000 px (25.0 million pixels), ...; measure a smaller window"
+    assert "--roi" in refusal_hint("too-large", whole) and refusal_hint("too-large", window) == ""
+
+
+def test_a_warning_names_the_option_that_answers_it_where_the_command_has_it():
+    unknown = "the image is not in sensor geometry (map-projected): ...; give the track's azimuth to label it"
+    measure, fit = (Command.of(next(c for c in COMMANDS if c.name == name)) for name in ("measure", "fit"))
+    assert hinted_warning(unknown, running=measure) == unknown + " (--track-azimuth DEG gives it)"
+    assert hinted_warning(unknown, running=fit) == unknown
+    assert hinted_warning("another warning", running=measure) == "another warning"
 
 
 @pytest.mark.parametrize("reason, message, option", [
@@ -72,7 +98,7 @@ def test_a_scan_names_no_option_where_none_moves_the_limit():
 
 
 def test_every_hint_is_for_a_command_that_shows_it_and_names_an_option():
-    assert {h.command for h in HINTS} == {CHIP, SCAN}
+    assert {h.command for h in HINTS} == {CHIP, SCAN, WARNING}
     assert all(FLAG.search(h.text) for h in HINTS)
     assert len({(h.command, h.reason, h.words, h.only) for h in HINTS}) == len(HINTS)   # one answer per refusal
 
@@ -124,5 +150,5 @@ def test_a_command_s_refusal_names_its_own_options_end_to_end(tmp_path):
         dst.write(image)
     fit = CliRunner().invoke(main, ["fit", str(tmp_path / "two.tif")])
     measure = CliRunner().invoke(main, ["measure", str(tmp_path / "two.tif")])
-    assert fit.exit_code == 1 and "(--band N chooses one)" in fit.output and "--band all" not in fit.output
+    assert fit.exit_code == 1 and "(--band N chooses one)" in fit.output and "all" not in fit.output
     assert "--band all measures each" in measure.output

@@ -6,17 +6,19 @@
   CLI (each ``$ imgmtf ...`` line, its exit status 0 unless the line ends
   with a ``# exit status N`` comment, and the output shown beneath it, where
   ``...`` stands for any text, as in a doctest; a command shown without
-  output has its output unchecked), ``python`` blocks as doctests sharing
-  the document's names, ``toml`` blocks read as sensor files.
-* The package's docstring examples, module by module, as doctests.
+  output prints nothing; ``> FILE`` sends what it prints to FILE),
+  ``python`` blocks as doctests sharing the document's names, ``toml``
+  blocks read as sensor files.
+* No other block shows a command (``$ imgmtf ...``) but the few that
+  :data:`RECORDED` names with why the suite cannot run them.
+* (The package's docstring examples: tests/test_docstring_examples.py, a
+  file of its own so that a parallel run spreads the two.)
 
 When a change moves what a command prints, ``python tests/test_docs.py
 --update`` rewrites the console outputs the documents show (lines with
 ``...`` kept where they still match); read the diff before committing it.
 """
 import doctest
-import importlib
-import pkgutil
 import re
 import shlex
 from pathlib import Path
@@ -34,10 +36,20 @@ ROOT = Path(__file__).parent.parent
 # method), and the generated reproduction report
 OTHERS = {"accuracy.md", "method.md"}
 # pages whose examples read the shared real scenes (never copied into the repository): linked into
-# the folder the examples run in, the page skipped where they are absent (conftest.real_scene)
-REAL_SCENES_READ = {"docs/scan.md": ("baotou_l0r_checkerboard.tif",),
-                    "docs/regions.md": ("sentinel2_b04_bagnolo.tif",
-                                        *(f"bagnolo_roi/mtf_al_bagnolo.{e}" for e in ("shp", "shx", "dbf", "prj")))}
+# the folder the examples run in (under the name the page gives it; a shapefile's parts in their
+# folder), the page skipped where they are absent (conftest.real_scene)
+REAL_SCENES_READ = {"docs/scan.md": {"baotou_l0r_checkerboard.tif": "baotou_l0r_checkerboard.tif"},
+                    "docs/restore.md": {"baotou.tif": "baotou_l0r_checkerboard.tif"},
+                    "docs/regions.md": {name: name for name in (
+                        "sentinel2_b04_bagnolo.tif",
+                        *(f"bagnolo_roi/mtf_al_bagnolo.{e}" for e in ("shp", "shx", "dbf", "prj")))}}
+# blocks that show commands the suite does not run, each (document, its first command) with why
+RECORDED = {
+    ("docs/campaign.md", "imgmtf simulate --campaign scenes"):
+        "six 320 px scenes scanned with fits take about a minute; bench/campaign.py runs them against the truth",
+    ("docs/campaign.md", "imgmtf report store.gpkg --out report --requirement 0.1"):
+        "a store of the two real chips bench/campaign.py makes",
+}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -66,14 +78,22 @@ def console_steps(body: str):
 
 def run_command(command: str, where: str) -> list[str]:
     """Run one ``$ imgmtf ...`` line, check its exit status, return its
-    output lines (stdout and stderr as a terminal shows them)."""
+    output lines (stdout and stderr as a terminal shows them; with
+    ``> FILE``, stderr's, stdout written to FILE)."""
     args = shlex.split(command, comments=True)
     assert args[0] == "imgmtf", f"{where}: console blocks run imgmtf only, got {command!r}"
+    redirect = None
+    if len(args) > 2 and args[-2] == ">":
+        args, redirect = args[:-2], args[-1]
     status = EXIT_STATUS.search(command)
     result = CliRunner().invoke(main, args[1:])
     assert result.exit_code == int(status[1] if status else 0), (
         f"{where}: `{command}` exited {result.exit_code}:\n{result.output}")
-    return [line.rstrip() for line in result.output.strip("\n").splitlines()]
+    shown = result.output
+    if redirect is not None:
+        Path(redirect).write_text(result.stdout)
+        shown = result.stderr
+    return [line.rstrip() for line in shown.strip("\n").splitlines()]
 
 
 def run_console(body: str, where: str) -> None:
@@ -85,6 +105,9 @@ def run_console(body: str, where: str) -> None:
             assert checker.check_output(want, "\n".join(got) + "\n", doctest.ELLIPSIS), (
                 f"{where}: `{command}` printed\n" + "\n".join(got) + f"\nthe document shows\n{want}"
                 + "(python tests/test_docs.py --update rewrites what the documents show)")
+        else:       # shown without output: it prints none (a reader would not expect a table)
+            assert not got, (f"{where}: `{command}` printed\n" + "\n".join(got) + "\nthe document shows "
+                             "nothing (python tests/test_docs.py --update writes it; ... stands for lines left out)")
 
 
 def run_python(body: str, globs: dict, where: str) -> None:
@@ -131,9 +154,19 @@ def test_every_example_of_the_document_runs(document, sample_folder):
 
 
 def link_real_scenes(document: str, folder: Path) -> None:
-    for name in REAL_SCENES_READ.get(document, ()):
-        (folder / name).parent.mkdir(exist_ok=True)         # a shapefile's parts, in their folder
-        (folder / name).symlink_to(real_scene(name))
+    for link, name in REAL_SCENES_READ.get(document, {}).items():
+        (folder / link).parent.mkdir(exist_ok=True)         # a shapefile's parts, in their folder
+        (folder / link).symlink_to(real_scene(name))
+
+
+def test_every_block_that_shows_a_command_runs_or_says_why_not():
+    shown = {}
+    for document in DOCUMENTS:
+        for language, body, line in fenced_blocks((ROOT / document).read_text()):
+            commands = [c for c, _ in console_steps(body)] if body.lstrip().startswith("$ ") else []
+            if commands and language != "console":
+                shown[(document, commands[0])] = line
+    assert sorted(set(shown) - set(RECORDED)) == [] and sorted(set(RECORDED) - set(shown)) == []
 
 
 def assert_ignored(folder: Path) -> None:
@@ -172,20 +205,6 @@ def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
     assert '".[$extras]"' in ci and "run_suite .venv-ci test" in ci and "\n    pytest" in ci
 
 
-MODULES = sorted(m.name for m in pkgutil.walk_packages(imgmtf.__path__, "imgmtf."))
-
-
-@pytest.mark.parametrize("name", MODULES)
-def test_docstring_examples(name, tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)                       # examples may write files
-    module = importlib.import_module(name)
-    runner = doctest.DocTestRunner(optionflags=DOCTEST_FLAGS)
-    report: list[str] = []
-    for test in doctest.DocTestFinder().find(module, name):
-        runner.run(test, out=report.append)
-    assert not runner.failures, "".join(report)
-
-
 def update_console_outputs(document: str) -> None:
     """Rewrite the outputs a document's console blocks show with what the
     commands print now, in a fresh folder as the test runs them; a shown
@@ -210,7 +229,10 @@ def update_console_outputs(document: str) -> None:
                     if any(shown) and len(shown) == len(got):
                         got = [e if checker.check_output(e + "\n", g + "\n", doctest.ELLIPSIS) else g
                                for e, g in zip(shown, got)]
-                    lines += [f"$ {command}", *(got if any(shown) else shown)]
+                    elif any(shown) and checker.check_output("\n".join(shown) + "\n", "\n".join(got) + "\n",
+                                                             doctest.ELLIPSIS):
+                        got = shown                 # an abbreviated output ("...") that still matches
+                    lines += [f"$ {command}", *got]
                 text = text.replace(body, "\n".join(lines) + "\n", 1)
         finally:
             os.chdir(here)

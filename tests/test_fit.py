@@ -1,4 +1,5 @@
 import json
+import re
 
 import numpy as np
 import pytest
@@ -54,6 +55,12 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     wrong = im.fit_sensor(chip.image, stages="optics,detector", hold="detector")
     assert wrong.misfit and any("does not fit" in w for w in wrong.warnings)
     assert wrong.edges[0].misfit_p < 1e-3
+    # and its figure says so in its title, the right one does not
+    from imgmtf.plot import plot_fit
+    figure = plot_fit(wrong)
+    assert figure._suptitle.get_text().startswith("MISFIT: the model does not fit 1 of its 1 edges")
+    assert "MISFIT" in figure.axes[0].get_title()
+    assert "MISFIT" not in plot_fit(right)._suptitle.get_text()
     # the advice names stages the model lacks, never one it has
     from imgmtf.estimate.fit.model import other_stages as _other_stages
     assert _other_stages(wrong.sensor.stages) == ("try the stages real blur adds (diffusion, halo, lag; stages "
@@ -189,6 +196,31 @@ def test_cli_json_contract_toml_and_plot(pair, tmp_path):
     assert text.exit_code == 0 and "optics" in text.stdout
     assert CliRunner().invoke(main, ["simulate", "--sensor", str(out), "--size", "20",
                                      "--out", str(tmp_path / "again.tif")]).exit_code == 0
+
+
+def test_the_text_table_shortens_long_paths_and_keeps_its_columns_within_120(capsys):
+    from types import SimpleNamespace
+
+    from imgmtf.cli.tables import print_fit
+    deep = "/archive/" + "a_folder_with_a_long_name_" * 3
+    edges = [SimpleNamespace(source=f"{deep}/a_long_file_name_for_an_edge_of_the_sensor_{k}.tif[0,0,60,60]",
+                             normal_angle_deg=angle, direction=d, constrains=d, mtf_nyquist=0.27,
+                             mtf_nyquist_ci=(0.26, 0.28), measured_mtf_nyquist=0.27, reduced_chi_square=1.0,
+                             misfit_fraction=0.0) for k, (angle, d) in enumerate(((5.0, "across"), (-84.0, "along")))]
+    result = SimpleNamespace(edges=edges, sensor=TRUTH, reduced_chi_square=1.0, choice=None, parameters=[],
+                             pixel_units=False,
+                             correlations=[], confidence=0.95, warnings=[],
+                             directions={"across": {"mtf_nyquist": 0.27, "mtf_nyquist_ci": (0.26, 0.28),
+                                                    "mtf50_cy_px": 0.36, "constrained": True}})
+    print_fit(result)
+    lines = capsys.readouterr().out.splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("edge "))
+    assert lines[header - 1] == f"edges below {deep}/"
+    rows = lines[header: header + 3]
+    assert all(len(line) <= 120 for line in rows) and rows[1].split()[0] != rows[2].split()[0]
+    for row in rows[1:]:                # right-aligned: the headings end where the figures do
+        assert rows[0].index("normal") + len("normal") == re.search(r" (-?\d+\.\d\d) ", row).end(1)
+        assert len(rows[0]) == len(row)
 
 
 @pytest.mark.parametrize("args, message", [

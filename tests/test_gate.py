@@ -159,6 +159,10 @@ def test_force_measures_anyway_with_every_failed_check_as_a_warning():
     r = im.measure_edge(chip, force=True)
     assert {w.split(":")[0] for w in r.warnings} >= {"fill", "non-uniform"}
     assert r.to_dict()["checks"]
+    # and its figure says so first, in red: it looks like no other
+    from imgmtf.plot import plot_measurement
+    header = plot_measurement(r, title="chip.tif")._suptitle
+    assert header.get_text().splitlines()[1].startswith("FORCED past") and header.get_color() == "C3"
 
 
 def test_direction_is_labelled_only_near_the_track():

@@ -188,6 +188,8 @@ def test_the_fit_figure_draws_the_models_interval_and_the_truth_with_short_title
     fig.canvas.draw()
     boxes = [a.title.get_window_extent() for a in fig.axes[:2]]
     assert boxes[0].x1 < boxes[1].x0                                           # titles apart
+    # two edges, residuals and PSF: a 2 x 2 page, not a strip of four panels whose text shrinks when shown
+    assert fig.get_figwidth() / fig.get_figheight() < 1.2
     assert imgmtf.plot.plot_fit is plot_fit
 
 

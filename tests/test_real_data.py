@@ -8,6 +8,7 @@ MTF50 bands are the three peers' (MTF Mapper, sfrmat5, sfrmat3) widened by
 environment variable IMGMTF_SHARED_DATA names (see its README for provenance
 and licences; the GPL-3.0 files are read there, never copied); the tests are
 skipped when that folder is absent and IMGMTF_SHARED_DATA is unset."""
+import re
 from pathlib import Path
 
 import pytest
@@ -97,6 +98,15 @@ def test_the_shared_data_variable_points_the_tests_at_a_copy(tmp_path, monkeypat
     monkeypatch.setattr(conftest, "REAL_SCENES", copy / "real-scenes")
     with pytest.raises(pytest.fail.Exception, match="no real-scenes/missing.tif there"):
         conftest.real_scene("missing.tif")
+
+
+def test_every_test_finds_the_shared_data_where_the_variable_says():
+    """No test file but conftest builds the shared data's path itself (one
+    that did ignored IMGMTF_SHARED_DATA and always skipped elsewhere)."""
+    here = Path(__file__).parent
+    own = [p.name for p in sorted(here.glob("test_*.py")) if p.name != Path(__file__).name
+           and re.search(r"""["']shared["']""", p.read_text())]
+    assert own == []
 
 
 @pytest.mark.parametrize("name, reason, said", [

@@ -45,6 +45,10 @@ def test_csv_schema_names_units_and_scan_extends_it():
     assert row["mtf_nyquist_ci_low"] == 0.26 and row["mtf50_ci_high_cy_px"] == 0.37
     assert row["roi_px"] == "[0, 0, 64, 64]" and json.loads(row["warnings"]) == ["a warning"]
     assert row["noise_limit_cy_px"] == "" and row["rer"] == ""
+    # the record answers every CSV column by the CSV's name, as the CSV holds it
+    for column in ("mtf_nyquist_ci_low", "mtf_nyquist_ci_high", "mtf50_ci_low_cy_px", "mtf50_ci_high_cy_px"):
+        assert record.get(column) == row[column]
+    assert record.get("roi_px") == [0, 0, 64, 64] and record.get("mtf_at_0.50_cy_px", "-") == "-"
 
 
 def test_utc_timestamp_is_iso_8601():
@@ -94,6 +98,8 @@ def test_csv_rows_carry_the_mtf_curve_on_a_fixed_grid():
     assert set(CURVE_COLUMNS) <= set(CSV_COLUMNS) and CURVE_COLUMNS[10] == "mtf_at_0.50_cy_px"
     assert row["mtf_at_0.50_cy_px"] == 0.75 and row["mtf_at_0.25_cy_px"] == 0.875
     assert row["mtf_at_0.70_cy_px"] == ""                  # undefined there (a bar's sinc zero)
+    record = Record.measured("a.tif", 1, summary, params={}, run_utc="t")
+    assert record.get("mtf_at_0.50_cy_px") == 0.75 and record.get("mtf_at_0.70_cy_px") is None
     assert all(v is None for v in curve_values(None, None).values())   # failures: empty cells
 
 

@@ -94,9 +94,18 @@ def test_saturated_pixels_are_kept_and_clipping_counted(filt, tmp_path):
     assert out.min() == 0
 
 
+def test_zero_fill_around_a_target_is_kept_and_counted_as_fill_not_saturation(filt, tmp_path):
+    data = np.zeros((100, 100))
+    data[20:80, 20:80] = np.where(np.arange(60) < 30, 400, 3000)[None, :]     # a target cut out of its scene
+    write(tmp_path / "in.tif", data, "uint16")
+    done = im.restore_file(tmp_path / "in.tif", filt, tmp_path / "out.tif", tile_px=64)
+    assert done.saturated_fraction == 0 and done.fill_fraction == pytest.approx(1 - 0.36)
+    assert np.all(im.read_raster(tmp_path / "out.tif").data[data == 0] == 0)
+
+
 def test_integer_clip_avoids_a_nodata_value_at_the_range_end():
     output = OutputType("uint8", 0.0, None)
-    samples, clipped, _ = output.convert(np.array([[-5.0, 7.4, 300.0]]), np.array([[3.0, 7.0, 200.0]]))
+    samples, clipped, _, _ = output.convert(np.array([[-5.0, 7.4, 300.0]]), np.array([[3.0, 7.0, 200.0]]))
     assert samples.tolist() == [[1, 7, 255]] and clipped == 2
 
 

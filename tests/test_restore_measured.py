@@ -46,7 +46,11 @@ def test_the_rows_the_scan_chose_are_taken_and_none_is_refused(tmp_path):
     other = [{**r, "assumption": "elliptical", "mtf": [1.0] * F.size} for r in chosen]
     sensor = measured_sensor(other + chosen + rows(scope="target"))
     assert sensor.mtf_nyquist("across") == pytest.approx(TRUTH.mtf_nyquist("across"), abs=1e-9)
-    with pytest.raises(ImgmtfError, match="no across- and along-track rows") as refused:
+    # an image without track information names its axes: horizontal across its columns, vertical along
+    axes = [{**r, "direction": {"across-track": "horizontal", "along-track": "vertical"}[r["direction"]]}
+            for r in chosen]
+    assert measured_sensor(axes).mtf_nyquist("along") == pytest.approx(TRUTH.mtf_nyquist("along"), abs=1e-9)
+    with pytest.raises(ImgmtfError, match="no across- and along-track") as refused:
         measured_sensor(chosen[:1], "scan.jsonl")
     assert refused.value.reason == "no-target"
     path = tmp_path / "scan.jsonl"

@@ -116,6 +116,43 @@ def test_overview_draws_collections_labels_targets_and_fills_its_figure(scan_rec
     assert (x1 - x0) * fig.get_figwidth() / ((y1 - y0) * fig.get_figheight()) == pytest.approx(2.0)
 
 
+def test_an_overview_of_hundreds_of_candidates_reads_and_its_target_label_leaves_the_junction_clear():
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import CROWD_ALPHA, MAX_LISTED
+    rng = np.random.default_rng(3)
+    x, y = rng.uniform(0, 400, (2, 300))
+    crowd = [{"id": k + 10, "status": "rejected", "reason": "too-short", "x0_px": a, "y0_px": b, "x1_px": a + 12,
+              "y1_px": b + 4} for k, (a, b) in enumerate(zip(x, y))]
+    # a checkerboard's four half-edges meeting at (200, 200), each with its ROI
+    ends = [(200, 120), (120, 200), (200, 280), (280, 200)]
+    accepted = [{"id": k + 1, "status": "accepted", "x0_px": 200.0, "y0_px": 200.0, "x1_px": float(a),
+                 "y1_px": float(b), "roi_polygon_px": [(200 - 10 * (b != 200), 200 - 10 * (a != 200)),
+                                                       (a + 10 * (b != 200), b + 10 * (a != 200)),
+                                                       (a - 10 * (b != 200), b - 10 * (a != 200))]}
+                for k, (a, b) in enumerate(ends)]
+    target = [{"scope": "target", "target_id": 1, "x_px": 200.0, "y_px": 200.0, "direction": d,
+               "normal_angle_deg": 0.0, "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3} for d in ("oblique", "unknown")]
+    fig = plot_scan(np.zeros((400, 400)), 1.0, [*accepted, *crowd], target)
+    ax = fig.axes[0]
+    lines = [c for c in ax.collections if isinstance(c, LineCollection) and not isinstance(c, PolyCollection)]
+    # the rejected faint (too many to label: bare, no outline), the accepted opaque; the ROIs unfilled
+    assert len(crowd) > MAX_LISTED and lines[0].get_alpha() == CROWD_ALPHA and not lines[0].get_path_effects()
+    assert lines[-1].get_alpha() is None and lines[-1].get_path_effects()
+    roi = next(c for c in ax.collections if isinstance(c, PolyCollection))
+    assert np.all(roi.get_facecolor()[:, 3] == 0)
+    # the target's label covers neither the junction nor its half-edges; its title says what the labels hold
+    label = next(t for t in ax.texts if t.get_text().startswith("T1"))
+    box = label.get_window_extent()
+    for (a, b) in ends:
+        for f in np.linspace(0.0, 1.0, 30):
+            px, py = ax.transData.transform((200 + f * (a - 200), 200 + f * (b - 200)))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
+    assert ax.get_title(loc="left").splitlines()[1].startswith("target labels: MTF at Nyquist | MTF50")
+    assert "300 rejected (faint)" in ax.get_title(loc="left")
+
+
 def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     out = tmp_path / "scan"
     result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
@@ -124,6 +161,7 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
     assert rejected and not any(f"{SCENE}:" in line for line in rejected)
     assert "warning: the image is not in sensor geometry" in result.stdout
+    assert "give the track's azimuth to label it (--track-azimuth DEG gives it)" in result.stdout
     geo = json.loads((out / "targets.geojson").read_text())
     assert geo["imgmtf_coordinates"].startswith("longitude/latitude")
     first = geo["features"][0]

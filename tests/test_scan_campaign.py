@@ -51,6 +51,7 @@ def test_a_folder_of_scenes_goes_into_the_store_once_whatever_is_added_again(cam
     assert again.exit_code == 0, again.output
     assert layer_counts(store) == counts
     assert "no acquisition time" not in again.output
+    assert f"1 acquisition(s) written to {store}" in again.output          # as measure --campaign says it
 
 
 def test_a_scene_that_says_not_when_is_stored_with_one_note(tmp_path):

@@ -1,6 +1,7 @@
 """A candidate's ROI: its rectangle along the segment, and the stretch of it
 clear of junctions, fill and the scene's border."""
 import math
+import re
 
 import numpy as np
 import pytest
@@ -65,6 +66,17 @@ def test_the_clear_stretch_stops_short_of_a_partner_and_of_fill():
     reason, _ = clear_extent(roi, t, d, xs, ys, fill, [], info)
     assert reason == "fill"
 
+
+def test_a_target_with_no_clear_row_says_none_of_its_rows_not_only_0():
+    info = RasterInfo("scene.tif", 100, 100, 1, ("gray",), "uint16", None, Affine.identity(), None)
+    roi = Roi(50.0, 40.0, 0.0, 1.0, 0.0, 30.0, 8.0)          # 30 rows, crossed at both ends and the middle
+    t, d, xs, ys = _pixels(roi, 100, 100)
+    fill = np.zeros((ys.max() - ys.min() + 1, xs.max() - xs.min() + 1), bool)
+    partners = [np.array([0.0, y, 100.0, y]) for y in np.arange(40.0, 71.0, 5.0)]
+    reason, message = clear_extent(roi, t, d, xs, ys, fill, partners, info)
+    assert reason == "too-short" and message.startswith("none of its 30 rows lie clear of the junctions")
+    reason, message = clear_extent(roi, t, d, xs, ys, fill, [np.array([0.0, 55.0, 100.0, 55.0])], info)
+    assert reason == "too-short" and re.match(r"1\d of its 30 rows lie clear", message)
 
 
 def _reference_bad_bins(roi, t, xs, ys, partners, info):

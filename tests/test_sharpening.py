@@ -75,6 +75,8 @@ def test_a_sharpened_product_is_measured_with_its_peak_and_a_note(sigma, kernel,
     assert any(w.startswith("sharpened: the MTF rises to") for w in r.warnings)
     out = r.to_dict()
     assert out["sharpened"] and out["mtf_peak"] > 1
+    from imgmtf.plot.measurement import measurement_verdict  # the figure's header says so too
+    assert measurement_verdict(r)[0].startswith(f"SHARPENED: the MTF rises to {r.mtf_peak:.3f}")
     explained = [c for c in out["checks"] if c.get("explained_by") == "sharpening"]
     assert explained and explained[0]["outcome"] == "passed"
 

@@ -16,8 +16,9 @@ import re
 from collections.abc import Collection
 from dataclasses import dataclass
 
-#: the commands a hint is written for: one file measured as given, or a scene searched
-CHIP, SCAN = "chip", "scan"
+#: the commands a hint is written for: one file measured as given, or a scene searched; and
+#: the warnings of a measurement (keyed by their words, having no reason code)
+CHIP, SCAN, WARNING = "chip", "scan", "warning"
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,8 @@ HINTS = (
     Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
     Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
     Hint(CHIP, "star", "--target star measures a Siemens star"),
-    Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window"),
+    # an image too large, not a window too large (which a smaller --roi answers, as its message says)
+    Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window", words="measure a window of it"),
     Hint(CHIP, "no-crs", "--roi X,Y,W,H measures a window in pixels"),
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
@@ -63,6 +65,7 @@ HINTS = (
     Hint(SCAN, "not-a-bar", "--target edge measures edges"),
     Hint(SCAN, "few-points", "--point-spacing PX groups targets farther apart, a star field's whole frame with "
                              "its size"),
+    Hint(WARNING, "", "--track-azimuth DEG gives it", words="give the track's azimuth"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and
@@ -134,3 +137,16 @@ def rejection_hint(reason: str | None, message: str, *, running: Command | None 
     ``""`` when no option moves the limit it failed."""
     hints = option_hints(SCAN, reason, message, running=running or command_options())
     return f" ({'; '.join(hints)})" if hints else ""
+
+
+def hinted_warning(message: str, *, running: Command | None = None) -> str:
+    """A warning as the CLI prints it: with the option that answers it in
+    parentheses, when the command running has one.
+
+    Examples
+    --------
+    >>> hinted_warning("the direction is unknown; give the track's azimuth to label it")
+    "the direction is unknown; give the track's azimuth to label it (--track-azimuth DEG gives it)"
+    """
+    hints = option_hints(WARNING, "", message, running=running or command_options())
+    return message + (f" ({'; '.join(hints)})" if hints else "")

@@ -146,7 +146,7 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
                                       plot_dir=plot_dir, progress=progress, run_utc=run_utc,
                                       ordered=False)
         stdout = (JsonLinesWriter(sys.stdout) if fmt == "json"
-                  else TextRows(kind, path_width=max(map(len, files)), bands=band is not None))
+                  else TextRows(kind, files, bands=band is not None))
         order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
         with ExitStack() as outputs:
             writers = [stdout]

@@ -195,7 +195,7 @@ def _print_text(done, written: list[str]) -> None:
                    f"{a.achieved_mtf_nyquist:8.4f} {a.peak_mtf_below_nyquist:5.3f} {a.rer_before:6.3f} "
                    f"{a.rer_after:6.3f} {a.overshoot_pct:5.2f} {a.undershoot_pct:5.2f} {a.ringing_pct:5.2f}")
     click.echo(f"clipped {100 * f.clipped_fraction:.3g} %, saturated (kept) {100 * f.saturated_fraction:.3g} %, "
-               f"nodata {100 * f.nodata_fraction:.3g} % of the pixels")
+               f"fill (kept) {100 * f.fill_fraction:.3g} %, nodata {100 * f.nodata_fraction:.3g} % of the pixels")
     for warning in done.warnings:
         click.echo(f"warning: {warning}")
     for path in written:

@@ -283,8 +283,11 @@ def _closing_notes(outcomes, paths, store, kind, fmt) -> None:
                    "ACQUISITION_DATETIME metadata item nor a product name with a date says when it was "
                    f"taken; stored in {store} without one, so a trend leaves it out: give --acquired TIME",
                    err=True)
+    written = sum(o.acquisition is not None and o.ok for o in outcomes)
     if len(paths) > 1:
         usable = sum(o.ok for o in outcomes)
-        stored = f"; {sum(o.acquisition is not None and o.ok for o in outcomes)} stored in {store}" if store else ""
+        stored = f"; {written} stored in {store}" if store else ""
         click.echo(f"{len(outcomes)} of {len(paths)} scenes scanned: {usable} with a usable {kind}, "
                    f"{len(outcomes) - usable} without or failed{stored}", err=True)
+    elif store and outcomes and not outcomes[0].interrupted:      # as measure --campaign says it
+        click.echo(f"{written} acquisition(s) written to {store}", err=True)

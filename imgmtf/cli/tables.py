@@ -5,20 +5,63 @@ from __future__ import annotations
 import click
 
 from ..kinds import get_kind
-from .hints import refusal_hint, rejection_hint
+from .hints import hinted_warning, refusal_hint, rejection_hint
+
+#: the widest a table's path column grows (characters), so that its rows fit 120 columns
+MAX_PATH_COLUMN = 36
+
+
+#: the widest fit's edge column grows: its rows' other columns take 73 characters
+FIT_EDGE_COLUMN = 46
+
+
+def path_labels(paths, width: int = MAX_PATH_COLUMN) -> tuple[dict[str, str], str]:
+    """Each path (or source, ``path[x,y,w,h]``) as a table's column shows
+    it, and the folder left out of every label (``""`` for none): the paths
+    as given when the longest fits ``width``; else below the folder they
+    all share, and a label still too long keeps its start and its end
+    (the file's name and extension, an ROI) about ``...``.
+
+    Examples
+    --------
+    >>> path_labels(["a.tif", "data/b.tif"])
+    ({'a.tif': 'a.tif', 'data/b.tif': 'data/b.tif'}, '')
+    >>> labels, folder = path_labels(["/archive/site/2021/scene_a.tif", "/archive/site/2022/b.tif"], width=20)
+    >>> list(labels.values()), folder
+    (['2021/scene_a.tif', '2022/b.tif'], '/archive/site')
+    """
+    import os
+    paths = list(dict.fromkeys(paths))
+    if not paths or max(map(len, paths)) <= width:
+        return {p: p for p in paths}, ""
+    try:
+        folder = os.path.commonpath([os.path.dirname(p) or "." for p in paths])
+    except ValueError:                      # absolute and relative paths mixed: no folder shared
+        folder = ""
+    cut = len(folder.rstrip("/")) + 1 if folder and folder != "." else 0
+    labels = {p: p[cut:] if cut else p for p in paths}
+    head = (width - 3) // 3
+    short = {p: label if len(label) <= width else label[:head] + "..." + label[-(width - 3 - head):]
+             for p, label in labels.items()}
+    # labels that no longer tell the paths apart are not shortened
+    return (short if len(set(short.values())) == len(short) else labels), folder if cut else ""
 
 
 class TextRows:
     """The text table of ``measure``, one row per record as it comes: the
-    path column as wide as the longest input, the band column when bands
-    were asked for."""
+    path column as wide as the longest input's label (:func:`path_labels`:
+    at most :data:`MAX_PATH_COLUMN`, so that rows fit 120 columns), the
+    band column when bands were asked for."""
 
-    def __init__(self, kind: str, path_width: int = 32, bands: bool = False):
+    def __init__(self, kind: str, paths=(), bands: bool = False):
         self.kind, self.bands = kind, bands
-        self.path_width = max(path_width, 4)
+        self.labels, self.folder = path_labels(paths)
+        self.path_width = max([4, *map(len, self.labels.values())])
 
     def header(self, confidence: float) -> None:
         last = get_kind(self.kind).column
+        if self.folder:
+            click.echo(f"paths below {self.folder}/")
         first = f"{'path':<{self.path_width}}" + (f" {'band':>4}" if self.bands else "")
         blank = " " * len(first)
         click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
@@ -27,13 +70,15 @@ class TextRows:
                    f"{'cy/px':>7} {'px':>6} {last.unit:>6}")
 
     def write(self, record) -> None:
-        click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands))
+        click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands,
+                            self.labels.get(record.path)))
 
 
-def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False) -> str:
+def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False, label: str | None = None) -> str:
     """One record as rows of the text table: figures in px units, a
-    ground line in metres when the GSD is known, then its warnings."""
-    first = f"{record['path']:<{path_width}}"
+    ground line in metres when the GSD is known, then its warnings; the
+    path shown as ``label`` when given."""
+    first = f"{label or record['path']:<{path_width}}"
     if bands:
         band = record["band"]
         first += f" {'lum' if band == 'luminance' else '' if band is None else band:>4}"
@@ -62,7 +107,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False)
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
     if record["status"] == "untrusted":
         cells.append(f"{indent} error: {record['error']}")
-    cells += [f"{indent} warning: {w}" for w in record.get("warnings") or []]
+    cells += [f"{indent} warning: {hinted_warning(w)}" for w in record.get("warnings") or []]
     return "\n".join(cells)
 
 
@@ -118,14 +163,18 @@ def print_fit(result) -> None:
         click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
                    "better than each")
     pct = f"{100 * result.confidence:g}%"
-    click.echo(f"{'edge':<32} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
+    labels, folder = path_labels((e.source for e in edges), width=FIT_EDGE_COLUMN)
+    width = max([4, *map(len, labels.values())])
+    if folder:
+        click.echo(f"edges below {folder}/")
+    click.echo(f"{'edge':<{width}} {'normal':>6} {'dir':>7} {'axis':>6} {'MTF@Nyq':>7} {pct + ' interval':>17} "
                f"{'measured':>8} {'chi2':>6} {'misfit':>7}")
     axes = {"across": "x", "along": "y"} if result.pixel_units else {}
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
-        click.echo(f"{e.source:<32} {e.normal_angle_deg:6.2f} {SHORT_DIRECTIONS.get(e.direction, e.direction):>7} "
-                   f"{axes.get(e.constrains, e.constrains):>6} "
-                   f"{e.mtf_nyquist:7.4f} "
+        direction = SHORT_DIRECTIONS.get(e.direction, e.direction)
+        click.echo(f"{labels[e.source]:<{width}} {e.normal_angle_deg:6.2f} {direction:>7} "
+                   f"{axes.get(e.constrains, e.constrains):>6} {e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
                    f"{100 * e.misfit_fraction:6.2f}%")
     click.echo(f"{'direction':<10} {'MTF@Nyq':>7} {pct + ' interval':>17} {'MTF50 cy/px':>11}")
@@ -135,7 +184,7 @@ def print_fit(result) -> None:
         click.echo(f"{names.get(name, name):<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
                    f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
     for warning in result.warnings:
-        click.echo(f"warning: {warning}")
+        click.echo(f"warning: {hinted_warning(warning)}")
 
 
 def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: bool = False) -> None:
@@ -167,7 +216,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
             click.echo(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
                        f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
             for warning in r.get("warnings") or []:
-                click.echo(f"{'':>{len(head)}} warning: {warning}")
+                click.echo(f"{'':>{len(head)}} warning: {hinted_warning(warning)}")
         else:       # the scene's name heads the table: the message need not repeat it
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
     if not verbose:
@@ -254,7 +303,7 @@ def print_target_fits(fitted) -> None:
         for warning in r.get("warnings") or []:
             if warning not in warned:           # across and along share their fit's warnings
                 warned.add(warning)
-                click.echo(f"{'':>11} warning: {warning}")
+                click.echo(f"{'':>11} warning: {hinted_warning(warning)}")
                 if "does not fit" in warning and not hinted:
                     hinted = True
                     click.echo(f"{'':>11} (--fit-stages fits other stages; the combined and sections rows "

@@ -85,11 +85,13 @@ def plot_fit_edge(fit: SensorFit, index: int, ax: Axes | None = None,
     window = window[np.isfinite(window)]
     pad = 0.15 * max(float(np.ptp(window)), 0.01)
     inset.set(xlim=(NYQUIST - half, NYQUIST + half), ylim=(window.min() - pad, window.max() + pad))
-    inset.tick_params(labelsize=6)
-    inset.set_title("about Nyquist", fontsize=6, pad=2)
-    ax.set_title(f"{_short(edge.source)}\nnormal {edge.normal_angle_deg:.1f} deg ({edge.direction})", fontsize="medium")
+    inset.tick_params(labelsize=7)
+    inset.set_title("about Nyquist", fontsize=7, pad=2)
+    verdict = f": MISFIT (structure {100 * edge.misfit_fraction:.2f} % of the step)" if edge.misfit else ""
+    ax.set_title(f"{_short(edge.source)}\nnormal {edge.normal_angle_deg:.1f} deg ({edge.direction}){verdict}",
+                 fontsize="medium", color="C3" if edge.misfit else "black")
     ax.set(xlim=(0, 1), ylim=(0, 1.05), xlabel="frequency along the normal (cy/px)", ylabel="MTF")
-    ax.legend(fontsize="x-small", title=f"at Nyquist ({percent} interval)", title_fontsize="x-small",
+    ax.legend(fontsize="small", title=f"at Nyquist ({percent} interval)", title_fontsize="small",
               loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)   # below, off the data
     return fig
 
@@ -142,7 +144,7 @@ def plot_fit_residuals(fit: SensorFit, ax: Axes | None = None) -> Figure | SubFi
     ax.axhline(0, color="0.4", lw=0.8)
     ax.set(title=f"Residuals along the normal ({MISFIT_BIN_PX:g} px bins)", xlabel="distance from the edge (px)",
            ylabel="data - model (% of the step)")
-    ax.legend(fontsize="x-small", title="structure (RMS)", title_fontsize="x-small", loc="upper center",
+    ax.legend(fontsize="small", title="structure (RMS)", title_fontsize="small", loc="upper center",
               bbox_to_anchor=(0.5, -0.2), ncols=2, frameon=False)       # below the axes, off the data
     return fig
 
@@ -270,9 +272,9 @@ def plot_fit(fit: SensorFit, max_edges: int = 6,
     truths = list(truths) if truths is not None else [None] * len(fit.edges)
     shown = min(len(fit.edges), max_edges)
     panels = shown + 2
-    cols = min(panels, 4)
+    cols = 2 if panels <= 4 else 3          # a page's width: more columns shrink the text when shown
     rows = -(-panels // cols)
-    fig = Figure(figsize=(4.4 * cols, 4.4 * rows), layout="constrained")
+    fig = Figure(figsize=(5.0 * cols, 4.8 * rows), layout="constrained")
     axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
     for i in range(shown):
         plot_fit_edge(fit, i, axes[i], truth=truths[i])
@@ -283,7 +285,18 @@ def plot_fit(fit: SensorFit, max_edges: int = 6,
         ax.set_visible(False)
     held = [p.key for p in fit.parameters if p.status != "fitted" and p.note != "not fitted"]
     more = f" (first {shown} of {len(fit.edges)} edges)" if shown < len(fit.edges) else ""
-    fig.suptitle(f"Fit of {', '.join(s.name for s in fit.sensor.stages)}{more}: reduced chi-square "
-                 f"{fit.reduced_chi_square:.3g}" + (f"; held or tied: {', '.join(held)}" if held else ""),
-                 fontsize="medium")
+    misfit = [e for e in fit.edges if e.misfit]
+    verdict = ""
+    if misfit:
+        verdict = (f"MISFIT: the model does not fit {len(misfit)} of its {len(fit.edges)} edges (residual structure "
+                   f"up to {100 * max(e.misfit_fraction for e in misfit):.2f} % of the step): its MTF may be biased")
+    elif fit.misfit:
+        verdict = "MISFIT: a fitted parameter sits at the bound of its range: its MTF may be biased"
+    import textwrap
+    lines = [*verdict.splitlines(), f"Fit of {', '.join(s.name for s in fit.sensor.stages)}{more}: reduced "
+             f"chi-square {fit.reduced_chi_square:.3g}", *([f"held or tied: {', '.join(held)}"] if held else [])]
+    # wrapped to the figure's width (about 12 characters an inch at this size), never cut at its edges
+    width = int(12 * fig.get_figwidth())
+    fig.suptitle("\n".join(textwrap.fill(line, width) for line in lines),
+                 fontsize="large" if fit.misfit else "medium", color="C3" if fit.misfit else "black")
     return fig

@@ -326,7 +326,10 @@ def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray
                      title: str | None = None, warnings: Iterable[str] | None = None) -> Figure:
     """Target locations, profile (ESF or PRF), LSF and MTF of one
     measurement, headed by ``title`` (the file), the figures a report
-    quotes and its warnings; ``truth(f)`` overlays a known MTF.
+    quotes and its warnings; ``truth(f)`` overlays a known MTF.  A
+    measurement forced past failed checks says so first, in red (and when
+    its number is not to be trusted at all, why); a sharpened product's
+    says its figures are the product's, not the sensor's.
 
     ``warnings`` are those of the record the figure belongs to (default
     the result's; ``imgmtf measure`` adds the file's own, such as a
@@ -385,5 +388,37 @@ def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray
     if len(warnings) > HEADER_WARNINGS:
         summary += (f"\nand {len(warnings) - HEADER_WARNINGS} more warning(s), listed in full by the text table "
                     "and the record (JSON, CSV)")
-    fig.suptitle(f"{title}\n{summary}" if title else summary, fontsize="medium")
+    verdict, colour = measurement_verdict(result)
+    head = "\n".join(line for line in (title, verdict) if line)
+    fig.suptitle(f"{head}\n{summary}" if head else summary, fontsize="medium", color=colour)
     return fig
+
+
+def measurement_verdict(result: MTFResult) -> tuple[str, str]:
+    """What the figure's header says first, and its colour: a number
+    forced past failed checks (``FORCED``), one not to be trusted even
+    so (``UNTRUSTED``, :func:`imgmtf.estimate.gate.untrusted_when_forced`),
+    a sharpened product; ``""`` and black for a measurement the gate
+    passed.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> measurement_verdict(imgmtf.measure_edge(chip.image))
+    ('', 'black')
+    """
+    from ..estimate.gate import untrusted_when_forced
+    lines, colour = [], "black"
+    failed = sorted({c.reason for c in result.checks if c.failed})
+    if failed:
+        colour = "C3"
+        untrusted = untrusted_when_forced(result.checks)
+        lines.append(f"FORCED past {len(failed)} failed check(s) ({', '.join(failed)})"
+                     + (f"; UNTRUSTED ({untrusted.reason}): not to be used" if untrusted is not None
+                        else ": measured anyway"))
+    if getattr(result, "sharpened", False):
+        colour = "C3" if failed else "darkorange"
+        lines.append(f"SHARPENED: the MTF rises to {result.mtf_peak:.3f} at {result.mtf_peak_cy_px:.3f} cy/px: "
+                     "the figures are the sharpened product's, not the sensor's")
+    return "\n".join(lines), colour

@@ -104,7 +104,10 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
             lines += [f"{_short(m)}: {_interval(m)}" for m in members]
         else:
             lines.append(first.get("reason") or "rejected")
-        ax.text(x - 0.5, y - 1.5, "\n".join(lines), fontsize=6, color="black", ha="left", va="bottom", zorder=6,
+        # above the box, or inside its top where the box starts at the image's top (a label above is clipped)
+        above = y - 0.5 > 0.04 * extent_h
+        ax.text(x - 0.5 + (0 if above else 0.01 * extent_w), y - 1.5 if above else y + 0.01 * extent_h,
+                "\n".join(lines), fontsize=6, color="black", ha="left", va="bottom" if above else "top", zorder=6,
                 clip_on=True, bbox={"boxstyle": "round,pad=0.2", "fc": (0.85, 1.0, 0.85, 0.9) if ok else "white",
                                     "ec": colour, "lw": 0.6})
     handles = [Line2D([], [], color=ACCEPTED, lw=2, label=f"accepted ({accepted})")]

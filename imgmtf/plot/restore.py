@@ -26,10 +26,13 @@ def _expect_filter(restoration: object) -> None:
 
 
 def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
-                      ax: Axes | None = None) -> Figure | SubFigure:
+                      ax: Axes | None = None, gain_axis: bool | None = None) -> Figure | SubFigure:
     """Along one axis: the sensor's MTF, the filter's transfer, the restored
     MTF and the target, to twice Nyquist (the filter's transfer repeats
-    every 1 cy/px), with the values at Nyquist in the legend.
+    every 1 cy/px), with the values at Nyquist in the legend.  A filter
+    whose gain rises above ``SHARED_AXIS_GAIN`` is drawn against an axis of
+    its own on the right, so that a high gain leaves the MTF curves their
+    full height.
 
     Parameters
     ----------
@@ -39,6 +42,10 @@ def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
         The axis: across track (x, the default) or along track (y).
     ax : matplotlib.axes.Axes, optional
         The axes to draw on (default a new figure's).
+    gain_axis : bool, optional
+        Draw the filter against an axis of its own (default: when its gain
+        rises above ``SHARED_AXIS_GAIN``); a figure of both axes decides
+        once for both.
 
     Returns
     -------
@@ -65,24 +72,41 @@ def plot_restored_mtf(restoration: RestorationFilter, direction: str = "across",
     c = axis_curves(restoration, direction, f)
     at = {k: float(v[200]) for k, v in c.items()}
     ax.plot(f, c["system"], color="C0", label=f"sensor: {at['system']:.3f}")
-    ax.plot(f, c["filter"], color="C1", ls="--", label=f"filter: {at['filter']:.2f}")
     ax.plot(f, c["restored"], color="k", lw=2.0, label=f"restored: {at['restored']:.3f}")
     ax.plot(f[:201], c["target"][:201], color="C2", ls=":", lw=2.0, label=f"target: {at['target']:.3f}")
     ax.axvline(NYQUIST, color="0.5", ls="--", lw=0.8)
-    top = max(1.05, float(c["filter"].max()) * 1.05)
-    ax.set(xlim=(0, 1), ylim=(min(0.0, float(c["filter"].min()) * 1.05), top),
+    low, high = float(c["filter"].min()), float(c["filter"].max())
+    gain_ax = ax.twinx() if (high > SHARED_AXIS_GAIN if gain_axis is None else gain_axis) else ax
+    gain_ax.plot(f, c["filter"], color="C1", ls="--", label=f"filter: {at['filter']:.2f}"
+                 + (" (right axis)" if gain_ax is not ax else ""))
+    mtf_top = max(1.05, float(max(c["system"].max(), c["restored"].max(), c["target"].max())) * 1.05)
+    ax.set(xlim=(0, 1), ylim=(min(0.0, low * 1.05) if gain_ax is ax else 0.0,
+                              max(mtf_top, high * 1.05) if gain_ax is ax else mtf_top),
            xlabel=f"frequency {'across' if direction == 'across' else 'along'} track (cy/px)",
-           ylabel="MTF, filter gain")
+           ylabel="MTF, filter gain" if gain_ax is ax else "MTF")
+    if gain_ax is not ax:
+        gain_ax.set(ylim=(min(0.0, low * 1.05), high * 1.05), ylabel="filter gain")
+        gain_ax.tick_params(axis="y", colors="C1")
+        gain_ax.yaxis.label.set_color("C1")
     title_once(ax, f"{direction.capitalize()} track")
-    ax.legend(fontsize="x-small", title="at Nyquist", title_fontsize="x-small", loc="upper center",
+    handles = [h for a in dict.fromkeys((ax, gain_ax)) for h in a.get_legend_handles_labels()[0]]
+    ax.legend(handles=handles, fontsize="small", title="at Nyquist", title_fontsize="small", loc="upper center",
               bbox_to_anchor=(0.5, -0.16), ncols=2)       # off the data, which fill the axes
     return fig
+
+
+#: the filter gain up to which the filter shares the MTF's axis; above, it has its own
+SHARED_AXIS_GAIN = 1.5
+#: across and along edge responses closer than this (of the step) are drawn as one
+SAME_RESPONSE = 0.02
 
 
 def plot_restored_edge(restoration: RestorationFilter, ax: Axes | None = None) -> Figure | SubFigure:
     """The edge response before and after restoration across and along
     track (0 dark, 1 bright), in pixels from the edge, with the RER and
-    overshoot of each.
+    overshoot of each; across and along drawn as one pair of curves where
+    they differ by less than ``SAME_RESPONSE`` of the step (four curves
+    on top of each other read as none).
 
     Parameters
     ----------
@@ -106,24 +130,38 @@ def plot_restored_edge(restoration: RestorationFilter, ax: Axes | None = None) -
     >>> from imgmtf import Sensor, design_filter
     >>> from imgmtf.plot import plot_restored_edge
     >>> fig = plot_restored_edge(design_filter(Sensor(), 0.3, kernel_size=7))
-    >>> len(fig.axes[0].lines)            # before and after, each axis, and the 0 and 1 levels
-    6
+    >>> len(fig.axes[0].lines)            # before and after (across = along here), the 0 and 1 levels
+    4
     """
     _expect_filter(restoration)
     from ..restore.report import edge_responses, restoration_report
     fig, ax = figure_axes(ax)
     report = restoration_report(restoration)
-    for i, direction in enumerate(("across", "along")):
-        x, before, after = edge_responses(restoration, direction, np.arange(-6.0, 6.0 + 1 / 64, 1 / 32))
-        a = report.axes[direction]
-        ax.plot(x, before, color=f"C{i}", ls="--", lw=1.0, label=f"{direction}, sensor: RER {a.rer_before:.3f}")
-        ax.plot(x, after, color=f"C{i}", lw=2.6 - 1.4 * i,      # the thinner along line shows over the across
-                label=f"{direction}, restored: RER {a.rer_after:.3f}, overshoot {a.overshoot_pct:.1f} %")
+    grid = np.arange(-6.0, 6.0 + 1 / 64, 1 / 32)
+    curves = {d: edge_responses(restoration, d, grid) for d in ("across", "along")}
+    a, b = report.axes["across"], report.axes["along"]
+    apart = max(float(np.abs(curves["across"][k] - curves["along"][k]).max()) for k in (1, 2))
+    if apart < SAME_RESPONSE:
+        x, before, after = curves["across"]
+        ax.plot(x, before, color="C0", ls="--", lw=1.2,
+                label=f"sensor: RER {a.rer_before:.3f} across, {b.rer_before:.3f} along")
+        ax.plot(x, after, color="k", lw=1.8, label=f"restored: RER {a.rer_after:.3f} across, {b.rer_after:.3f} "
+                                                     f"along; overshoot {max(a.overshoot_pct, b.overshoot_pct):.1f} %")
+        note = f"across and along within {100 * apart:.1f} % of the step: one curve"
+    else:
+        note = ""
+        for i, direction in enumerate(("across", "along")):
+            x, before, after = curves[direction]
+            r = report.axes[direction]
+            ax.plot(x, before, color=f"C{i}", ls="--", lw=1.0, label=f"{direction}, sensor: RER {r.rer_before:.3f}")
+            ax.plot(x, after, color=f"C{i}", lw=1.8,
+                    label=f"{direction}, restored: RER {r.rer_after:.3f}, overshoot {r.overshoot_pct:.1f} %")
     for level in (0.0, 1.0):
         ax.axhline(level, color="0.6", lw=0.7, ls=":")
     ax.set(xlim=(-6, 6), xlabel="distance from the edge (px)", ylabel="edge response")
     title_once(ax, f"Edge response (noise gain {report.noise_gain:.2f})")
-    ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2)    # off the data
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1, title=note or None,
+              title_fontsize="small")    # off the data
     return fig
 
 
@@ -157,8 +195,12 @@ def plot_restoration(restoration: RestorationFilter) -> Figure:
     _expect_filter(restoration)
     fig = Figure(figsize=(14.0, 5.0), layout="constrained")
     axes = fig.subplots(1, 3)
-    plot_restored_mtf(restoration, "across", ax=axes[0])
-    plot_restored_mtf(restoration, "along", ax=axes[1])
+    from ..restore.report import axis_curves
+    f = np.linspace(0.0, 1.0, 401)
+    separate = max(float(axis_curves(restoration, d, f)["filter"].max()) for d in ("across", "along")) \
+        > SHARED_AXIS_GAIN                      # both panels alike
+    plot_restored_mtf(restoration, "across", ax=axes[0], gain_axis=separate)
+    plot_restored_mtf(restoration, "along", ax=axes[1], gain_axis=separate)
     plot_restored_edge(restoration, ax=axes[2])
     form = "FFT" if restoration.kernel_size is None else "spatial"
     fig.suptitle(f"Restoration to MTF {restoration.target_nyquist:g} at Nyquist: {form} form, "

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -24,6 +24,8 @@ MAX_LISTED = 24
 PALETTE = ("#ff7f0e", "#e0202a", "#b07cff", "#ffd92f", "#ff5ec4", "#17d4e8", "#c5d625", "#ff9f9f",
            "#4f8bff", "#ffffff", "#b58b5b", "#9edae5")
 ACCEPTED = "#00ff00"
+#: the opacity of rejected candidates: a reason's few, labelled ones, and the many of a common reason
+REJECTED_ALPHA, CROWD_ALPHA = 0.6, 0.45
 
 
 def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Mapping[str, Any]],
@@ -42,17 +44,20 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     records : iterable of Record or mapping
         The candidates' records (:class:`imgmtf.Record`, as
         :func:`imgmtf.scan_scene` returns them, or their ``to_dict()``):
-        accepted ones are drawn as their tilted ROI (``roi_polygon_px``)
-        and segment in green, above the rest; rejected ones as a line
-        coloured by reason, outlined in black so that it reads on any
-        background.  Each accepted candidate carries its id, and so do the
-        rejected ones of a reason with at most ``MAX_LISTED`` candidates.
+        accepted ones are drawn as their tilted ROI (``roi_polygon_px``,
+        outlined, unfilled: the scene shows through) and segment in
+        green, above the rest; rejected ones faint, as a line coloured by
+        reason (outlined in black where the reason's few candidates carry
+        their ids, so that they read on any background).  Each accepted
+        candidate carries its id, and so do the rejected ones of a reason
+        with at most ``MAX_LISTED`` candidates.
     summaries : iterable of Record or mapping, optional
         The per-target summaries (``scope`` "target", records or
         dicts, as :func:`imgmtf.summarise_scan` returns them): each
         target is labelled beside its centre with, per direction, MTF at
-        Nyquist and MTF50 (cy/px); crowded targets' labels move apart,
-        each with a leader to its target, and stay inside the image.
+        Nyquist and MTF50 (cy/px), where it covers neither the accepted
+        half-edges nor another label (a leader to its target when moved
+        away), inside the image.
     levels : (float, float), optional
         (black, white) DN of the display; default the 0.5 and 99.5
         percentiles.
@@ -107,9 +112,9 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     ax.imshow(overview, cmap="gray", vmin=lo, vmax=hi if hi > lo else lo + 1,
               extent=(-0.5, extent_w - 0.5, extent_h - 0.5, -0.5), interpolation="nearest")
     ax.set(xlim=(-0.5, extent_w - 0.5), ylim=(extent_h - 0.5, -0.5))
-    ax.tick_params(labelsize=7)
-    ax.set_xlabel("column (px)", fontsize=7)
-    ax.set_ylabel("row (px)", fontsize=7)
+    ax.tick_params(labelsize=8)
+    ax.set_xlabel("column (px)", fontsize=8)
+    ax.set_ylabel("row (px)", fontsize=8)
     accepted = [r for r in candidates if r.get("status") == "accepted"]
     rejected = [r for r in candidates if r.get("status") != "accepted"]
     outline = [patheffects.Stroke(linewidth=3.2, foreground="black"), patheffects.Normal()]
@@ -118,23 +123,25 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     by_reason: dict[str, list] = {}
     for r in rejected:
         by_reason.setdefault(r.get("reason") or "rejected", []).append(r)
-    width = 1.4 if len(rejected) <= 300 else 0.9          # thousands of lines: thinner, the scene still shows
+    width = 1.2 if len(rejected) <= 300 else 0.8          # thousands of lines: thinner, the scene still shows
     unlabelled = 0
     for k, (reason, group) in enumerate(sorted(by_reason.items(), key=lambda kv: (-len(kv[1]), kv[0]))):
         colour = PALETTE[k % len(PALETTE)]
-        ax.add_collection(LineCollection([_ends(r) for r in group], colors=colour, linewidths=width,
-                                         path_effects=outline, zorder=3))
-        handles.append(Line2D([], [], color=colour, lw=1.6, path_effects=outline,
-                              label=_legend_label(reason, group)))
-        if len(group) <= MAX_LISTED:
+        # rejected: faint; a reason too common to label bare (hundreds of outlines would hide the scene)
+        listed = len(group) <= MAX_LISTED
+        style = {"path_effects": outline, "alpha": REJECTED_ALPHA} if listed else {"alpha": CROWD_ALPHA}
+        ax.add_collection(LineCollection([_ends(r) for r in group], colors=colour, linewidths=width, zorder=3,
+                                         **style))
+        handles.append(Line2D([], [], color=colour, lw=1.6, label=_legend_label(reason, group), **style))
+        if listed:
             for r in group:
                 labels.add(r, colour, "black", zorder=5)
         else:
             unlabelled += len(group)
     if accepted:
         polygons = [r["roi_polygon_px"] for r in accepted if r.get("roi_polygon_px")]
-        ax.add_collection(PolyCollection(polygons, facecolors=(0.2, 1.0, 0.2, 0.10), edgecolors=ACCEPTED,
-                                         linewidths=1.0, zorder=4))
+        ax.add_collection(PolyCollection(polygons, facecolors="none", edgecolors=ACCEPTED, linewidths=0.8,
+                                         linestyles=(0, (4, 2)), alpha=0.8, zorder=4))
         ax.add_collection(LineCollection([_ends(r) for r in accepted], colors=ACCEPTED, linewidths=2.0,
                                          path_effects=outline, zorder=4))
         handles.insert(0, Line2D([], [], color=ACCEPTED, lw=2.2, path_effects=outline,
@@ -151,35 +158,44 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
                                      for s in rows]
         if len(lines) > 1:
             target_labels.append(((rows[0]["x_px"], rows[0]["y_px"]), "\n".join(lines)))
-    _place_target_labels(ax, target_labels)
+    _place_target_labels(ax, target_labels, [_ends(r) for r in accepted])
     n_targets = len({s["target_id"] for s in targets})
-    ids = "ids as in the table and the CSV" + (f" ({unlabelled} in reasons too common to label)" if unlabelled
+    ids = "ids as in the table and the CSV" + (f", {unlabelled} in reasons too common to label" if unlabelled
                                                  else "")
-    ax.set_title(f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
-                 f"target{'s' * (n_targets != 1)} (labels: MTF at Nyquist | MTF50 cy/px per direction, * to quote); "
-                 f"{len(rejected)} rejected; {ids}", fontsize=7.5, loc="left")
+    title = (f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
+             f"target{'s' * (n_targets != 1)}, {len(rejected)} rejected (faint); {ids}")
+    if target_labels:
+        title += "\ntarget labels: MTF at Nyquist | MTF50 cy/px per direction, * the row to quote"
+    ax.set_title(title, fontsize=8.5, loc="left")
     if handles:
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7,
-                  title="candidates (ids)", title_fontsize=7, alignment="left", frameon=False)
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
+                  title="candidates (ids)", title_fontsize=8, alignment="left", frameon=False)
     return fig
 
 
 #: where a target's label may go: its box's corner this many points from the
 #: target's centre, nearest first, in each quadrant
-LABEL_OFFSETS_PT = (6.0, 20.0, 40.0, 64.0)
+LABEL_OFFSETS_PT = (6.0, 20.0, 40.0, 64.0, 100.0, 150.0)
+#: what covering an accepted half-edge costs a label's spot, per point of the
+#: edge sampled every few points (display px^2: a point weighs as a small label's corner)
+EDGE_POINT_COST = 400.0
 
 
-def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]]) -> None:
-    """Each target's label beside its centre where it overlaps no label
-    placed before it (nor an id) and stays inside the image: the nearest
-    free spot of the four quadrants at :data:`LABEL_OFFSETS_PT`, or the
-    least covered one; a label moved off its first ring gets a leader."""
-    style = {"textcoords": "offset points", "fontsize": 6.5, "color": "black", "annotation_clip": True,
-             "zorder": 8, "bbox": {"boxstyle": "round,pad=0.25", "fc": (0.85, 1.0, 0.85, 0.85), "ec": "#00a000",
+def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]],
+                         segments: Sequence[Sequence[tuple[float, float]]] = ()) -> None:
+    """Each target's label beside its centre where it covers no accepted
+    half-edge (``segments``, whose junction is the target's centre), no
+    label placed before it (nor an id) and stays inside the image: the
+    nearest free spot of the four quadrants at :data:`LABEL_OFFSETS_PT`,
+    or the least covered one; a label moved off its first ring gets a
+    leader."""
+    style = {"textcoords": "offset points", "fontsize": 8, "color": "black", "annotation_clip": True,
+             "zorder": 8, "bbox": {"boxstyle": "round,pad=0.25", "fc": (0.9, 1.0, 0.9, 0.9), "ec": "#00a000",
                                    "lw": 0.8}}
     frame = ax.get_window_extent()
     taken = [t.get_window_extent() for t in ax.texts]           # the ids drawn already
     pad = 3.0 * ax.figure.dpi / 72.0                             # the label's box around its text
+    edge_points = _sampled(ax, segments, step_pt=4.0)
     for xy, text in labels:
         probe = ax.annotate(text, xy, xytext=(0.0, 0.0), **style)
         best: tuple = (math.inf, 0, (LABEL_OFFSETS_PT[0], LABEL_OFFSETS_PT[0]), None)
@@ -190,6 +206,10 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]]) -> N
                 probe.set_verticalalignment("bottom" if sy > 0 else "top")
                 box = probe.get_window_extent().padded(pad)
                 covered = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
+                if edge_points.size:
+                    covered += EDGE_POINT_COST * np.count_nonzero(
+                        (edge_points[:, 0] > box.x0) & (edge_points[:, 0] < box.x1)
+                        & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1))
                 if covered < best[0]:
                     best = (covered, ring, probe.xyann, box)
             if best[0] == 0:
@@ -200,6 +220,19 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]]) -> N
         ax.annotate(text, xy, xytext=(dx, dy), ha="left" if dx > 0 else "right", va="bottom" if dy > 0 else "top",
                     **style, **leader)
         taken.append(box)
+
+
+def _sampled(ax, segments, step_pt: float) -> np.ndarray:
+    """Points along ``segments`` (data coordinates) every ``step_pt``
+    points or so, in display coordinates, shape (n, 2)."""
+    points = []
+    to_display = ax.transData.transform
+    for (x0, y0), (x1, y1) in segments:
+        (a, b), (c, d) = to_display([(x0, y0), (x1, y1)])
+        n = max(int(math.hypot(c - a, d - b) / (step_pt * ax.figure.dpi / 72.0)), 1) + 1
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        points.append(np.array([a, b]) + t * np.array([c - a, d - b]))
+    return np.concatenate(points) if points else np.empty((0, 2))
 
 
 def _overlap(a, b) -> float:
@@ -245,12 +278,12 @@ class _Labels:
         if record.get("id") is None:
             return
         (x0, y0), (x1, y1) = _ends(record)
-        clearance = 9.0 * self.px_per_pt
+        clearance = 14.0 * self.px_per_pt          # about a three-digit id's width
         spots = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
         free = [p for p in spots if all(np.hypot(p[0] - q[0], p[1] - q[1]) > clearance for q in self.placed)]
         x, y = (free or spots)[0]
         self.placed.append((x, y))
-        self.ax.text(x, y, str(record["id"]), fontsize=5.5, color=text_colour, ha="center", va="center",
+        self.ax.text(x, y, str(record["id"]), fontsize=6.5, color=text_colour, ha="center", va="center",
                      weight=weight, zorder=zorder, clip_on=True,
                      bbox={"boxstyle": "round,pad=0.15", "fc": face, "ec": "black", "lw": 0.4})
 

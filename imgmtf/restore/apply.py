@@ -14,7 +14,9 @@ describes the restored pixels.
 Integer output is rounded and clipped to its type's range; the clipped
 fraction is counted.  Input pixels at the saturation levels (an integer
 type's limits, or those given) carry no information about the scene beyond
-the level: they are kept as they were.  Nodata pixels stay nodata; while
+the level: they are kept as they were, and so is undeclared fill (a region
+at the band's least value with a hard boundary, such as the 0 around a target
+cut out of its scene), counted apart from the saturated pixels.  Nodata pixels stay nodata; while
 filtering they hold a fill value (the band's median, from an overview), so
 a pixel's restoration never depends on the tile it falls in.  Alpha bands
 are copied.
@@ -101,14 +103,19 @@ class OutputType:
             high -= 1
         return low, high
 
-    def convert(self, restored: np.ndarray, original: np.ndarray) -> tuple[np.ndarray, int, int]:
-        """(samples, pixels clipped, saturated pixels kept) for one tile;
-        ``original`` is the input's DN (NaN at nodata)."""
+    def convert(self, restored: np.ndarray, original: np.ndarray,
+                fill_value: float | None = None) -> tuple[np.ndarray, int, int, int]:
+        """(samples, pixels clipped, saturated pixels kept, fill pixels kept)
+        for one tile; ``original`` is the input's DN (NaN at nodata), and
+        its pixels at ``fill_value`` (the band's undeclared fill) are fill,
+        kept as they were, not saturated."""
         valid = np.isfinite(original)
         kept = np.zeros(original.shape, bool)
+        fill = valid & (original == fill_value) if fill_value is not None else kept
         if self.saturation is not None:
             low, high = self.saturation
             kept = valid & ((original <= low) | (original >= high))
+        kept = kept | fill
         values = np.where(kept, original, restored)       # the one tile-sized copy; the rest in place
         limits = self.limits()
         clipped = 0
@@ -121,7 +128,8 @@ class OutputType:
             values[~valid] = self.nodata
         elif limits is None:
             values[~valid] = np.nan          # a float image's NaN stay NaN
-        return values.astype(self.dtype), clipped, int(np.count_nonzero(kept))
+        filled = int(np.count_nonzero(fill))
+        return values.astype(self.dtype), clipped, int(np.count_nonzero(kept)) - filled, filled
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,6 +142,7 @@ class TileTask:
     taps: np.ndarray | None         # None: copy the band (alpha)
     fill: float
     output: OutputType
+    fill_value: float | None = None     # the band's undeclared fill, kept and counted as fill
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,6 +153,7 @@ class TileResult:
     clipped: int
     saturated: int
     valid: int
+    filled: int = 0
 
 
 def restore_tile(task: TileTask) -> TileResult:
@@ -161,8 +171,8 @@ def restore_tile(task: TileTask) -> TileResult:
         padded[~np.isfinite(padded)] = task.fill
         restored = convolve_padded(padded, task.taps)
         del padded
-    samples, clipped, saturated = task.output.convert(restored, core)
-    return TileResult(task.band, task.tile.core, samples, clipped, saturated, int(np.isfinite(core).sum()))
+    samples, clipped, saturated, filled = task.output.convert(restored, core, task.fill_value)
+    return TileResult(task.band, task.tile.core, samples, clipped, saturated, int(np.isfinite(core).sum()), filled)
 
 
 @dataclass(frozen=True)
@@ -189,6 +199,9 @@ class RestoredFile:
         Fraction of the pixels that are nodata (kept).
     input_sha256 : str
         The input file's SHA-256.
+    fill_fraction : float
+        Fraction of the valid pixels that are undeclared fill (a region at
+        the band's least value with a hard boundary), kept as they were.
 
     Examples
     --------
@@ -210,12 +223,14 @@ class RestoredFile:
     saturated_fraction: float
     nodata_fraction: float
     input_sha256: str
+    fill_fraction: float = 0.0
 
     def to_dict(self) -> dict:
         return {"input": self.path, "out": self.out, "width_px": self.width, "height_px": self.height,
                 "bands": list(self.bands), "dtype": self.dtype, "tiles": self.tiles,
                 "clipped_fraction": self.clipped_fraction, "saturated_fraction": self.saturated_fraction,
-                "nodata_fraction": self.nodata_fraction, "input_sha256": self.input_sha256}
+                "nodata_fraction": self.nodata_fraction, "fill_fraction": self.fill_fraction,
+                "input_sha256": self.input_sha256}
 
 
 def restore_file(path: str | Path, restoration: RestorationFilter, out: str | Path, *, tile_px: int = DEFAULT_TILE_PX,
@@ -309,13 +324,13 @@ def restore_file(path: str | Path, restoration: RestorationFilter, out: str | Pa
     tiles = plan_tiles(info.width, info.height, tile_px, restoration.radius_px)
     tasks = []
     for band in range(1, info.count + 1):
-        fill = 0.0 if band in alpha else _band_fill(read_raster, path, band, info)
+        fill, fill_value = (0.0, None) if band in alpha else _band_fill(read_raster, path, band, info)
         taps = None if band in alpha else restoration.taps
-        tasks += [TileTask(path, band, tile, taps, fill, output) for tile in tiles]
+        tasks += [TileTask(path, band, tile, taps, fill, output, fill_value) for tile in tiles]
     sha256 = file_sha256(path)
     provenance = {"imgmtf_version": __version__, "method": "wiener", "filter": restoration.to_dict(),
                   "input": path, "input_sha256": sha256, "run_utc": run_utc or utc_now(), "tile_px": tile_px}
-    counts = {"clipped": 0, "saturated": 0, "valid": 0}
+    counts = {"clipped": 0, "saturated": 0, "valid": 0, "filled": 0}
     from rasterio.windows import Window
     with atomic_output(out) as partial, warnings.catch_warnings():
         warnings.simplefilter("ignore", NotGeoreferencedWarning)      # a chip without a geotransform stays so
@@ -345,18 +360,25 @@ def restore_file(path: str | Path, restoration: RestorationFilter, out: str | Pa
     return RestoredFile(path, out, info.width, info.height, bands, info.dtype, len(tiles),
                         counts["clipped"] / valid if valid else 0.0,
                         counts["saturated"] / valid if valid else 0.0,
-                        1.0 - valid / pixels if pixels else 0.0, sha256)
+                        1.0 - valid / pixels if pixels else 0.0, sha256,
+                        counts["filled"] / valid if valid else 0.0)
 
 
-def _band_fill(read_raster, path: str, band: int, info) -> float:
-    """The band's median over an overview: the value nodata pixels hold while filtering."""
+def _band_fill(read_raster, path: str, band: int, info) -> tuple[float, float | None]:
+    """The band's median over an overview (the value nodata pixels hold
+    while filtering), and the value of its undeclared fill: its least value
+    where a region at it has a hard boundary (:func:`imgmtf.scene.fill.fill_mask`),
+    else None."""
+    from ..scene.fill import fill_mask
     scale = max(info.width / OVERVIEW_PX, info.height / OVERVIEW_PX, 1.0)
     shape = (max(int(info.height / scale), 1), max(int(info.width / scale), 1))
     data = read_raster(path, band, out_shape=shape).data
     values = data[np.isfinite(data)]
     if not values.size:
         raise ImageContentError(f"{path}: band {band} has no valid pixel (all nodata): nothing to restore")
-    return float(np.median(values))
+    least = float(values.min())
+    at_fill = fill_mask(data, info.dtype) & (data == least)
+    return float(np.median(values)), least if at_fill.any() else None
 
 
 def file_sha256(path: str) -> str:

@@ -18,9 +18,13 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ImgmtfError, ParameterError
+from ..estimate.geometry import IMAGE_AXES
 from ..sensor.model import Sensor
 from ..sensor.stages import MeasuredMTF
 
+#: the image axes' names of the track's directions, as a scan gives them for an image with no
+#: track information (horizontal: across its columns, the x axis)
+TRACK_OF = {axis: track for track, axis in IMAGE_AXES.items()}
 #: the row a direction takes, by preference: the scene's, else a target's
 SCOPES = ("scene", "target")
 
@@ -94,12 +98,14 @@ def measured_sensor(rows: Sequence[Mapping[str, Any]], source: str = "the rows",
     chosen = None
     for scope in SCOPES:
         mine = [r for r in sections if r.get("scope") == scope and r.get("assumption") == r.get("chosen_assumption")]
-        by_direction = {r.get("direction"): r for r in mine}
+        # an image without track information names its axes instead (horizontal: across its columns)
+        by_direction = {TRACK_OF.get(str(r.get("direction")), r.get("direction")): r for r in mine}
         if {"across-track", "along-track"} <= set(by_direction):
             chosen = by_direction
             break
     if chosen is None:
-        raise ImgmtfError(f"{source}: no across- and along-track rows measured without a model (summary "
+        raise ImgmtfError(f"{source}: no across- and along-track (or horizontal and vertical) rows measured "
+                          "without a model (summary "
                           "'sections'): a scan of a target with edges in two directions gives them",
                           reason="no-target")
     across, along = chosen["across-track"], chosen["along-track"]

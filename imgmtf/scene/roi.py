@@ -170,13 +170,14 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
     starts, ends = np.flatnonzero(step == 1), np.flatnonzero(step == -1)
     longest = int(np.argmax(ends - starts)) if starts.size else None
     length = float(ends[longest] - starts[longest]) if longest is not None else 0.0
-    rows = int(length * max(abs(roi.ux), abs(roi.uy)))      # rows (or columns) it crosses
+    along = max(abs(roi.ux), abs(roi.uy))
+    rows = int(length * along)                              # rows (or columns) it crosses
     if rows < gate.MIN_ROWS:
+        clear = f"{rows} of its {int(bins * along)} rows" if rows else f"none of its {int(bins * along)} rows"
         if by_fill.mean() >= 0.5:
-            return "fill", (f"fill or nodata leaves only {rows} rows of the target clear (at least "
-                            f"{gate.MIN_ROWS} needed)")
-        return "too-short", (f"only {rows} rows of the target lie clear of its junctions, fill and the "
-                             f"scene's border (at least {gate.MIN_ROWS} needed)")
+            return "fill", (f"fill or nodata leaves {clear} clear (at least {gate.MIN_ROWS} needed)")
+        return "too-short", (f"{clear} lie clear of the junctions, fill and the scene's border (at least "
+                             f"{gate.MIN_ROWS} needed)")
     return roi.t0_px + starts[longest], roi.t0_px + ends[longest]
 
 
