@@ -14,6 +14,7 @@ import numpy as np
 from .errors import ImgmtfError, ParameterError
 from .estimate.fit.bars import BarFit, bar_profile, fit_bars
 from .kinds import get_kind
+from .sensor.model import Sensor
 
 Roi = tuple[int, int, int, int]
 
@@ -22,7 +23,8 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width: tuple[float
                   gap: tuple[float, str] | float | str | None = None,
                   stages: str | None = "optics,detector", band: int | None = None, roi: Roi | None = None,
                   gsd_m: float | None = None, confidence: float = 0.95, force: bool = False,
-                  transfer: str = "linear", saturation: tuple[float, float] | None = None) -> BarFit:
+                  transfer: str = "linear", saturation: tuple[float, float] | None = None,
+                  start: Sensor | None = None, hold: str | Sequence[str] = ()) -> BarFit:
     """Fit the sensor's stages to the bars (or double bars) of image files.
 
     Parameters
@@ -50,6 +52,11 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width: tuple[float
         How the stored values relate to light ("linear", "srgb", "gamma:G").
     saturation : (float, float), optional
         DN the sensor records (default an integer file's type range).
+    start : Sensor, optional
+        Starting (and held) values of its stages (``--sensor``); its
+        stages are fitted when ``stages`` is None.
+    hold : str or sequence of str, optional
+        Parameters held at their starting values (``--hold``).
 
     Returns
     -------
@@ -102,4 +109,4 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width: tuple[float
         integer = transfer == "linear" and np.issubdtype(np.dtype(raster.dtype), np.integer)
         profiles.append(bar_profile(result, str(path), 1.0 if integer else 0.0))
         gsd = gsd or raster.gsd_m
-    return fit_bars(profiles, stages=stages, gsd_m=gsd or 1.0, confidence=confidence)
+    return fit_bars(profiles, stages=stages, gsd_m=gsd or 1.0, confidence=confidence, start=start, hold=hold)

@@ -72,6 +72,11 @@ def test_the_same_chips_as_one_bar_give_no_number(width, gap):
         with pytest.raises(UnsuitableTargetError, match=rf"two parallel bars {width + gap:.1f} px apart") as info:
             imgmtf.measure_pulse(c.image, width_px=given)
         assert info.value.reason == "double-bar"
+    # asked for as an edge, the refusal names the two bars at once (not "a bar", then "two bars")
+    with pytest.raises(UnsuitableTargetError, match=rf"two parallel bars {width + gap:.1f} px apart .*not an edge"
+                       ) as info:
+        imgmtf.measure_edge(c.image)
+    assert info.value.reason == "double-bar"
 
 
 def test_one_bar_through_a_blur_is_never_two():
@@ -119,3 +124,46 @@ def test_the_command_line_simulates_measures_fits_and_refuses(tmp_path):
     assert "two parallel bars 3.0 px apart" in refused.output and "--target double-bar" in refused.output
     no_gap = runner.invoke(main, ["measure", "--target", "double-bar", "--pulse-width", "1", path])
     assert no_gap.exit_code == 2 and "--gap" in no_gap.output
+
+
+def test_where_the_pair_hides_the_mtf_the_model_curve_and_its_band_are_shown():
+    c = chip(1.0, 2.0, SNR_100_DN, seed=3, size=40)
+    result = imgmtf.measure_double_bar(c.image, width_px=1.0, gap_px=2.0)
+    f, model = result.frequencies_cy_px, result.model_mtf
+    nyquist = int(np.argmin(np.abs(f - 0.5)))
+    assert np.isnan(result.mtf[nyquist]) and result.model_figures == ("mtf_nyquist",)
+    assert np.array_equal(model.frequencies_cy_px, f) and np.isfinite(model.mtf).all()
+    assert model.mtf[nyquist] == pytest.approx(result.mtf_nyquist, abs=1e-9)
+    assert model.low[nyquist] == pytest.approx(result.mtf_nyquist_ci.low, abs=1e-9)
+    assert np.all(model.low <= model.mtf) and np.all(model.mtf <= model.high)
+    assert np.abs(model.mtf - c.true_mtf(f))[f <= 0.75].max() < 0.02
+    record = result.to_dict()
+    assert len(record["model_mtf"]) == len(record["mtf"]) == f.size and len(record["model_mtf_ci"]) == f.size
+    from imgmtf.plot import plot_mtf
+    labels = plot_mtf(result).axes[0].get_legend_handles_labels()[1]
+    assert any(label.startswith("sensor model (optics,detector) fitted") for label in labels)
+    assert any(label.startswith("MTF@Nyquist") and label.endswith("(model)") for label in labels)
+    # where the transfer is divided, nothing is the model's
+    divided = imgmtf.measure_double_bar(chip(0.6, 1.2, size=40).image, width_px=0.6, gap_px=1.2)
+    assert divided.model_mtf is None and "model_mtf" not in divided.to_dict()
+
+
+def test_fit_of_bars_writes_the_sensor_starts_from_one_holds_and_refuses_what_is_the_edges(tmp_path):
+    runner = CliRunner()
+    path, toml = str(tmp_path / "pair.tif"), str(tmp_path / "fitted.toml")
+    imgmtf.write_geotiff(path, chip(1.0, 2.0, size=40).image, gsd_m=1.0)
+    bars = ["fit", "--target", "double-bar", "--pulse-width", "1", "--gap", "2", path]
+    written = runner.invoke(main, [*bars, "--out", toml])
+    assert written.exit_code == 0 and f"wrote {toml}" in written.output, written.output
+    record, sensor = imgmtf.read_fit_record(toml), imgmtf.Sensor.from_toml(toml)
+    assert record.misfit is False and record.sources == (path,) and [s.name for s in sensor.stages] == [
+        "optics", "detector"]
+    held = runner.invoke(main, [*bars, "--sensor", toml, "--hold", "detector", "--format", "json"])
+    assert held.exit_code == 0, held.output
+    parameters = {p["name"]: p for p in json.loads(held.output)["parameters"]}
+    assert parameters["width_x_m"]["status"] == "held" and parameters["sigma_x_m"]["status"] == "fitted"
+    assert parameters["width_x_m"]["value"] == pytest.approx(sensor.stages[1].width_x_m)
+    for flag, value, why in (("--plot", "fit.png", "imgmtf measure --plot"), ("--campaign", "store", "misfit test"),
+                             ("--hold", "motion", "cannot hold 'motion'")):
+        refused = runner.invoke(main, [*bars, flag, value])
+        assert refused.exit_code == 2 and why in refused.output, refused.output

@@ -15,8 +15,13 @@ from .tables import print_fit
 
 #: the kinds fit takes: those of the 1-D pipeline (points have their own)
 FIT_KINDS = tuple(name for name, kind in KINDS.items() if kind.measuring is not None)
-#: what fit does with edges only (bars' fit takes the stages, the files and how to read them)
-EDGE_ONLY = ("sensor_path", "hold", "out_path", "plot_path", "campaign")
+#: what fit does with edges only, and why not with bars
+EDGE_ONLY = {
+    "plot_path": ("--plot", "its figure is the edges' fit's (each edge's measured MTF against the model's); "
+                            "imgmtf measure --plot draws a double bar's profile and MTF with the model's"),
+    "campaign": ("--campaign", "a campaign's acquisition holds the model's across- and along-track rows "
+                               "with each edge's misfit test, which the bars' fit does not make"),
+}
 
 
 @click.command(short_help="Fit the sensor model to edges or bars: its MTF in every direction.")
@@ -77,9 +82,8 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
     if get_kind(kind).has_width:
         if roi_file:
             raise click.UsageError("--roi-file gives the windows of edges: fit bars with --roi X,Y,W,H")
-        _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, saturation, transfer, confidence,
-                  fmt, given={"sensor_path": sensor_path, "hold": hold, "out_path": out_path,
-                              "plot_path": plot_path, "campaign": campaign})
+        _fit_bars(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, force, saturation,
+                  transfer, confidence, out_path, fmt, given={"plot_path": plot_path, "campaign": campaign})
         return
     if pulse_width or gap:
         raise click.UsageError("--pulse-width and --gap describe bars: give --target pulse or double-bar")
@@ -151,32 +155,46 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
         click.echo(f"wrote {path}")
 
 
-def _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, saturation, transfer, confidence, fmt,
-              given):
-    """``fit --target pulse|double-bar``: the stages fitted to the bars' profiles."""
+def _fit_bars(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi, force, saturation,
+              transfer, confidence, out_path, fmt, given):
+    """``fit --target pulse|double-bar``: the stages fitted to the bars'
+    profiles; --sensor, --hold and --out as for edges."""
     clash = [name for name in EDGE_ONLY if given.get(name)]
     if clash:
-        flag = {"sensor_path": "--sensor", "hold": "--hold", "out_path": "--out", "plot_path": "--plot",
-                "campaign": "--campaign"}[clash[0]]
-        raise click.UsageError(f"{flag} is the edges' fit's: not with --target {kind}")
+        flag, why = EDGE_ONLY[clash[0]]
+        raise click.UsageError(f"{flag} is the edges' fit's, not with --target {kind}: {why}")
     if len(roi) > 1:
         raise click.UsageError("--target pulse or double-bar takes one --roi for every file")
     from ..bar_fit import fit_bar_files
     from ..batch import expand_inputs
+    from ..estimate.fit import check_names
+    from ..sensor.model import Sensor
     with reported_errors():
+        start = Sensor.from_toml(sensor_path) if sensor_path else None
+        with option_errors():
+            if stages is not None and stages.strip() == "auto":
+                raise ParameterError("--stages auto is the edges' fit's: name the bars' stages (optics,detector)")
+            check_names(stages or (None if start else "optics,detector"), hold or (), start)
+            from ..measure_settings import MeasureSettings
+            MeasureSettings(kind, pulse_width=pulse_width, gap=gap)
         files = expand_inputs(paths, False)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")
-        with option_errors():
-            from ..measure_settings import MeasureSettings
-            MeasureSettings(kind, pulse_width=pulse_width, gap=gap)
+        if out_path:
+            check_output_file(out_path)
         result = fit_bar_files(files, target=kind, pulse_width=pulse_width, gap=gap,
-                               stages=stages or "optics,detector", band=band, roi=roi[0] if roi else None,
-                               gsd_m=gsd, confidence=confidence, force=force, transfer=transfer,
-                               saturation=saturation)
+                               stages=stages or (None if start else "optics,detector"), band=band,
+                               roi=roi[0] if roi else None, gsd_m=gsd, confidence=confidence, force=force,
+                               transfer=transfer, saturation=saturation, start=start, hold=hold or ())
+        written = []
+        if out_path:
+            from ..version import __version__
+            result.to_toml(out_path, comment=f"fitted by imgmtf {__version__} to {len(result.sources)} "
+                                             f"{get_kind(kind).noun}(s): {', '.join(result.sources)}")
+            written.append(out_path)
     if fmt == "json":
         from ..records import json_safe
-        click.echo(json.dumps(json_safe(result.to_dict())))
+        click.echo(json.dumps(json_safe({**result.to_dict(), "written": written})))
         return
     click.echo(f"stages: {result.stages}   reduced chi-square {result.reduced_chi_square:.2f}")
     for p in result.parameters:
@@ -190,3 +208,5 @@ def _fit_bars(paths, kind, pulse_width, gap, stages, gsd, band, roi, force, satu
                    f"[{ci.low:.4f}, {ci.high:.4f}] ({confidence_pct}), MTF50 {f50:.4f} cy/px")
     for warning in result.warnings:
         click.echo(f"  warning: {warning}")
+    for path in written:
+        click.echo(f"wrote {path}")

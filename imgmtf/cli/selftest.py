@@ -15,7 +15,7 @@ def selftest(method):
     """Render generic-sensor chips with known MTF, measure them, and compare
     measured with true; exit 1 if any estimate is out of tolerance."""
     with reported_errors():
-        from ..selftest import CASES, POINT_CASE, run_selftest
+        from ..selftest import CASES, POINT_CASE, POINT_CHIP_PX, run_selftest
         from ..sensor.model import DIRECTIONS, Sensor
         from ..version import __version__
         sensor = Sensor()
@@ -23,8 +23,9 @@ def selftest(method):
         for d in DIRECTIONS:
             click.echo(f"  model {d:>6}-track: FWHM {sensor.fwhm_m(d):.4f} m, "
                        f"MTF at Nyquist {sensor.mtf_nyquist(d):.4f}")
-        click.echo(f"measuring 100 x 100 px 16-bit chips with method {method!r} "
-                   "(! marks a figure out of tolerance):")
+        own = [(case.name, case.size_px) for case in CASES if case.size_px] + [(POINT_CASE[0], POINT_CHIP_PX)]
+        click.echo(f"measuring 100 x 100 px 16-bit chips ({'; '.join(f'{name}: {n} x {n} px' for name, n in own)}) "
+                   f"with method {method!r} (! marks a figure out of tolerance):")
         width = max(*(len(case.name) for case in CASES), len(POINT_CASE[0]) + len(" across-track"))
         click.echo(f"{'case':<{width}} {'':>4} {'MTF@Nyq':>8} {'MTF50':>8} {'FWHM':>8}")
         click.echo(f"{'':<{width}} {'':>4} {'':>8} {'cy/px':>8} {'px':>8}")

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: the reason code of a bar refused as two (the double-bar kind's name too: the kind that measures it)
+PAIR_REASON = "double-bar"
 #: a dip between two peaks counts when it falls below this share of the lower
 #: peak (a sharpened wide bar's overshoots at its sides dip to 0.85-0.9 of them;
 #: two 0.6 px bars 1.2 px apart through sigma 0.39 px + pixel to 0.47)
@@ -36,10 +38,11 @@ class BarPair:
         """Their peaks' distance, px (the bars' centres', for equal bars)."""
         return self.right_px - self.left_px
 
-    def message(self) -> str:
-        """The refusal's words: what was seen, and what measures it."""
+    def message(self, instead: str = "one bar") -> str:
+        """The refusal's words: what was seen, ``instead`` of what was asked
+        for ("one bar", "an edge"), and what measures it."""
         return (f"two parallel bars {self.apart_px:.1f} px apart (the profile dips to "
-                f"{self.dip_share:.0%} of its peaks between them), not one bar: measure them as a double bar")
+                f"{self.dip_share:.0%} of its peaks between them), not {instead}: measure them as a double bar")
 
 
 def bar_pair(grid: np.ndarray, prf01: np.ndarray, noise: float = 0.0) -> BarPair | None:
@@ -84,3 +87,42 @@ def bar_pair(grid: np.ndarray, prf01: np.ndarray, noise: float = 0.0) -> BarPair
                     best is None or share < best.dip_share):
                 best = BarPair(float(grid[left]), float(grid[right]), share)
     return best
+
+
+def pair_in_profile(grid: np.ndarray, values: np.ndarray, noise_dn: float = 0.0) -> BarPair | None:
+    """The two bars a raw profile across a bar holds (DN, not yet above its
+    background), or None: its background the mean of its outer eighths,
+    its excursion from there (bright or dark) scaled to a unit peak, then
+    :func:`bar_pair`.  What another kind of target (an edge) uses to say
+    that the bar it met is two.
+
+    Parameters
+    ----------
+    grid : numpy.ndarray
+        Positions along the normal, px (uniform, ascending).
+    values : numpy.ndarray
+        The profile, DN.
+    noise_dn : float, optional
+        Its noise, DN (0: noise-free).
+
+    Returns
+    -------
+    BarPair or None
+        As :func:`bar_pair`.
+
+    Examples
+    --------
+    >>> x = np.linspace(-8, 8, 321)
+    >>> two = 200 + 900 * (np.exp(-(x - 1.5) ** 2 / 0.5) + np.exp(-(x + 1.5) ** 2 / 0.5))
+    >>> round(pair_in_profile(x, two, noise_dn=5.0).apart_px, 1), pair_in_profile(x, 1100 - two) is not None
+    (3.0, True)
+    """
+    values = np.asarray(values, float)
+    ends = max(values.size // 8, 2)
+    background = float(np.mean(np.r_[values[:ends], values[-ends:]]))
+    excursion = values - background
+    peak = excursion if excursion.max() >= -excursion.min() else -excursion
+    height = float(peak.max())
+    if not height > 0:
+        return None
+    return bar_pair(grid, peak / height, noise_dn / height)

@@ -96,8 +96,15 @@ class DoubleBarResult(MTFResult):
         Whether the sensor model was fitted to the profile.
     measured_mtf_nyquist : float
         The MTF at Nyquist by division (NaN where the transfer hides it).
-    model : imgmtf.SensorFit or None
+    model : imgmtf.estimate.fit.bars.BarFit or None
         The fitted model, when fitted.
+    model_mtf : imgmtf.estimate.fit.bars.ModelMTF or None
+        The fitted model's MTF along the normal on ``frequencies_cy_px``,
+        with its band, when fitted: what the figures read off the model
+        come from, across the pair's transfer zeros where ``mtf`` is NaN
+        (``mtf`` stays the profile's own, divided by the pair's transfer).
+    model_figures : tuple of str
+        The figures read off the model ("mtf_nyquist", "mtf50_cy_px").
     prf_x_px, prf : numpy.ndarray
         The pair's pulse response (peak 1 above its background) and its
         positions along the normal, px.
@@ -123,6 +130,8 @@ class DoubleBarResult(MTFResult):
     model_fitted: bool
     measured_mtf_nyquist: float
     model: Any = None
+    model_mtf: Any = None
+    model_figures: tuple[str, ...] = ()
     prf_x_px: np.ndarray
     prf: np.ndarray
     prf_fwhm_px: float
@@ -149,7 +158,28 @@ class DoubleBarResult(MTFResult):
                 "pair_transfer_nyquist": finite(self.pair_transfer_nyquist), "model_fitted": self.model_fitted,
                 "measured_mtf_nyquist": finite(self.measured_mtf_nyquist),
                 "prf_fwhm_px": finite(self.prf_fwhm_px), "background_dn": finite(self.background_dn),
-                "peak_dn": finite(self.peak_dn)}
+                "peak_dn": finite(self.peak_dn), "model_figures": list(self.model_figures)}
+
+    def to_dict(self, curves: bool = True) -> dict:
+        """JSON-ready summary, as :meth:`MTFResult.to_dict`; with ``curves``
+        and a fitted model, also the model's MTF on the same frequencies and
+        its band (``model_mtf``, ``model_mtf_ci``), apart from the measured
+        ``mtf``.
+
+        Parameters
+        ----------
+        curves : bool, optional
+            Add the curves (default True).
+
+        Returns
+        -------
+        dict
+            The record's figures (units in the names).
+        """
+        out = super().to_dict(curves)
+        if curves and self.model_mtf is not None:
+            out.update(self.model_mtf.to_dict())
+        return out
 
 
 class DoubleBarKind(PulseKind):
@@ -275,7 +305,8 @@ class DoubleBarEstimator:
         fields = m.result_fields()
         warnings = list(m.warnings)
         measured = float(fields["mtf_nyquist"])
-        fitted = None
+        fitted = model_mtf = None
+        model_figures: tuple[str, ...] = ()
         if abs(transfer_nyquist) < MODEL_BELOW_TRANSFER:
             from .fit.bars import BarProfile, fit_bars
             samples = m.estimate.samples
@@ -284,8 +315,11 @@ class DoubleBarEstimator:
                                  float(m.shape.low), float(m.shape.high), m.chip.quantum_dn)
             fitted = fit_bars([profile], stages=self.stages, confidence=self.settings.intervals.confidence)
             fields.update(mtf_nyquist=fitted.mtf_nyquist[0], mtf_nyquist_ci=fitted.mtf_nyquist_ci[0])
+            model_figures = ("mtf_nyquist",)
             if not math.isfinite(fields["mtf50_cy_px"]):
                 fields.update(mtf50_cy_px=fitted.mtf50_cy_px[0], mtf50_ci_cy_px=fitted.mtf50_ci_cy_px[0])
+                model_figures += ("mtf50_cy_px",)
+            model_mtf = fitted.mtf_curve(np.asarray(fields["frequencies_cy_px"], float))
             warnings.append(f"the pair's transfer at Nyquist is {abs(transfer_nyquist):.2f} in modulus (below "
                             f"{MODEL_BELOW_TRANSFER}): MTF at Nyquist read off the sensor model "
                             f"({fitted.stages}) fitted to the profile, as Storey did")
@@ -298,7 +332,7 @@ class DoubleBarEstimator:
             polarity="bright" if extra["sign"] > 0 else "dark", warnings=tuple(warnings),
             pulse_width_px=kind.bar_px, gap_px=kind.gap_px, pair_transfer_nyquist=transfer_nyquist,
             model_fitted=fitted is not None, measured_mtf_nyquist=measured,
-            model=fitted, prf_x_px=m.profile.grid, prf=extra["prf01"],
+            model=fitted, model_mtf=model_mtf, model_figures=model_figures, prf_x_px=m.profile.grid, prf=extra["prf01"],
             prf_fwhm_px=fwhm(m.profile.grid, extra["prf01"]), background_dn=float(m.shape.low),
             peak_dn=float(m.shape.high))
 

@@ -29,6 +29,7 @@ warnings.  Reasons:
 ``snr``                   noise too strong to measure anything
 ``not-an-edge``,          the profile is a bar where an edge was asked for,
 ``not-a-bar``             or a step where a bar was
+``double-bar``            the bar is two parallel bars (:mod:`.bar_pair`)
 ========================  ===================================================
 """
 from __future__ import annotations
@@ -39,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
+from .bar_pair import PAIR_REASON, pair_in_profile
 from .phase import without_phase_bias
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
@@ -351,17 +353,25 @@ def mixed_profile(values: np.ndarray) -> bool:
     return abs(right - left) >= MIXED_SHARE * span and max(beyond, turned) >= MIXED_SHARE * span
 
 
-def kind_check(kind: str, wanted: str, values: np.ndarray | None = None) -> Check:
+def kind_check(kind: str, wanted: str, values: np.ndarray | None = None, grid: np.ndarray | None = None,
+               noise_dn: float = 0.0) -> Check:
     """Is the profile's shape ``kind`` (:func:`classify_profile`) the one the
     target asked for wants?  Where it is not and it holds a step and a bar
     at once (``values`` given), the reason is the second feature beside the
-    target, not the kind."""
+    target, not the kind; where a step was wanted and the bar is two
+    (``grid``, px, given: :func:`.bar_pair.pair_in_profile`, the pulse
+    kind's own test), the reason is the pair (``double-bar``), so that one
+    refusal names what measures it."""
     reason, message = WRONG_PROFILE[wanted]
     if kind == wanted:
         return Check(reason, True, f"the profile is a {kind}")
     if values is not None and mixed_profile(values):
         return Check("two-targets", False, f"the profile holds a step and a bar: a second feature (a road, a "
                      f"shadow, another {kind}) lies beside the target")      # of two shapes, the other
+    if wanted == STEP_PROFILE and values is not None and grid is not None:
+        pair = pair_in_profile(grid, values, noise_dn)
+        if pair is not None:
+            return Check(PAIR_REASON, False, pair.message("an edge"))
     return Check(reason, False, message)
 
 

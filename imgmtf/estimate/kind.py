@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import UnsuitableTargetError
 from ..kinds import Kind
 from . import gate
+from .bar_pair import PAIR_REASON
 from .detection import Line
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
 from .intervals.width import WidthReading
@@ -158,4 +159,36 @@ def refuse_other_kind(kind: TargetKind, work: np.ndarray, seed_x: np.ndarray) ->
             if covered.sum() > 2 * EDGE_FIT_HALF_WINDOW_PX + 1:
                 whole = wide.sum(axis=0)[covered] / wide_counts[covered]
                 check = gate.kind_check(gate.classify_profile(mean), kind.profile, whole)
+            if check.reason != "two-targets":
+                # whole pixels blur two close bars into one: their sub-pixel phases part them
+                grid, fine, noise_dn = seed_profile(work, seed_x, EDGE_FIT_HALF_WINDOW_PX)
+                pair = gate.kind_check(gate.classify_profile(mean), kind.profile, fine, grid, noise_dn)
+                check = pair if pair.reason == PAIR_REASON else check
             raise UnsuitableTargetError(check.message, reason=check.reason) from None
+
+
+def seed_profile(work: np.ndarray, seed_x: np.ndarray, half_window: int,
+                 step_px: float = 0.25) -> tuple[np.ndarray, np.ndarray, float]:
+    """The rows' pixels within ``half_window`` of the seed line, binned by
+    their signed distance from it (``step_px`` bins): the profile a target
+    that could not be followed row by row still shows, its bins' centres
+    (px) and the pixels' noise beyond 0.6 ``half_window`` (DN).
+
+    Examples
+    --------
+    >>> work = np.tile((np.arange(21) == 10) * 100.0, (40, 1))
+    >>> grid, values, noise = seed_profile(work, np.full(40, 10.0), 5)
+    >>> float(grid[np.argmax(values)]), noise
+    (0.125, 0.0)
+    """
+    cols, values, inside = row_windows(work, seed_x, half_window)
+    distance = (cols - seed_x[:, None])[inside]
+    values = values[inside]
+    edges = np.arange(-half_window, half_window + step_px / 2, step_px)
+    index = np.clip(np.searchsorted(edges, distance, side="right") - 1, 0, edges.size - 2)
+    counts = np.bincount(index, minlength=edges.size - 1)
+    sums = np.bincount(index, weights=values, minlength=edges.size - 1)
+    filled = counts > 0
+    outer = np.abs(distance) > 0.6 * half_window
+    noise_dn = float(np.std(values[outer])) if outer.sum() > 3 else 0.0
+    return (edges[:-1] + step_px / 2)[filled], sums[filled] / counts[filled], noise_dn

@@ -101,8 +101,11 @@ def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
     reach = samples.reach_px
     try:
         profile = resample_samples(samples, settings, min(reach, INITIAL_SPAN_PX), kind.name)
-        kind_check = gate.kind_check(gate.classify_profile(profile.values), kind.profile, profile.values)
-        if not kind_check.passed:
+        seen = gate.classify_profile(profile.values)
+        if seen != kind.profile:
+            outer = np.abs(samples.distance_px) > 0.6 * samples.half_range_px      # as a bar's shape reads its noise
+            noise_dn = float(np.std(samples.values_dn[outer])) if outer.sum() > 3 else 0.0
+            kind_check = gate.kind_check(seen, kind.profile, profile.values, profile.grid, noise_dn)
             raise UnsuitableTargetError(kind_check.message, reason=kind_check.reason)
         try:
             shape = kind.shape(profile.grid, profile.values, samples.distance_px, samples.values_dn,

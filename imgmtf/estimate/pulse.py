@@ -25,7 +25,7 @@ from ..inputs import check_width
 from ..kinds.pulse import PULSE
 from ..metrics import fwhm
 from . import gate
-from .bar_pair import bar_pair
+from .bar_pair import PAIR_REASON, bar_pair
 from .bar_width import estimate_width, half_width_at, width_reading
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
@@ -162,7 +162,7 @@ class PulseKind(TargetKind):
         prf01 = peak / height
         pair = bar_pair(grid, prf01, noise / height)
         if pair is not None:        # measured as one bar, a pair's MTF would read times |cos(pi f s)|
-            raise UnsuitableTargetError(pair.message(), reason="double-bar")
+            raise UnsuitableTargetError(pair.message(), reason=PAIR_REASON)
         h10 = half_width_at(grid, prf01, 0.1)
         if self.width_px is None:
             density = d.size / (2.0 * half_range)           # samples per px along the normal

@@ -226,6 +226,13 @@ def plot_mtf(result: MTFResult, ax: Axes | None = None, truth: Callable[[np.ndar
     f = result.frequencies_cy_px
     line, = ax.plot(f, result.mtf, color=color, label=label or "measured")
     c = line.get_color()
+    model = getattr(result, "model_mtf", None)         # a sensor model fitted where the divisor hides the MTF
+    if model is not None:
+        ax.fill_between(model.frequencies_cy_px, model.low, model.high, color="tab:orange", alpha=0.3, lw=0,
+                        zorder=1, label=f"its {model.confidence:.0%} interval")
+        ax.plot(model.frequencies_cy_px, model.mtf, "-.", color="tab:orange", lw=1.2, zorder=1,
+                label=f"sensor model ({model.stages}) fitted to the profile")
+    from_model = getattr(result, "model_figures", ())
     if truth is not None:
         ax.plot(f, truth(f), "--", color="0.2", lw=1.0, label="true")
     if np.isfinite(result.noise_limit_cy_px) and result.noise_limit_cy_px < f.max():
@@ -238,12 +245,13 @@ def plot_mtf(result: MTFResult, ax: Axes | None = None, truth: Callable[[np.ndar
     interval = f" [{ci.low:.4f}, {ci.high:.4f}]" if yerr else ""
     ax.errorbar([NYQUIST], [result.mtf_nyquist], yerr=yerr, fmt="o", color=c, capsize=3, ms=4,
                 label=f"MTF@Nyquist {_figure(result.mtf_nyquist, missing=missing_cause(result, 'mtf_nyquist'))}"
-                      f"{interval}")
+                      f"{interval}{' (model)' if 'mtf_nyquist' in from_model else ''}")
     ci50 = result.mtf50_ci_cy_px
     xerr = ([[result.mtf50_cy_px - ci50.low], [ci50.high - result.mtf50_cy_px]] if np.isfinite(ci50.low) else None)
     interval50 = f" [{ci50.low:.4f}, {ci50.high:.4f}]" if xerr else ""
     ax.errorbar([result.mtf50_cy_px], [0.5], xerr=xerr, fmt="s", color=c, capsize=3, ms=4,
-                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px', missing_cause(result, 'mtf50'))}{interval50}")
+                label=f"MTF50 {_figure(result.mtf50_cy_px, 'cy/px', missing_cause(result, 'mtf50'))}{interval50}"
+                      f"{' (model)' if 'mtf50_cy_px' in from_model else ''}")
     if getattr(result, "sharpened", False):
         # a sharpened product's MTF rises above 1: its peak marked, the axis taken above it
         ax.axhline(1.0, color="0.5", lw=0.6)

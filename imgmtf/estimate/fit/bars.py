@@ -30,7 +30,8 @@ under that form.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import os
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from statistics import NormalDist
 from typing import Any
@@ -44,9 +45,11 @@ from ...sensor.model import Sensor
 from ..intervals import Interval
 from ..spectrum import NYQUIST
 from .data import ProfileBins, bin_profile, profile_noise
-from .model import initial_stages, stage_names
+from .model import hold_keys, initial_stages, stage_names
 from .results import FittedParameter
 
+#: a reduced chi-square above this: the model's form is not the sensor's (warned; ``misfit`` in its file)
+MISFIT_REDUCED_CHI_SQUARE = 2.0
 #: MTF50 is read off the model on this grid, cy/px
 MTF50_GRID_CY_PX = np.linspace(0.0, 2.0, 2001)
 
@@ -136,6 +139,38 @@ def bar_profile(result: Any, source: str, quantum_dn: float = 0.0) -> BarProfile
 
 
 @dataclass(frozen=True, eq=False)
+class ModelMTF:
+    """The fitted model's MTF along one profile's normal, with its
+    delta-method band: what a figure draws where the profile's own
+    transform cannot be read (a pair's transfer zeros).
+
+    Attributes
+    ----------
+    frequencies_cy_px, mtf : numpy.ndarray
+        The model's MTF (1 at zero frequency) and its frequencies, cy/px.
+    low, high : numpy.ndarray
+        Its band at ``confidence``, clipped to [0, 1].
+    stages : str
+        The model's stages, comma-separated.
+    confidence : float
+        Of the band.
+    """
+
+    frequencies_cy_px: np.ndarray
+    mtf: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    stages: str
+    confidence: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the curve and its band, rounded to 6 decimals."""
+        return {"model_stages": self.stages, "model_confidence": self.confidence,
+                "model_mtf": [round(float(v), 6) for v in self.mtf],
+                "model_mtf_ci": [[round(float(a), 6), round(float(b), 6)] for a, b in zip(self.low, self.high)]}
+
+
+@dataclass(frozen=True, eq=False)
 class BarFit:
     """The sensor model fitted to bars' profiles.
 
@@ -179,10 +214,70 @@ class BarFit:
     mtf50_ci_cy_px: tuple[Interval, ...]
     confidence: float
     warnings: tuple[str, ...] = ()
+    #: ``band(f, angle_deg)``: the model's MTF along a normal at ``f`` and its band
+    band: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = field(
+        default=None, repr=False, compare=False)
+
+    def mtf_curve(self, frequencies_cy_px: np.ndarray, index: int = 0) -> ModelMTF:
+        """The model's MTF along the ``index``-th profile's normal at
+        ``frequencies_cy_px`` (cy/px), with its delta-method band at
+        ``confidence``.
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("double-bar", 5.0, width_px=1.0, gap_px=2.0), 40)
+        >>> r = imgmtf.measure_double_bar(chip.image, width_px=1.0, gap_px=2.0)
+        >>> curve = fit_bars([bar_profile(r, "chip")]).mtf_curve(np.array([0.0, 0.5]))
+        >>> float(curve.mtf[0]), bool(curve.low[1] <= curve.mtf[1] <= curve.high[1])
+        (1.0, True)
+        """
+        if self.band is None:
+            raise ParameterError("this fit carries no model to evaluate")
+        f = np.asarray(frequencies_cy_px, float)
+        value, low, high = self.band(f, self.normal_angles_deg[index])
+        return ModelMTF(f, value, low, high, self.stages, self.confidence)
+
+    @property
+    def misfit(self) -> bool:
+        """Whether the profiles' residuals exceed their noise beyond what
+        the model's form explains (reduced chi-square above
+        ``MISFIT_REDUCED_CHI_SQUARE``; warned)."""
+        return self.reduced_chi_square > MISFIT_REDUCED_CHI_SQUARE
+
+    def to_toml(self, path: str | os.PathLike, comment: str = "") -> None:
+        """Write the fitted sensor as TOML with its ``[fit]`` record, as
+        :meth:`imgmtf.SensorFit.to_toml` does for edges:
+        :meth:`imgmtf.Sensor.from_toml` reads it, ``imgmtf restore``
+        refuses it when ``misfit``.  The bars' fit has no test of structure
+        in each profile's residuals: ``misfit_p`` and ``misfit_fraction``
+        are NaN (not tested), the verdict the reduced chi-square's.
+
+        Raises
+        ------
+        FileWriteError
+            The file cannot be written.
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("double-bar", 5.0, width_px=1.0, gap_px=2.0), 40)
+        >>> r = imgmtf.measure_double_bar(chip.image, width_px=1.0, gap_px=2.0)
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "pair_sensor.toml")
+        >>> fit_bars([bar_profile(r, "pair.tif")]).to_toml(path)
+        >>> imgmtf.read_fit_record(path).sources
+        ('pair.tif',)
+        """
+        from ...version import __version__
+        from .record import FitRecord, write_fitted_sensor
+        record = FitRecord(self.misfit, float(self.reduced_chi_square), math.nan, math.nan,
+                           tuple(s.name for s in self.sensor.stages), self.sources, __version__)
+        write_fitted_sensor(path, self, comment=comment, record=record)
 
     def to_dict(self) -> dict:
         """JSON-ready: the parameters, and per profile the model's figures."""
-        return {"stages": self.stages, "reduced_chi_square": self.reduced_chi_square,
+        return {"stages": self.stages, "reduced_chi_square": self.reduced_chi_square, "misfit": self.misfit,
                 "confidence": self.confidence, "parameters": [p.to_dict() for p in self.parameters],
                 "profiles": [{"source": s, "normal_angle_deg": a, "mtf_nyquist": m, "mtf_nyquist_ci": [ci.low, ci.high],
                               "mtf50_cy_px": f, "mtf50_ci_cy_px": [fci.low, fci.high]}
@@ -196,7 +291,7 @@ class _BarModel:
     """The stages' free coordinates and each profile's (B, A, x0) as one
     vector; each profile's line response kept for the last coordinates."""
 
-    def __init__(self, profiles: Sequence[BarProfile], stages: list, gsd: float):
+    def __init__(self, profiles: Sequence[BarProfile], stages: list, gsd: float, hold: Any = ()):
         self.profiles, self.gsd = list(profiles), gsd
         self.stages = stages
         self.keys, self.specs, self.units, start = [], {}, {}, {}
@@ -208,10 +303,11 @@ class _BarModel:
                 self.units[key] = stage.units()[name]
             start.update({f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()})
         self.start = start
+        self.held = hold_keys(hold, self.keys)        # at their starting values
         seen = {"x" if abs(p.normal_angle_deg) < 45 else "y" for p in self.profiles}
         self.ties: dict[str, str] = {}
         for key, spec in self.specs.items():
-            if spec.axis == "xy" or spec.axis in seen:
+            if spec.axis == "xy" or spec.axis in seen or key in self.held:
                 continue
             stage = key.split(".")[0]
             twin = f"{stage}.{spec.pair}" if spec.pair else next(
@@ -220,7 +316,7 @@ class _BarModel:
                 raise ParameterError(f"{key} acts on an axis no profile sees and has no twin to follow: hold "
                                      "it or give a profile along that axis")
             self.ties[key] = twin
-        self.free = [k for k in self.keys if k not in self.ties]
+        self.free = [k for k in self.keys if k not in self.ties and k not in self.held]
         self._kept: tuple[bytes | None, list] = (None, [])
 
     @property
@@ -228,7 +324,8 @@ class _BarModel:
         return len(self.free)
 
     def sensor(self, u: np.ndarray) -> Sensor:
-        coords = dict(zip(self.free, (float(v) for v in u)))
+        coords = {key: self.start[key] for key in self.held}
+        coords.update(zip(self.free, (float(v) for v in u)))
         coords.update({key: coords[twin] for key, twin in self.ties.items()})
         stages = [stage.with_fit_coordinates({name: coords[f"{stage.name}.{name}"] for name in stage.fit_specs()},
                                              self.gsd) for stage in self.stages]
@@ -287,7 +384,8 @@ class _BarModel:
 
 
 def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | None = "optics,detector",
-             gsd_m: float = 1.0, confidence: float = 0.95) -> BarFit:
+             gsd_m: float = 1.0, confidence: float = 0.95, start: Sensor | None = None,
+             hold: str | Sequence[str] = ()) -> BarFit:
     """Fit the sensor's stages to bars' and double bars' profiles.
 
     Parameters
@@ -302,6 +400,12 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
         The pixel, m (parameters in its units; default 1: in px).
     confidence : float, optional
         Of the intervals, in (0, 1).
+    start : Sensor, optional
+        Starting (and held) values of the stages it has; its stages are
+        fitted when ``stages`` is None.
+    hold : str or sequence of str, optional
+        Parameters held at their starting values: a stage ("detector") or
+        "stage.parameter" ("detector.width_x_m").
 
     Returns
     -------
@@ -312,7 +416,8 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
     Raises
     ------
     ParameterError
-        No profiles, unknown stages, a bad ``confidence``.
+        No profiles, unknown stages, a held name that is no fitted
+        parameter, a bad ``confidence``.
     ImgmtfError
         A fit that does not converge (reason ``fit``).
 
@@ -333,8 +438,8 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
         raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
     if isinstance(stages, str) and stages.strip() == "auto":
         raise ParameterError("stages 'auto' is the edges' fit's; name the bars' stages (optics,detector)")
-    names = stage_names(stages, None)
-    model = _BarModel(profiles, initial_stages(names, None, gsd_m), gsd_m)
+    names = stage_names(stages, start)
+    model = _BarModel(profiles, initial_stages(names, start, gsd_m), gsd_m, hold)
     lower, upper = model.bounds()
     z0 = np.clip(model.initial_vector(), lower, upper)
     with one_blas_thread():
@@ -360,12 +465,13 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
         mtf50_ci.append(Interval(float(first_crossing(MTF50_GRID_CY_PX, low, 0.5)),
                                  float(first_crossing(MTF50_GRID_CY_PX, high, 0.5))))
     warnings = []
-    if reduced > 2.0:
+    if reduced > MISFIT_REDUCED_CHI_SQUARE:
         warnings.append(f"the model ({', '.join(names)}) leaves the profiles' residuals {math.sqrt(reduced):.1f} "
                         "times their noise: its form may not be the sensor's, and its MTF not the truth")
     return BarFit(sensor, ",".join(names), _parameters(model, z, covariance), float(reduced),
                   tuple(p.source for p in model.profiles), tuple(p.normal_angle_deg for p in model.profiles),
-                  tuple(nyquist), tuple(nyquist_ci), tuple(mtf50), tuple(mtf50_ci), confidence, tuple(warnings))
+                  tuple(nyquist), tuple(nyquist_ci), tuple(mtf50), tuple(mtf50_ci), confidence, tuple(warnings),
+                  lambda f, angle_deg: _mtf_band(model, u, cov, f, angle_deg, quantile))
 
 
 def _mtf_band(model: _BarModel, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
@@ -397,6 +503,10 @@ def _parameters(model: _BarModel, z: np.ndarray, covariance: np.ndarray) -> tupl
         for name, spec in stage.fit_specs().items():
             key = f"{stage.name}.{name}"
             value = float(getattr(stage, name))
+            if key in model.held:
+                out.append(FittedParameter(stage.name, name, value, math.nan, model.units[key], "held",
+                                           "at its starting value"))
+                continue
             if key in model.ties:
                 out.append(FittedParameter(stage.name, name, value, math.nan, model.units[key], "tied",
                                            f"no profile along its axis: taken equal to {model.ties[key]}"))

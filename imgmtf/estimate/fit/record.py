@@ -122,7 +122,7 @@ class FitRecord:
 
 
 def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
-                        sources: list[str] | None = None) -> None:
+                        sources: list[str] | None = None, record: FitRecord | None = None) -> None:
     """Write ``fit``'s sensor as TOML with its ``[fit]`` record: the
     sensor in a ``[sensor]`` table (``gsd_m`` and ``[[sensor.stages]]``),
     which :meth:`imgmtf.Sensor.from_toml` reads as it reads
@@ -138,13 +138,17 @@ def write_fitted_sensor(path: str | os.PathLike, fit: Any, *, comment: str = "",
         Lines written as TOML comments on top.
     sources : list of str, optional
         What the edges were (default the fit's edge names).
+    record : FitRecord, optional
+        The ``[fit]`` record, for a fit of other targets than edges (bars:
+        :meth:`imgmtf.estimate.fit.bars.BarFit.to_toml`); default
+        :meth:`FitRecord.of` ``fit``.
 
     Raises
     ------
     FileWriteError
         The file cannot be written.
     """
-    record = FitRecord.of(fit, sources)
+    record = record if record is not None else FitRecord.of(fit, sources)
     lines = [f"# {line}" for line in comment.splitlines()]
     lines += ["# imgmtf fitted sensor: metres on the ground, cycles/metre for frequencies",
               "# [fit] says whether the model fits the edges it was fitted to (imgmtf restore refuses a misfit)",
