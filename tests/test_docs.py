@@ -195,6 +195,24 @@ def test_python_m_doctest_passes_on_the_readme(sample_folder):
     assert_ignored(sample_folder)
 
 
+def test_every_page_reading_real_scenes_says_how_to_link_them():
+    """A newcomer runs a page's commands in a folder of their own: each real
+    scene (or shapefile folder) it reads is one the page says how to link
+    from ../shared/data beside the clone."""
+    for document, links in REAL_SCENES_READ.items():
+        text = " ".join((ROOT / document).read_text().split())     # a command may wrap
+        for link, name in links.items():
+            top, source = link.split("/")[0], name.split("/")[0]
+            target = f"ln -s ../shared/data/real-scenes/{source}"
+            assert target in text and (top == source or f"{target} {top}" in text), (document, link)
+
+
+def test_the_readme_says_early_what_the_tests_take_and_need():
+    first_screen = "\n".join((ROOT / "README.md").read_text().splitlines()[:40])
+    assert "under a minute" not in first_screen and "minutes on 2 cores" in first_screen
+    assert "IMGMTF_SHARED_DATA" in first_screen and "skip" in first_screen
+
+
 def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
     readme = (ROOT / "README.md").read_text()
     first_screen = "\n".join(readme.splitlines()[:40])
