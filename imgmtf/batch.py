@@ -333,7 +333,9 @@ def _band_plot_path(plot_path: str, band, n_bands: int) -> str:
     if n_bands == 1:
         return plot_path
     p = Path(plot_path)
-    return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
+    if p.name.endswith("_mtf.png"):
+        return str(p.with_name(p.name.replace("_mtf.png", f"_b{band}_mtf.png")))
+    return str(p.with_name(f"{p.stem}_b{band}{p.suffix}"))      # --plot FILE: not one figure per band over it
 
 
 def _place(summary: dict) -> str:

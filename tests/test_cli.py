@@ -59,6 +59,23 @@ def test_text_output_plots_and_methods(run, chip, tmp_path):
     assert (out_dir / "edge_mtf.png").exists()
 
 
+def test_measure_says_each_figure_it_writes_and_why_none(run, chip, tmp_path):
+    png = tmp_path / "edge.png"
+    result = run("measure", "--plot", png, chip)
+    assert result.exit_code == 0 and f"wrote {png}" in result.stdout.splitlines()
+    bad = tmp_path / "bad.tif"
+    bad.write_text("junk")
+    result = run("measure", "--plot", tmp_path / "bad.png", bad)
+    assert result.exit_code == 1 and not (tmp_path / "bad.png").exists()
+    assert f"no figure written for {bad}" in result.stderr and "wrote" not in result.output
+
+
+def test_plot_names_a_figure_per_band_apart():
+    from imgmtf.batch import _band_plot_path
+    assert _band_plot_path("a.png", 2, 3) == "a_b2.png" and _band_plot_path("a.png", 1, 1) == "a.png"
+    assert _band_plot_path("d/x_mtf.png", 2, 3) == "d/x_b2_mtf.png"
+
+
 def test_roi_and_band(run, chip):
     assert run("measure", "--roi", "0,0,64,64", "--band", 1, chip).exit_code == 0
     r = run("measure", "--band", 2, chip)

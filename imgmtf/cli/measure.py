@@ -61,7 +61,9 @@ MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pu
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text", show_default=True)
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False),
               help="also write a CSV summary (each row as its file completes)")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="figure for a single input (PNG)")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False),
+              help="figure for a single input (PNG); several figures (--roi-file's features, --band all's "
+                   "bands) take _f<id> and _b<band> before the suffix: FILE_f0.png, FILE_b2.png")
 @click.option("--plot-dir", type=click.Path(file_okay=False), help="one figure per input in this folder")
 @click.option("--recursive", is_flag=True, help="also look for images in sub-folders of folders given")
 @click.option("--force", is_flag=True,
@@ -148,6 +150,7 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
         stdout = (JsonLinesWriter(sys.stdout) if fmt == "json"
                   else TextRows(kind, files, bands=band is not None))
         order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
+        figures: dict[str, list] = {}       # each file's figures written, in the order they come
         with ExitStack() as outputs:
             writers = [stdout]
             if csv_path:
@@ -162,6 +165,9 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
                             for writer in writers:
                                 writer.write(record)
                             counts["ok" if record.ok else "error"] += 1
+                        plots = figures.setdefault(record.path, [])
+                        if record.plot and record.plot not in plots:
+                            plots.append(record.plot)
                     if store:       # a file's (and band's) chips are one acquisition: its features together
                         for path, band_read in dict.fromkeys((r.path, r.band) for r in batch if r.ok):
                             with signals_deferred():
@@ -175,6 +181,8 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
                 emit(order.pending())            # measured, though after a file still running
                 interrupted = exc
     total = counts["ok"] + counts["error"]
+    if plot_path or plot_dir:
+        say_figures(figures, json=fmt == "json")
     if store:
         store.summary()
     if interrupted is not None:
@@ -187,3 +195,14 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
                    + (f"; summary in {csv_path}" if csv_path else ""), err=True)
     sys.exit(1 if counts["error"] else 0)
 
+
+def say_figures(figures: dict[str, list], json: bool = False) -> None:
+    """A ``wrote FILE`` line per figure written (on stderr under ``--format
+    json``, whose stdout is JSON), and for a file measured with none (every
+    chip refused or unreadable) that no figure was written, and why."""
+    for path, written in figures.items():
+        for plot in written:
+            click.echo(f"wrote {plot}", err=json)
+        if not written:
+            click.echo(f"imgmtf: no figure written for {path}: nothing was measured (its error above "
+                       "says why)", err=True)
