@@ -82,6 +82,17 @@ def test_a_warning_names_the_option_that_answers_it_where_the_command_has_it():
     assert hinted_warning("another warning", running=measure) == "another warning"
 
 
+def test_a_gamma_encoded_file_is_told_the_transfer_option():
+    from imgmtf.file_notes import file_notes
+    from imgmtf.io import Raster
+    measure = Command.of(next(c for c in COMMANDS if c.name == "measure"))
+    for band in (1, "luminance"):
+        raster = Raster(np.zeros((4, 4)), "edge.png", band=band, gsd_m=None, dtype="uint8")
+        [note] = [n for n in file_notes(raster) if "gamma" in n]
+        assert hinted_warning(note, running=measure).endswith("(--transfer srgb or --transfer gamma:G linearises them)")
+        assert hinted_warning(note, running=Command("x", frozenset())) == note
+
+
 @pytest.mark.parametrize("reason, message, option", [
     ("too-short", "the line is 12 px long, shorter than the minimum 20 px", "--min-length"),
     ("two-targets", "its ROI reaches another edge", "--margin"),

@@ -66,6 +66,9 @@ HINTS = (
     Hint(SCAN, "few-points", "--point-spacing PX groups targets farther apart, a star field's whole frame with "
                              "its size"),
     Hint(WARNING, "", "--track-azimuth DEG gives it", words="give the track's azimuth"),
+    # a photo's gamma-encoded values, RGB or 8-bit
+    Hint(WARNING, "", "--transfer srgb or --transfer gamma:G linearises them",
+         words="the sRGB or a gamma transfer curve"),
 )
 
 # refusals of one file that a scan of it resolves: the scan finds each edge and
