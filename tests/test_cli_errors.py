@@ -82,6 +82,21 @@ def test_a_warning_names_the_option_that_answers_it_where_the_command_has_it():
     assert hinted_warning("another warning", running=measure) == "another warning"
 
 
+def test_a_wrong_kind_is_told_every_other_registered_kind():
+    from imgmtf.kinds import kind_names
+    for reason, kind in (("not-a-star", "star"), ("not-points", "points")):
+        [hint] = option_hints(CHIP, reason)
+        assert all(name in hint for name in kind_names() if name != kind) and f" {kind}" not in hint
+
+
+def test_a_double_bar_refusal_says_once_what_measures_it_with_its_spacing():
+    message = "two parallel bars 3.0 px apart (the profile dips to 7% of its peaks between them), not one bar"
+    hint = refusal_hint("double-bar", message)
+    assert "--target double-bar --pulse-width W --gap G" in hint and "W + G near 3.0 px" in hint
+    from imgmtf.estimate.bar_pair import BarPair
+    assert "measure" not in BarPair(0.0, 3.0, 0.1).message()       # the hint says it, once
+
+
 def test_a_gamma_encoded_file_is_told_the_transfer_option():
     from imgmtf.file_notes import file_notes
     from imgmtf.io import Raster

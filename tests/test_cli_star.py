@@ -53,7 +53,7 @@ def test_an_edge_measured_as_a_star_is_refused(tmp_path):
     assert run("simulate", "--size", 50, "--noise-std", 3, "--seed", 1, "--out", path).exit_code == 0
     result = run("measure", "--target", "star", path)
     assert result.exit_code == 1
-    assert "no Siemens star about" in result.output and "--target edge, pulse or points" in result.output
+    assert "no Siemens star about" in result.output and "--target edge, pulse, points or double-bar" in result.output
 
 
 def test_star_options_apply_to_stars_only(tmp_path):

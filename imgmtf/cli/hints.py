@@ -16,6 +16,8 @@ import re
 from collections.abc import Collection
 from dataclasses import dataclass
 
+from ..kinds import kind_names
+
 #: the commands a hint is written for: one file measured as given, or a scene searched; and
 #: the warnings of a measurement (keyed by their words, having no reason code)
 CHIP, SCAN, WARNING = "chip", "scan", "warning"
@@ -36,13 +38,32 @@ class Hint:
     only: frozenset[str] = frozenset()
 
 
+def other_targets(kind: str) -> str:
+    """``--target`` with every registered kind but ``kind``, as a hint
+    names them.
+
+    Examples
+    --------
+    >>> other_targets("star")
+    '--target edge, pulse, points or double-bar'
+    """
+    others = [name for name in kind_names() if name != kind]
+    return f"--target {', '.join(others[:-1])} or {others[-1]}"
+
+
+#: the hint to a double bar refused as one bar or an edge, the spacing its profile shows filled in
+PAIR_HINT = "--target double-bar --pulse-width W --gap G measures them"
+#: the spacing of two bars as the refusal's message gives it
+PAIR_SPACING = re.compile(r"two parallel bars (\d+(?:\.\d+)?) px apart")
+
+
 HINTS = (
     Hint(CHIP, "two-targets", "--roi X,Y,W,H crops it to one target"),
     Hint(CHIP, "not-an-edge", "--target pulse measures a bar"),
     Hint(CHIP, "not-a-bar", "--target edge measures an edge"),
     Hint(CHIP, "points", "--target points measures point targets"),
-    Hint(CHIP, "not-points", "--target edge or --target pulse measures it"),
-    Hint(CHIP, "not-a-star", "--target edge, pulse or points measures what it holds"),
+    Hint(CHIP, "not-points", f"{other_targets('points')} measures it"),
+    Hint(CHIP, "not-a-star", f"{other_targets('star')} measures what it holds"),
     Hint(CHIP, "star", "--target star measures a Siemens star"),
     # an image too large, not a window too large (which a smaller --roi answers, as its message says)
     Hint(CHIP, "too-large", "--roi X,Y,W,H measures a window", words="measure a window of it"),
@@ -50,7 +71,7 @@ HINTS = (
     Hint(CHIP, "bands", "--band N chooses one"),
     Hint(CHIP, "bands", "--band all measures each", only=frozenset({"measure"})),
     Hint(CHIP, "bar-width", "--pulse-width gives it"),
-    Hint(CHIP, "double-bar", "--target double-bar --pulse-width W --gap G measures them"),
+    Hint(CHIP, "double-bar", PAIR_HINT),
     Hint(CHIP, "fit", "--stages fits fewer, --hold holds some"),
     # a scene's half-edges: fit takes the ROIs scan prints, one per file named
     Hint(CHIP, "fill", "--roi X,Y,W,H once per file fits the edges imgmtf scan finds", only=frozenset({"fit"})),
@@ -114,8 +135,17 @@ def command_options(command=None) -> Command | None:
 def option_hints(command: str, reason: str | None, message: str = "", *, running: Command | None = None) -> list[str]:
     """The options in :data:`HINTS` that answer a refusal ``command`` met
     (only those ``running`` has, when given)."""
-    return [h.text for h in HINTS if h.command == command and h.reason == reason and h.words in message
-            and (running is None or running.gives(h.text, h.only))]
+    return [_filled(h.text, message) for h in HINTS if h.command == command and h.reason == reason
+            and h.words in message and (running is None or running.gives(h.text, h.only))]
+
+
+def _filled(text: str, message: str) -> str:
+    """A hint with what the refusal measured: a double bar's spacing
+    (its bars' centres apart, the width plus the gap)."""
+    spacing = PAIR_SPACING.search(message)
+    if text == PAIR_HINT and spacing:
+        return f"{text}, W + G near {spacing.group(1)} px, the peaks' spacing"
+    return text
 
 
 def refusal_hint(reason: str | None, message: str = "", path: str | None = None, *,

@@ -42,7 +42,7 @@ class BarPair:
         """The refusal's words: what was seen, ``instead`` of what was asked
         for ("one bar", "an edge"), and what measures it."""
         return (f"two parallel bars {self.apart_px:.1f} px apart (the profile dips to "
-                f"{self.dip_share:.0%} of its peaks between them), not {instead}: measure them as a double bar")
+                f"{self.dip_share:.0%} of its peaks between them), not {instead} but a double bar")
 
 
 def bar_pair(grid: np.ndarray, prf01: np.ndarray, noise: float = 0.0) -> BarPair | None:
