@@ -69,3 +69,15 @@ def test_a_star_measured_as_an_edge_is_refused_naming_the_star(star_chip):
     row = json.loads(result.stdout.splitlines()[0])
     assert row["reason"] == "star" and "sinusoidal Siemens star of 46 cycles" in row["error"]
     assert "--target star" in run("measure", "--target", "edge", star_chip).output
+
+
+def test_a_star_row_keeps_the_columns_and_shows_no_fwhm_it_lacks():
+    from imgmtf.cli.tables import text_row
+    record = {"path": "star.tif", "status": "ok", "normal_angle_deg": 112.5, "tilt_deg": None,
+              "direction": "112.5deg", "snr": 98.0, "mtf_nyquist": 0.26, "mtf_nyquist_ci": [0.25, 0.27],
+              "mtf50_cy_px": 0.36, "fwhm_px": None, "star_cycles": 46, "gsd_m": 1.0, "mtf50_cy_m": 0.36,
+              "fwhm_m": None}
+    row, ground = text_row(record, "star", path_width=8).splitlines()
+    across = text_row({**record, "direction": "across-track"}, "star", path_width=8).splitlines()[0]
+    assert len(row) == len(across) and row.index("0.2600") == across.index("0.2600")
+    assert ground.endswith("MTF50 0.36 cy/m") and "FWHM" not in ground

@@ -90,8 +90,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
-    direction = record.get("direction") or "-"
-    direction = SHORT_DIRECTIONS.get(direction, direction)
+    direction = direction_cell(record.get("direction"))
     cells = [f"{first} {num_cell(record.get('normal_angle_deg'), 7, 2)} "
              f"{num_cell(record.get('tilt_deg'), 5, 1)} {direction:>7} "
              f"{snr_cell(record.get('snr'))} {num_cell(record.get('mtf_nyquist'), 7, 4)} {interval:>17} "
@@ -102,13 +101,30 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     if record.get("radial_distance_px") is not None:
         cells.append(f"{indent} {record.get('field_direction') or 'at the optical centre'}, "
                      f"{record['radial_distance_px']:g} px from the optical centre")
-    if record.get("gsd_m"):
-        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
-                     f"{ground_cell(record.get('mtf50_cy_m'))} cy/m, FWHM {ground_cell(record.get('fwhm_m'))} m")
+    ground = [f"{name} {ground_cell(record.get(field))} {unit}" for name, field, unit in
+              (("MTF50", "mtf50_cy_m", "cy/m"), ("FWHM", "fwhm_m", "m")) if record.get(field) is not None]
+    if record.get("gsd_m") and ground:      # a figure the target does not give (a star's FWHM) left out
+        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): {', '.join(ground)}")
     if record["status"] == "untrusted":
         cells.append(f"{indent} error: {record['error']}")
     cells += [f"{indent} warning: {hinted_warning(w)}" for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def direction_cell(direction: str | None) -> str:
+    """A direction as the table's 7-character ``dir`` column shows it:
+    across and along track short, an angle without its unit (the
+    ``normal`` column beside it is in degrees), '-' for none.
+
+    Examples
+    --------
+    >>> [direction_cell(d) for d in ("across-track", "112.5deg", "45deg", None)]
+    ['across', '112.5', '45', '-']
+    """
+    if not direction:
+        return "-"
+    direction = SHORT_DIRECTIONS.get(direction, direction)
+    return direction[:-3] if direction.endswith("deg") else direction
 
 
 def feature_line(record: dict, indent: str) -> str:
@@ -172,7 +188,7 @@ def print_fit(result) -> None:
     axes = {"across": "x", "along": "y"} if result.pixel_units else {}
     for e in edges:
         lo, hi = e.mtf_nyquist_ci
-        direction = SHORT_DIRECTIONS.get(e.direction, e.direction)
+        direction = direction_cell(e.direction)
         click.echo(f"{labels[e.source]:<{width}} {e.normal_angle_deg:6.2f} {direction:>7} "
                    f"{axes.get(e.constrains, e.constrains):>6} {e.mtf_nyquist:7.4f} "
                    f"{f'[{lo:.4f},{hi:.4f}]':>17} {e.measured_mtf_nyquist:8.4f} {e.reduced_chi_square:6.3g} "
