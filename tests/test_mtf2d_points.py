@@ -129,3 +129,10 @@ def test_wings_the_gaussian_model_lacks_are_measured_not_eased_away():
     assert any("of their light beyond" in w for w in result.warnings)
     truth = 0.9 * np.exp(-2 * np.pi ** 2 * 0.25 * 0.25) + 0.1 * np.exp(-2 * np.pi ** 2 * 2.25 * 0.25)
     assert abs(result.directions[0].mtf_nyquist - truth * 2 / np.pi) < 0.005
+
+
+def test_a_lack_of_tail_light_is_not_called_a_halo():
+    from imgmtf.estimate.mtf2d.stack import tail_note
+    lack, halo = tail_note(-0.043, 2.2), tail_note(0.043, 2.2)
+    assert "4.3 % less" in lack and "halo" not in lack and "-" not in lack.split(":")[0]
+    assert "4.3 % more" in halo and "halo" in halo

@@ -124,9 +124,7 @@ class Stack:
         tail = np.where(r > core, self.stamps - models, 0.0).sum(axis=(1, 2))      # light beyond the model's
         spread = float(tail.std(ddof=1)) / math.sqrt(len(tail)) if len(tail) > 1 else math.inf
         if abs(float(tail.mean())) > max(3.0 * spread, MAX_TAIL_LIGHT):
-            return self.stamps, (f"the targets hold {100 * float(tail.mean()):+.1f} % of their light beyond "
-                                 f"{core:.1f} px that their Gaussian model has not (a halo or wings): measured as "
-                                 "they are, not eased into the model, at the cost of precision")
+            return self.stamps, tail_note(float(tail.mean()), core)
         weight = np.sin(0.5 * np.pi * np.clip((outer - r) / TAPER_WIDTH_PX, 0.0, 1.0)) ** 2
         return weight * self.stamps + (1.0 - weight) * models, ""
 
@@ -249,3 +247,19 @@ class Stack:
         psf = np.fft.fftshift(np.fft.ifft2(t).real) / step ** 2
         return psf, step
 
+
+def tail_note(share: float, core_px: float) -> str:
+    """The warning of targets whose light beyond ``core_px`` (px from
+    their centres) differs from their Gaussian model's by ``share`` of
+    their light: more is a halo or wings, less tails that fall faster than
+    the Gaussian's (a flat-topped spot, a background taken too high).
+
+    Examples
+    --------
+    >>> tail_note(-0.043, 2.2).split(":")[0]
+    "the targets hold 4.3 % less of their light beyond 2.2 px than their Gaussian model (tails lighter than a Gaussian's)"
+    """
+    what = "more" if share > 0 else "less"
+    why = "a halo or wings" if share > 0 else "tails lighter than a Gaussian's"
+    return (f"the targets hold {100 * abs(share):.1f} % {what} of their light beyond {core_px:.1f} px than their "
+            f"Gaussian model ({why}): measured as they are, not eased into the model, at the cost of precision")
