@@ -104,3 +104,18 @@ def test_a_campaign_scene_point_array_settles_the_edges_across_along_choice(tmp_
     assert abs(quoted_points["mtf_nyquist"] - TRUTH["across-track"]) < 0.01
     edge_rows = read_layer(store, "edges")
     assert sum(r["target"] == "points" for r in edge_rows) == 2          # the array, across and along
+
+
+def test_a_rejected_array_tells_the_scans_peaks_from_the_features_measured(capsys):
+    from types import SimpleNamespace
+
+    from imgmtf.cli.point_tables import print_point_scan
+    from imgmtf.errors import ImageContentError
+    from imgmtf.records import Record
+    error = ImageContentError("s.tif: the array at (10, 20) has 3 usable targets of the 21 features found in its "
+                              "window (18 faint); an array needs 4", reason="few-points")
+    record = Record.failed("s.tif", 1, "points", "points", error, params={}, run_utc="2026-01-01T00:00:00Z",
+                           status="rejected", site={"target_id": 1, "x_px": 10.0, "y_px": 20.0, "points_found": 4})
+    print_point_scan("s.tif", SimpleNamespace(width=64, height=64), [record], [], [], "text")
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert "grouped from 4 peaks the scan found" in line and "4 points found" not in line

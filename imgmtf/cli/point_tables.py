@@ -43,8 +43,10 @@ def print_point_scan(scene, info, records, summaries, written, fmt) -> None:
         if not record.ok:
             r = record.to_dict()
             message = r["error"].removeprefix(r["path"] + ": ")
-            click.echo(f"array {r['target_id']} at ({r['x_px']:.0f}, {r['y_px']:.0f}), {r['points_found']} "
-                       f"points found: rejected, {r['reason']}: {message}{rejection_hint(r['reason'], message)}")
+            # the scan's peaks grouped into the array, not the features its measurement then finds in the ROI
+            click.echo(f"array {r['target_id']} at ({r['x_px']:.0f}, {r['y_px']:.0f}), grouped from "
+                       f"{plural(r['points_found'], 'peak')} the scan found: rejected, {r['reason']}: {message}"
+                       f"{rejection_hint(r['reason'], message)}")
     if summaries:
         click.echo("the scene per direction, its arrays combined by precision (* the row to quote):")
         for summary in summaries:

@@ -280,7 +280,8 @@ def _measured_array(path, settings, estimator, roi, site, params, run_utc, track
         if len(result.used) < MIN_ARRAY_POINTS:
             counts = ", ".join(f"{n} {why}" for why, n in sorted(result.refusal_counts().items())) or "none refused"
             raise ImageContentError(f"{path}: the array at ({site['x_px']:.0f}, {site['y_px']:.0f}) has "
-                                    f"{len(result.used)} usable targets of {len(result.sources)} ({counts}); an "
+                                    f"{len(result.used)} usable targets of the {len(result.sources)} features found in "
+                                    f"its window ({counts}); an "
                                     f"array needs {MIN_ARRAY_POINTS}", reason=FEW_POINTS)
     except ImgmtfError as exc:
         return [Record.failed(path, settings.band, settings.target, settings.method, exc, params=params,
