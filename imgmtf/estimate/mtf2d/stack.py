@@ -256,8 +256,8 @@ def tail_note(share: float, core_px: float) -> str:
 
     Examples
     --------
-    >>> tail_note(-0.043, 2.2).split(":")[0]
-    "the targets hold 4.3 % less of their light beyond 2.2 px than their Gaussian model (tails lighter than a Gaussian's)"
+    >>> tail_note(-0.043, 2.2).split(" than ")[0]
+    'the targets hold 4.3 % less of their light beyond 2.2 px'
     """
     what = "more" if share > 0 else "less"
     why = "a halo or wings" if share > 0 else "tails lighter than a Gaussian's"
