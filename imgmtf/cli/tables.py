@@ -101,10 +101,10 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     if record.get("radial_distance_px") is not None:
         cells.append(f"{indent} {record.get('field_direction') or 'at the optical centre'}, "
                      f"{record['radial_distance_px']:g} px from the optical centre")
-    ground = [f"{name} {ground_cell(record.get(field))} {unit}" for name, field, unit in
-              (("MTF50", "mtf50_cy_m", "cy/m"), ("FWHM", "fwhm_m", "m")) if record.get(field) is not None]
-    if record.get("gsd_m") and ground:      # a figure the target does not give (a star's FWHM) left out
-        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): {', '.join(ground)}")
+    if record.get("gsd_m"):     # MTF50 '-' behind a bar's sinc zero; a FWHM the target has none of (a star's) left out
+        fwhm = record.get("fwhm_m")
+        cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
+                     f"{ground_cell(record.get('mtf50_cy_m'))} cy/m" + ("" if fwhm is None else f", FWHM {fwhm:.4g} m"))
     if record["status"] == "untrusted":
         cells.append(f"{indent} error: {record['error']}")
     cells += [f"{indent} warning: {hinted_warning(w)}" for w in record.get("warnings") or []]
