@@ -76,6 +76,37 @@ def test_a_scan_overview_keeps_crowded_targets_labels_apart_and_inside_the_image
     assert any(t.arrow_patch is not None for t in labels)       # the crowded ones point back to their targets
 
 
+def test_a_scan_overview_of_a_chart_shrinks_many_targets_labels_to_the_rows_to_quote():
+    """A camera chart's 12 targets with four rows each cannot all be
+    labelled in full in a 400 x 300 px image: the labels fall back to the
+    rows to quote, each near its own target, none over another or out of
+    the image (over the title or the axis labels)."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    summaries = [{"scope": "target", "target_id": k, "x_px": x, "y_px": y, "summary": summary,
+                  "direction": direction, "normal_angle_deg": 5.0, "mtf_nyquist": 0.1, "mtf50_cy_px": 0.25,
+                  "assumption": "bracket", "chosen_assumption": "bracket", "recommended": summary == "sections"}
+                 for k, (x, y) in enumerate([(x, y) for y in (50, 150, 250) for x in (50, 150, 250, 350)], 1)
+                 for summary in ("combined", "sections") for direction in ("horizontal", "vertical")]
+    fig = plot_scan(np.zeros((300, 400)), 1.0, [], summaries)
+    ax = fig.axes[0]
+    labels = [t for t in ax.texts if t.get_text().startswith("T")]
+    assert len(labels) == 12 and all(t.get_text().count("\n") == 2 for t in labels)   # T, *H, *V
+    fig.draw_without_rendering()
+    boxes = [Text.get_window_extent(t) for t in labels]
+    frame = ax.get_window_extent()
+    assert all(_overlap(a, b) == 0 for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    assert all(_overlap(b, frame) == pytest.approx(b.width * b.height) for b in boxes)
+    per_px = frame.width / 400.0
+    for t, b in zip(labels, boxes):       # beside its own target: its nearest corner within ~60 px of the target
+        x, y = ax.transData.transform(t.xy)
+        gap = np.hypot(max(b.x0 - x, 0, x - b.x1), max(b.y0 - y, 0, y - b.y1))
+        assert gap < 60 * per_px
+    assert "rows to quote" in ax.get_title(loc="left")
+
+
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():
     from imgmtf.plot.measurement import _figure
     assert _figure(0.36431, "cy/px") == "0.3643 cy/px" and _figure(0.2667) == "0.2667"
