@@ -137,10 +137,17 @@ def test_a_missing_figure_is_labelled_by_its_cause():
 
 def test_the_header_counts_every_warning_and_drops_none_unsaid():
     from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    from imgmtf.plot.scan import _overlap
     result = _measured(6.0)
     warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
-    header = plot_measurement(result, warnings=warnings).get_suptitle()
+    warnings[1] = "note 1 " + "long " * 40 + "its advice at the end"
+    fig = plot_measurement(result, warnings=warnings)
+    header = fig.get_suptitle()
     assert f"warning 1 of {len(warnings)}: note 0" in header and "note 2" in header
+    assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150   # wrapped, not cut
+    fig.draw_without_rendering()            # the MTF panel's legend below it, off the curve and its markers
+    mtf = fig.axes[3]
+    assert _overlap(mtf.get_legend().get_window_extent(), mtf.get_window_extent()) == 0
     assert "and 2 more warning(s)" in header and "note 3" not in header
     assert "warning" not in plot_measurement(result).get_suptitle()
 
