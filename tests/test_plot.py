@@ -267,3 +267,28 @@ def test_the_sections_figure_draws_each_assumption_and_the_measured_sections():
     assert len(ax.collections) == 2           # the chosen assumption's intervals, across and along
     with pytest.raises(ParameterError, match="MTF2D"):
         plot_sections("not a result")
+
+
+def test_the_point_figure_keeps_its_panels_labels_on_the_page_and_its_truth_above_the_curves():
+    """The 2-D MTF panel's colour bar once pushed its y tick labels and axis
+    label off the figure's left edge; the truth, drawn in the curves'
+    colour under them, did not show."""
+    from imgmtf.estimate.mtf2d import measure_points
+    from imgmtf.plot.points import plot_points
+    from imgmtf.sensor.points import PointArray, render_points
+    sensor = im.Sensor()
+    chip = render_points(sensor, PointArray(3, 3), 48)
+    fig = plot_points(measure_points(chip.image, intervals="none"), chip.image,
+                      truth=lambda f, angle: abs(sensor.normal_transfer(f, angle)))
+    fig.draw_without_rendering()
+    renderer = fig._get_renderer()
+    page = fig.bbox
+    for ax in fig.axes:
+        box = ax.get_tightbbox(renderer)
+        assert page.x0 - 1 <= box.x0 and box.x1 <= page.x1 + 1, ax.get_title()
+    mtf = next(ax for ax in fig.axes if ax.get_title().startswith("MTF from"))
+    truths = [line for line in mtf.lines if line.get_label().startswith("truth")]
+    measured = [line for line in mtf.lines if "at Nyquist" in line.get_label()]
+    assert len(truths) == len(measured) == 2
+    assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)
+    assert all(t.get_linestyle() != "-" and t.get_color() not in {m.get_color() for m in measured} for t in truths)
