@@ -292,3 +292,17 @@ def test_the_point_figure_keeps_its_panels_labels_on_the_page_and_its_truth_abov
     assert len(truths) == len(measured) == 2
     assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)
     assert all(t.get_linestyle() != "-" and t.get_color() not in {m.get_color() for m in measured} for t in truths)
+
+
+def test_the_star_figure_draws_its_truth_above_the_curves():
+    """The truth, in each direction's colour under its curve, did not show."""
+    from imgmtf.plot.star import plot_star_mtf
+    sensor = im.Sensor()
+    chip = im.render_star(sensor, im.SiemensStar(cycles=32), 101)
+    truth = lambda f, angle: abs(sensor.normal_transfer(f, angle))  # noqa: E731
+    ax = plot_star_mtf(im.measure_star(chip.image), truth=truth).axes[0]
+    measured = [line for line in ax.lines if line.get_linestyle() == "-" and line.get_label()[0] != "_"]
+    truths = [line for line in ax.lines if line.get_linestyle() == "--" and len(line.get_xdata())]
+    assert len(truths) == len(measured) > 1
+    assert all(t.get_color() == "black" for t in truths)
+    assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)

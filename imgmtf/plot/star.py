@@ -136,9 +136,10 @@ def plot_star_mtf(result: StarResult, truth: Callable[[np.ndarray, float], np.nd
         ax.plot(d.ring_frequencies_cy_px, d.ring_mtf, ".", color=colour, ms=2, alpha=0.6)
         if truth is not None:
             f = d.frequencies_cy_px
-            ax.plot(f, truth(f, d.angle_deg), color=colour, ls="--", lw=0.9)
+            # black, dashed, above the curves: in their colour it hid under them
+            ax.plot(f, truth(f, d.angle_deg), color="black", ls="--", lw=0.9, zorder=3)
     if truth is not None:
-        ax.plot([], [], color="0.3", ls="--", lw=0.9, label="truth (dashed)")
+        ax.plot([], [], color="black", ls="--", lw=0.9, label="truth (black, dashed)")
     ax.axvline(0.5, color="0.6", lw=0.8, ls=":")
     ax.set_xlim(0.0, max(0.8, max(float(d.frequencies_cy_px[-1]) for d in result.directions)))
     ax.set_ylim(0.0, 1.05)
@@ -194,7 +195,7 @@ def plot_star_directions(result: StarResult, truth: Callable[[np.ndarray, float]
                 f = np.linspace(0.0, 1.0, 501)
                 from ..metrics import first_crossing
                 expected = np.array([float(first_crossing(f, truth(f, a), 0.5)) for a in fine])
-            ax.plot(fine, expected, color=colour, ls="--", lw=0.9, label=f"truth, {label}")
+            ax.plot(fine, expected, color="black", ls="--", lw=0.9, zorder=3, label=f"truth, {label}")
     ax.set_xlim(-5.0, 185.0)
     ax.set_xticks(np.arange(0, 181, 45))
     ax.set_xlabel("direction of the frequency, deg from x (90: along the rows)")
