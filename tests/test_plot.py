@@ -306,3 +306,31 @@ def test_the_star_figure_draws_its_truth_above_the_curves():
     assert len(truths) == len(measured) > 1
     assert all(t.get_color() == "black" for t in truths)
     assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)
+
+
+def test_a_scan_overview_of_a_checkerboard_crop_puts_its_target_label_beside_the_image():
+    """One target whose half-edges cross the whole image (Baotou's crop):
+    no spot inside is free, so the label goes right of the image and the
+    target carries its id only, off its half-edges."""
+    from matplotlib.offsetbox import AnchoredText
+
+    from imgmtf.plot import plot_scan
+    ends = [(50.0, 0.0), (0.0, 50.0), (50.0, 99.0), (99.0, 50.0)]
+    accepted = [{"id": k, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": a, "y1_px": b}
+                for k, (a, b) in enumerate(ends, 1)]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "sections",
+               "direction": d, "assumption": "bracket", "chosen_assumption": "bracket", "recommended": True,
+               "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3} for d in ("across-track", "along-track")]
+    fig = plot_scan(np.zeros((100, 100)), 1.0, accepted, target, width_in=4.5)    # an image 1.4 in wide
+    ax = fig.axes[0]
+    fig.draw_without_rendering()
+    aside = [a for a in ax.artists if isinstance(a, AnchoredText)]
+    assert len(aside) == 1 and "*across (bracket): 0.200 | 0.300" in aside[0].txt.get_text()
+    assert aside[0].get_window_extent().x0 >= ax.get_window_extent().x1
+    tag = next(t for t in ax.texts if t.get_text().startswith("T1"))
+    assert tag.get_text() == "T1"
+    box = tag.get_window_extent()
+    for a, b in ends:
+        for f in np.linspace(0.0, 1.0, 30):
+            px, py = ax.transData.transform((50 + f * (a - 50), 50 + f * (b - 50)))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)

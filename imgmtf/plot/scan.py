@@ -206,7 +206,10 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
     leader.  Each label is ``(xy, full text, compact text)``; the styles
     of :data:`LABEL_STYLES` are tried in turn (smaller text, then the
     compact texts) until every label is free of the others and inside the
-    image.  Returns whether the compact texts were drawn."""
+    image.  Up to :data:`MAX_ASIDE` labels that cannot avoid the
+    half-edges (a checkerboard's crop, all target) go in full to the
+    column right of the image, each target tagged by its id.  Returns
+    whether the compact texts were drawn."""
     if not labels:
         return False
     frame = ax.get_window_extent()
@@ -231,12 +234,11 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
                     probe.set_verticalalignment(_VA[sy])
                     box = probe.get_window_extent().padded(pad)
                     hard = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
-                    soft = sum(_overlap(box, t) for t in ids)
-                    if edge_points.size:
-                        soft += EDGE_POINT_COST * np.count_nonzero(
-                            (edge_points[:, 0] > box.x0) & (edge_points[:, 0] < box.x1)
-                            & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1))
-                    covers = soft > 0
+                    covered = np.count_nonzero(
+                        (edge_points[:, 0] > box.x0) & (edge_points[:, 0] < box.x1)
+                        & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1)) if edge_points.size else 0
+                    covers = covered > 0
+                    soft = sum(_overlap(box, t) for t in ids) + EDGE_POINT_COST * covered
                     soft += RING_COST * ring * box.width * box.height     # near its target first
                     if (hard, soft) < best[:2]:
                         best = (hard, soft, ring, probe.xyann, box, covers)
@@ -251,13 +253,16 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
     if len(spots) <= MAX_ASIDE and any(spot[4] for spot in spots):
         # a scene that is its few targets (a checkerboard's crop) has no free spot: the labels go
         # to the column right of the image, below the legend, each target tagged by its id only
-        aside = "\n\n".join(text for _, text, *_ in spots)
-        ax.text(1.01, 0.0, aside, transform=ax.transAxes, ha="left", va="bottom", fontsize=7.5, zorder=8,
-                bbox={"boxstyle": "round,pad=0.3", "fc": (0.9, 1.0, 0.9), "ec": "#00a000", "lw": 0.8})
+        from matplotlib.offsetbox import AnchoredText
+        aside = AnchoredText("\n\n".join(full for _, full, _ in labels), loc="lower left",     # in full: room there
+                             bbox_to_anchor=(1.01, 0.0), bbox_transform=ax.transAxes, borderpad=0.0,
+                             prop={"fontsize": 7.5})
+        aside.patch.set(boxstyle="round,pad=0.3", facecolor=(0.9, 1.0, 0.9), edgecolor="#00a000", lw=0.8)
+        ax.add_artist(aside)
         for xy, text, *_ in spots:
             tag = text.split("\n")[0]
             ax.annotate(tag, xy, xytext=(4.0, 4.0), ha="left", va="bottom", **{**_label_style(7.0), "zorder": 8})
-        return compact
+        return False
     for xy, text, ring, (dx, dy), _ in spots:
         leader = {"arrowprops": {"arrowstyle": "-", "color": "#00a000", "lw": 0.6, "alpha": 0.8}} if ring > 1 else {}
         ax.annotate(text, xy, xytext=(dx, dy), ha=_HA[int(np.sign(dx))], va=_VA[int(np.sign(dy))], **style, **leader)
