@@ -334,3 +334,17 @@ def test_a_scan_overview_of_a_checkerboard_crop_puts_its_target_label_beside_the
         for f in np.linspace(0.0, 1.0, 30):
             px, py = ax.transData.transform((50 + f * (a - 50), 50 + f * (b - 50)))
             assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
+
+
+def test_the_point_and_star_headers_wrap_a_long_warning():
+    from imgmtf.estimate.mtf2d import measure_points
+    from imgmtf.plot.points import plot_points
+    from imgmtf.plot.star import plot_star
+    from imgmtf.sensor.points import PointArray, render_points
+    long = "long " * 60 + "its advice at the end"
+    star = im.render_star(im.Sensor(), im.SiemensStar(cycles=32), 101)
+    chip = render_points(im.Sensor(), PointArray(3, 3), 48)
+    for fig in (plot_star(im.measure_star(star.image), warnings=[long]),
+                plot_points(measure_points(chip.image, intervals="none"), warnings=[long])):
+        header = fig.get_suptitle()
+        assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150

@@ -3,6 +3,7 @@ the targets found on the chip, the stacked 2-D PSF, the 2-D MTF and the
 MTF across and along track with their intervals and the truth when known."""
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -292,7 +293,7 @@ def plot_points(result: PointsResult, image: np.ndarray | None = None,
     figures = ", ".join(f"{d.direction} MTF@Nyq {d.mtf_nyquist:.3f}, MTF50 {d.mtf50_cy_px:.3f} cy/px, "
                         f"FWHM {d.fwhm_px:.2f} px" for d in result.directions)
     lines.append(figures)
-    lines += [f"warning: {w}" for w in warnings[:2]]
+    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
     if len(warnings) > 2:
         lines.append(f"... and {len(warnings) - 2} more warning(s)")
     fig.suptitle("\n".join(lines), fontsize=9)

@@ -5,6 +5,7 @@ Nyquist and MTF50 against direction."""
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -257,7 +258,7 @@ def plot_star(result: StarResult, image: np.ndarray | None = None,
              f"{across.direction} MTF@Nyq {across.mtf_nyquist:.3f}, MTF50 {across.mtf50_cy_px:.3f} cy/px; "
              f"{along.direction} MTF@Nyq {along.mtf_nyquist:.3f}, MTF50 {along.mtf50_cy_px:.3f} cy/px; "
              f"SNR {result.snr:.0f}"]
-    lines += [f"warning: {w}" for w in warnings[:2]]
+    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
     if len(warnings) > 2:
         lines.append(f"... and {len(warnings) - 2} more warning(s)")
     fig.suptitle("\n".join(lines), fontsize=9)
