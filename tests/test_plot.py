@@ -76,6 +76,37 @@ def test_a_scan_overview_keeps_crowded_targets_labels_apart_and_inside_the_image
     assert any(t.arrow_patch is not None for t in labels)       # the crowded ones point back to their targets
 
 
+def test_a_scan_overview_of_a_chart_shrinks_many_targets_labels_to_the_rows_to_quote():
+    """A camera chart's 12 targets with four rows each cannot all be
+    labelled in full in a 400 x 300 px image: the labels fall back to the
+    rows to quote, each near its own target, none over another or out of
+    the image (over the title or the axis labels)."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    summaries = [{"scope": "target", "target_id": k, "x_px": x, "y_px": y, "summary": summary,
+                  "direction": direction, "normal_angle_deg": 5.0, "mtf_nyquist": 0.1, "mtf50_cy_px": 0.25,
+                  "assumption": "bracket", "chosen_assumption": "bracket", "recommended": summary == "sections"}
+                 for k, (x, y) in enumerate([(x, y) for y in (50, 150, 250) for x in (50, 150, 250, 350)], 1)
+                 for summary in ("combined", "sections") for direction in ("horizontal", "vertical")]
+    fig = plot_scan(np.zeros((300, 400)), 1.0, [], summaries)
+    ax = fig.axes[0]
+    labels = [t for t in ax.texts if t.get_text().startswith("T")]
+    assert len(labels) == 12 and all(t.get_text().count("\n") == 2 for t in labels)   # T, *H, *V
+    fig.draw_without_rendering()
+    boxes = [Text.get_window_extent(t) for t in labels]
+    frame = ax.get_window_extent()
+    assert all(_overlap(a, b) == 0 for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    assert all(_overlap(b, frame) == pytest.approx(b.width * b.height) for b in boxes)
+    per_px = frame.width / 400.0
+    for t, b in zip(labels, boxes):       # beside its own target: its nearest corner within ~60 px of the target
+        x, y = ax.transData.transform(t.xy)
+        gap = np.hypot(max(b.x0 - x, 0, x - b.x1), max(b.y0 - y, 0, y - b.y1))
+        assert gap < 60 * per_px
+    assert "rows to quote" in ax.get_title(loc="left")
+
+
 def test_a_figure_prints_with_its_unit_or_says_what_masked_it():
     from imgmtf.plot.measurement import _figure
     assert _figure(0.36431, "cy/px") == "0.3643 cy/px" and _figure(0.2667) == "0.2667"
@@ -106,10 +137,17 @@ def test_a_missing_figure_is_labelled_by_its_cause():
 
 def test_the_header_counts_every_warning_and_drops_none_unsaid():
     from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    from imgmtf.plot.scan import _overlap
     result = _measured(6.0)
     warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
-    header = plot_measurement(result, warnings=warnings).get_suptitle()
+    warnings[1] = "note 1 " + "long " * 40 + "its advice at the end"
+    fig = plot_measurement(result, warnings=warnings)
+    header = fig.get_suptitle()
     assert f"warning 1 of {len(warnings)}: note 0" in header and "note 2" in header
+    assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150   # wrapped, not cut
+    fig.draw_without_rendering()            # the MTF panel's legend below it, off the curve and its markers
+    mtf = fig.axes[3]
+    assert _overlap(mtf.get_legend().get_window_extent(), mtf.get_window_extent()) == 0
     assert "and 2 more warning(s)" in header and "note 3" not in header
     assert "warning" not in plot_measurement(result).get_suptitle()
 
@@ -229,3 +267,84 @@ def test_the_sections_figure_draws_each_assumption_and_the_measured_sections():
     assert len(ax.collections) == 2           # the chosen assumption's intervals, across and along
     with pytest.raises(ParameterError, match="MTF2D"):
         plot_sections("not a result")
+
+
+def test_the_point_figure_keeps_its_panels_labels_on_the_page_and_its_truth_above_the_curves():
+    """The 2-D MTF panel's colour bar once pushed its y tick labels and axis
+    label off the figure's left edge; the truth, drawn in the curves'
+    colour under them, did not show."""
+    from imgmtf.estimate.mtf2d import measure_points
+    from imgmtf.plot.points import plot_points
+    from imgmtf.sensor.points import PointArray, render_points
+    sensor = im.Sensor()
+    chip = render_points(sensor, PointArray(3, 3), 48)
+    fig = plot_points(measure_points(chip.image, intervals="none"), chip.image,
+                      truth=lambda f, angle: abs(sensor.normal_transfer(f, angle)))
+    fig.draw_without_rendering()
+    renderer = fig._get_renderer()
+    page = fig.bbox
+    for ax in fig.axes:
+        box = ax.get_tightbbox(renderer)
+        assert page.x0 - 1 <= box.x0 and box.x1 <= page.x1 + 1, ax.get_title()
+    mtf = next(ax for ax in fig.axes if ax.get_title().startswith("MTF from"))
+    truths = [line for line in mtf.lines if line.get_label().startswith("truth")]
+    measured = [line for line in mtf.lines if "at Nyquist" in line.get_label()]
+    assert len(truths) == len(measured) == 2
+    assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)
+    assert all(t.get_linestyle() != "-" and t.get_color() not in {m.get_color() for m in measured} for t in truths)
+
+
+def test_the_star_figure_draws_its_truth_above_the_curves():
+    """The truth, in each direction's colour under its curve, did not show."""
+    from imgmtf.plot.star import plot_star_mtf
+    sensor = im.Sensor()
+    chip = im.render_star(sensor, im.SiemensStar(cycles=32), 101)
+    truth = lambda f, angle: abs(sensor.normal_transfer(f, angle))  # noqa: E731
+    ax = plot_star_mtf(im.measure_star(chip.image), truth=truth).axes[0]
+    measured = [line for line in ax.lines if line.get_linestyle() == "-" and line.get_label()[0] != "_"]
+    truths = [line for line in ax.lines if line.get_linestyle() == "--" and len(line.get_xdata())]
+    assert len(truths) == len(measured) > 1
+    assert all(t.get_color() == "black" for t in truths)
+    assert min(t.get_zorder() for t in truths) > max(m.get_zorder() for m in measured)
+
+
+def test_a_scan_overview_of_a_checkerboard_crop_puts_its_target_label_beside_the_image():
+    """One target whose half-edges cross the whole image (Baotou's crop):
+    no spot inside is free, so the label goes right of the image and the
+    target carries its id only, off its half-edges."""
+    from matplotlib.offsetbox import AnchoredText
+
+    from imgmtf.plot import plot_scan
+    ends = [(50.0, 0.0), (0.0, 50.0), (50.0, 99.0), (99.0, 50.0)]
+    accepted = [{"id": k, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": a, "y1_px": b}
+                for k, (a, b) in enumerate(ends, 1)]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "sections",
+               "direction": d, "assumption": "bracket", "chosen_assumption": "bracket", "recommended": True,
+               "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3} for d in ("across-track", "along-track")]
+    fig = plot_scan(np.zeros((100, 100)), 1.0, accepted, target, width_in=4.5)    # an image 1.4 in wide
+    ax = fig.axes[0]
+    fig.draw_without_rendering()
+    aside = [a for a in ax.artists if isinstance(a, AnchoredText)]
+    assert len(aside) == 1 and "*across (bracket): 0.200 | 0.300" in aside[0].txt.get_text()
+    assert aside[0].get_window_extent().x0 >= ax.get_window_extent().x1
+    tag = next(t for t in ax.texts if t.get_text().startswith("T1"))
+    assert tag.get_text() == "T1"
+    box = tag.get_window_extent()
+    for a, b in ends:
+        for f in np.linspace(0.0, 1.0, 30):
+            px, py = ax.transData.transform((50 + f * (a - 50), 50 + f * (b - 50)))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
+
+
+def test_the_point_and_star_headers_wrap_a_long_warning():
+    from imgmtf.estimate.mtf2d import measure_points
+    from imgmtf.plot.points import plot_points
+    from imgmtf.plot.star import plot_star
+    from imgmtf.sensor.points import PointArray, render_points
+    long = "long " * 60 + "its advice at the end"
+    star = im.render_star(im.Sensor(), im.SiemensStar(cycles=32), 101)
+    chip = render_points(im.Sensor(), PointArray(3, 3), 48)
+    for fig in (plot_star(im.measure_star(star.image), warnings=[long]),
+                plot_points(measure_points(chip.image, intervals="none"), warnings=[long])):
+        header = fig.get_suptitle()
+        assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150

@@ -150,7 +150,7 @@ def test_an_overview_of_hundreds_of_candidates_reads_and_its_target_label_leaves
             px, py = ax.transData.transform((200 + f * (a - 200), 200 + f * (b - 200)))
             assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
     assert ax.get_title(loc="left").splitlines()[1].startswith("target labels: MTF at Nyquist | MTF50")
-    assert "300 rejected (faint)" in ax.get_title(loc="left")
+    assert "300 rejected (coloured by reason)" in ax.get_title(loc="left")
 
 
 def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):

@@ -270,7 +270,8 @@ def plot_mtf(result: MTFResult, ax: Axes | None = None, truth: Callable[[np.ndar
 
         ax.secondary_xaxis("top", functions=(per_metre, per_pixel)).set_xlabel("frequency (cy/m)")
     title_once(ax, "MTF")
-    ax.legend(fontsize="small")
+    # below the axes: inside, its seven entries covered the curve and its MTF50 marker
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -383,8 +384,9 @@ def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray
                f"{result.rows_used} rows, method {result.method}")
     warnings = list(result.warnings if warnings is None else warnings)
     for i, warning in enumerate(warnings[:HEADER_WARNINGS]):
-        summary += "\n" + textwrap.shorten(f"warning {i + 1} of {len(warnings)}: {warning}", 170,
-                                           placeholder=" [...]")
+        # wrapped, not cut: a warning's end is often what to do about it
+        summary += "\n" + "\n".join(textwrap.wrap(f"warning {i + 1} of {len(warnings)}: {warning}", 150,
+                                                  max_lines=4, placeholder=" [...]"))
     if len(warnings) > HEADER_WARNINGS:
         summary += (f"\nand {len(warnings) - HEADER_WARNINGS} more warning(s), listed in full by the text table "
                     "and the record (JSON, CSV)")

@@ -3,6 +3,7 @@ the targets found on the chip, the stacked 2-D PSF, the 2-D MTF and the
 MTF across and along track with their intervals and the truth when known."""
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -105,8 +106,8 @@ def plot_point_psf(result: PointsResult, ax: Axes | None = None) -> Figure | Sub
     >>> from imgmtf.estimate.mtf2d import measure_points
     >>> from imgmtf.sensor.points import PointArray, render_points
     >>> chip = render_points(imgmtf.Sensor(), PointArray(4, 4), 64)
-    >>> len(plot_point_psf(measure_points(chip.image, intervals="none")).axes)
-    2
+    >>> plot_point_psf(measure_points(chip.image, intervals="none")).axes[0].get_xlabel()
+    'x (across track), px'
     """
     _expect_points(result)
     fig, ax = figure_axes(ax, (4.4, 3.8))
@@ -123,9 +124,20 @@ def plot_point_psf(result: PointsResult, ax: Axes | None = None) -> Figure | Sub
     ax.set_xlabel("x (across track), px")
     ax.set_ylabel("y (along track), px")
     ax.set_aspect("equal")
-    fig.colorbar(image, ax=ax, label="PSF, peak 1", shrink=0.85)
+    _colorbar(fig, ax, image, "PSF, peak 1")
     title_once(ax, f"stacked PSF ({len(result.used)} targets, {result.psf_step_px:g} px grid)")
     return fig
+
+
+#: the truth's dashes across and along track (black, above the measured curves)
+TRUTH_DASHES = ((0, (5.0, 3.0)), (0, (1.5, 2.0)))
+
+
+def _colorbar(fig, ax: Axes, image, label: str) -> None:
+    """A colour bar beside an equal-aspect panel, as an inset of its axes: a
+    bar stolen from the layout's cell (``colorbar(ax=...)``) left the panel's
+    y tick labels and axis label cut off the figure's left edge."""
+    fig.colorbar(image, cax=ax.inset_axes((1.04, 0.0, 0.05, 1.0)), label=label)
 
 
 def plot_point_mtf2d(result: PointsResult, ax: Axes | None = None) -> Figure | SubFigure:
@@ -150,8 +162,8 @@ def plot_point_mtf2d(result: PointsResult, ax: Axes | None = None) -> Figure | S
     >>> from imgmtf.estimate.mtf2d import measure_points
     >>> from imgmtf.sensor.points import PointArray, render_points
     >>> chip = render_points(imgmtf.Sensor(), PointArray(4, 4), 64)
-    >>> len(plot_point_mtf2d(measure_points(chip.image, intervals="none")).axes)
-    2
+    >>> plot_point_mtf2d(measure_points(chip.image, intervals="none")).axes[0].get_xlabel()
+    'fx (across track), cy/px'
     """
     _expect_points(result)
     fig, ax = figure_axes(ax, (4.4, 3.8))
@@ -166,7 +178,7 @@ def plot_point_mtf2d(result: PointsResult, ax: Axes | None = None) -> Figure | S
     ax.set_xlabel("fx (across track), cy/px")
     ax.set_ylabel("fy (along track), cy/px")
     ax.set_aspect("equal")
-    fig.colorbar(image, ax=ax, label="MTF", shrink=0.85)
+    _colorbar(fig, ax, image, "MTF")
     title_once(ax, "2-D MTF (Nyquist dashed)")
     return fig
 
@@ -204,7 +216,7 @@ def plot_point_mtf(result: PointsResult, truth: Callable[[np.ndarray, float], np
     """
     _expect_points(result)
     fig, ax = figure_axes(ax, (5.0, 3.6))
-    for colour, section in zip(_COLOURS, result.directions):
+    for k, (colour, section) in enumerate(zip(_COLOURS, result.directions)):
         ax.plot(section.frequencies_cy_px, section.mtf, color=colour, lw=1.5,
                 label=f"{section.direction}: {section.mtf_nyquist:.3f} at Nyquist")
         ci = section.mtf_nyquist_ci
@@ -213,7 +225,9 @@ def plot_point_mtf(result: PointsResult, truth: Callable[[np.ndarray, float], np
             ax.errorbar([0.5], [section.mtf_nyquist], yerr=spread, color=colour, capsize=4, lw=1.2, fmt="o", ms=3)
         if truth is not None:
             f = section.frequencies_cy_px
-            ax.plot(f, truth(f, section.angle_deg), color=colour, ls="--", lw=1.0,
+            # black, dashed, above the measured curves: in their colour it hid under them
+            ax.plot(f, truth(f, section.angle_deg), color="black", ls=TRUTH_DASHES[k % len(TRUTH_DASHES)], lw=1.1,
+                    zorder=3,
                     label=f"truth {section.direction}: {float(truth(np.array(0.5), section.angle_deg)):.3f}")
     ax.axvline(0.5, color="0.6", lw=0.8, ls=":")
     ax.set_xlim(0.0, 1.0)
@@ -279,7 +293,7 @@ def plot_points(result: PointsResult, image: np.ndarray | None = None,
     figures = ", ".join(f"{d.direction} MTF@Nyq {d.mtf_nyquist:.3f}, MTF50 {d.mtf50_cy_px:.3f} cy/px, "
                         f"FWHM {d.fwhm_px:.2f} px" for d in result.directions)
     lines.append(figures)
-    lines += [f"warning: {w}" for w in warnings[:2]]
+    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
     if len(warnings) > 2:
         lines.append(f"... and {len(warnings) - 2} more warning(s)")
     fig.suptitle("\n".join(lines), fontsize=9)

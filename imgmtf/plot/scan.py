@@ -46,7 +46,7 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         :func:`imgmtf.scan_scene` returns them, or their ``to_dict()``):
         accepted ones are drawn as their tilted ROI (``roi_polygon_px``,
         outlined, unfilled: the scene shows through) and segment in
-        green, above the rest; rejected ones faint, as a line coloured by
+        green, above the rest; rejected ones as a line coloured by
         reason (outlined in black where the reason's few candidates carry
         their ids, so that they read on any background).  Each accepted
         candidate carries its id, and so do the rejected ones of a reason
@@ -57,7 +57,9 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         target is labelled beside its centre with, per direction, MTF at
         Nyquist and MTF50 (cy/px), where it covers neither the accepted
         half-edges nor another label (a leader to its target when moved
-        away), inside the image.
+        away), inside the image; many targets' labels shrink to the rows
+        to quote, and a few targets that fill the image (a checkerboard's
+        crop) are tagged by id with their labels beside the image.
     levels : (float, float), optional
         (black, white) DN of the display; default the 0.5 and 99.5
         percentiles.
@@ -127,7 +129,7 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     unlabelled = 0
     for k, (reason, group) in enumerate(sorted(by_reason.items(), key=lambda kv: (-len(kv[1]), kv[0]))):
         colour = PALETTE[k % len(PALETTE)]
-        # rejected: faint; a reason too common to label bare (hundreds of outlines would hide the scene)
+        # rejected: half-opaque; a reason too common to label bare (hundreds of outlines would hide the scene)
         listed = len(group) <= MAX_LISTED
         style = {"path_effects": outline, "alpha": REJECTED_ALPHA} if listed else {"alpha": CROWD_ALPHA}
         ax.add_collection(LineCollection([_ends(r) for r in group], colors=colour, linewidths=width, zorder=3,
@@ -154,18 +156,20 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         # of the sections, the chosen assumption's rows only (the table and the CSV hold the others)
         rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None
                 and (s.get("summary") != "sections" or s.get("assumption") == s.get("chosen_assumption"))]
-        lines = [f"T{target_id}"] + [f"{_label(s)}: {_num(s.get('mtf_nyquist'))} | {_num(s.get('mtf50_cy_px'))}"
-                                     for s in rows]
-        if len(lines) > 1:
-            target_labels.append(((rows[0]["x_px"], rows[0]["y_px"]), "\n".join(lines)))
-    _place_target_labels(ax, target_labels, [_ends(r) for r in accepted])
+        if rows:
+            quoted = [s for s in rows if s.get("recommended")] or rows
+            full = "\n".join([f"T{target_id}"] + [_row(s) for s in rows])
+            short = "\n".join([f"T{target_id}"] + [_row(s, short=True) for s in quoted])
+            target_labels.append(((rows[0]["x_px"], rows[0]["y_px"]), full, short))
+    compact = _place_target_labels(ax, target_labels, [_ends(r) for r in accepted])
     n_targets = len({s["target_id"] for s in targets})
     ids = "ids as in the table and the CSV" + (f", {unlabelled} in reasons too common to label" if unlabelled
                                                  else "")
     title = (f"{len(accepted)} accepted half-edge{'s' * (len(accepted) != 1)} in {n_targets} "
-             f"target{'s' * (n_targets != 1)}, {len(rejected)} rejected (faint); {ids}")
+             f"target{'s' * (n_targets != 1)}, {len(rejected)} rejected (coloured by reason); {ids}")
     if target_labels:
-        title += "\ntarget labels: MTF at Nyquist | MTF50 cy/px per direction, * the row to quote"
+        title += ("\ntarget labels: MTF at Nyquist | MTF50 cy/px, the rows to quote only (all rows in the table)"
+                  if compact else "\ntarget labels: MTF at Nyquist | MTF50 cy/px per direction, * the row to quote")
     ax.set_title(title, fontsize=8.5, loc="left")
     if handles:
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
@@ -181,45 +185,94 @@ LABEL_OFFSETS_PT = (6.0, 20.0, 40.0, 64.0, 100.0, 150.0)
 EDGE_POINT_COST = 400.0
 
 
-def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str]],
-                         segments: Sequence[Sequence[tuple[float, float]]] = ()) -> None:
+#: what each ring farther from its target costs a label's spot, per its box's area
+RING_COST = 0.3
+_HA = {1: "left", -1: "right", 0: "center"}
+_VA = {1: "bottom", -1: "top", 0: "center"}
+#: up to this many targets' labels go beside the image when they cannot avoid its half-edges
+MAX_ASIDE = 3
+#: the label styles tried in turn, (compact, font size pt): the first with
+#: which every label finds a free spot inside the image is kept
+LABEL_STYLES = ((False, 8.0), (False, 6.5), (True, 7.0), (True, 6.0), (True, 5.0))
+
+
+def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
+                         segments: Sequence[Sequence[tuple[float, float]]] = ()) -> bool:
     """Each target's label beside its centre where it covers no accepted
     half-edge (``segments``, whose junction is the target's centre), no
     label placed before it (nor an id) and stays inside the image: the
     nearest free spot of the four quadrants at :data:`LABEL_OFFSETS_PT`,
     or the least covered one; a label moved off its first ring gets a
-    leader."""
-    style = {"textcoords": "offset points", "fontsize": 8, "color": "black", "annotation_clip": True,
-             "zorder": 8, "bbox": {"boxstyle": "round,pad=0.25", "fc": (0.9, 1.0, 0.9, 0.9), "ec": "#00a000",
-                                   "lw": 0.8}}
+    leader.  Each label is ``(xy, full text, compact text)``; the styles
+    of :data:`LABEL_STYLES` are tried in turn (smaller text, then the
+    compact texts) until every label is free of the others and inside the
+    image.  Up to :data:`MAX_ASIDE` labels that cannot avoid the
+    half-edges (a checkerboard's crop, all target) go in full to the
+    column right of the image, each target tagged by its id.  Returns
+    whether the compact texts were drawn."""
+    if not labels:
+        return False
     frame = ax.get_window_extent()
-    taken = [t.get_window_extent() for t in ax.texts]           # the ids drawn already
+    ids = [t.get_window_extent() for t in ax.texts]           # the ids drawn already
     pad = 3.0 * ax.figure.dpi / 72.0                             # the label's box around its text
     edge_points = _sampled(ax, segments, step_pt=4.0)
-    for xy, text in labels:
-        probe = ax.annotate(text, xy, xytext=(0.0, 0.0), **style)
-        best: tuple = (math.inf, 0, (LABEL_OFFSETS_PT[0], LABEL_OFFSETS_PT[0]), None)
-        for ring, offset in enumerate(LABEL_OFFSETS_PT):
-            for sx, sy in ((1, 1), (-1, 1), (1, -1), (-1, -1)):
-                probe.xyann = (sx * offset, sy * offset)
-                probe.set_horizontalalignment("left" if sx > 0 else "right")
-                probe.set_verticalalignment("bottom" if sy > 0 else "top")
-                box = probe.get_window_extent().padded(pad)
-                covered = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
-                if edge_points.size:
-                    covered += EDGE_POINT_COST * np.count_nonzero(
+    for compact, fontsize in LABEL_STYLES:
+        style = _label_style(fontsize)
+        spots = []
+        taken: list = []
+        all_free = True
+        for xy, full, short in labels:
+            text = short if compact else full
+            probe = ax.annotate(text, xy, xytext=(0.0, 0.0), **style)
+            # (hard: outside the image or over another label, soft: over ids and edges, ring, offset, box)
+            best: tuple = (math.inf, math.inf, 0, (LABEL_OFFSETS_PT[0], LABEL_OFFSETS_PT[0]), None, True)
+            for ring, offset in enumerate((0.0, *LABEL_OFFSETS_PT)):
+                for sx, sy in ((1, 1), (-1, 1), (1, -1), (-1, -1)) if offset else ((0, 0),):
+                    # ring 0: centred on the target (inside a chart's square); then its quadrants
+                    probe.xyann = (sx * offset, sy * offset)
+                    probe.set_horizontalalignment(_HA[sx])
+                    probe.set_verticalalignment(_VA[sy])
+                    box = probe.get_window_extent().padded(pad)
+                    hard = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
+                    covered = np.count_nonzero(
                         (edge_points[:, 0] > box.x0) & (edge_points[:, 0] < box.x1)
-                        & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1))
-                if covered < best[0]:
-                    best = (covered, ring, probe.xyann, box)
-            if best[0] == 0:
-                break
-        probe.remove()
-        _, ring, (dx, dy), box = best
-        leader = {"arrowprops": {"arrowstyle": "-", "color": "#00a000", "lw": 0.7}} if ring else {}
-        ax.annotate(text, xy, xytext=(dx, dy), ha="left" if dx > 0 else "right", va="bottom" if dy > 0 else "top",
-                    **style, **leader)
-        taken.append(box)
+                        & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1)) if edge_points.size else 0
+                    covers = covered > 0
+                    soft = sum(_overlap(box, t) for t in ids) + EDGE_POINT_COST * covered
+                    soft += RING_COST * ring * box.width * box.height     # near its target first
+                    if (hard, soft) < best[:2]:
+                        best = (hard, soft, ring, probe.xyann, box, covers)
+                if best[0] == 0 and best[1] <= RING_COST * ring * best[4].width * best[4].height:
+                    break           # nothing farther can do better
+            probe.remove()
+            all_free &= best[0] < 1.0
+            spots.append((xy, text, best[2], best[3], best[5]))
+            taken.append(best[4])
+        if all_free:
+            break
+    if len(spots) <= MAX_ASIDE and any(spot[4] for spot in spots):
+        # a scene that is its few targets (a checkerboard's crop) has no free spot: the labels go
+        # to the column right of the image, below the legend, each target tagged by its id only
+        from matplotlib.offsetbox import AnchoredText
+        aside = AnchoredText("\n\n".join(full for _, full, _ in labels), loc="lower left",     # in full: room there
+                             bbox_to_anchor=(1.01, 0.0), bbox_transform=ax.transAxes, borderpad=0.0,
+                             prop={"fontsize": 7.5})
+        aside.patch.set(boxstyle="round,pad=0.3", facecolor=(0.9, 1.0, 0.9), edgecolor="#00a000", lw=0.8)
+        ax.add_artist(aside)
+        for xy, text, *_ in spots:
+            tag = text.split("\n")[0]
+            ax.annotate(tag, xy, xytext=(4.0, 4.0), ha="left", va="bottom", **{**_label_style(7.0), "zorder": 8})
+        return False
+    for xy, text, ring, (dx, dy), _ in spots:
+        leader = {"arrowprops": {"arrowstyle": "-", "color": "#00a000", "lw": 0.6, "alpha": 0.8}} if ring > 1 else {}
+        ax.annotate(text, xy, xytext=(dx, dy), ha=_HA[int(np.sign(dx))], va=_VA[int(np.sign(dy))], **style, **leader)
+    return compact
+
+
+def _label_style(fontsize: float) -> dict:
+    return {"textcoords": "offset points", "fontsize": fontsize, "color": "black", "annotation_clip": True,
+            "zorder": 8, "bbox": {"boxstyle": "round,pad=0.25", "fc": (0.9, 1.0, 0.9, 0.9), "ec": "#00a000",
+                                  "lw": 0.8}}
 
 
 def _sampled(ax, segments, step_pt: float) -> np.ndarray:
@@ -300,6 +353,18 @@ def _label(summary: Mapping[str, Any]) -> str:
     if summary.get("summary") == "sections":
         return f"{mark}{direction} ({summary.get('assumption')})"
     return f"{direction} {summary['normal_angle_deg']:.0f}\u00b0"
+
+
+def _row(summary: Mapping[str, Any], short: bool = False) -> str:
+    """A summary's line in its target's label: its name, MTF at Nyquist and
+    MTF50 (cy/px); ``short`` drops the sections' assumption."""
+    name = _label(summary)
+    if short:
+        name = name.split(" (")[0]            # the sections' assumption (the table has it)
+        name = name.replace("horizontal", "H").replace("vertical", "V")
+        return f"{name} {_num(summary.get('mtf_nyquist'))}|{_num(summary.get('mtf50_cy_px'))}"
+    return f"{name}: {_num(summary.get('mtf_nyquist'))} | {_num(summary.get('mtf50_cy_px'))}"
+
 
 
 def _num(value) -> str:

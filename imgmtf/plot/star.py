@@ -5,6 +5,7 @@ Nyquist and MTF50 against direction."""
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -136,9 +137,10 @@ def plot_star_mtf(result: StarResult, truth: Callable[[np.ndarray, float], np.nd
         ax.plot(d.ring_frequencies_cy_px, d.ring_mtf, ".", color=colour, ms=2, alpha=0.6)
         if truth is not None:
             f = d.frequencies_cy_px
-            ax.plot(f, truth(f, d.angle_deg), color=colour, ls="--", lw=0.9)
+            # black, dashed, above the curves: in their colour it hid under them
+            ax.plot(f, truth(f, d.angle_deg), color="black", ls="--", lw=0.9, zorder=3)
     if truth is not None:
-        ax.plot([], [], color="0.3", ls="--", lw=0.9, label="truth (dashed)")
+        ax.plot([], [], color="black", ls="--", lw=0.9, label="truth (black, dashed)")
     ax.axvline(0.5, color="0.6", lw=0.8, ls=":")
     ax.set_xlim(0.0, max(0.8, max(float(d.frequencies_cy_px[-1]) for d in result.directions)))
     ax.set_ylim(0.0, 1.05)
@@ -194,7 +196,7 @@ def plot_star_directions(result: StarResult, truth: Callable[[np.ndarray, float]
                 f = np.linspace(0.0, 1.0, 501)
                 from ..metrics import first_crossing
                 expected = np.array([float(first_crossing(f, truth(f, a), 0.5)) for a in fine])
-            ax.plot(fine, expected, color=colour, ls="--", lw=0.9, label=f"truth, {label}")
+            ax.plot(fine, expected, color="black", ls="--", lw=0.9, zorder=3, label=f"truth, {label}")
     ax.set_xlim(-5.0, 185.0)
     ax.set_xticks(np.arange(0, 181, 45))
     ax.set_xlabel("direction of the frequency, deg from x (90: along the rows)")
@@ -256,7 +258,7 @@ def plot_star(result: StarResult, image: np.ndarray | None = None,
              f"{across.direction} MTF@Nyq {across.mtf_nyquist:.3f}, MTF50 {across.mtf50_cy_px:.3f} cy/px; "
              f"{along.direction} MTF@Nyq {along.mtf_nyquist:.3f}, MTF50 {along.mtf50_cy_px:.3f} cy/px; "
              f"SNR {result.snr:.0f}"]
-    lines += [f"warning: {w}" for w in warnings[:2]]
+    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
     if len(warnings) > 2:
         lines.append(f"... and {len(warnings) - 2} more warning(s)")
     fig.suptitle("\n".join(lines), fontsize=9)
