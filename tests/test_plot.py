@@ -90,10 +90,13 @@ def test_a_scan_overview_of_a_chart_shrinks_many_targets_labels_to_the_rows_to_q
                   "assumption": "bracket", "chosen_assumption": "bracket", "recommended": summary == "sections"}
                  for k, (x, y) in enumerate([(x, y) for y in (50, 150, 250) for x in (50, 150, 250, 350)], 1)
                  for summary in ("combined", "sections") for direction in ("horizontal", "vertical")]
+    for s in summaries[:4:2]:       # target 1 horizontal: MTF50 read, the MTF at Nyquist below the noise
+        s["mtf_nyquist"] = None
     fig = plot_scan(np.zeros((300, 400)), 1.0, [], summaries)
     ax = fig.axes[0]
     labels = [t for t in ax.texts if t.get_text().startswith("T")]
     assert len(labels) == 12 and all(t.get_text().count("\n") == 2 for t in labels)   # T, *H, *V
+    assert "*H -|0.250" in labels[0].get_text()
     fig.draw_without_rendering()
     boxes = [Text.get_window_extent(t) for t in labels]
     frame = ax.get_window_extent()

@@ -154,7 +154,9 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     target_labels = []
     for target_id in sorted({s["target_id"] for s in targets}):
         # of the sections, the chosen assumption's rows only (the table and the CSV hold the others)
-        rows = [s for s in targets if s["target_id"] == target_id and s.get("mtf_nyquist") is not None
+        # a row with an MTF50 but no MTF at Nyquist (a blur that takes Nyquist under the noise) is labelled too
+        rows = [s for s in targets if s["target_id"] == target_id
+                and (s.get("mtf_nyquist") is not None or s.get("mtf50_cy_px") is not None)
                 and (s.get("summary") != "sections" or s.get("assumption") == s.get("chosen_assumption"))]
         if rows:
             quoted = [s for s in rows if s.get("recommended")] or rows
