@@ -37,6 +37,7 @@ import numpy as np
 from ...errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
 from ...version import __version__
 from ..intervals import Intervals, as_intervals
+from ..results import finite
 from .sources import FoundSources, Source, SourceTally, find_sources
 from .stack import DirectionMTF, Stack
 
@@ -171,25 +172,25 @@ class PointsResult(SourceTally):
         for section in self.directions:
             row: dict[str, Any] = {
                 "target": self.target, "method": self.method, "direction": section.direction,
-                "normal_angle_deg": _finite(section.angle_deg),
-                "polarity": self.polarity, "snr": _finite(snr), "noise_dn": _finite(self.noise_dn),
-                "mtf_nyquist": _finite(section.mtf_nyquist),
-                "mtf_nyquist_ci": [_finite(section.mtf_nyquist_ci.low), _finite(section.mtf_nyquist_ci.high)],
-                "mtf50_cy_px": _finite(section.mtf50_cy_px),
-                "mtf50_ci_cy_px": [_finite(section.mtf50_ci_cy_px.low), _finite(section.mtf50_ci_cy_px.high)],
-                "fwhm_px": _finite(section.fwhm_px), "gsd_m": self.gsd_m,
-                "mtf50_cy_m": _finite(section.mtf50_cy_px / self.gsd_m) if self.gsd_m else None,
-                "fwhm_m": _finite(section.fwhm_px * self.gsd_m) if self.gsd_m else None,
+                "normal_angle_deg": finite(section.angle_deg),
+                "polarity": self.polarity, "snr": finite(snr), "noise_dn": finite(self.noise_dn),
+                "mtf_nyquist": finite(section.mtf_nyquist),
+                "mtf_nyquist_ci": [finite(section.mtf_nyquist_ci.low), finite(section.mtf_nyquist_ci.high)],
+                "mtf50_cy_px": finite(section.mtf50_cy_px),
+                "mtf50_ci_cy_px": [finite(section.mtf50_ci_cy_px.low), finite(section.mtf50_ci_cy_px.high)],
+                "fwhm_px": finite(section.fwhm_px), "gsd_m": self.gsd_m,
+                "mtf50_cy_m": finite(section.mtf50_cy_px / self.gsd_m) if self.gsd_m else None,
+                "fwhm_m": finite(section.fwhm_px * self.gsd_m) if self.gsd_m else None,
                 "points_used": len(self.used), "points_refused": len(self.refused),
                 "points_refused_by": refusals, "point_size_px": self.point_size_px,
-                "alias_weight": _finite(self.alias_weight), "phase_cells": int(self.phase_cells),
-                "phase_uniform_p": _finite(self.phase_uniform_p),
+                "alias_weight": finite(self.alias_weight), "phase_cells": int(self.phase_cells),
+                "phase_uniform_p": finite(self.phase_uniform_p),
                 "roi": list(self.roi), "warnings": list(self.warnings), "params": dict(self.params),
                 "imgmtf_version": __version__,
             }
             if curves:
                 row["frequencies_cy_px"] = [round(float(f), 4) for f in section.frequencies_cy_px]
-                row["mtf"] = [_finite(v) for v in section.mtf]
+                row["mtf"] = [finite(v) for v in section.mtf]
             out.append(row)
         return out
 
@@ -208,10 +209,6 @@ class PointsResult(SourceTally):
         """
         return self.summaries(curves)[0]
 
-
-def _finite(value: Any) -> float | None:
-    value = float(value)
-    return round(value, 6) if math.isfinite(value) else None
 
 
 def measure_points(image: np.ndarray, *, point_size_px: float = 0.0, polarity: str = "auto",

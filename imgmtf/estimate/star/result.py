@@ -11,6 +11,7 @@ import numpy as np
 from ...errors import ParameterError
 from ...version import __version__
 from ..intervals import Interval
+from ..results import finite
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,26 +175,26 @@ class StarResult:
         for d in self.directions:
             row: dict[str, Any] = {
                 "target": self.target, "method": self.method, "direction": d.direction,
-                "direction_deg": _finite(d.angle_deg), "normal_angle_deg": _finite(d.angle_deg),
-                "snr": _finite(self.snr), "noise_dn": _finite(self.noise_dn),
-                "mtf_nyquist": _finite(d.mtf_nyquist),
-                "mtf_nyquist_ci": [_finite(d.mtf_nyquist_ci.low), _finite(d.mtf_nyquist_ci.high)],
-                "mtf50_cy_px": _finite(d.mtf50_cy_px),
-                "mtf50_ci_cy_px": [_finite(d.mtf50_ci_cy_px.low), _finite(d.mtf50_ci_cy_px.high)],
+                "direction_deg": finite(d.angle_deg), "normal_angle_deg": finite(d.angle_deg),
+                "snr": finite(self.snr), "noise_dn": finite(self.noise_dn),
+                "mtf_nyquist": finite(d.mtf_nyquist),
+                "mtf_nyquist_ci": [finite(d.mtf_nyquist_ci.low), finite(d.mtf_nyquist_ci.high)],
+                "mtf50_cy_px": finite(d.mtf50_cy_px),
+                "mtf50_ci_cy_px": [finite(d.mtf50_ci_cy_px.low), finite(d.mtf50_ci_cy_px.high)],
                 "gsd_m": self.gsd_m,
-                "mtf50_cy_m": _finite(d.mtf50_cy_px / self.gsd_m) if self.gsd_m else None,
+                "mtf50_cy_m": finite(d.mtf50_cy_px / self.gsd_m) if self.gsd_m else None,
                 "star_cycles": self.cycles, "star_profile": self.profile,
-                "centre_x_px": _finite(self.centre_px[0] + self.roi[0]),
-                "centre_y_px": _finite(self.centre_px[1] + self.roi[1]),
-                "nyquist_radius_px": _finite(self.nyquist_radius_px),
-                "unresolved_radius_px": _finite(self.unresolved_radius_px),
-                "star_contrast": _finite(self.contrast), "contrast_method": self.contrast_method,
+                "centre_x_px": finite(self.centre_px[0] + self.roi[0]),
+                "centre_y_px": finite(self.centre_px[1] + self.roi[1]),
+                "nyquist_radius_px": finite(self.nyquist_radius_px),
+                "unresolved_radius_px": finite(self.unresolved_radius_px),
+                "star_contrast": finite(self.contrast), "contrast_method": self.contrast_method,
                 "roi": list(self.roi), "warnings": list(self.warnings), "params": dict(self.params),
                 "imgmtf_version": __version__,
             }
             if curves:
                 row["frequencies_cy_px"] = [round(float(f), 4) for f in d.frequencies_cy_px]
-                row["mtf"] = [_finite(v) for v in d.mtf]
+                row["mtf"] = [finite(v) for v in d.mtf]
             out.append(row)
         return out
 
@@ -212,7 +213,3 @@ class StarResult:
         """
         return self.summaries(curves)[0]
 
-
-def _finite(value: Any) -> float | None:
-    value = float(value)
-    return round(value, 6) if math.isfinite(value) else None
