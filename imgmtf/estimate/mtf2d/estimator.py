@@ -4,13 +4,13 @@ the file's values linearised, a window cut, :func:`.points.measure_points`
 run."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from ...errors import ParameterError
 from ..intervals import Intervals, as_intervals
+from ..linear_window import linear_window, placed
 from .points import PointsResult, measure_points
 
 
@@ -66,24 +66,8 @@ class PointsEstimator:
                  saturation: tuple[float, float] | None = None, dtype: Any = None,
                  track_azimuth_deg: float | None = 0.0, roi: tuple[int, int, int, int] | None = None) -> PointsResult:
         """Measure the point targets on ``image`` (see :func:`measure_points`)."""
-        from ...transfer import full_scale
-        data = np.asarray(image)
-        if roi is not None:
-            x, y, w, h = roi
-            data = data[y: y + h, x: x + w]
-        stored = np.dtype(dtype) if dtype is not None else data.dtype
-        notes = []
-        if not self.transfer.is_linear:
-            scale = full_scale(stored)
-            data = self.transfer.linearise(np.asarray(data, float), scale)
-            if saturation is not None:
-                saturation = (float(self.transfer.linearise(np.array(saturation[0]), scale)),
-                              float(self.transfer.linearise(np.array(saturation[1]), scale)))
-            notes.append(f"the values were linearised ({self.transfer}, full scale {scale:g} DN) before measuring")
+        data, saturation, notes = linear_window(image, roi, dtype, saturation, self.transfer)
         result = measure_points(data, point_size_px=point_size_px or 0.0, saturation=saturation,
                                 intervals=self.intervals, gsd_m=gsd_m, track_azimuth_deg=track_azimuth_deg,
                                 **self.options)
-        params = {**result.params, "resampling": self.method, "transfer": str(self.transfer)}
-        origin = (0, 0) if roi is None else roi[:2]
-        return replace(result, params=params, warnings=(*notes, *result.warnings),
-                       roi=(origin[0], origin[1], result.roi[2], result.roi[3]))
+        return placed(result, roi, self.method, self.transfer, notes)

@@ -4,13 +4,13 @@ the file's values linearised, a window cut, :func:`.measure.measure_star`
 run."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from ...errors import ParameterError
 from ..intervals import Intervals, as_intervals
+from ..linear_window import linear_window, placed
 from .measure import measure_star
 from .result import StarResult
 
@@ -63,23 +63,7 @@ class StarEstimator:
                  saturation: tuple[float, float] | None = None, dtype: Any = None,
                  track_azimuth_deg: float | None = 0.0, roi: tuple[int, int, int, int] | None = None) -> StarResult:
         """Measure the star filling ``image`` (see :func:`measure_star`)."""
-        from ...transfer import full_scale
-        data = np.asarray(image)
-        if roi is not None:
-            x, y, w, h = roi
-            data = data[y: y + h, x: x + w]
-        stored = np.dtype(dtype) if dtype is not None else data.dtype
-        notes = []
-        if not self.transfer.is_linear:
-            scale = full_scale(stored)
-            data = self.transfer.linearise(np.asarray(data, float), scale)
-            if saturation is not None:
-                saturation = (float(self.transfer.linearise(np.array(saturation[0]), scale)),
-                              float(self.transfer.linearise(np.array(saturation[1]), scale)))
-            notes.append(f"the values were linearised ({self.transfer}, full scale {scale:g} DN) before measuring")
+        data, saturation, notes = linear_window(image, roi, dtype, saturation, self.transfer)
         result = measure_star(data, intervals=self.intervals, gsd_m=gsd_m, track_azimuth_deg=track_azimuth_deg,
                               saturation=saturation, **self.options)
-        params = {**result.params, "resampling": self.method, "transfer": str(self.transfer)}
-        origin = (0, 0) if roi is None else roi[:2]
-        return replace(result, params=params, warnings=(*notes, *result.warnings),
-                       roi=(origin[0], origin[1], result.roi[2], result.roi[3]))
+        return placed(result, roi, self.method, self.transfer, notes)
