@@ -15,10 +15,13 @@ def read(path):
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
     """``imgmtf reproduce --quick`` on a study made smaller still (the
-    figures, tables and report are all there; few chips)."""
+    figures, tables and report are all there; few chips: two noise levels
+    of each sweep, one chip each, 6 chips where the quick study has 28)."""
     out = tmp_path_factory.mktemp("quick")
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr("imgmtf.reproduce.QUICK", StudySize(QUICK.system_stds[:2], 1, 1))
+        patch.setattr("imgmtf.reproduce.GROUND_SNRS", (10, 100))
+        patch.setattr("imgmtf.reproduce.THRESHOLD_SNRS", (20, 100))
         result = CliRunner().invoke(main, ["reproduce", "--quick", "--workers", "1", "--no-progress",
                                            "--out", str(out)])
     return out, result
