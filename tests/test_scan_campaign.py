@@ -55,10 +55,10 @@ def test_a_folder_of_scenes_goes_into_the_store_once_whatever_is_added_again(cam
 
 
 def test_a_scene_that_says_not_when_is_stored_with_one_note(tmp_path):
-    scene = SyntheticCampaign(acquisitions=2, size_px=128).render(0)
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 64).image
     paths = [tmp_path / "a.tif", tmp_path / "b.tif"]
     for path in paths:
-        im.write_geotiff(path, scene.image)                 # no ACQUISITION_DATETIME
+        im.write_geotiff(path, chip)                        # no ACQUISITION_DATETIME
     store = str(tmp_path / "site.gpkg")
     out = tmp_path / "out"
     result = CliRunner().invoke(main, ["scan", *map(str, paths), "--campaign", store, "--fit-stages", "none",
@@ -177,12 +177,17 @@ def test_a_landsat_product_scanned_without_options_is_dated_and_named_by_its_fil
     assert "no acquisition time" not in result.output
 
 
-def test_scenes_scanned_with_outputs_name_their_overviews_in_the_store(campaign, tmp_path):
-    # the campaign report shows each acquisition's overview from what the store names: one folder per scene
-    _, paths, _ = campaign
+def test_scenes_scanned_with_outputs_name_their_overviews_and_edge_figures_in_the_store(tmp_path):
+    # the campaign report shows each acquisition's overview and each accepted half-edge's figure from
+    # what the store names: one folder per scene (two edge chips, one edge each: a figure costs about
+    # 0.7 s, where a campaign scene has twelve half-edges)
+    paths = []
+    for k, angle in enumerate((6.0, -84.0)):
+        paths.append(tmp_path / f"chip{k}.tif")
+        im.write_geotiff(paths[-1], im.render(im.Sensor(), im.Target("edge", angle), 64).image)
     store, out = str(tmp_path / "site.gpkg"), tmp_path / "out"
-    result = CliRunner().invoke(main, ["scan", str(paths[0]), str(paths[1]), "--campaign", store, "--out", str(out),
-                                       "--fit-stages", "none", "--format", "json"])
+    result = CliRunner().invoke(main, ["scan", *map(str, paths), "--campaign", store, "--out", str(out),
+                                       "--edge-figures", "--fit-stages", "none", "--format", "json"])
     assert result.exit_code == 0, result.output
     rows = read_layer(store, "acquisitions")
     assert len(rows) == 2
@@ -191,15 +196,6 @@ def test_scenes_scanned_with_outputs_name_their_overviews_in_the_store(campaign,
         overview = str(figure_path(store, row["overview"]))
         assert os.path.isfile(overview) and overview.endswith("overview.png")
         assert os.path.basename(os.path.dirname(overview)) == os.path.splitext(os.path.basename(row["path"]))[0]
-
-
-def test_a_scene_scanned_with_edge_figures_names_each_in_the_store(tmp_path):
-    # ... and each accepted half-edge's figure (a figure costs about 0.7 s: a target cut out of its
-    # scene, as an L0R chip is, has four half-edges where the whole target has twelve)
-    paths = write_campaign(tmp_path / "scenes", SyntheticCampaign(acquisitions=2, size_px=128, seed=5, fill=True))
-    store, out = str(tmp_path / "site.gpkg"), tmp_path / "out"
-    result = CliRunner().invoke(main, ["scan", str(paths[0]), "--campaign", store, "--out", str(out),
-                                       "--edge-figures", "--fit-stages", "none", "--format", "json"])
-    assert result.exit_code == 0, result.output
     plots = [row["plot"] for row in read_layer(store, "edges")]
-    assert plots and all(p.startswith("out/edges/") and figure_path(store, p).is_file() for p in plots)
+    assert len(plots) == 2 and all(p.startswith("out/chip") and "/edges/" in p and figure_path(store, p).is_file()
+                                   for p in plots)
