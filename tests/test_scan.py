@@ -153,9 +153,9 @@ def test_an_overview_of_hundreds_of_candidates_reads_and_its_target_label_leaves
     assert "300 rejected (coloured by reason)" in ax.get_title(loc="left")
 
 
-def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
+def test_cli_scan_writes_csv_geojson_overview_and_edge_figures(tmp_path):
     out = tmp_path / "scan"
-    result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2"])
+    result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--workers", "2", "--edge-figures"])
     assert result.exit_code == 0, result.output
     # the table names the scene once; an accepted edge's warnings stand beneath it
     rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
@@ -178,6 +178,15 @@ def test_cli_scan_writes_csv_geojson_and_overview(tmp_path):
     assert len(targets) == 2 and all(f["geometry"]["type"] == "Point" for f in targets)
     assert geo["features"][-1]["properties"]["scope"] == "scene" and geo["features"][-1]["geometry"] is None
     assert (out / "overview.png").stat().st_size > 20_000
+    # a figure per accepted half-edge, named by its id, drawn in the workers; none for the rejected
+    edges = [f["properties"] for f in geo["features"] if f["properties"]["scope"] == "edge"]
+    accepted = [r for r in edges if r["status"] == "accepted"]
+    assert accepted and sorted(p.name for p in (out / "edges").iterdir()) == sorted(
+        f"edge{r['id']}.png" for r in accepted)
+    assert all(r["plot"] == str(out / "edges" / f"edge{r['id']}.png") for r in accepted)
+    assert not any(r.get("plot") for r in edges if r["status"] == "rejected")
+    refused = CliRunner().invoke(main, ["scan", str(SCENE), "--edge-figures"])
+    assert refused.exit_code == 2 and "give --out DIR" in refused.output
 
 
 def test_cli_scan_of_a_featureless_image_exits_1(tmp_path):
@@ -276,21 +285,6 @@ def test_a_scene_without_a_crs_gives_features_without_geometry(scan_records, tmp
 def test_api_arguments_of_the_wrong_kind_are_named(make, message):
     with pytest.raises(im.ParameterError, match=message):
         make()
-
-
-def test_edge_figures_one_per_accepted_half_edge_named_by_its_id(tmp_path):
-    out = tmp_path / "scan"
-    result = CliRunner().invoke(main, ["scan", str(SCENE), "--out", str(out), "--edge-figures", "--workers", "2",
-                                       "--format", "json"])
-    assert result.exit_code == 0, result.output
-    rows = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
-    accepted = [r for r in rows if r["status"] == "accepted"]
-    assert accepted and sorted(p.name for p in (out / "edges").iterdir()) == sorted(
-        f"edge{r['id']}.png" for r in accepted)
-    assert all(r["plot"] == str(out / "edges" / f"edge{r['id']}.png") for r in accepted)
-    assert not any(r.get("plot") for r in rows if r["status"] == "rejected")
-    refused = CliRunner().invoke(main, ["scan", str(SCENE), "--edge-figures"])
-    assert refused.exit_code == 2 and "give --out DIR" in refused.output
 
 
 def test_the_text_table_tallies_rejections_by_reason_and_verbose_lists_every_candidate():
