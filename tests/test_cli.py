@@ -49,6 +49,18 @@ def test_batch_keeps_going_past_a_bad_file(run, chip, tmp_path):
     assert "bad.tif" in rows[0]["error"] and "no such file" in rows[2]["error"]
 
 
+def test_a_file_that_cannot_be_read_is_an_error_line_on_stderr_as_scan_and_fit_say_it(run, chip, tmp_path):
+    bad, missing, summary = tmp_path / "bad.tif", tmp_path / "missing.tif", tmp_path / "summary.csv"
+    bad.write_text("junk")
+    result = run("measure", bad, chip, missing, "--csv", summary)
+    assert result.exit_code == 1
+    assert "error" not in result.stdout and str(chip.name) in result.stdout       # the table: the chip alone
+    errors = [line for line in result.stderr.splitlines() if line.startswith("imgmtf: error: ")]
+    assert len(errors) == 2 and f"{bad}: not an image" in errors[0] and f"{missing}: no such file" in errors[1]
+    rows = summary.read_text().splitlines()[1:]
+    assert len(rows) == 3 and sum(",error," in row for row in rows) == 2             # no row lost in the CSV
+
+
 def test_text_output_plots_and_methods(run, chip, tmp_path):
     png = tmp_path / "edge.png"
     result = run("measure", "--method", "sliding", "--plot", png, chip)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from ..errors import READ_REASONS
 from ..kinds import get_kind
 from .hints import hinted_warning, refusal_hint, rejection_hint
 
@@ -67,9 +68,15 @@ class TextRows:
         click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
                    f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last.heading:>6}")
         click.echo(f"{blank} {'deg':>7} {'deg':>5} {'':>7} {'':>5} {'':>7} {'':>17} "
-                   f"{'cy/px':>7} {'px':>6} {last.unit:>6}")
+                   f"{'cy/px':>7} {'px':>6} {last.unit:>6}".rstrip())
 
     def write(self, record) -> None:
+        """A record's rows; a file that cannot be read, one error line on
+        stderr instead (as ``scan`` and ``fit`` say it; its CSV and JSON row stay)."""
+        if record.status == "error" and record.reason in READ_REASONS:
+            click.echo(f"imgmtf: error: {record.error}{refusal_hint(record.reason, record.error or '', record.path)}",
+                       err=True)
+            return
         click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands,
                             self.labels.get(record.path)))
 
