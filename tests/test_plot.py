@@ -351,3 +351,43 @@ def test_the_point_and_star_headers_wrap_a_long_warning():
                 plot_points(measure_points(chip.image, intervals="none"), warnings=[long])):
         header = fig.get_suptitle()
         assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150
+
+
+def test_a_scan_overview_s_target_label_leaves_its_roi_s_outline_clear():
+    """A target's label sat where it covered no half-edge but its ROI's dashed outline."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    roi = [[40.0, 0.0], [60.0, 0.0], [60.0, 56.0], [40.0, 56.0]]
+    accepted = [{"id": 1, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": 50.0, "y1_px": 2.0,
+                 "roi_polygon_px": roi}]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "combined",
+               "direction": "across-track", "normal_angle_deg": 0.0, "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3}]
+    ax = plot_scan(np.zeros((100, 200)), 1.0, accepted, target, width_in=8.0).axes[0]
+    ax.figure.draw_without_rendering()
+    box = Text.get_window_extent(next(t for t in ax.texts if t.get_text().startswith("T1")))
+    for k in range(4):
+        for f in np.linspace(0.0, 1.0, 40):
+            (x0, y0), (x1, y1) = roi[k - 1], roi[k]
+            px, py = ax.transData.transform((x0 + f * (x1 - x0), y0 + f * (y1 - y0)))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
+
+
+def test_a_target_label_beside_the_image_goes_below_a_tall_legend():
+    from matplotlib.offsetbox import AnchoredText
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    ends = [(50.0, 0.0), (0.0, 50.0), (50.0, 99.0), (99.0, 50.0)]     # a checkerboard's crop: no free spot
+    accepted = [{"id": k, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": a, "y1_px": b}
+                for k, (a, b) in enumerate(ends, 1)]
+    rejected = [{"id": 5 + k, "status": "rejected", "reason": f"reason-{k}", "x0_px": 5.0 + 8 * k, "y0_px": 90.0,
+                 "x1_px": 8.0 + 8 * k, "y1_px": 98.0} for k in range(6)]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "sections",
+               "direction": d, "assumption": "bracket", "chosen_assumption": "bracket", "recommended": True,
+               "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3} for d in ("across-track", "along-track")]
+    ax = plot_scan(np.zeros((100, 100)), 1.0, accepted + rejected, target, width_in=6.0).axes[0]
+    ax.figure.draw_without_rendering()
+    [aside] = [a for a in ax.artists if isinstance(a, AnchoredText)]
+    assert _overlap(aside.get_window_extent(), ax.get_legend().get_window_extent()) == 0
+    assert aside.get_window_extent().y0 >= 0
