@@ -391,3 +391,14 @@ def test_a_target_label_beside_the_image_goes_below_a_tall_legend():
     [aside] = [a for a in ax.artists if isinstance(a, AnchoredText)]
     assert _overlap(aside.get_window_extent(), ax.get_legend().get_window_extent()) == 0
     assert aside.get_window_extent().y0 >= 0
+
+
+def test_the_measurement_figure_s_profile_and_lsf_legends_sit_under_their_axes_off_the_data():
+    """A double bar's profile fills its panel: 'best' put the legend over the pixels."""
+    from imgmtf.plot import plot_measurement
+    from imgmtf.plot.scan import _overlap
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 40, noise_std_dn=2.0, seed=1)
+    fig = plot_measurement(im.measure_edge(chip.image))
+    fig.draw_without_rendering()
+    for ax in fig.axes[1:3]:            # the profile, the LSF
+        assert _overlap(ax.get_legend().get_window_extent(), ax.get_window_extent()) == 0

@@ -126,7 +126,8 @@ def plot_profile(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigur
     view = _view_px(result)
     ax.set(xlim=(-view, view), xlabel="distance from the line along the normal (px)", ylabel="normalised DN")
     title_once(ax, f"{name} (SNR {result.snr:.0f})")
-    ax.legend(fontsize="small", loc="best")
+    # a double bar's or a wide pulse's profile fills the axes: the legend goes under them, off the data
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -178,7 +179,8 @@ def plot_lsf(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigure:
     view = max(4.0, 2.5 * result.fwhm_px)
     ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
     title_once(ax, "Line spread function")
-    ax.legend(fontsize="small", loc="upper right")           # over a tail, clear of the peak
+    # under the axes: a ringing or two-lobed LSF reaches every corner
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
