@@ -139,7 +139,8 @@ def test_a_missing_figure_is_labelled_by_its_cause():
 
 
 def test_the_header_counts_every_warning_and_drops_none_unsaid():
-    from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    from imgmtf.plot._common import HEADER_WARNINGS
+    from imgmtf.plot.measurement import plot_measurement
     from imgmtf.plot.scan import _overlap
     result = _measured(6.0)
     warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
