@@ -121,7 +121,7 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
     refused = [(t["x_px"], t["y_px"]) for t in targets if t.get("status") != "used"]
     # a ring about 6 scene px across around each target (its blur shows inside), kept readable when
     # the overview shrinks a large scene: between 5 and 14 points
-    points_per_px = ax.get_position().width * fig.get_figwidth() * 72.0 / max(extent_w, 1.0)
+    points_per_px = ax.get_window_extent().width * 72.0 / fig.dpi / max(extent_w, 1.0)
     size = float(np.clip(6.0 * points_per_px, 5.0, 14.0))
     if used:
         ax.plot(*zip(*used), "o", ms=size, mfc="none", mec=ACCEPTED, mew=0.9, zorder=5)
@@ -132,7 +132,7 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
                        label=f"{reason} ({sum(1 for m in arrays.values() if m[0].get('reason') == reason)})")
                 for reason in reasons]
     if targets:     # the targets of each window: which the measurement used, which it refused
-        counts = {}
+        counts: dict[str, int] = {}
         for t in targets:
             if t.get("status") != "used":
                 counts[t["status"]] = counts.get(t["status"], 0) + 1

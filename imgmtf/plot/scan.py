@@ -169,8 +169,8 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
     # the ROIs' outlines and the labelled rejections are data a label should not hide either
     outlines = [(tuple(polygon[k - 1]), tuple(polygon[k])) for r in accepted if r.get("roi_polygon_px")
                 for polygon in [r["roi_polygon_px"]] for k in range(len(polygon))]
-    listed = [_ends(r) for group in by_reason.values() if len(group) <= MAX_LISTED for r in group]
-    compact = _place_target_labels(ax, target_labels, [_ends(r) for r in accepted], outlines, listed)
+    labelled = [_ends(r) for group in by_reason.values() if len(group) <= MAX_LISTED for r in group]
+    compact = _place_target_labels(ax, target_labels, [_ends(r) for r in accepted], outlines, labelled)
     n_targets = len({s["target_id"] for s in targets})
     ids = "ids as in the table and the CSV" + (f", {unlabelled} in reasons too common to label" if unlabelled
                                                  else "")
@@ -270,21 +270,23 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
         # a scene that is its few targets (a checkerboard's crop) has no free spot: the labels go
         # to the column right of the image, below the legend, each target tagged by its id only
         from matplotlib.offsetbox import AnchoredText
+        from matplotlib.transforms import Bbox
         aside = AnchoredText("\n\n".join(full for _, full, _ in labels), loc="lower left",     # in full: room there
                              bbox_to_anchor=(1.01, 0.0), bbox_transform=ax.transAxes, borderpad=0.0,
                              prop={"fontsize": 7.5})
         aside.patch.set(boxstyle="round,pad=0.3", facecolor=(0.9, 1.0, 0.9), edgecolor="#00a000", lw=0.8)
         ax.add_artist(aside)
         legend = ax.get_legend()
+        fits = True
         if legend is not None and _overlap(aside.get_window_extent(), legend.get_window_extent()) > 0:
             # a tall legend: the box goes right under it, as long as the figure holds it
-            below = ax.transAxes.inverted().transform(legend.get_window_extent().p0)[1] - 0.03
-            aside.set_bbox_to_anchor((1.01, below), transform=ax.transAxes)
+            below = float(ax.transAxes.inverted().transform(legend.get_window_extent().p0)[1]) - 0.03
+            aside.set_bbox_to_anchor(Bbox.from_bounds(1.01, below, 0.0, 0.0), transform=ax.transAxes)
             aside.loc = 2           # upper left
-            if aside.get_window_extent().y0 < 0:
+            fits = aside.get_window_extent().y0 >= 0
+            if not fits:
                 aside.remove()
-                aside = None
-        if aside is not None:
+        if fits:
             for xy, text, *_ in spots:
                 tag = text.split("\n")[0]
                 ax.annotate(tag, xy, xytext=(4.0, 4.0), ha="left", va="bottom", **{**_label_style(7.0), "zorder": 8})
