@@ -367,3 +367,21 @@ def test_help_explains_methods_and_lists_every_command_in_full(run):
     listing = run("--help").stdout
     assert "Rerun the paper's study and find each method's SNR threshold." in listing
     assert "Figs.\n" not in listing
+
+
+def test_a_fit_with_no_gsd_names_its_parameters_in_px_and_wraps_long_notes_to_120_columns(monkeypatch):
+    from types import SimpleNamespace
+
+    from imgmtf.cli.tables import print_fit
+    lines: list[str] = []
+    monkeypatch.setattr("click.echo", lambda text="", **_: lines.extend(str(text).splitlines()))
+    held = SimpleNamespace(key="electronics.cutoff_cy_m", value=0.62, standard_error=0.0, unit="cy/m",
+                           status="held", note="not determined by the data (within one standard error its blur "
+                                               "length spans 11 px); held at its starting value")
+    result = SimpleNamespace(edges=[], pixel_units=True, sensor=SimpleNamespace(stages=[]), reduced_chi_square=1.0,
+                             choice=None, parameters=[held], correlations=[], confidence=0.95, directions={},
+                             warnings=[])
+    print_fit(result)
+    row = next(i for i, line in enumerate(lines) if line.startswith("electronics."))
+    assert lines[row].split()[:4] == ["electronics.cutoff_cy_px", "0.62", "-", "cy/px"]
+    assert max(len(line) for line in lines[row:row + 2]) <= 120 and "held at its starting value" in lines[row + 1]
