@@ -385,3 +385,11 @@ def test_a_fit_with_no_gsd_names_its_parameters_in_px_and_wraps_long_notes_to_12
     row = next(i for i, line in enumerate(lines) if line.startswith("electronics."))
     assert lines[row].split()[:4] == ["electronics.cutoff_cy_px", "0.62", "-", "cy/px"]
     assert max(len(line) for line in lines[row:row + 2]) <= 120 and "held at its starting value" in lines[row + 1]
+
+
+def test_the_closing_count_is_of_files_measured_not_of_a_point_array_s_direction_rows(run, tmp_path):
+    chip = tmp_path / "points.tif"
+    assert run("simulate", "--target", "points", "--size", 48, "--seed", 1, "--out", chip).exit_code == 0
+    result = run("measure", "--target", "points", "--intervals", "none", chip, tmp_path / "missing.tif")
+    assert result.stdout.count("points.tif") == 2                  # two rows, across and along, of one file
+    assert "1 measured, 1 failed" in result.stderr                 # it said "2 measured, 1 failed"
