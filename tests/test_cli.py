@@ -390,6 +390,6 @@ def test_a_fit_with_no_gsd_names_its_parameters_in_px_and_wraps_long_notes_to_12
 def test_the_closing_count_is_of_files_measured_not_of_a_point_array_s_direction_rows(run, tmp_path):
     chip = tmp_path / "points.tif"
     assert run("simulate", "--target", "points", "--size", 48, "--seed", 1, "--out", chip).exit_code == 0
-    result = run("measure", "--target", "points", "--intervals", "none", chip, tmp_path / "missing.tif")
+    result = run("measure", "--target", "points", "--intervals", "none", "--workers", 1, chip, tmp_path / "missing.tif")
     assert result.stdout.count("points.tif") == 2                  # two rows, across and along, of one file
     assert "1 measured, 1 failed" in result.stderr                 # it said "2 measured, 1 failed"
