@@ -403,3 +403,17 @@ def test_the_measurement_figure_s_profile_and_lsf_legends_sit_under_their_axes_o
     fig.draw_without_rendering()
     for ax in fig.axes[1:3]:            # the profile, the LSF
         assert _overlap(ax.get_legend().get_window_extent(), ax.get_window_extent()) == 0
+
+
+def test_the_ids_of_short_collinear_candidates_stack_apart_instead_of_over_each_other():
+    """A road's short pieces, each rejected: their ids sat on one another."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    pieces = [{"id": 100 + k, "status": "rejected", "reason": "angle", "x0_px": 200.0 + 4 * k, "y0_px": 300.0,
+               "x1_px": 203.0 + 4 * k, "y1_px": 300.0} for k in range(4)]
+    ax = plot_scan(np.zeros((600, 600)), 1.0, pieces).axes[0]
+    ax.figure.draw_without_rendering()
+    boxes = [Text.get_window_extent(t) for t in ax.texts if t.get_text().isdigit()]
+    assert len(boxes) == 4 and all(_overlap(a, b) == 0 for i, a in enumerate(boxes) for b in boxes[i + 1:])

@@ -367,9 +367,13 @@ class _Labels:
         if record.get("id") is None:
             return
         (x0, y0), (x1, y1) = _ends(record)
-        clearance = 14.0 * self.px_per_pt          # about a three-digit id's width
-        spots = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
-        free = [p for p in spots if all(np.hypot(p[0] - q[0], p[1] - q[1]) > clearance for q in self.placed)]
+        # an id's box, about a three-digit id's width and a line's height: two boxes apart
+        # when their centres differ by more than that across or along
+        width, height = 16.0 * self.px_per_pt, 10.0 * self.px_per_pt
+        along = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
+        # collinear short candidates (a road's pieces) leave no free spot along them: stacked beside
+        spots = along + [(x, y + 1.1 * k * height) for k in (-1, 1, -2, 2, -3, 3) for x, y in along]
+        free = [p for p in spots if all(abs(p[0] - q[0]) > width or abs(p[1] - q[1]) > height for q in self.placed)]
         x, y = (free or spots)[0]
         self.placed.append((x, y))
         self.ax.text(x, y, str(record["id"]), fontsize=6.5, color=text_colour, ha="center", va="center",
