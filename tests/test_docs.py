@@ -237,10 +237,16 @@ def update_console_outputs(document: str) -> None:
         os.chdir(folder)
         os.symlink(ROOT / "data", "data", target_is_directory=True)
         link_real_scenes(document, Path(folder))
+        globs: dict = {"__name__": "__docs__"}
         try:
             for language, body, line in list(fenced_blocks(text)):
                 if language == "toml" and fence_name(text, line):
                     Path(fence_name(text, line)).write_text(body)
+                if language == "python" and document != "README.md":    # what the commands after it read
+                    try:                                                  # (camera.md's chart.png)
+                        run_python(body, globs, f"{document}:{line}")
+                    except AssertionError as exc:                         # its output is the test's to judge
+                        print(f"{document}:{line}: a Python example's output differs:\n{exc}")
                 if language != "console":
                     continue
                 lines = []
