@@ -59,7 +59,8 @@ and a batch of 20 four-square charts (seeds SEED to SEED + 19) in one
 ``imgmtf scan`` command, each against MTF Mapper run on the same images
 (a process per chart), once each in turn; then the sweep of the scene
 fit's time against the half-edges fitted (16 to 1936, doubling: budget
-time(2n) / time(n) at most 2).
+time(2n) / time(n) at most 2), and ("targets") the per-target work of one
+dense scan: its combined rows, across/along sections and sensor fits.
 
 usage: python bench/scan_speed.py [--cache DIR] [--runs N] [--no-cli] [--mtfmapper PATH] [--scale [PARTS]]
 """
@@ -284,7 +285,34 @@ def fit_sweep(dense: Path, runs: int) -> None:
         before = (n, best)
 
 
-SCALE_PARTS = ("dense", "bootstrap", "batch", "sweep")
+def per_target(dense: Path) -> None:
+    """The per-target work of the dense chart's scan, in this process on
+    one scan's records: the combined rows (``summarise_scan``), the
+    across/along sections of 484 targets (``section_rows``) and the sensor
+    fits of every target and of the scene (``fit_targets``, stages auto),
+    each with its share of the three."""
+    from imgmtf.scene.combine import summarise_scan
+    from imgmtf.scene.measure import scan_scene
+    from imgmtf.scene.sections import section_rows
+    from imgmtf.scene.targetfit import fit_targets
+    records = scan_scene(str(dense))
+    fit_targets([r for r in records if r.site.get("target_id") == 1])     # warm-up: SciPy's optimizer loaded
+
+    def timed(step):
+        wall, cpu = time.perf_counter(), time.process_time()
+        out = step()
+        return out, Timing(time.perf_counter() - wall, time.process_time() - cpu)
+    summaries, combined = timed(lambda: summarise_scan(records))
+    times = {"summarise_scan (combined rows)": combined,
+             "section_rows (across/along sections)": timed(lambda: section_rows(summaries))[1],
+             "fit_targets (targets' and scene's fits)": timed(lambda: fit_targets(records))[1]}
+    total = sum(t.wall_s for t in times.values())
+    print(f"per-target work of the dense chart's scan (in process, {len(records)} candidates):")
+    for label, t in times.items():
+        print(f"  {label + ':':52s} {t.wall_s:6.2f} s (CPU {t.cpu_s:6.2f} s)   {100 * t.wall_s / total:4.1f} %")
+
+
+SCALE_PARTS = ("dense", "bootstrap", "batch", "sweep", "targets")
 
 
 def scale(cache: Path, runs: int, peer: str | None, parts: set[str]) -> None:
@@ -292,7 +320,7 @@ def scale(cache: Path, runs: int, peer: str | None, parts: set[str]) -> None:
     "bootstrap": with --bootstrap 50) and a batch of 20 four-square charts
     in one command, each against MTF Mapper run on the same images (once
     per chart), timed in the same run; then the fit sweep."""
-    dense = dense_chart(cache) if parts & {"dense", "bootstrap", "sweep"} else None
+    dense = dense_chart(cache) if parts & {"dense", "bootstrap", "sweep", "targets"} else None
     batch = [four_square_chart(cache, SEED + k) for k in range(BATCH)] if "batch" in parts else []
     with tempfile.TemporaryDirectory() as work:
         def peer_on(paths: list[Path]) -> int:
@@ -342,6 +370,8 @@ def scale(cache: Path, runs: int, peer: str | None, parts: set[str]) -> None:
               f"{against}   (budget 2 x), {accepted_edges(t.out)} edges accepted")
     if dense is not None and "sweep" in parts:
         fit_sweep(dense, runs)
+    if dense is not None and "targets" in parts:
+        per_target(dense)
 
 
 def main() -> None:

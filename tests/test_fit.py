@@ -275,3 +275,6 @@ def test_a_fit_keeps_no_evaluation_caches_and_its_band_still_works(pair):
             value, low, high = other.mtf_band(0.5, angle)
             reported = fit.directions[direction]
             assert float(value) == reported["mtf_nyquist"] and [float(low), float(high)] == reported["mtf_nyquist_ci"]
+        for edge in fit.edges:                  # each edge's, its band's sensors made once for all of them
+            value, low, high = other.mtf_band(0.5, edge.normal_angle_deg, edge.gsd_m)
+            assert float(value) == edge.mtf_nyquist and (float(low), float(high)) == edge.mtf_nyquist_ci

@@ -10,7 +10,7 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
-from .model import Model, model_mtf50_band, model_mtf_band, other_stages
+from .model import Model, band_sensors, model_mtf50_band, model_mtf_band, other_stages
 from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test
@@ -62,6 +62,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                     correlations.append((model.free[i], model.free[j], float(corr[i, j])))
 
     edges, start_row = [], 0
+    stepped = band_sensors(model, u)
     for e, (d, r) in enumerate(zip(model.data, responses)):
         lo, hi, x0 = z[n + 3 * e: n + 3 * e + 3]
         bins = d.bins
@@ -70,7 +71,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
         chi = float(sample_chi_squares[e] / max(d.x.size - 3 - n / len(model.data), 1))
         # on the samples: the fit's bins, formed before x0 was known, straddle the misfit test's
         p, fraction = misfit_test(d.x - x0, sample_residuals[e], d.noise, abs(hi - lo), r)
-        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, confidence)
+        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m,
+                                            confidence, stepped)
         f = np.linspace(0.0, 2.0, 4001)
         measured = d.measurement
         edge = EdgeFit(d.source, d.normal_angle_deg, direction_label(d.normal_angle_deg, 0.0),
@@ -96,8 +98,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     directions = {}
     for direction in DIRECTIONS:
         angle = direction_angle(direction)
-        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), angle, model.gsd, confidence)
-        mtf50, mtf50_ci = model_mtf50_band(model, u, covariance, angle, model.gsd, confidence)
+        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), angle, model.gsd, confidence, stepped)
+        mtf50, mtf50_ci = model_mtf50_band(model, u, covariance, angle, model.gsd, confidence, stepped)
         directions[direction] = {"mtf_nyquist": float(value), "mtf_nyquist_ci": [float(low), float(high)],
                                  "mtf50_cy_px": mtf50, "mtf50_cy_px_ci": list(mtf50_ci),
                                  "constrained": direction in seen}

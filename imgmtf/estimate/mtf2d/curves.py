@@ -36,8 +36,7 @@ def interp_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
     xp = np.broadcast_to(np.asarray(xp, float), fp.shape)
     k, m = fp.shape
     row = np.arange(k)[:, None]
-    # numpy's binary search: j with xp[j] <= x < xp[j + 1]; -1 below the first node, m - 1 from the last
-    j = np.sum(x[:, :, None] >= xp[:, None, :], axis=2) - 1
+    j = _search_rows(x, xp, row)
     low, high = np.clip(j, 0, m - 2), np.clip(j + 1, 1, m - 1)
     x_low, x_high, y_low, y_high = xp[row, low], xp[row, high], fp[row, low], fp[row, high]
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -49,6 +48,27 @@ def interp_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
     out = np.where(x == x_low, y_low, out)                       # on a node: its value
     out = np.where(j < 0, fp[:, :1], np.where(j >= m - 1, fp[:, -1:], out))
     return np.where(np.isnan(x), x, out)
+
+
+def _search_rows(x: np.ndarray, xp: np.ndarray, row: np.ndarray) -> np.ndarray:
+    """numpy's binary search, row by row: j with xp[j] <= x < xp[j + 1];
+    -1 below the first node, m - 1 from the last (NaN: any).  Guessed as
+    if the nodes were uniform (they are: a model's nodes are a linspace),
+    then stepped down or up while a comparison with the nodes themselves
+    says so: exact for any strictly increasing rows, a step or none for
+    uniform ones (comparing every point with every node cost a dense
+    chart's sections a tenth of their time)."""
+    m = xp.shape[1]
+    first, last = xp[:, :1], xp[:, -1:]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        guess = np.floor((x - first) / (last - first) * (m - 1))
+    j = np.clip(np.nan_to_num(guess, nan=0.0), -1, m - 1).astype(int)
+    while True:
+        down = (j >= 0) & (x < xp[row, np.maximum(j, 0)])
+        up = (j < m - 1) & (x >= xp[row, np.minimum(j + 1, m - 1)])
+        if not (down.any() or up.any()):
+            return j
+        j = j - down + up
 
 
 def _interp_inside(x: np.ndarray, nodes: np.ndarray, values: np.ndarray) -> np.ndarray:

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...errors import ParameterError
+from . import hats
 
 NODE_STEP_CY_PX = 0.025     # the curves' node spacing
 REACH_CY_PX = 0.8           # the sections are inverted up to this frequency on each axis
@@ -174,73 +175,79 @@ class EllipticalProblem:
         for all of them at once, each refined by a parabola."""
         targets = self.remainders(many)
         trials = near + np.linspace(-0.3, 0.3, 13)
-        costs = self.costs(trials, targets)
-        return self.each_model(np.array([_vertex(trials, costs[:, k]) for k in range(targets.shape[1])]), targets)
+        return self.each_model(_vertices(trials, self.costs(trials, targets)), targets)
 
     def costs(self, log_aspects: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """The weighted misfit (:meth:`_fit`'s first value) of ``targets``
         (samples, or samples x k) at each of ``log_aspects``, every
         aspect's least squares solved in one call: (aspects,) or (aspects, k)."""
-        _, design = self._stacked(log_aspects)
-        columns = targets if targets.ndim == 2 else targets[:, None]
-        solution = self._solutions(design, np.broadcast_to(columns, (len(log_aspects), *columns.shape)))
-        misfit = self.weight[:, None] * (design @ solution - columns)
-        costs = np.sum(misfit ** 2, axis=1)
-        return costs if targets.ndim == 2 else costs[:, 0]
+        _, h = self._stacked(log_aspects)
+        if targets.ndim == 1:
+            solution = self._solved(h, np.broadcast_to(targets, h.low.shape))
+            return np.sum((self.weight * (hats.predicted(h, solution) - targets)) ** 2, axis=1)
+        # many right-hand sides per aspect: one dense product each (BLAS), the normal matrices still sparse
+        weighted = hats.dense(h) * self.weight[None, :, None]
+        goal = targets * self.weight[:, None]
+        solution = np.linalg.solve(self._normal(h), np.transpose(weighted, (0, 2, 1)) @ goal)
+        misfit = weighted @ solution - goal
+        return np.einsum("ask,ask->ak", misfit, misfit)
 
     def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> list[EllipticalModel]:
         """:meth:`model` of each column of ``targets`` (samples x draws) at
         its own log aspect, solved together: each draw's design (its
-        stretch, its nodes) stacked, the normal equations of all of them
-        solved in one call (a call per draw cost a dense chart's scan,
-        484 targets of a hundred-odd draws each, a sixth of its time)."""
-        nodes, design = self._stacked(log_aspects)
+        stretch, its nodes) kept sparse, the normal equations of all of
+        them solved in one call (a call per draw cost a dense chart's
+        scan, 484 targets of a hundred-odd draws each, a sixth of its
+        time; their dense designs another sixth)."""
+        nodes, h = self._stacked(log_aspects)
         size = nodes.shape[1]
-        solution = np.concatenate([np.zeros((len(log_aspects), 1)),
-                                   self._solutions(design, targets.T[:, :, None])[:, :, 0]], axis=1)
-        touched = np.abs(design).sum(axis=1) > 0                                   # draws x (nodes - 1)
+        solution = np.concatenate([np.zeros((len(log_aspects), 1)), self._solved(h, targets.T)], axis=1)
+        touched = hats.touched(h)                                                    # draws x (nodes - 1)
         last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
         reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
         return [EllipticalModel(nodes[k], np.where(reach[k], solution[k], np.nan), math.exp(log_aspects[k]))
                 for k in range(len(log_aspects))]
 
-    def _stacked(self, log_aspects: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _stacked(self, log_aspects: np.ndarray) -> tuple[np.ndarray, hats.Hats]:
         """:meth:`_fit`'s nodes and design at each of ``log_aspects``,
-        stacked: (aspects, 33) and (aspects, samples, 32)."""
+        stacked: (aspects, 33) and the samples' interpolation weights
+        (aspects x samples) on them."""
         stretch = np.sqrt(self.c ** 2 + self.s ** 2 * np.exp(-2 * np.asarray(log_aspects))[:, None, None])
         w = (self.f * stretch)[:, self.use]                                         # aspects x samples
         nodes = np.linspace(0.0, np.maximum(w.max(axis=1, initial=0.0), NODE_STEP_CY_PX), 33, axis=-1)
         step = nodes[:, 1] - nodes[:, 0]
-        position = np.clip(w / step[:, None], 0, nodes.shape[1] - 1)
-        low = np.minimum(np.floor(position).astype(int), nodes.shape[1] - 2)
-        frac = position - low
-        hat = np.zeros((*w.shape, nodes.shape[1]))
-        row, sample = np.indices(w.shape)
-        hat[row, sample, low] = 1.0 - frac
-        hat[row, sample, low + 1] = frac
-        return nodes, hat[:, :, 1:]
+        return nodes, hats.hats(w / step[:, None], nodes.shape[1])
 
-    def _solutions(self, design: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    def _normal(self, h: hats.Hats) -> np.ndarray:
+        """:func:`_solve`'s normal matrices of stacked designs (sparse)."""
+        return hats.gram(h, self.weight) + _penalty(1, h.size) + 1e-10 * np.eye(h.size - 1)
+
+    def _solved(self, h: hats.Hats, targets: np.ndarray) -> np.ndarray:
         """:func:`_solve`'s node values (but the first, 0) for stacked
-        designs (aspects x samples x nodes) and their targets (aspects x
-        samples x k)."""
-        weighted = design * self.weight[None, :, None]
-        size = design.shape[2] + 1
-        normal = np.transpose(weighted, (0, 2, 1)) @ weighted + _penalty(1, size) + 1e-10 * np.eye(size - 1)
-        return np.linalg.solve(normal, np.transpose(weighted, (0, 2, 1)) @ (targets * self.weight[None, :, None]))
+        designs and one target each (batch x samples): batch x (nodes - 1)."""
+        rhs = hats.transposed(h, self.weight * (targets * self.weight))
+        return np.linalg.solve(self._normal(h), rhs[:, :, None])[:, :, 0]
 
 
 def _vertex(trials: np.ndarray, costs: np.ndarray) -> float:
     """Where the parabola through the lowest cost and its neighbours has
     its minimum (at most a step from the lowest; the lowest at an end)."""
-    i = int(np.argmin(costs))
-    if i == 0 or i == trials.size - 1:
-        return float(trials[i])
+    return float(_vertices(trials, costs[:, None])[0])
+
+
+def _vertices(trials: np.ndarray, costs: np.ndarray) -> np.ndarray:
+    """:func:`_vertex` of each column of ``costs`` (trials x k), the same
+    arithmetic on arrays: (k,)."""
+    i = np.argmin(costs, axis=0)
+    inner = np.clip(i, 1, trials.size - 2)
+    columns = np.arange(costs.shape[1])
+    left, mid, right = costs[inner - 1, columns], costs[inner, columns], costs[inner + 1, columns]
     step = trials[1] - trials[0]
-    left, mid, right = costs[i - 1:i + 2]
     curvature = left - 2 * mid + right
-    shift = 0.5 * step * (left - right) / curvature if curvature > 0 else 0.0
-    return float(trials[i] + np.clip(shift, -step, step))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = np.where(curvature > 0, 0.5 * step * (left - right) / curvature, 0.0)
+    at_end = (i == 0) | (i == trials.size - 1)
+    return np.where(at_end, trials[i], trials[i] + np.clip(shift, -step, step))
 
 
 def fitted_model(assumption: str, normals, f, m, sd):

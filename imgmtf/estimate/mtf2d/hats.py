@@ -1,0 +1,143 @@
+"""Linear interpolation on uniform nodes as a least-squares design, kept
+sparse: each sample touches two neighbouring nodes (``low`` with weight
+1 - ``frac``, ``low + 1`` with ``frac``), so its normal matrix is
+tridiagonal and its products with one right-hand side are sums over the
+samples (:func:`numpy.bincount`), not products with a dense
+samples x nodes matrix of which all but two columns are zero.
+
+The elliptical inversion (:mod:`.inversion`) solves such designs for many
+aspects and draws per target; dense, their normal matrices were most of a
+dense chart's section time.  Every array has leading batch axes (aspects,
+draws); the first node (log 1 = 0, fixed) is dropped from the unknowns,
+as :func:`.inversion._hat` drops it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Hats:
+    """Samples' linear-interpolation weights on ``size`` uniform nodes.
+
+    Attributes
+    ----------
+    low : numpy.ndarray of int
+        (batch, samples): the node at or below each sample, 0 to size - 2.
+    frac : numpy.ndarray
+        (batch, samples): the weight of node ``low + 1`` (``low``'s is
+        1 - frac).
+    size : int
+        Nodes, the first fixed (not an unknown).
+    """
+
+    low: np.ndarray
+    frac: np.ndarray
+    size: int
+
+
+def hats(position: np.ndarray, size: int) -> Hats:
+    """The weights of samples at ``position`` (batch, samples; in node
+    steps from the first node) on ``size`` nodes, clipped to them exactly
+    as :func:`.inversion._hat` clips.
+
+    Examples
+    --------
+    >>> h = hats(np.array([[0.25, 1.5, 9.0]]), 3)
+    >>> h.low.tolist(), h.frac.tolist()
+    ([[0, 1, 1]], [[0.25, 0.5, 1.0]])
+    """
+    position = np.clip(position, 0, size - 1)
+    low = np.minimum(np.floor(position).astype(int), size - 2)
+    return Hats(low, position - low, size)
+
+
+def dense(h: Hats) -> np.ndarray:
+    """The design (batch, samples, size - 1), the first node dropped: for
+    products with many right-hand sides at once (BLAS does those best).
+
+    Examples
+    --------
+    >>> dense(hats(np.array([[0.25, 1.5]]), 3)).tolist()
+    [[[0.25, 0.0], [0.5, 0.5]]]
+    """
+    batch, samples = h.low.shape
+    out = np.zeros((batch, samples, h.size))
+    row, sample = np.indices(h.low.shape)
+    out[row, sample, h.low] = 1.0 - h.frac
+    out[row, sample, h.low + 1] = h.frac
+    return out[:, :, 1:]
+
+
+def gram(h: Hats, weight: np.ndarray) -> np.ndarray:
+    """The weighted normal matrix D^T W^2 D of each batch's design
+    (batch, size - 1, size - 1): tridiagonal, from the samples' two
+    weights each.
+
+    Examples
+    --------
+    >>> h = hats(np.array([[0.25, 1.5]]), 3)
+    >>> bool(np.allclose(gram(h, np.ones(2))[0], dense(h)[0].T @ dense(h)[0]))
+    True
+    """
+    lower, upper = weight * (1.0 - h.frac), weight * h.frac
+    diagonal = _scatter(h.low, lower * lower, h.size) + _scatter(h.low + 1, upper * upper, h.size)
+    beside = _scatter(h.low, lower * upper, h.size)[:, :-1]
+    batch, nodes = diagonal.shape
+    out = np.zeros((batch, nodes, nodes))
+    k = np.arange(nodes)
+    out[:, k, k] = diagonal
+    out[:, k[:-1], k[1:]] = beside
+    out[:, k[1:], k[:-1]] = beside
+    return out[:, 1:, 1:]
+
+
+def transposed(h: Hats, values: np.ndarray) -> np.ndarray:
+    """D^T ``values`` for one right-hand side per batch (batch, samples):
+    (batch, size - 1).
+
+    Examples
+    --------
+    >>> h = hats(np.array([[0.25, 1.5]]), 3)
+    >>> transposed(h, np.array([[2.0, 4.0]])).tolist()
+    [[2.5, 2.0]]
+    """
+    return (_scatter(h.low, (1.0 - h.frac) * values, h.size) + _scatter(h.low + 1, h.frac * values, h.size))[:, 1:]
+
+
+def predicted(h: Hats, solution: np.ndarray) -> np.ndarray:
+    """D ``solution`` for one solution per batch (batch, size - 1; the
+    first node 0): each sample's interpolated value, (batch, samples).
+
+    Examples
+    --------
+    >>> predicted(hats(np.array([[0.25, 1.5]]), 3), np.array([[2.0, 4.0]])).tolist()
+    [[0.5, 3.0]]
+    """
+    full = np.concatenate([np.zeros((solution.shape[0], 1)), solution], axis=1)
+    return (1.0 - h.frac) * np.take_along_axis(full, h.low, axis=1) + h.frac * np.take_along_axis(full, h.low + 1,
+                                                                                                  axis=1)
+
+
+def touched(h: Hats) -> np.ndarray:
+    """Whether any sample weighs on each unknown node (batch, size - 1),
+    as a dense design's non-zero columns say.
+
+    Examples
+    --------
+    >>> touched(hats(np.array([[0.0, 1.0]]), 4)).tolist()
+    [[True, False, False]]
+    """
+    weights = _scatter(h.low, (1.0 - h.frac != 0).astype(float), h.size) + \
+        _scatter(h.low + 1, (h.frac != 0).astype(float), h.size)
+    return weights[:, 1:] > 0
+
+
+def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """Sums of ``values`` (batch, samples) by node ``index``: (batch, size)."""
+    batch = index.shape[0]
+    flat = (index + size * np.arange(batch)[:, None]).ravel()
+    return np.bincount(flat, weights=np.broadcast_to(values, index.shape).ravel(),
+                       minlength=batch * size).reshape(batch, size)

@@ -1,0 +1,55 @@
+"""Sparse linear-interpolation designs (imgmtf.estimate.mtf2d.hats): the
+dense design's algebra, and the draws' vertices and the curves' node
+search, batched, each exactly what one at a time gives."""
+import numpy as np
+
+from imgmtf.estimate.mtf2d import hats
+from imgmtf.estimate.mtf2d.curves import _search_rows
+from imgmtf.estimate.mtf2d.inversion import _hat, _vertex, _vertices
+
+
+def test_the_sparse_designs_algebra_is_the_dense_designs():
+    """Normal matrix, transposed and direct products, touched nodes: those
+    of the dense design (:func:`.inversion._hat`'s, row for row), samples
+    below, between, on and beyond the nodes."""
+    rng = np.random.default_rng(4)
+    nodes = np.linspace(0.0, 0.8, 9)
+    x = np.concatenate([rng.uniform(-0.1, 0.5, (3, 12)), np.tile(nodes[[0, 2]], (3, 1))], axis=1)
+    h = hats.hats(x / (nodes[1] - nodes[0]), nodes.size)
+    design = np.array([_hat(row, nodes) for row in x])
+    assert np.array_equal(hats.dense(h), design)
+    weight, values, solution = rng.uniform(0.5, 2.0, x.shape[1]), rng.normal(size=x.shape), rng.normal(size=(3, 8))
+    weighted = design * weight[None, :, None]
+    assert np.allclose(hats.gram(h, weight), np.transpose(weighted, (0, 2, 1)) @ weighted, rtol=1e-13, atol=1e-13)
+    assert np.allclose(hats.transposed(h, values), np.einsum("bsn,bs->bn", design, values), rtol=1e-13, atol=1e-13)
+    assert np.allclose(hats.predicted(h, solution), np.einsum("bsn,bn->bs", design, solution), rtol=1e-13,
+                       atol=1e-13)
+    assert np.array_equal(hats.touched(h), np.abs(design).sum(axis=1) > 0)
+    assert not hats.touched(h)[:, -3:].any()                  # nothing reaches past 0.5 cy/px
+
+
+def test_the_draws_vertices_are_each_draws_own():
+    """Columns with their lowest inside, at either end, tied, flat (no
+    curvature): the vectorised vertices bit for bit the one-column rule."""
+    trials = np.linspace(-0.3, 0.3, 13) + np.log(0.8)
+    rng = np.random.default_rng(5)
+    costs = (trials[:, None] - rng.uniform(-0.5, 0.5, 40)) ** 2 + rng.uniform(0, 1e-3, (13, 40))
+    costs[:, 0] = 1.0                                          # flat: the first trial
+    costs[6:9, 1] = 0.5                                        # a tie
+    together = _vertices(trials, costs)
+    assert np.array_equal(together, [_vertex(trials, costs[:, k]) for k in range(costs.shape[1])])
+
+
+def test_the_node_search_is_numpys():
+    """Uniform rows (a model's linspace, the guess then exact), uneven
+    rows (several steps), points on nodes, outside and NaN: the index of
+    the last node at or below each point, as comparing with every node."""
+    rng = np.random.default_rng(6)
+    uniform = np.linspace(0.0, rng.uniform(0.5, 1.2, 4), 33, axis=-1)
+    uneven = np.sort(rng.uniform(0, 1, (4, 33)), axis=1)
+    for nodes in (uniform, uneven):
+        x = np.concatenate([rng.uniform(-0.2, 1.3, (4, 50)), nodes, np.full((4, 1), np.nan)], axis=1)
+        expected = np.sum(x[:, :, None] >= nodes[:, None, :], axis=2) - 1
+        found = _search_rows(x, nodes, np.arange(4)[:, None])
+        finite = np.isfinite(x)
+        assert np.array_equal(found[finite], expected[finite])
