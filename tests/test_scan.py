@@ -237,13 +237,13 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
     import imgmtf.scene.candidates as scan_module
     calls = []
 
-    def breaks_once(*args):
+    def breaks_once(self, *args):
         calls.append(args)
         if len(calls) == 1:
             raise ZeroDivisionError("float division by zero")
-        return real(*args)
-    real = scan_module._estimate
-    monkeypatch.setattr(scan_module, "_estimate", breaks_once)
+        return real(self, *args)
+    real = scan_module._Estimator.__call__
+    monkeypatch.setattr(scan_module._Estimator, "__call__", breaks_once)
     records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
     internal = [r for r in records if r.reason == "internal"]
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error

@@ -103,11 +103,12 @@ def measure_batch(task) -> list[tuple[int, Record]]:
         verdicts = _quick_looks(read)
     except Exception as exc:           # ... and one batch's quick look, never the scan
         return out + [(plan.index, _failed(exc, raster, context)) for plan, _ in read]
+    estimator = _Estimator(context, raster) if read else None    # made once: its settings checked once
     for (plan, band), verdict in zip(read, verdicts):
         if verdict:
             out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
         else:
-            out.append((plan.index, safely(measure_band, plan, band, raster, context)))
+            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator)))
     return out
 
 
@@ -167,9 +168,10 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
     return Band(data, (x, y), rows, cols, values, t, d, noise, site)
 
 
-def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
+def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _Estimator | None = None) -> Record:
     """A candidate's record from the gate's verdict on the estimate of its
-    ROI (``band``, which passed the quick look)."""
+    ROI (``band``, which passed the quick look); ``estimator`` the batch's
+    (:class:`_Estimator`), else one made for it."""
     settings = context.settings
     rows, cols = band.rows, band.cols
     r0, c0 = rows[0], cols.min()
@@ -179,7 +181,7 @@ def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
     try:
         # the quality gate refuses a chip before its intervals are computed
         # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
-        result = _estimate(chip, chip_mask, raster, context, plan)
+        result = (estimator or _Estimator(context, raster))(chip, chip_mask)
     except ImgmtfError as exc:
         return _rejected(context, raster, band.site, exc.reason, _one_line(exc), verdict_by="gate",
                          **_gate_figures(getattr(exc, "checks", ())))
@@ -221,14 +223,22 @@ def _confident_snr(target: str, rows: int) -> float:
     return get_kind(target).load("measuring").confident_snr(rows)
 
 
-def _estimate(chip, mask, raster, context: Context, plan: Plan):
-    """The estimator's result on the masked chip."""
-    settings = context.settings
-    measuring = settings.measure_settings()
-    common = {"mask": mask, "gsd_m": raster.gsd_m, "dtype": raster.dtype,
-              "track_azimuth_deg": context.track_azimuth_deg,
-              "saturation": settings.saturation or saturation_levels(raster.dtype)}
-    return measuring.estimator()(chip, **measuring.target_keywords(raster), **common)
+class _Estimator:
+    """The estimator of a scan's candidates in one window of the scene:
+    made once for all of them (the settings' checks cost about a
+    millisecond), called on each masked chip."""
+
+    def __init__(self, context: Context, raster):
+        settings = context.settings
+        measuring = settings.measure_settings()
+        self.estimate = measuring.estimator()
+        self.keywords = {**measuring.target_keywords(raster), "gsd_m": raster.gsd_m, "dtype": raster.dtype,
+                         "track_azimuth_deg": context.track_azimuth_deg,
+                         "saturation": settings.saturation or saturation_levels(raster.dtype)}
+
+    def __call__(self, chip, mask):
+        """The estimator's result on the masked chip."""
+        return self.estimate(chip, mask=mask, **self.keywords)
 
 
 def _gate_figures(checks) -> dict:
