@@ -237,11 +237,11 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
     import imgmtf.scene.candidates as scan_module
     calls = []
 
-    def breaks_once(self, *args):
+    def breaks_once(self, *args, **keywords):
         calls.append(args)
         if len(calls) == 1:
             raise ZeroDivisionError("float division by zero")
-        return real(self, *args)
+        return real(self, *args, **keywords)
     real = scan_module._Estimator.__call__
     monkeypatch.setattr(scan_module._Estimator, "__call__", breaks_once)
     records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))

@@ -21,9 +21,11 @@ from .._blas import one_blas_thread
 from ..kinds.edge import EDGE
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
-from .geometry import TargetGeometry, locate_edge
+from .fermi import FermiRows
+from .geometry import TargetGeometry, edge_rows, locate_edge
 from .kind import Shape, TargetKind
 from .pipeline import run
+from .prefit import Prefit, prefit_chips
 from .results import MTFResult, finite
 from .settings import Settings, make_settings
 from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
@@ -117,6 +119,12 @@ class EdgeKind(TargetKind):
 
     def locate(self, work, seed_x, transposed) -> TargetGeometry:
         return locate_edge(work, seed_x, transposed=transposed)
+
+    def fermi_rows(self, work, seed_x) -> FermiRows:
+        return edge_rows(work, seed_x)[1]
+
+    def locate_fitted(self, work, seed_x, transposed, fit) -> TargetGeometry:
+        return locate_edge(work, seed_x, transposed=transposed, fit=fit)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
         # the levels: the samples in the outer eighth of the range each side
@@ -214,11 +222,12 @@ class EdgeEstimator:
     def __call__(self, image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None,
                  mask: np.ndarray | None = None, gsd_m: float | None = None,
                  saturation: tuple[float, float] | None = None, dtype: DTypeLike | None = None,
-                 track_azimuth_deg: float | None = 0.0) -> EdgeResult:
-        """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
+                 track_azimuth_deg: float | None = 0.0, prefit: Prefit | None = None) -> EdgeResult:
+        """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`.
+        ``prefit``: its first stages made among other chips' (:meth:`prefit`)."""
         with one_blas_thread():         # small matrices: threads cost more than they save
             m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
-                    dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+                    dtype=dtype, track_azimuth_deg=track_azimuth_deg, prefit=prefit)
         left, right = m.estimate.lsf.side_levels_dn
         return EdgeResult(
             **m.result_fields(), method=self.settings.method, params=m.params,
@@ -226,6 +235,27 @@ class EdgeEstimator:
             bright_side=_bright_side(right > left, m.located.transposed), rer=m.shape.extra["rer"],
             esf_x_px=m.profile.grid, esf=(m.profile.values - left) / (right - left),
             levels_dn=(float(left), float(right)))
+
+
+    def prefit(self, images: list[np.ndarray], masks: list[np.ndarray | None], **keywords: Any
+               ) -> list[Prefit | None]:
+        """The first stages of many chips' estimates, their rows' Fermi fits
+        made together (:func:`imgmtf.estimate.prefit.prefit_chips`): each
+        for this estimator's call on its chip (``prefit=``), which then
+        gives the same result sooner.  ``keywords``: those of the calls
+        (``gsd_m``, ``saturation``, ``dtype``, ``track_azimuth_deg``).
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 40).image for a in (5.0, 8.0)]
+        >>> estimate = EdgeEstimator(intervals=imgmtf.Intervals("none"))
+        >>> first, second = estimate.prefit(chips, [None, None])
+        >>> estimate(chips[1], prefit=second).mtf_nyquist == estimate(chips[1]).mtf_nyquist
+        True
+        """
+        with one_blas_thread():
+            return prefit_chips(EdgeKind(), images, self.settings, [{**keywords, "mask": m} for m in masks])
 
 
 def measure_edge(image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None, mask: np.ndarray | None = None,

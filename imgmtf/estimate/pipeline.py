@@ -51,6 +51,7 @@ from .evidence import Evidence
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
 from .intervals import Estimate, FigureIntervals, intervals
 from .kind import Shape, TargetKind, refuse_other_kind
+from .prefit import Prefit
 from .profile import read_profile, rebuild_staircase, widen_profile
 from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
@@ -159,7 +160,8 @@ class Measurement:
 
 def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[int, int, int, int] | None = None,
         mask: np.ndarray | None = None, gsd_m: float | None = None, saturation: tuple[float, float] | None = None,
-        dtype: DTypeLike | None = None, track_azimuth_deg: float | None = 0.0) -> Measurement:
+        dtype: DTypeLike | None = None, track_azimuth_deg: float | None = 0.0,
+        prefit: Prefit | None = None) -> Measurement:
     """Measure the target of ``kind`` in ``image`` (2-D array, DN).
 
     Parameters
@@ -188,6 +190,10 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
         Direction of the ground track in the image, degrees clockwise from
         the image's up direction (0: rows along track, as in L0/L1
         products); None when unknown (map-projected).
+    prefit : Prefit, optional
+        The chip's first stages made among other chips'
+        (:func:`.prefit.prefit_chips`, from these arguments): the same
+        result, sooner.
 
     Returns
     -------
@@ -209,10 +215,11 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
     >>> abs(m.estimate.spectrum.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002, m.located.rows_used
     (True, 60)
     """
-    chip = prepare_chip(image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
-                        track_azimuth_deg=track_azimuth_deg)
+    chip = prefit.chip if prefit is not None else prepare_chip(
+        image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+        track_azimuth_deg=track_azimuth_deg)
     try:
-        located = locate_target(kind, chip, force=settings.force)
+        located = locate_target(kind, chip, force=settings.force, prefit=prefit)
         samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
         read, shape = read_profile(kind, samples, settings, located.checks)
         noise = measure_noise(kind, samples, shape, chip.quantum_dn)
@@ -261,7 +268,7 @@ def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: Array
     return UnsuitableTargetError(f"no {kind.name} here: the chip holds {seen}, not a line", reason="points")
 
 
-def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Located:
+def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: Prefit | None = None) -> Located:
     """The kind's target in the chip: its seed line, its per-row locations
     and the robust line through them (in the vertical frame), every
     pixel's signed distance from that line as a profile sample, and the
@@ -280,6 +287,9 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
         The prepared chip.
     force : bool, optional
         Raise the failure itself rather than a failed earlier check.
+    prefit : Prefit, optional
+        The chip's seed and rows' fit made among other chips'
+        (:func:`.prefit.prefit_chips`).
 
     Returns
     -------
@@ -304,11 +314,12 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
     """
     checks = list(chip.checks)
     try:
-        line, seed_checks = kind.seed(chip.pixels, chip.noise_dn)
+        line, seed_checks = kind.seed(chip.pixels, chip.noise_dn) if prefit is None else prefit.seeded()
         checks += seed_checks
         frame, seed_x, transposed = vertical_frame(chip.pixels, line)
         try:
-            geometry = kind.locate(frame, seed_x, transposed)
+            geometry = (kind.locate(frame, seed_x, transposed) if prefit is None or prefit.fit is None
+                        else kind.locate_fitted(frame, seed_x, transposed, prefit.fit))
             check_angle(geometry, kind.name)
             distance, values, rows, half_range = profile_samples(frame, geometry, kind.name)
         except (TargetNotFoundError, UnsuitableTargetError):

@@ -104,11 +104,16 @@ def measure_batch(task) -> list[tuple[int, Record]]:
     except Exception as exc:           # ... and one batch's quick look, never the scan
         return out + [(plan.index, _failed(exc, raster, context)) for plan, _ in read]
     estimator = _Estimator(context, raster) if read else None    # made once: its settings checked once
+    passed = [band for (_, band), verdict in zip(read, verdicts) if not verdict]
+    try:    # the estimates' first stages of all at once (their Fermi fits stacked), each then finished alone
+        prefits = iter(estimator.prefit([_chip(band) for band in passed]) if estimator and passed else [])
+    except Exception:                  # (each then measured from the start, its own failure its own)
+        prefits = iter([None] * len(passed))
     for (plan, band), verdict in zip(read, verdicts):
         if verdict:
             out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
         else:
-            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator)))
+            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator, next(prefits))))
     return out
 
 
@@ -168,20 +173,17 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
     return Band(data, (x, y), rows, cols, values, t, d, noise, site)
 
 
-def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _Estimator | None = None) -> Record:
+def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _Estimator | None = None,
+                 prefit=None) -> Record:
     """A candidate's record from the gate's verdict on the estimate of its
     ROI (``band``, which passed the quick look); ``estimator`` the batch's
-    (:class:`_Estimator`), else one made for it."""
+    (:class:`_Estimator`), else one made for it, and ``prefit`` the first
+    stages of its estimate made with the batch's (:meth:`_Estimator.prefit`)."""
     settings = context.settings
-    rows, cols = band.rows, band.cols
-    r0, c0 = rows[0], cols.min()
-    chip = band.data[r0:rows[-1] + 1, c0:cols.max() + 1]
-    chip_mask = np.zeros(chip.shape, bool)
-    chip_mask[rows - r0, cols - c0] = True
     try:
         # the quality gate refuses a chip before its intervals are computed
         # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
-        result = (estimator or _Estimator(context, raster))(chip, chip_mask)
+        result = (estimator or _Estimator(context, raster))(*_chip(band), prefit=prefit)
     except ImgmtfError as exc:
         return _rejected(context, raster, band.site, exc.reason, _one_line(exc), verdict_by="gate",
                          **_gate_figures(getattr(exc, "checks", ())))
@@ -205,6 +207,17 @@ def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _E
     if context.figures_dir:
         record = _with_figure(record, result, context, plan)
     return record
+
+
+def _chip(band: Band) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate's chip (its band's bounding box) and the mask of the
+    band's pixels in it."""
+    rows, cols = band.rows, band.cols
+    r0, c0 = rows[0], cols.min()
+    chip = band.data[r0:rows[-1] + 1, c0:cols.max() + 1]
+    mask = np.zeros(chip.shape, bool)
+    mask[rows - r0, cols - c0] = True
+    return chip, mask
 
 
 def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record:
@@ -236,9 +249,19 @@ class _Estimator:
                          "track_azimuth_deg": context.track_azimuth_deg,
                          "saturation": settings.saturation or saturation_levels(raster.dtype)}
 
-    def __call__(self, chip, mask):
-        """The estimator's result on the masked chip."""
-        return self.estimate(chip, mask=mask, **self.keywords)
+    def __call__(self, chip, mask, prefit=None):
+        """The estimator's result on the masked chip (``prefit``: its first
+        stages, from :meth:`prefit`)."""
+        return self.estimate(chip, mask=mask, **self.keywords, **({} if prefit is None else {"prefit": prefit}))
+
+    def prefit(self, chips: list[tuple[np.ndarray, np.ndarray]]) -> list:
+        """The first stages of the masked chips' estimates made together
+        where the estimator can (an edge's: its rows' Fermi fits stacked,
+        :func:`imgmtf.estimate.prefit.prefit_chips`), each None otherwise."""
+        many = getattr(self.estimate, "prefit", None)
+        if many is None:
+            return [None] * len(chips)
+        return many([chip for chip, _ in chips], [mask for _, mask in chips], **self.keywords)
 
 
 def _gate_figures(checks) -> dict:
