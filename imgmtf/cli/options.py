@@ -227,7 +227,11 @@ class WorkerCount(click.ParamType):
     def convert(self, value, param, ctx):
         if value is None or (isinstance(value, str) and value.strip().lower() == "auto"):
             return None
-        return click.IntRange(1, MAX_WORKERS).convert(value, param, ctx)
+        try:
+            number = int(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is neither 'auto' nor a number of workers (1 to {MAX_WORKERS})", param, ctx)
+        return click.IntRange(1, MAX_WORKERS).convert(number, param, ctx)
 
 
 def parallel_options(command, *, auto: bool = False):
