@@ -36,7 +36,7 @@ from ..kinds import get_kind
 from ..parallel import auto_workers, run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
-from .detect import detect_segments
+from .detect import detect_segments, tile_windows
 from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
@@ -57,6 +57,7 @@ from .settings import ScanSettings
 # with workers chosen automatically, a local pool measures the candidates when each worker has at least
 # this many (about 2-3 s of work against a pool's start of 0.2-0.5 s); fewer are measured here
 AUTO_PLANS_PER_WORKER = 100
+AUTO_TILES_PER_WORKER = 4       # ... and detection its tiles from this many a worker (0.2-0.3 s a tile)
 TASKS_PER_WORKER = 4            # a pool's candidates are split into this many tasks a worker: a late tile waits less
 
 
@@ -91,8 +92,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         How to scan (:class:`imgmtf.ScanSettings`; default its defaults).
     workers : int or None, optional
         Local worker processes (default 1: none, the work runs here); None
-        chooses: the available cores for the candidates' measurement when
-        each has ``AUTO_PLANS_PER_WORKER`` of them
+        chooses: the available cores for the detection when each has
+        ``AUTO_TILES_PER_WORKER`` tiles to read, and for the candidates'
+        measurement when each has ``AUTO_PLANS_PER_WORKER`` of them
         (:func:`imgmtf.parallel.auto_workers`), else none.  The records are
         the same whatever the workers.
     scheduler : str, optional
@@ -146,8 +148,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         # a strip or a one-pixel scene holds no chip: refused before any tile is read
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; an edge or bar chip needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
-    segments, fill_fraction = detect_segments(path, settings, workers=1 if workers is None else workers,
-                                              scheduler=scheduler, progress=progress)
+    detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
+                 else workers)
+    segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
     sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
     halves = split_at_junctions(sampled, junctions, events, fill_fraction)
