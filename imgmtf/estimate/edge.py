@@ -24,8 +24,8 @@ from .detection import describe, find_edge, meet_inside, parallel_within
 from .fermi import FermiRows
 from .geometry import TargetGeometry, edge_rows, locate_edge
 from .kind import Shape, TargetKind
+from .many import run_many
 from .pipeline import run
-from .prefit import Prefit, prefit_chips
 from .results import MTFResult, finite
 from .settings import Settings, make_settings
 from .spectrum import MIN_TRANSFER, central_difference, edge_divisor, relative_edge_response, rise_distance
@@ -222,12 +222,45 @@ class EdgeEstimator:
     def __call__(self, image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None,
                  mask: np.ndarray | None = None, gsd_m: float | None = None,
                  saturation: tuple[float, float] | None = None, dtype: DTypeLike | None = None,
-                 track_azimuth_deg: float | None = 0.0, prefit: Prefit | None = None) -> EdgeResult:
-        """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`.
-        ``prefit``: its first stages made among other chips' (:meth:`prefit`)."""
+                 track_azimuth_deg: float | None = 0.0) -> EdgeResult:
+        """Measure the edge in ``image`` (2-D array, DN); see :func:`measure_edge`."""
         with one_blas_thread():         # small matrices: threads cost more than they save
             m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
-                    dtype=dtype, track_azimuth_deg=track_azimuth_deg, prefit=prefit)
+                    dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        return self._result(m)
+
+    def measure_many(self, images: list[np.ndarray], masks: list[np.ndarray | None], **keywords: Any
+                     ) -> list[EdgeResult | Exception]:
+        """Measure the edge in each image, the work alike across them made
+        together (:func:`imgmtf.estimate.many.run_many`): each the result of
+        this estimator's call on it, or the exception the call raises.
+        ``keywords``: those of the calls (``gsd_m``, ``saturation``,
+        ``dtype``, ``track_azimuth_deg``).
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 40).image for a in (5.0, 8.0)]
+        >>> estimate = EdgeEstimator(intervals=imgmtf.Intervals("none"))
+        >>> [r.mtf_nyquist for r in estimate.measure_many(chips, [None, None])] == [estimate(c).mtf_nyquist
+        ...                                                                          for c in chips]
+        True
+        """
+        with one_blas_thread():
+            measured = run_many(EdgeKind(), images, self.settings, [{**keywords, "mask": m} for m in masks])
+        return [self._outcome(m) for m in measured]
+
+    def _outcome(self, m) -> EdgeResult | Exception:
+        """A measurement's result, or the exception it or its making raised."""
+        if isinstance(m, Exception):
+            return m
+        try:
+            return self._result(m)
+        except Exception as exc:        # as the call would have raised it
+            return exc
+
+    def _result(self, m) -> EdgeResult:
+        """The pipeline's measurement as this estimator's result."""
         left, right = m.estimate.lsf.side_levels_dn
         return EdgeResult(
             **m.result_fields(), method=self.settings.method, params=m.params,
@@ -235,27 +268,6 @@ class EdgeEstimator:
             bright_side=_bright_side(right > left, m.located.transposed), rer=m.shape.extra["rer"],
             esf_x_px=m.profile.grid, esf=(m.profile.values - left) / (right - left),
             levels_dn=(float(left), float(right)))
-
-
-    def prefit(self, images: list[np.ndarray], masks: list[np.ndarray | None], **keywords: Any
-               ) -> list[Prefit | None]:
-        """The first stages of many chips' estimates, their rows' Fermi fits
-        made together (:func:`imgmtf.estimate.prefit.prefit_chips`): each
-        for this estimator's call on its chip (``prefit=``), which then
-        gives the same result sooner.  ``keywords``: those of the calls
-        (``gsd_m``, ``saturation``, ``dtype``, ``track_azimuth_deg``).
-
-        Examples
-        --------
-        >>> import imgmtf
-        >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 40).image for a in (5.0, 8.0)]
-        >>> estimate = EdgeEstimator(intervals=imgmtf.Intervals("none"))
-        >>> first, second = estimate.prefit(chips, [None, None])
-        >>> estimate(chips[1], prefit=second).mtf_nyquist == estimate(chips[1]).mtf_nyquist
-        True
-        """
-        with one_blas_thread():
-            return prefit_chips(EdgeKind(), images, self.settings, [{**keywords, "mask": m} for m in masks])
 
 
 def measure_edge(image: ArrayLike, *, roi: tuple[int, int, int, int] | None = None, mask: np.ndarray | None = None,

@@ -50,6 +50,10 @@ class Evidence:
         "left background"...).
     geometry : TargetGeometry or None
         The target's line and its per-row locations.
+    blur_widths : list or None
+        The widths :func:`.blur_along.uniform_blur` reads in the target's
+        halves and thirds, when fitted with other chips'
+        (:func:`.blur_along.group_widths_many`); None: it fits them.
     """
 
     distance_px: np.ndarray
@@ -67,6 +71,7 @@ class Evidence:
     profile: str
     side_names: tuple[str, str]
     geometry: TargetGeometry | None = None
+    blur_widths: list | None = None     # the blur check's group widths, fitted among other chips' (blur_along)
 
     @property
     def contrast(self) -> float:

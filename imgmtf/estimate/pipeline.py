@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -215,9 +215,21 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
     >>> abs(m.estimate.spectrum.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002, m.located.rows_used
     (True, 60)
     """
-    chip = prefit.chip if prefit is not None else prepare_chip(
-        image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
-        track_azimuth_deg=track_azimuth_deg)
+    steps = run_steps(kind, image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+                      track_azimuth_deg=track_azimuth_deg, prefit=prefit)
+    next(steps)
+    return finish_steps(steps)
+
+
+def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit: Prefit | None = None,
+              **chip_options: Any) -> Generator[Evidence, list | None, Measurement]:
+    """:func:`run` as a generator that pauses before the quality gate: it
+    yields what the gate's profile checks read (:class:`.evidence.Evidence`)
+    and takes the blur check's widths (:attr:`.evidence.Evidence.blur_widths`,
+    fitted among other chips' by :func:`.blur_along.group_widths_many`; None:
+    the check fits them), then returns the measurement (:func:`finish_steps`).
+    ``chip_options``: :func:`run`'s keywords of the chip (``roi``, ``mask``...)."""
+    chip = prefit.chip if prefit is not None else prepare_chip(image, settings, **chip_options)
     try:
         located = locate_target(kind, chip, force=settings.force, prefit=prefit)
         samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
@@ -227,7 +239,9 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
         profile = widen_profile(read, samples, shape, window, settings, kind.name)
         lsf = blend_tails(kind, samples, profile, shape, window)
         spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
-        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings)
+        blur_widths = yield evidence_of(kind, chip, located, samples, shape, noise)
+        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings,
+                                 blur_widths=blur_widths)
     except ImgmtfError as exc:
         raise _points_instead(exc, kind, chip, image) from None
     estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
@@ -243,6 +257,17 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
               "dequantised": samples.dequantised, **chip.left_out_px}
     return Measurement(chip, located, shape, noise, estimate, found, tuple(checks), tuple(warnings), params,
                        settings.frequencies_cy_px)
+
+
+def finish_steps(steps: Generator[Evidence, list | None, Measurement], blur_widths: list | None = None
+                 ) -> Measurement:
+    """The measurement of :func:`run_steps` paused at its gate, given the
+    blur check's ``blur_widths`` (None: it fits them)."""
+    try:
+        steps.send(blur_widths)
+    except StopIteration as done:
+        return done.value
+    raise RuntimeError("the pipeline's steps paused twice")      # pragma: no cover - a bug, never data
 
 
 def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: ArrayLike) -> ImgmtfError:
@@ -393,7 +418,8 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
 
 
 def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-          window: Window, spectrum: Spectrum, settings: Settings) -> tuple[list[gate.Check], list[str]]:
+          window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
+          ) -> tuple[list[gate.Check], list[str]]:
     """The quality gate: every check (saturation, the sides, SNR, MTF above
     its noise, the figures, then the registered profile checks) added to
     those run so far, enforced (failures raise unless ``settings.force``),
@@ -419,6 +445,9 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
         The MTF and its figures.
     settings : Settings
         The SNR threshold and ``force``.
+    blur_widths : list, optional
+        The blur check's widths fitted among other chips'
+        (:func:`.blur_along.group_widths_many`); None: the check fits them.
 
     Returns
     -------
@@ -462,9 +491,7 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    evidence = Evidence(distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
-                        noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile,
-                        (side_names[0], side_names[1]), located.geometry)
+    evidence = evidence_of(kind, chip, located, samples, shape, noise, blur_widths)
     # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
     excess, sharpening_notes, _, _ = sharpening_check(
         gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)
@@ -479,6 +506,19 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
         warnings.append(f"the LSF window's core ({window.core_px:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
     return checks, warnings
+
+
+def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
+                blur_widths: list | None = None) -> Evidence:
+    """What the gate's profile checks read of a measured chip: its samples,
+    the shape read off them, its noise and its sides' names."""
+    offsets = samples.distance_px - shape.centre
+    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
+                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    return Evidence(samples.distance_px, samples.raw_dn, samples.rows, shape.centre, shape.scale_px, shape.plateau_px,
+                    shape.low, shape.high, noise.noise_dn, chip.quantum_dn, kind.tail_power, kind.name, kind.profile,
+                    (side_names[0], side_names[1]), located.geometry, blur_widths)
 
 
 def normal_angle(geometry: TargetGeometry) -> float:

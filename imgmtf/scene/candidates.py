@@ -105,15 +105,15 @@ def measure_batch(task) -> list[tuple[int, Record]]:
         return out + [(plan.index, _failed(exc, raster, context)) for plan, _ in read]
     estimator = _Estimator(context, raster) if read else None    # made once: its settings checked once
     passed = [band for (_, band), verdict in zip(read, verdicts) if not verdict]
-    try:    # the estimates' first stages of all at once (their Fermi fits stacked), each then finished alone
-        prefits = iter(estimator.prefit([_chip(band) for band in passed]) if estimator and passed else [])
-    except Exception:                  # (each then measured from the start, its own failure its own)
-        prefits = iter([None] * len(passed))
+    try:    # the estimates of all at once where the estimator can (the fits alike across them stacked)
+        estimates = iter(estimator.many([_chip(band) for band in passed]) if estimator and passed else [])
+    except Exception:                  # (each then estimated alone, its own failure its own)
+        estimates = iter([None] * len(passed))
     for (plan, band), verdict in zip(read, verdicts):
         if verdict:
             out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
         else:
-            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator, next(prefits))))
+            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator, next(estimates))))
     return out
 
 
@@ -174,16 +174,21 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
 
 
 def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _Estimator | None = None,
-                 prefit=None) -> Record:
+                 estimate=None) -> Record:
     """A candidate's record from the gate's verdict on the estimate of its
-    ROI (``band``, which passed the quick look); ``estimator`` the batch's
-    (:class:`_Estimator`), else one made for it, and ``prefit`` the first
-    stages of its estimate made with the batch's (:meth:`_Estimator.prefit`)."""
+    ROI (``band``, which passed the quick look): ``estimate`` made with the
+    batch's (:meth:`_Estimator.many`: a result, or the exception its
+    estimator raised), else made now by ``estimator`` (the batch's
+    :class:`_Estimator`, else one made for it)."""
     settings = context.settings
     try:
         # the quality gate refuses a chip before its intervals are computed
         # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
-        result = (estimator or _Estimator(context, raster))(*_chip(band), prefit=prefit)
+        if estimate is None:
+            estimate = (estimator or _Estimator(context, raster))(*_chip(band))
+        elif isinstance(estimate, Exception):
+            raise estimate
+        result = estimate
     except ImgmtfError as exc:
         return _rejected(context, raster, band.site, exc.reason, _one_line(exc), verdict_by="gate",
                          **_gate_figures(getattr(exc, "checks", ())))
@@ -249,16 +254,16 @@ class _Estimator:
                          "track_azimuth_deg": context.track_azimuth_deg,
                          "saturation": settings.saturation or saturation_levels(raster.dtype)}
 
-    def __call__(self, chip, mask, prefit=None):
-        """The estimator's result on the masked chip (``prefit``: its first
-        stages, from :meth:`prefit`)."""
-        return self.estimate(chip, mask=mask, **self.keywords, **({} if prefit is None else {"prefit": prefit}))
+    def __call__(self, chip, mask):
+        """The estimator's result on the masked chip."""
+        return self.estimate(chip, mask=mask, **self.keywords)
 
-    def prefit(self, chips: list[tuple[np.ndarray, np.ndarray]]) -> list:
-        """The first stages of the masked chips' estimates made together
-        where the estimator can (an edge's: its rows' Fermi fits stacked,
-        :func:`imgmtf.estimate.prefit.prefit_chips`), each None otherwise."""
-        many = getattr(self.estimate, "prefit", None)
+    def many(self, chips: list[tuple[np.ndarray, np.ndarray]]) -> list:
+        """The masked chips' estimates made together where the estimator can
+        (an edge's: :meth:`imgmtf.estimate.edge.EdgeEstimator.measure_many`),
+        each a result or the exception its call raises; None for each
+        where it cannot (each then estimated alone)."""
+        many = getattr(self.estimate, "measure_many", None)
         if many is None:
             return [None] * len(chips)
         return many([chip for chip, _ in chips], [mask for _, mask in chips], **self.keywords)
