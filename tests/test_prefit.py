@@ -51,7 +51,8 @@ def test_the_blur_checks_of_many_chips_fitted_together_are_each_their_own_to_the
 
     from imgmtf.estimate.blur_along import _group_masks, _group_widths, _splits, group_widths_many
     from imgmtf.estimate.edge import EdgeKind
-    from imgmtf.estimate.pipeline import evidence_of, run
+    from imgmtf.estimate.evidence import evidence_of
+    from imgmtf.estimate.pipeline import run
     from imgmtf.estimate.pulse import PulseKind
     from imgmtf.estimate.settings import make_settings
     settings, rng = make_settings(), np.random.default_rng(5)

@@ -92,7 +92,8 @@ def group_widths_many(evidence: list[Evidence]) -> list[list | None]:
     --------
     >>> import imgmtf
     >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.pipeline import evidence_of, run
+    >>> from imgmtf.estimate.evidence import evidence_of
+    >>> from imgmtf.estimate.pipeline import run
     >>> from imgmtf.estimate.settings import make_settings
     >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
     >>> m = run(EdgeKind(), chip.image, make_settings())

@@ -47,7 +47,7 @@ from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
 from . import gate
 from .chip import prepare_chip
-from .evidence import Evidence
+from .evidence import Evidence, evidence_of
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
 from .intervals import Estimate, FigureIntervals, intervals
 from .kind import Shape, TargetKind, refuse_other_kind
@@ -506,19 +506,6 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
         warnings.append(f"the LSF window's core ({window.core_px:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
     return checks, warnings
-
-
-def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-                blur_widths: list | None = None) -> Evidence:
-    """What the gate's profile checks read of a measured chip: its samples,
-    the shape read off them, its noise and its sides' names."""
-    offsets = samples.distance_px - shape.centre
-    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
-                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
-    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
-    return Evidence(samples.distance_px, samples.raw_dn, samples.rows, shape.centre, shape.scale_px, shape.plateau_px,
-                    shape.low, shape.high, noise.noise_dn, chip.quantum_dn, kind.tail_power, kind.name, kind.profile,
-                    (side_names[0], side_names[1]), located.geometry, blur_widths)
 
 
 def normal_angle(geometry: TargetGeometry) -> float:
