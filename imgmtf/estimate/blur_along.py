@@ -58,7 +58,7 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
             continue
         for i in range(parts):
             for j in range(i + 1, parts):
-                (wi, vi), (wj, vj) = group[i], group[j]  # type: ignore[misc]
+                (wi, vi), (wj, vj) = group[i], group[j]
                 change = abs(wi - wj) / (0.5 * (wi + wj))
                 z = abs(wi - wj) / math.sqrt(vi + vj) if vi + vj > 0 else math.inf
                 if worst is None or (z >= WARN_SIGNIFICANCE, change) > (worst[1] >= WARN_SIGNIFICANCE, worst[0]):
@@ -109,9 +109,9 @@ def group_widths_many(evidence: list[Evidence]) -> list[list | None]:
             groups = _group_masks(ev, _splits(rows))
             inputs[k] = (len(groups), _group_inputs(ev, groups))
     buckets: dict[tuple[int, bool], list[int]] = {}
-    for k, (groups, fitted) in inputs.items():
+    for k, (count, fitted) in inputs.items():
         if fitted is None:
-            out[k] = [None] * groups
+            out[k] = [None] * count
         else:       # stacked only with chips whose groups are padded alike: each fit's sums as alone
             buckets.setdefault((fitted[1].shape[1], fitted[5]), []).append(k)
     for (_, bar), members in buckets.items():
