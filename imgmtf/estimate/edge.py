@@ -234,8 +234,22 @@ class EdgeEstimator:
         """Measure the edge in each image, the work alike across them made
         together (:func:`imgmtf.estimate.many.run_many`): each the result of
         this estimator's call on it, or the exception the call raises.
-        ``keywords``: those of the calls (``gsd_m``, ``saturation``,
-        ``dtype``, ``track_azimuth_deg``).
+
+        Parameters
+        ----------
+        images : list of numpy.ndarray
+            The chips (2-D arrays, DN).
+        masks : list of numpy.ndarray or None
+            Each chip's mask (True for its pixels), or None for all.
+        **keywords
+            What every call takes alike (``gsd_m``, ``saturation``,
+            ``dtype``, ``track_azimuth_deg``; see :func:`measure_edge`).
+
+        Returns
+        -------
+        list of EdgeResult or Exception
+            One per image, in order: a refusal is the exception the call
+            raises (an :class:`imgmtf.errors.ImgmtfError` for the data's).
 
         Examples
         --------
