@@ -128,6 +128,11 @@ class ImageReadError(ImgmtfError, OSError):
     reason = "unreadable"
 
 
+#: the reasons of :class:`ImageReadError`: the file itself cannot be read (an input's
+#: error, said on stderr as each command says it), not a measurement refused
+READ_REASONS = frozenset({"unreadable", "too-large", "unsupported-type"})
+
+
 class ImageContentError(ImgmtfError):
     """An image was read but cannot be measured (NaN, flat, too small...).
 

@@ -49,6 +49,18 @@ def test_batch_keeps_going_past_a_bad_file(run, chip, tmp_path):
     assert "bad.tif" in rows[0]["error"] and "no such file" in rows[2]["error"]
 
 
+def test_a_file_that_cannot_be_read_is_an_error_line_on_stderr_as_scan_and_fit_say_it(run, chip, tmp_path):
+    bad, missing, summary = tmp_path / "bad.tif", tmp_path / "missing.tif", tmp_path / "summary.csv"
+    bad.write_text("junk")
+    result = run("measure", bad, chip, missing, "--csv", summary)
+    assert result.exit_code == 1
+    assert "error" not in result.stdout and str(chip.name) in result.stdout       # the table: the chip alone
+    errors = [line for line in result.stderr.splitlines() if line.startswith("imgmtf: error: ")]
+    assert len(errors) == 2 and f"{bad}: not an image" in errors[0] and f"{missing}: no such file" in errors[1]
+    rows = summary.read_text().splitlines()[1:]
+    assert len(rows) == 3 and sum(",error," in row for row in rows) == 2             # no row lost in the CSV
+
+
 def test_text_output_plots_and_methods(run, chip, tmp_path):
     png = tmp_path / "edge.png"
     result = run("measure", "--method", "sliding", "--plot", png, chip)
@@ -355,3 +367,29 @@ def test_help_explains_methods_and_lists_every_command_in_full(run):
     listing = run("--help").stdout
     assert "Rerun the paper's study and find each method's SNR threshold." in listing
     assert "Figs.\n" not in listing
+
+
+def test_a_fit_with_no_gsd_names_its_parameters_in_px_and_wraps_long_notes_to_120_columns(monkeypatch):
+    from types import SimpleNamespace
+
+    from imgmtf.cli.tables import print_fit
+    lines: list[str] = []
+    monkeypatch.setattr("click.echo", lambda text="", **_: lines.extend(str(text).splitlines()))
+    held = SimpleNamespace(key="electronics.cutoff_cy_m", value=0.62, standard_error=0.0, unit="cy/m",
+                           status="held", note="not determined by the data (within one standard error its blur "
+                                               "length spans 11 px); held at its starting value")
+    result = SimpleNamespace(edges=[], pixel_units=True, sensor=SimpleNamespace(stages=[]), reduced_chi_square=1.0,
+                             choice=None, parameters=[held], correlations=[], confidence=0.95, directions={},
+                             warnings=[])
+    print_fit(result)
+    row = next(i for i, line in enumerate(lines) if line.startswith("electronics."))
+    assert lines[row].split()[:4] == ["electronics.cutoff_cy_px", "0.62", "-", "cy/px"]
+    assert max(len(line) for line in lines[row:row + 2]) <= 120 and "held at its starting value" in lines[row + 1]
+
+
+def test_the_closing_count_is_of_files_measured_not_of_a_point_array_s_direction_rows(run, tmp_path):
+    chip = tmp_path / "points.tif"
+    assert run("simulate", "--target", "points", "--size", 48, "--seed", 1, "--out", chip).exit_code == 0
+    result = run("measure", "--target", "points", "--intervals", "none", "--workers", 1, chip, tmp_path / "missing.tif")
+    assert result.stdout.count("points.tif") == 2                  # two rows, across and along, of one file
+    assert "1 measured, 1 failed" in result.stderr                 # it said "2 measured, 1 failed"

@@ -44,12 +44,7 @@ REAL_SCENES_READ = {"docs/scan.md": {"baotou_l0r_checkerboard.tif": "baotou_l0r_
                         "sentinel2_b04_bagnolo.tif",
                         *(f"bagnolo_roi/mtf_al_bagnolo.{e}" for e in ("shp", "shx", "dbf", "prj")))}}
 # blocks that show commands the suite does not run, each (document, its first command) with why
-RECORDED = {
-    ("docs/campaign.md", "imgmtf simulate --campaign scenes"):
-        "six 320 px scenes scanned with fits take about a minute; bench/campaign.py runs them against the truth",
-    ("docs/campaign.md", "imgmtf report store.gpkg --out report --requirement 0.1"):
-        "a store of the two real chips bench/campaign.py makes",
-}
+RECORDED: dict[tuple[str, str], str] = {}
 DOCUMENTS = ["README.md", *(f"docs/{p.name}" for p in sorted((ROOT / "docs").glob("*.md"))
                             if p.name not in OTHERS)]
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -61,6 +56,12 @@ def fenced_blocks(text: str):
     """(language, body, line number) of every fenced block."""
     for match in FENCE.finditer(text):
         yield match[1], match[2], text.count("\n", 0, match.start()) + 1
+
+
+def fence_name(text: str, line: int) -> str | None:
+    """The file name a fence gives after its language (```toml prelaunch.toml), if any."""
+    words = text.splitlines()[line - 1].split()
+    return words[1] if len(words) > 1 else None
 
 
 def console_steps(body: str):
@@ -142,8 +143,8 @@ def test_every_example_of_the_document_runs(document, sample_folder):
             run_console(body, where)
         elif language == "python" and document != "README.md":     # README: python -m doctest, below
             run_python(body, globs, where)
-        elif language == "toml":
-            path = sample_folder / f"block{line}.toml"
+        elif language == "toml":         # a fence of ```toml NAME writes NAME, which later commands read
+            path = sample_folder / (fence_name(text, line) or f"block{line}.toml")
             path.write_text(body)
             imgmtf.Sensor.from_toml(path)
         else:
@@ -236,8 +237,16 @@ def update_console_outputs(document: str) -> None:
         os.chdir(folder)
         os.symlink(ROOT / "data", "data", target_is_directory=True)
         link_real_scenes(document, Path(folder))
+        globs: dict = {"__name__": "__docs__"}
         try:
             for language, body, line in list(fenced_blocks(text)):
+                if language == "toml" and fence_name(text, line):
+                    Path(fence_name(text, line)).write_text(body)
+                if language == "python" and document != "README.md":    # what the commands after it read
+                    try:                                                  # (camera.md's chart.png)
+                        run_python(body, globs, f"{document}:{line}")
+                    except AssertionError as exc:                         # its output is the test's to judge
+                        print(f"{document}:{line}: a Python example's output differs:\n{exc}")
                 if language != "console":
                     continue
                 lines = []

@@ -139,7 +139,8 @@ def test_a_missing_figure_is_labelled_by_its_cause():
 
 
 def test_the_header_counts_every_warning_and_drops_none_unsaid():
-    from imgmtf.plot.measurement import HEADER_WARNINGS, plot_measurement
+    from imgmtf.plot._common import HEADER_WARNINGS
+    from imgmtf.plot.measurement import plot_measurement
     from imgmtf.plot.scan import _overlap
     result = _measured(6.0)
     warnings = [f"note {k}" for k in range(HEADER_WARNINGS + 2)]
@@ -351,3 +352,68 @@ def test_the_point_and_star_headers_wrap_a_long_warning():
                 plot_points(measure_points(chip.image, intervals="none"), warnings=[long])):
         header = fig.get_suptitle()
         assert "its advice at the end" in header and max(map(len, header.splitlines())) <= 150
+
+
+def test_a_scan_overview_s_target_label_leaves_its_roi_s_outline_clear():
+    """A target's label sat where it covered no half-edge but its ROI's dashed outline."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    roi = [[40.0, 0.0], [60.0, 0.0], [60.0, 56.0], [40.0, 56.0]]
+    accepted = [{"id": 1, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": 50.0, "y1_px": 2.0,
+                 "roi_polygon_px": roi}]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "combined",
+               "direction": "across-track", "normal_angle_deg": 0.0, "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3}]
+    ax = plot_scan(np.zeros((100, 200)), 1.0, accepted, target, width_in=8.0).axes[0]
+    ax.figure.draw_without_rendering()
+    box = Text.get_window_extent(next(t for t in ax.texts if t.get_text().startswith("T1")))
+    for k in range(4):
+        for f in np.linspace(0.0, 1.0, 40):
+            (x0, y0), (x1, y1) = roi[k - 1], roi[k]
+            px, py = ax.transData.transform((x0 + f * (x1 - x0), y0 + f * (y1 - y0)))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1)
+
+
+def test_a_target_label_beside_the_image_goes_below_a_tall_legend():
+    from matplotlib.offsetbox import AnchoredText
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    ends = [(50.0, 0.0), (0.0, 50.0), (50.0, 99.0), (99.0, 50.0)]     # a checkerboard's crop: no free spot
+    accepted = [{"id": k, "status": "accepted", "x0_px": 50.0, "y0_px": 50.0, "x1_px": a, "y1_px": b}
+                for k, (a, b) in enumerate(ends, 1)]
+    rejected = [{"id": 5 + k, "status": "rejected", "reason": f"reason-{k}", "x0_px": 5.0 + 8 * k, "y0_px": 90.0,
+                 "x1_px": 8.0 + 8 * k, "y1_px": 98.0} for k in range(6)]
+    target = [{"scope": "target", "target_id": 1, "x_px": 50.0, "y_px": 50.0, "summary": "sections",
+               "direction": d, "assumption": "bracket", "chosen_assumption": "bracket", "recommended": True,
+               "mtf_nyquist": 0.2, "mtf50_cy_px": 0.3} for d in ("across-track", "along-track")]
+    ax = plot_scan(np.zeros((100, 100)), 1.0, accepted + rejected, target, width_in=6.0).axes[0]
+    ax.figure.draw_without_rendering()
+    [aside] = [a for a in ax.artists if isinstance(a, AnchoredText)]
+    assert _overlap(aside.get_window_extent(), ax.get_legend().get_window_extent()) == 0
+    assert aside.get_window_extent().y0 >= 0
+
+
+def test_the_measurement_figure_s_profile_and_lsf_legends_sit_under_their_axes_off_the_data():
+    """A double bar's profile fills its panel: 'best' put the legend over the pixels."""
+    from imgmtf.plot import plot_measurement
+    from imgmtf.plot.scan import _overlap
+    chip = im.render(im.Sensor(), im.Target("edge", 6.0), 40, noise_std_dn=2.0, seed=1)
+    fig = plot_measurement(im.measure_edge(chip.image))
+    fig.draw_without_rendering()
+    for ax in fig.axes[1:3]:            # the profile, the LSF
+        assert _overlap(ax.get_legend().get_window_extent(), ax.get_window_extent()) == 0
+
+
+def test_the_ids_of_short_collinear_candidates_stack_apart_instead_of_over_each_other():
+    """A road's short pieces, each rejected: their ids sat on one another."""
+    from matplotlib.text import Text
+
+    from imgmtf.plot import plot_scan
+    from imgmtf.plot.scan import _overlap
+    pieces = [{"id": 100 + k, "status": "rejected", "reason": "angle", "x0_px": 200.0 + 4 * k, "y0_px": 300.0,
+               "x1_px": 203.0 + 4 * k, "y1_px": 300.0} for k in range(4)]
+    ax = plot_scan(np.zeros((600, 600)), 1.0, pieces).axes[0]
+    ax.figure.draw_without_rendering()
+    boxes = [Text.get_window_extent(t) for t in ax.texts if t.get_text().isdigit()]
+    assert len(boxes) == 4 and all(_overlap(a, b) == 0 for i, a in enumerate(boxes) for b in boxes[i + 1:])

@@ -331,3 +331,11 @@ def test_a_strip_one_pixel_high_is_refused_before_any_tile_is_read(tmp_path):
     assert info.value.reason == "image" and "50000 x 1 px" in str(info.value)
     result = CliRunner().invoke(main, ["scan", str(path)])
     assert result.exit_code == 1 and "at least 16 x 16" in result.output and "Traceback" not in result.output
+
+
+def test_a_scene_whose_one_candidate_is_rejected_says_so_in_the_singular(tmp_path):
+    chip = tmp_path / "one.tif"
+    assert CliRunner().invoke(main, ["simulate", "--size", "60", "--out", str(chip)]).exit_code == 0
+    result = CliRunner().invoke(main, ["scan", str(chip), "--min-length", "100"])
+    assert result.exit_code == 1
+    assert f"{chip}: no usable edge found (1 candidate, rejected)" in result.stderr     # not "1 candidates, all"

@@ -48,6 +48,10 @@ def test_arrays_on_a_textured_field_are_found_and_measured_within_their_interval
     assert {(r.site["target_id"], r.site["polarity"], r.status) for r in records} == {
         (1, "bright", "accepted"), (2, "dark", "accepted")}
     assert all(r.site["points_found"] == 16 and r.figures["points_used"] == 16 for r in records)
+    for r in records:       # each target in the scene's pixels, the used ones about the peaks the scan grouped
+        xy = np.array([(t["x_px"], t["y_px"]) for t in r.site["point_targets"] if t["status"] == "used"])
+        assert len(xy) == 16 and len(r.site["point_targets"]) == 16 + r.figures["points_refused"]
+        assert np.allclose(xy.mean(axis=0), (r.site["x_px"], r.site["y_px"]), atol=0.5)
     covered = 0
     for r in records:
         truth = TRUTH[r.figures["direction"]]

@@ -68,7 +68,9 @@ class Figures:
         with Image.open(path) as full:
             width, height = (round(n * EMBED_DPI / FILE_DPI) for n in full.size)
             buffer = io.BytesIO()
-            full.resize((width, height), Image.Resampling.LANCZOS).save(buffer, format="png", optimize=True)
+            # opaque RGB (the figure's background is white) and zlib's default level: PIL's
+            # optimize=True took a fifth of a report's time for 0.4 % fewer bytes
+            full.convert("RGB").resize((width, height), Image.Resampling.LANCZOS).save(buffer, format="png")
         return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii"), \
             path.relative_to(self.out_dir).as_posix()
 

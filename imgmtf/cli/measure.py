@@ -150,6 +150,9 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
         stdout = (JsonLinesWriter(sys.stdout) if fmt == "json"
                   else TextRows(kind, files, bands=band is not None))
         order, counts, interrupted = InputOrder(), {"ok": 0, "error": 0}, None
+        # a measurement is a file's band (or vector feature): a star's or a point array's
+        # directions are rows of one, and the closing count is of measurements, not rows
+        measured: dict[tuple, bool] = {}
         figures: dict[str, list] = {}       # each file's figures written, in the order they come
         with ExitStack() as outputs:
             writers = [stdout]
@@ -165,6 +168,8 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
                             for writer in writers:
                                 writer.write(record)
                             counts["ok" if record.ok else "error"] += 1
+                            key = (record.path, record.band, record.site.get("feature_id"))
+                            measured[key] = measured.get(key, True) and record.ok
                         plots = figures.setdefault(record.path, [])
                         if record.plot and record.plot not in plots:
                             plots.append(record.plot)
@@ -190,8 +195,9 @@ def measure(paths, kind, pulse_width, point_size, gap, method, roi, roi_file, op
         click.echo(f"imgmtf: interrupted ({signal_name(interrupted)}): {total} result(s) of "
                    f"{len(files)} file(s) reported{kept}", err=True)
         sys.exit(interrupt_code(interrupted))
-    if total > 1 and fmt == "text":
-        click.echo(f"{counts['ok']} measured, {counts['error']} failed"
+    if len(measured) > 1 and fmt == "text":
+        ok = sum(measured.values())
+        click.echo(f"{ok} measured, {len(measured) - ok} failed"
                    + (f"; summary in {csv_path}" if csv_path else ""), err=True)
     sys.exit(1 if counts["error"] else 0)
 

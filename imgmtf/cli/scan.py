@@ -271,8 +271,9 @@ def _report(outcome, kind, band, folder, fmt, verbose) -> None:
     else:
         print_scan(outcome.path, info, kind, outcome.records, outcome.summaries, written, fmt, verbose)
     if not any(r.ok for r in outcome.records) and not outcome.interrupted:
+        n = len(outcome.records)
         click.echo(f"imgmtf: error: {outcome.path}: no usable {kind} found "
-                   f"({len(outcome.records)} candidates, all rejected)", err=True)
+                   f"({n} candidate{'s, all' if n != 1 else ','} rejected)", err=True)
 
 
 def _closing_notes(outcomes, paths, store, kind, fmt) -> None:

@@ -2,11 +2,16 @@
 the fit report (figures in px units, '-' where undefined)."""
 from __future__ import annotations
 
+import textwrap
+
 import click
 
+from ..errors import READ_REASONS
 from ..kinds import get_kind
 from .hints import hinted_warning, refusal_hint, rejection_hint
 
+#: the columns a text table's rows fit in
+TABLE_WIDTH = 120
 #: the widest a table's path column grows (characters), so that its rows fit 120 columns
 MAX_PATH_COLUMN = 36
 
@@ -67,9 +72,15 @@ class TextRows:
         click.echo(f"{first} {'normal':>7} {'tilt':>5} {'dir':>7} {'SNR':>5} {'MTF@Nyq':>7} "
                    f"{f'{100 * confidence:g}% interval':>17} {'MTF50':>7} {'FWHM':>6} {last.heading:>6}")
         click.echo(f"{blank} {'deg':>7} {'deg':>5} {'':>7} {'':>5} {'':>7} {'':>17} "
-                   f"{'cy/px':>7} {'px':>6} {last.unit:>6}")
+                   f"{'cy/px':>7} {'px':>6} {last.unit:>6}".rstrip())
 
     def write(self, record) -> None:
+        """A record's rows; a file that cannot be read, one error line on
+        stderr instead (as ``scan`` and ``fit`` say it; its CSV and JSON row stay)."""
+        if record.status == "error" and record.reason in READ_REASONS:
+            click.echo(f"imgmtf: error: {record.error}{refusal_hint(record.reason, record.error or '', record.path)}",
+                       err=True)
+            return
         click.echo(text_row(record.to_dict(), self.kind, self.path_width, self.bands,
                             self.labels.get(record.path)))
 
@@ -161,6 +172,18 @@ def num_cell(value, width: int, decimals: int) -> str:
     return f"{text.removeprefix('-') if float(text) == 0 else text:>{width}}"
 
 
+def _parameter_name(key: str, pixel_units: bool) -> str:
+    """A fitted parameter's name as the table shows it: with no GSD its
+    value is in px, and the name says so (``optics.sigma_x_px``, not ``_m``).
+
+    Examples
+    --------
+    >>> _parameter_name("electronics.cutoff_cy_m", True), _parameter_name("optics.sigma_x_m", False)
+    ('electronics.cutoff_cy_px', 'optics.sigma_x_m')
+    """
+    return key[:-2] + "_px" if pixel_units and key.endswith("_m") else key
+
+
 def print_fit(result) -> None:
     edges = result.edges
     scale = "no GSD: lengths in px" if result.pixel_units else f"GSD {result.sensor.gsd_m:g} m"
@@ -174,8 +197,13 @@ def print_fit(result) -> None:
     click.echo(f"{'parameter':<28} {'value':>11} {'std err':>10} {'unit':<5} status")
     for p in result.parameters:
         se = f"{p.standard_error:10.4g}" if p.status == "fitted" else f"{'-':>10}"
-        click.echo(f"{p.key:<28} {p.value:11.5g} {se} {p.unit:<5} {p.status}{': ' + p.note if p.note else ''}")
+        unit = "cy/px" if result.pixel_units and p.unit == "cy/m" else p.unit
+        head = f"{_parameter_name(p.key, result.pixel_units):<28} {p.value:11.5g} {se} {unit:<5} "
+        status = textwrap.wrap(f"{p.status}{': ' + p.note if p.note else ''}", TABLE_WIDTH - len(head),
+                               subsequent_indent="  ")         # a long note under its status: 120 columns
+        click.echo("\n".join([head + status[0], *(" " * len(head) + line for line in status[1:])]))
     for a, b, r in result.correlations:
+        a, b = (_parameter_name(k, result.pixel_units) for k in (a, b))
         click.echo(f"correlated: {a} and {b} (r = {r:+.3f}): the data constrain a combination of them "
                    "better than each")
     pct = f"{100 * result.confidence:g}%"

@@ -34,11 +34,12 @@ from ..inputs import check_number, check_width
 from ..kinds.double_bar import DOUBLE_BAR
 from ..metrics import fwhm
 from . import gate
+from .bar_results import BarProfileResult
 from .bar_width import half_width_at
 from .kind import Shape
 from .pipeline import run
 from .pulse import BACKGROUND_FRACTION, MIN_HEIGHT_NOISE, WINDOW_FACTOR, PulseKind
-from .results import MTFResult, finite
+from .results import finite
 from .settings import make_settings
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 from .tails import outer_samples
@@ -79,17 +80,18 @@ def check_gap(gap_px: float) -> float:
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
-class DoubleBarResult(MTFResult):
-    """MTF from a double bar (see :class:`imgmtf.estimate.results.MTFResult`
-    for the fields every measurement has).  Where the pair's transfer is
+class DoubleBarResult(BarProfileResult):
+    """MTF from a double bar (see :class:`imgmtf.estimate.bar_results.BarProfileResult`
+    for each bar's width and the pair's pulse response,
+    :class:`imgmtf.estimate.results.MTFResult` for the fields every measurement has).  Where the pair's transfer is
     near zero at Nyquist (``model_fitted``), ``mtf_nyquist`` and its
     interval are the fitted sensor model's (Storey's method); elsewhere the
     profile's transform divided by the pair's transfer.
 
     Attributes
     ----------
-    pulse_width_px, gap_px : float
-        Each bar's width and the gap between them (edge to edge), px.
+    gap_px : float
+        The gap between the bars (edge to edge), px.
     pair_transfer_nyquist : float
         The pair's transfer at Nyquist (:func:`pair_transfer`).
     model_fitted : bool
@@ -105,13 +107,6 @@ class DoubleBarResult(MTFResult):
         (``mtf`` stays the profile's own, divided by the pair's transfer).
     model_figures : tuple of str
         The figures read off the model ("mtf_nyquist", "mtf50_cy_px").
-    prf_x_px, prf : numpy.ndarray
-        The pair's pulse response (peak 1 above its background) and its
-        positions along the normal, px.
-    prf_fwhm_px : float
-        The pulse response's FWHM, px.
-    background_dn, peak_dn : float
-        The background's level and the profile's peak, DN.
 
     Examples
     --------
@@ -124,7 +119,6 @@ class DoubleBarResult(MTFResult):
     """
 
     target: ClassVar[str] = DOUBLE_BAR.name
-    pulse_width_px: float
     gap_px: float
     pair_transfer_nyquist: float
     model_fitted: bool
@@ -132,33 +126,12 @@ class DoubleBarResult(MTFResult):
     model: Any = None
     model_mtf: Any = None
     model_figures: tuple[str, ...] = ()
-    prf_x_px: np.ndarray
-    prf: np.ndarray
-    prf_fwhm_px: float
-    background_dn: float
-    peak_dn: float
-
-    @property
-    def width_px(self) -> float:
-        """Each bar's width, px (``pulse_width_px``)."""
-        return self.pulse_width_px
-
-    def normalised_profile(self) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
-        """The pulse response (0 to a unit peak), its positions along the
-        normal (px), and the background and peak levels (DN)."""
-        return self.prf_x_px, self.prf, (self.background_dn, self.peak_dn)
-
-    def lsf_like(self) -> tuple[np.ndarray, np.ndarray, float]:
-        """The pulse response (peak 1), its positions along the normal (px)
-        and its FWHM (px)."""
-        return self.prf_x_px, self.prf, self.prf_fwhm_px
 
     def _specific(self) -> dict:
         return {"pulse_width_px": finite(self.pulse_width_px), "gap_px": finite(self.gap_px),
                 "pair_transfer_nyquist": finite(self.pair_transfer_nyquist), "model_fitted": self.model_fitted,
                 "measured_mtf_nyquist": finite(self.measured_mtf_nyquist),
-                "prf_fwhm_px": finite(self.prf_fwhm_px), "background_dn": finite(self.background_dn),
-                "peak_dn": finite(self.peak_dn), "model_figures": list(self.model_figures)}
+                **self._profile_figures(), "model_figures": list(self.model_figures)}
 
     def to_dict(self, curves: bool = True) -> dict:
         """JSON-ready summary, as :meth:`MTFResult.to_dict`; with ``curves``

@@ -26,12 +26,13 @@ from ..kinds.pulse import PULSE
 from ..metrics import fwhm
 from . import gate
 from .bar_pair import PAIR_REASON, bar_pair
+from .bar_results import BarProfileResult
 from .bar_width import estimate_width, half_width_at, width_reading
 from .detection import bar_contrast, describe, find_lines, meet_inside, parallel_within
 from .geometry import fit_line, row_windows
 from .kind import Shape, TargetKind
 from .pipeline import run
-from .results import MTFResult, finite
+from .results import finite
 from .settings import make_settings
 from .spectrum import MIN_TRANSFER, NYQUIST, with_transfer
 from .tails import outer_samples
@@ -49,26 +50,18 @@ BACKGROUND_FRACTION = 2.0 / 3.0  # a bar's background is read from the samples b
 
 
 @dataclass(frozen=True, eq=False, kw_only=True, repr=False)
-class PulseResult(MTFResult):
-    """MTF from one bar (see :class:`imgmtf.estimate.results.MTFResult` for
-    the fields every measurement has; ``fwhm_px`` is the recovered LSF's).
+class PulseResult(BarProfileResult):
+    """MTF from one bar (see :class:`imgmtf.estimate.bar_results.BarProfileResult`
+    for the bar's width and its pulse response, :class:`imgmtf.estimate.results.MTFResult`
+    for the fields every measurement has; ``fwhm_px`` is the recovered LSF's).
 
     Attributes
     ----------
-    pulse_width_px : float
-        The bar's width used, px.
     width_estimated : bool
         True when the width came from the profile rather than the caller.
     usable_band_cy_px : float
         The frequency below which the bar's sinc stays above 0.1, so that
         dividing by it is meaningful, cy/px.
-    prf_x_px, prf : numpy.ndarray
-        The pulse response, normalised to a unit peak above the background
-        (positive for dark bars too), and its positions along the normal, px.
-    prf_fwhm_px : float
-        The pulse response's FWHM, px.
-    background_dn, peak_dn : float
-        The background's level and the bar's peak, DN.
 
     Examples
     --------
@@ -80,35 +73,12 @@ class PulseResult(MTFResult):
     """
 
     target: ClassVar[str] = PULSE.name
-    pulse_width_px: float
     width_estimated: bool
     usable_band_cy_px: float
-    prf_x_px: np.ndarray
-    prf: np.ndarray
-    prf_fwhm_px: float
-    background_dn: float
-    peak_dn: float
-
-    @property
-    def width_px(self) -> float:
-        """The bar's width used, px (``pulse_width_px``)."""
-        return self.pulse_width_px
-
-    def normalised_profile(self) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
-        """The pulse response (0 to a unit peak), its positions along the
-        normal (px), and the background and peak levels (DN)."""
-        return self.prf_x_px, self.prf, (self.background_dn, self.peak_dn)
-
-    def lsf_like(self) -> tuple[np.ndarray, np.ndarray, float]:
-        """The pulse response (peak 1), its positions along the normal (px)
-        and its FWHM (px)."""
-        return self.prf_x_px, self.prf, self.prf_fwhm_px
 
     def _specific(self) -> dict:
         return {"pulse_width_px": finite(self.pulse_width_px), "width_estimated": self.width_estimated,
-                "usable_band_cy_px": finite(self.usable_band_cy_px),
-                "prf_fwhm_px": finite(self.prf_fwhm_px), "background_dn": finite(self.background_dn),
-                "peak_dn": finite(self.peak_dn)}
+                "usable_band_cy_px": finite(self.usable_band_cy_px), **self._profile_figures()}
 
 
 class PulseKind(TargetKind):

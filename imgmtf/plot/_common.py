@@ -1,7 +1,9 @@
 """What every figure module shares: the checks of what it is given, new axes
-when none are, a title that defers to the caller's."""
+when none are, a title that defers to the caller's, a header's warnings."""
 from __future__ import annotations
 
+import textwrap
+from collections.abc import Sequence
 from typing import overload
 
 from matplotlib.axes import Axes
@@ -50,3 +52,42 @@ def title_once(ax: Axes, text: str) -> None:
     """Title the axes unless the caller already has."""
     if not ax.get_title():
         ax.set_title(text)
+
+
+#: warnings a figure's header prints in full; the rest it counts
+HEADER_WARNINGS = 3
+#: a header line's most characters: a long warning wraps (its end is often what to do about it)
+HEADER_WIDTH = 150
+
+
+def warning_lines(warnings: Sequence[str], shown: int = HEADER_WARNINGS) -> list[str]:
+    """A figure header's warnings: the first ``shown`` numbered, each
+    wrapped at :data:`HEADER_WIDTH` characters (at most four lines, not
+    cut short), and a count of the others, so that none is dropped unsaid.
+
+    Parameters
+    ----------
+    warnings : sequence of str
+        The record's warnings.
+    shown : int, optional
+        How many to print in full (default :data:`HEADER_WARNINGS`).
+
+    Returns
+    -------
+    list of str
+        The header's lines (none when there is no warning).
+
+    Examples
+    --------
+    >>> warning_lines(["low SNR", "few rows", "tilted", "clipped"], shown=2)      # doctest: +NORMALIZE_WHITESPACE
+    ['warning 1 of 4: low SNR', 'warning 2 of 4: few rows',
+     'and 2 more warning(s), listed in full by the text table and the record (JSON, CSV)']
+    """
+    lines = []
+    for i, warning in enumerate(warnings[:shown]):
+        lines += textwrap.wrap(f"warning {i + 1} of {len(warnings)}: {warning}", HEADER_WIDTH, max_lines=4,
+                               placeholder=" [...]")
+    if len(warnings) > shown:
+        lines.append(f"and {len(warnings) - shown} more warning(s), listed in full by the text table and the "
+                     "record (JSON, CSV)")
+    return lines

@@ -1,7 +1,6 @@
 """Figures of one measurement (edge or bar): locations, profile, LSF, MTF."""
 from __future__ import annotations
 
-import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -12,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from ..estimate.spectrum import NYQUIST
 from ..kinds import get_kind
-from ._common import check_truth, expect, figure_axes, title_once
+from ._common import check_truth, expect, figure_axes, title_once, warning_lines
 
 if TYPE_CHECKING:
     from ..estimate.results import MTFResult
@@ -126,7 +125,8 @@ def plot_profile(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigur
     view = _view_px(result)
     ax.set(xlim=(-view, view), xlabel="distance from the line along the normal (px)", ylabel="normalised DN")
     title_once(ax, f"{name} (SNR {result.snr:.0f})")
-    ax.legend(fontsize="small", loc="best")
+    # a double bar's or a wide pulse's profile fills the axes: the legend goes under them, off the data
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -178,7 +178,8 @@ def plot_lsf(result: MTFResult, ax: Axes | None = None) -> Figure | SubFigure:
     view = max(4.0, 2.5 * result.fwhm_px)
     ax.set(xlim=(centre - view, centre + view), xlabel="distance along the normal (px)", ylabel="LSF (1/px)")
     title_once(ax, "Line spread function")
-    ax.legend(fontsize="small", loc="upper right")           # over a tail, clear of the peak
+    # under the axes: a ringing or two-lobed LSF reaches every corner
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 
@@ -319,9 +320,6 @@ def missing_cause(result, figure: str) -> str:
     return "undefined"
 
 
-#: warnings the header prints in full; the rest it counts
-HEADER_WARNINGS = 3
-
 
 def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray] | None = None,
                      title: str | None = None, warnings: Iterable[str] | None = None) -> Figure:
@@ -383,13 +381,7 @@ def plot_measurement(result: MTFResult, truth: Callable[[np.ndarray], np.ndarray
                f"FWHM {result.fwhm_px:.3f} px, SNR {result.snr:.0f}, {result.direction}, "
                f"{result.rows_used} rows, method {result.method}")
     warnings = list(result.warnings if warnings is None else warnings)
-    for i, warning in enumerate(warnings[:HEADER_WARNINGS]):
-        # wrapped, not cut: a warning's end is often what to do about it
-        summary += "\n" + "\n".join(textwrap.wrap(f"warning {i + 1} of {len(warnings)}: {warning}", 150,
-                                                  max_lines=4, placeholder=" [...]"))
-    if len(warnings) > HEADER_WARNINGS:
-        summary += (f"\nand {len(warnings) - HEADER_WARNINGS} more warning(s), listed in full by the text table "
-                    "and the record (JSON, CSV)")
+    summary = "\n".join([summary, *warning_lines(warnings)])
     verdict, colour = measurement_verdict(result)
     head = "\n".join(line for line in (title, verdict) if line)
     fig.suptitle(f"{head}\n{summary}" if head else summary, fontsize="medium", color=colour)

@@ -15,6 +15,8 @@ from .scan import ACCEPTED, PALETTE
 if TYPE_CHECKING:
     from ..records import Record
 
+#: a refused target's mark (a cross: its shape, not its colour, tells it from the ROIs)
+REFUSED_POINT = "#ff3b3b"
 _SHORT = {"across-track": "across", "along-track": "along", "image-x": "x", "image-y": "y"}
 
 
@@ -24,7 +26,9 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
                     width_in: float = 10.0) -> Figure | SubFigure:
     """The overview of a point-array scan: the scene, each array's ROI (green
     when accepted, coloured by reason when rejected) labelled ``A<n>`` with,
-    per direction, the MTF at Nyquist and its interval.
+    per direction, the MTF at Nyquist and its interval; each target of the
+    windows circled where it passed the measurement's checks (kept), crossed
+    where it was refused (``point_targets``).
 
     Parameters
     ----------
@@ -35,7 +39,9 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
     records : iterable of Record or mapping
         The arrays' records (:func:`imgmtf.scene.points.scan_points`, or
         their ``to_dict()``): ``target_id``, ``roi``, ``status``, and for
-        accepted ones ``direction``, ``mtf_nyquist``, ``mtf_nyquist_ci``.
+        accepted ones ``direction``, ``mtf_nyquist``, ``mtf_nyquist_ci``;
+        ``point_targets`` (:func:`imgmtf.scene.points.point_targets`) where
+        known.
     summaries : iterable of Record or mapping, optional
         The scene's rows per direction (their MTF at Nyquist goes in the
         title, ``*`` on the one to quote).
@@ -110,10 +116,32 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
                 "\n".join(lines), fontsize=6, color="black", ha="left", va="bottom" if above else "top", zorder=6,
                 clip_on=True, bbox={"boxstyle": "round,pad=0.2", "fc": (0.85, 1.0, 0.85, 0.9) if ok else "white",
                                     "ec": colour, "lw": 0.6})
+    targets = [t for members in arrays.values() for t in members[0].get("point_targets") or []]
+    used = [(t["x_px"], t["y_px"]) for t in targets if t.get("status") == "used"]
+    refused = [(t["x_px"], t["y_px"]) for t in targets if t.get("status") != "used"]
+    # a ring about 6 scene px across around each target (its blur shows inside), kept readable when
+    # the overview shrinks a large scene: between 5 and 14 points
+    points_per_px = ax.get_window_extent().width * 72.0 / fig.dpi / max(extent_w, 1.0)
+    size = float(np.clip(6.0 * points_per_px, 5.0, 14.0))
+    if used:
+        ax.plot(*zip(*used), "o", ms=size, mfc="none", mec=ACCEPTED, mew=0.9, zorder=5)
+    if refused:
+        ax.plot(*zip(*refused), "x", ms=size * 0.7, color=REFUSED_POINT, mew=1.0, zorder=5)
     handles = [Line2D([], [], color=ACCEPTED, lw=2, label=f"accepted ({accepted})")]
     handles += [Line2D([], [], color=colours[reason], lw=2,
                        label=f"{reason} ({sum(1 for m in arrays.values() if m[0].get('reason') == reason)})")
                 for reason in reasons]
+    if targets:     # the targets of each window: which the measurement used, which it refused
+        counts: dict[str, int] = {}
+        for t in targets:
+            if t.get("status") != "used":
+                counts[t["status"]] = counts.get(t["status"], 0) + 1
+        handles.append(Line2D([], [], ls="none", marker="o", mfc="none", mec=ACCEPTED, ms=6,
+                              label=f"target kept ({len(used)})"))
+        if refused:
+            why = ", ".join(f"{n} {reason}" for reason, n in sorted(counts.items()))
+            handles.append(Line2D([], [], ls="none", marker="x", color=REFUSED_POINT, ms=6,
+                                  label=f"target refused ({len(refused)})\n{why}"))
     quoted = ", ".join(f"{'*' if s.get('recommended') else ''}{_short(s)} "
                        f"{_interval(s)}" for s in scene_rows if s.get("mtf_nyquist") is not None)
     ax.set_title(f"{accepted} point array{'s' * (accepted != 1)} accepted, {len(arrays) - accepted} rejected; "

@@ -3,7 +3,6 @@ the targets found on the chip, the stacked 2-D PSF, the 2-D MTF and the
 MTF across and along track with their intervals and the truth when known."""
 from __future__ import annotations
 
-import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -11,7 +10,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
-from ._common import figure_axes, title_once
+from ._common import figure_axes, title_once, warning_lines
 
 if TYPE_CHECKING:
     from ..estimate.mtf2d.points import PointsResult
@@ -293,8 +292,6 @@ def plot_points(result: PointsResult, image: np.ndarray | None = None,
     figures = ", ".join(f"{d.direction} MTF@Nyq {d.mtf_nyquist:.3f}, MTF50 {d.mtf50_cy_px:.3f} cy/px, "
                         f"FWHM {d.fwhm_px:.2f} px" for d in result.directions)
     lines.append(figures)
-    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
-    if len(warnings) > 2:
-        lines.append(f"... and {len(warnings) - 2} more warning(s)")
+    lines += warning_lines(warnings)
     fig.suptitle("\n".join(lines), fontsize=9)
     return fig

@@ -163,7 +163,14 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
             full = "\n".join([f"T{target_id}"] + [_row(s) for s in rows])
             short = "\n".join([f"T{target_id}"] + [_row(s, short=True) for s in quoted])
             target_labels.append(((rows[0]["x_px"], rows[0]["y_px"]), full, short))
-    compact = _place_target_labels(ax, target_labels, [_ends(r) for r in accepted])
+    if handles:         # before the labels: a label set beside the image goes below it
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
+                  title="candidates (ids)", title_fontsize=8, alignment="left", frameon=False)
+    # the ROIs' outlines and the labelled rejections are data a label should not hide either
+    outlines = [(tuple(polygon[k - 1]), tuple(polygon[k])) for r in accepted if r.get("roi_polygon_px")
+                for polygon in [r["roi_polygon_px"]] for k in range(len(polygon))]
+    labelled = [_ends(r) for group in by_reason.values() if len(group) <= MAX_LISTED for r in group]
+    compact = _place_target_labels(ax, target_labels, [_ends(r) for r in accepted], outlines, labelled)
     n_targets = len({s["target_id"] for s in targets})
     ids = "ids as in the table and the CSV" + (f", {unlabelled} in reasons too common to label" if unlabelled
                                                  else "")
@@ -173,9 +180,6 @@ def plot_scan(overview: np.ndarray, scale: float, records: Iterable[Record | Map
         title += ("\ntarget labels: MTF at Nyquist | MTF50 cy/px, the rows to quote only (all rows in the table)"
                   if compact else "\ntarget labels: MTF at Nyquist | MTF50 cy/px per direction, * the row to quote")
     ax.set_title(title, fontsize=8.5, loc="left")
-    if handles:
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8,
-                  title="candidates (ids)", title_fontsize=8, alignment="left", frameon=False)
     return fig
 
 
@@ -187,6 +191,10 @@ LABEL_OFFSETS_PT = (6.0, 20.0, 40.0, 64.0, 100.0, 150.0)
 EDGE_POINT_COST = 400.0
 
 
+#: the same for a point of an accepted half-edge's ROI outline or of a labelled rejected
+#: candidate: data too, but a label over them hides less than over an edge (and a label
+#: sent far to avoid them draws a leader across the scene)
+OTHER_POINT_COST = 100.0
 #: what each ring farther from its target costs a label's spot, per its box's area
 RING_COST = 0.3
 _HA = {1: "left", -1: "right", 0: "center"}
@@ -199,9 +207,13 @@ LABEL_STYLES = ((False, 8.0), (False, 6.5), (True, 7.0), (True, 6.0), (True, 5.0
 
 
 def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
-                         segments: Sequence[Sequence[tuple[float, float]]] = ()) -> bool:
+                         segments: Sequence[Sequence[tuple[float, float]]] = (),
+                         outlines: Sequence[Sequence[tuple[float, float]]] = (),
+                         others: Sequence[Sequence[tuple[float, float]]] = ()) -> bool:
     """Each target's label beside its centre where it covers no accepted
-    half-edge (``segments``, whose junction is the target's centre), no
+    half-edge (``segments``, whose junction is the target's centre) nor
+    their ROIs' ``outlines``, as little of ``others`` (the labelled
+    rejections) as it can, no
     label placed before it (nor an id) and stays inside the image: the
     nearest free spot of the four quadrants at :data:`LABEL_OFFSETS_PT`,
     or the least covered one; a label moved off its first ring gets a
@@ -209,7 +221,8 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
     of :data:`LABEL_STYLES` are tried in turn (smaller text, then the
     compact texts) until every label is free of the others and inside the
     image.  Up to :data:`MAX_ASIDE` labels that cannot avoid the
-    half-edges (a checkerboard's crop, all target) go in full to the
+    half-edges or their ROIs' outlines (a checkerboard's crop, all
+    target) go in full to the
     column right of the image, each target tagged by its id.  Returns
     whether the compact texts were drawn."""
     if not labels:
@@ -218,6 +231,8 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
     ids = [t.get_window_extent() for t in ax.texts]           # the ids drawn already
     pad = 3.0 * ax.figure.dpi / 72.0                             # the label's box around its text
     edge_points = _sampled(ax, segments, step_pt=4.0)
+    outline_points = _sampled(ax, outlines, step_pt=4.0)
+    other_points = _sampled(ax, others, step_pt=4.0)
     for compact, fontsize in LABEL_STYLES:
         style = _label_style(fontsize)
         spots = []
@@ -236,11 +251,10 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
                     probe.set_verticalalignment(_VA[sy])
                     box = probe.get_window_extent().padded(pad)
                     hard = box.width * box.height - _overlap(box, frame) + sum(_overlap(box, t) for t in taken)
-                    covered = np.count_nonzero(
-                        (edge_points[:, 0] > box.x0) & (edge_points[:, 0] < box.x1)
-                        & (edge_points[:, 1] > box.y0) & (edge_points[:, 1] < box.y1)) if edge_points.size else 0
-                    covers = covered > 0
-                    soft = sum(_overlap(box, t) for t in ids) + EDGE_POINT_COST * covered
+                    covered, outlined = _inside(edge_points, box), _inside(outline_points, box)
+                    covers = covered + outlined > 0
+                    soft = (sum(_overlap(box, t) for t in ids) + EDGE_POINT_COST * covered
+                            + OTHER_POINT_COST * (outlined + _inside(other_points, box)))
                     soft += RING_COST * ring * box.width * box.height     # near its target first
                     if (hard, soft) < best[:2]:
                         best = (hard, soft, ring, probe.xyann, box, covers)
@@ -256,15 +270,27 @@ def _place_target_labels(ax, labels: list[tuple[tuple[float, float], str, str]],
         # a scene that is its few targets (a checkerboard's crop) has no free spot: the labels go
         # to the column right of the image, below the legend, each target tagged by its id only
         from matplotlib.offsetbox import AnchoredText
+        from matplotlib.transforms import Bbox
         aside = AnchoredText("\n\n".join(full for _, full, _ in labels), loc="lower left",     # in full: room there
                              bbox_to_anchor=(1.01, 0.0), bbox_transform=ax.transAxes, borderpad=0.0,
                              prop={"fontsize": 7.5})
         aside.patch.set(boxstyle="round,pad=0.3", facecolor=(0.9, 1.0, 0.9), edgecolor="#00a000", lw=0.8)
         ax.add_artist(aside)
-        for xy, text, *_ in spots:
-            tag = text.split("\n")[0]
-            ax.annotate(tag, xy, xytext=(4.0, 4.0), ha="left", va="bottom", **{**_label_style(7.0), "zorder": 8})
-        return False
+        legend = ax.get_legend()
+        fits = True
+        if legend is not None and _overlap(aside.get_window_extent(), legend.get_window_extent()) > 0:
+            # a tall legend: the box goes right under it, as long as the figure holds it
+            below = float(ax.transAxes.inverted().transform(legend.get_window_extent().p0)[1]) - 0.03
+            aside.set_bbox_to_anchor(Bbox.from_bounds(1.01, below, 0.0, 0.0), transform=ax.transAxes)
+            aside.loc = 2           # upper left
+            fits = aside.get_window_extent().y0 >= 0
+            if not fits:
+                aside.remove()
+        if fits:
+            for xy, text, *_ in spots:
+                tag = text.split("\n")[0]
+                ax.annotate(tag, xy, xytext=(4.0, 4.0), ha="left", va="bottom", **{**_label_style(7.0), "zorder": 8})
+            return False
     for xy, text, ring, (dx, dy), _ in spots:
         leader = {"arrowprops": {"arrowstyle": "-", "color": "#00a000", "lw": 0.6, "alpha": 0.8}} if ring > 1 else {}
         ax.annotate(text, xy, xytext=(dx, dy), ha=_HA[int(np.sign(dx))], va=_VA[int(np.sign(dy))], **style, **leader)
@@ -288,6 +314,14 @@ def _sampled(ax, segments, step_pt: float) -> np.ndarray:
         t = np.linspace(0.0, 1.0, n)[:, None]
         points.append(np.array([a, b]) + t * np.array([c - a, d - b]))
     return np.concatenate(points) if points else np.empty((0, 2))
+
+
+def _inside(points: np.ndarray, box) -> int:
+    """How many of ``points`` (display coordinates, shape (n, 2)) a display box holds."""
+    if not points.size:
+        return 0
+    return int(np.count_nonzero((points[:, 0] > box.x0) & (points[:, 0] < box.x1)
+                                & (points[:, 1] > box.y0) & (points[:, 1] < box.y1)))
 
 
 def _overlap(a, b) -> float:
@@ -333,9 +367,13 @@ class _Labels:
         if record.get("id") is None:
             return
         (x0, y0), (x1, y1) = _ends(record)
-        clearance = 14.0 * self.px_per_pt          # about a three-digit id's width
-        spots = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
-        free = [p for p in spots if all(np.hypot(p[0] - q[0], p[1] - q[1]) > clearance for q in self.placed)]
+        # an id's box, about a three-digit id's width and a line's height: two boxes apart
+        # when their centres differ by more than that across or along
+        width, height = 16.0 * self.px_per_pt, 10.0 * self.px_per_pt
+        along = [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in self.SPOTS]
+        # collinear short candidates (a road's pieces) leave no free spot along them: stacked beside
+        spots = along + [(x, y + 1.1 * k * height) for k in (-1, 1, -2, 2, -3, 3) for x, y in along]
+        free = [p for p in spots if all(abs(p[0] - q[0]) > width or abs(p[1] - q[1]) > height for q in self.placed)]
         x, y = (free or spots)[0]
         self.placed.append((x, y))
         self.ax.text(x, y, str(record["id"]), fontsize=6.5, color=text_colour, ha="center", va="center",

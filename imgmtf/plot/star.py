@@ -5,7 +5,6 @@ Nyquist and MTF50 against direction."""
 from __future__ import annotations
 
 import math
-import textwrap
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
@@ -14,7 +13,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 from matplotlib.patches import Circle
 
-from ._common import figure_axes, title_once
+from ._common import figure_axes, title_once, warning_lines
 
 if TYPE_CHECKING:
     from ..estimate.star.result import StarResult
@@ -258,9 +257,7 @@ def plot_star(result: StarResult, image: np.ndarray | None = None,
              f"{across.direction} MTF@Nyq {across.mtf_nyquist:.3f}, MTF50 {across.mtf50_cy_px:.3f} cy/px; "
              f"{along.direction} MTF@Nyq {along.mtf_nyquist:.3f}, MTF50 {along.mtf50_cy_px:.3f} cy/px; "
              f"SNR {result.snr:.0f}"]
-    lines += [textwrap.fill(f"warning: {w}", 150) for w in warnings[:2]]      # wrapped: a long one ran off the page
-    if len(warnings) > 2:
-        lines.append(f"... and {len(warnings) - 2} more warning(s)")
+    lines += warning_lines(warnings)
     fig.suptitle("\n".join(lines), fontsize=9)
     return fig
 

@@ -277,6 +277,7 @@ def _measured_array(path, settings, estimator, roi, site, params, run_utc, track
         result = estimator(raster.data, gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
                            saturation=settings.saturation or saturation_levels(raster.dtype))
         result = replace(result, roi=roi)
+        site = {**site, "point_targets": point_targets(result.sources, roi)}
         if len(result.used) < MIN_ARRAY_POINTS:
             counts = ", ".join(f"{n} {why}" for why, n in sorted(result.refusal_counts().items())) or "none refused"
             raise ImageContentError(f"{path}: the array at ({site['x_px']:.0f}, {site['y_px']:.0f}) has "
@@ -289,6 +290,23 @@ def _measured_array(path, settings, estimator, roi, site, params, run_utc, track
     return [Record.measured(path, settings.band, summary, params=params, run_utc=run_utc, status="accepted",
                             site=dict(site), measurement=None)
             for summary in result.summaries(curves=True)]
+
+
+def point_targets(sources, roi: tuple[int, int, int, int]) -> list[dict]:
+    """Where each target of an array's window lies in the scene and whether
+    it was used: ``x_px``, ``y_px`` (scene pixels, centres at integers) and
+    ``status``, ``"used"`` or the reason it was refused (``faint``,
+    ``clipped``...), for the overview's marks and the records.
+
+    Examples
+    --------
+    >>> from imgmtf.estimate.mtf2d.sources import Source
+    >>> point_targets([Source(3.25, 4.5, 80.0, "used"), Source(9.0, 2.0, 3.0, "faint")], (100, 200, 20, 20))
+    [{'x_px': 103.25, 'y_px': 204.5, 'status': 'used'}, {'x_px': 109.0, 'y_px': 202.0, 'status': 'faint'}]
+    """
+    x0, y0 = roi[0], roi[1]
+    return [{"x_px": round(x0 + float(s.x_px), 2), "y_px": round(y0 + float(s.y_px), 2), "status": s.status}
+            for s in sources]
 
 
 def _ranked(records: list[Record]) -> list[Record]:
