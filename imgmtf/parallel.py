@@ -166,6 +166,38 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
         completed.close()       # on an interrupt or an early stop: workers stopped now
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system
+    says, else the machine's count), at most :data:`MAX_WORKERS`.
+
+    Examples
+    --------
+    >>> 1 <= available_cores() <= MAX_WORKERS
+    True
+    """
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):       # not on Linux: the machine's count
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, MAX_WORKERS))
+
+
+def auto_workers(tasks: int, per_worker: int, cores: int | None = None) -> int:
+    """How many local workers pay for ``tasks`` units of work when a worker
+    pays for itself from ``per_worker`` of them on: one (no pool, the work
+    runs here) below twice that, else one per ``per_worker`` units, at most
+    the ``cores`` available (default :func:`available_cores`).  A pool's
+    start (0.2-0.5 s) and its messages cost more than a few units save.
+
+    Examples
+    --------
+    >>> auto_workers(30, 100, cores=8), auto_workers(450, 100, cores=8), auto_workers(5000, 100, cores=8)
+    (1, 4, 8)
+    """
+    cores = available_cores() if cores is None else cores
+    return max(1, min(cores, tasks // max(per_worker, 1), MAX_WORKERS))
+
+
 def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     """Get ``workers`` local worker processes with ``modules`` imported
     ready now for the next :func:`run_tasks` of as many workers: their

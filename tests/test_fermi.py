@@ -1,6 +1,8 @@
+from unittest.mock import patch
+
 import numpy as np
 
-from imgmtf.estimate.fermi import MIN_WIDTH_PX, fermi, fit_fermi
+from imgmtf.estimate.fermi import MIN_WIDTH_PX, FermiRows, fermi, fit_fermi, fit_fermi_many
 
 
 def test_recovers_exact_parameters_for_every_row_at_once():
@@ -45,3 +47,31 @@ def test_a_row_collapsed_to_a_step_keeps_its_location():
     assert fit.ok.all() and fit.pinned.all()
     assert (fit.width == MIN_WIDTH_PX).all()
     np.testing.assert_allclose(fit.location, 0.5, atol=1e-5)
+
+
+def test_edges_fitted_together_are_each_fitted_as_alone_to_the_bit():
+    # noisy edges of different row counts, one with rows collapsed to a step (held), one flat:
+    # stacked in one fit (and in stacks of STACK_ROWS), every edge's fit is its own fit's, bit for bit
+    rng = np.random.default_rng(3)
+    edges = []
+    for rows, width in ((40, 0.6), (25, 1.1), (3, None), (60, 0.9), (12, 0.0)):
+        x = np.tile(np.arange(-10.0, 11.0), (rows, 1)) + rng.integers(-2, 3, (rows, 1))
+        b = x[:, 10] + rng.uniform(-0.5, 0.5, rows)
+        if width is None:
+            y = np.full(x.shape, 500.0) + rng.normal(0, 1, x.shape)
+        elif width == 0.0:
+            y = np.where(x < b[:, None], 200.0, 1200.0) + rng.normal(0, 2, x.shape)
+        else:
+            y = fermi(x, np.column_stack([np.full(rows, -900.0), b, np.full(rows, width), np.full(rows, 1000.0)]))
+            y = y + rng.normal(0, 5, x.shape)
+        w = np.ones_like(y)
+        w[0, :4] = 0.0
+        edges.append(FermiRows(x, y, w, x[:, 10].astype(float)))
+    alone = [fit_fermi(e.x, e.y, e.weight, e.b0) for e in edges]
+    assert any(f.pinned.any() for f in alone)
+    for stack in (10_000, 50):
+        with patch("imgmtf.estimate.fermi.STACK_ROWS", stack):
+            together = fit_fermi_many(edges)
+        for a, t in zip(alone, together, strict=True):
+            for name in ("params", "rms", "ok", "pinned"):
+                assert np.array_equal(getattr(a, name), getattr(t, name), equal_nan=name in ("params", "rms"))

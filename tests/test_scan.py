@@ -243,16 +243,17 @@ def test_the_scans_workers_load_no_scipy():
 
 
 def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypatch):
-    import imgmtf.scene.candidates as scan_module
+    # (inside the pipeline: the candidates' estimates are made together, each failure its own)
+    import imgmtf.estimate.pipeline as pipeline
     calls = []
 
-    def breaks_once(*args):
+    def breaks_once(*args, **keywords):
         calls.append(args)
         if len(calls) == 1:
             raise ZeroDivisionError("float division by zero")
-        return real(*args)
-    real = scan_module._estimate
-    monkeypatch.setattr(scan_module, "_estimate", breaks_once)
+        return real(*args, **keywords)
+    real = pipeline.transform
+    monkeypatch.setattr(pipeline, "transform", breaks_once)
     records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
     internal = [r for r in records if r.reason == "internal"]
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error

@@ -182,3 +182,21 @@ def test_candidates_ends_are_rounded_as_before_a_half_edges_as_numpy_rounds_them
     assert _rounded_ends([split, bar]) == [[round(np.float64(value), 2), 1.0, round(np.float64(value), 2), 80.0],
                                            [round(value, 2), 1.0, round(value, 2), 80.0]]
     assert round(np.float64(value), 2) != round(value, 2)
+
+
+def test_the_records_are_the_same_measured_in_the_pieces_a_pool_of_workers_gets(quadrant_scans, monkeypatch):
+    # with workers each tile's candidates are split into tasks, each reading the tile's window: one
+    # candidate a task here, measured in this process, gives every record as the whole tile did
+    import json
+
+    import imgmtf.scene.measure as measure
+    from imgmtf.records import to_json
+    _, records, _ = quadrant_scans[True]
+    whole = measure._batches
+    pieces = []
+    monkeypatch.setattr(measure, "_batches", lambda *a: pieces.extend(measure._split_batches(whole(*a), 100)) or pieces)
+
+    def plain(rs):
+        return [{k: v for k, v in json.loads(to_json(r)).items() if k != "run_utc"} for r in rs]
+    assert plain(scan_scene(records[0].path)) == plain(records)
+    assert len(pieces) > 1 and all(len(batch) == 1 for _, batch in pieces)

@@ -218,13 +218,39 @@ def parse_band(ctx, param, value):
     return band
 
 
-def parallel_options(command):
-    """--workers and --scheduler, shared by the batch commands."""
+class WorkerCount(click.ParamType):
+    """--workers N (1 to ``MAX_WORKERS``) or ``auto`` (None: the command
+    chooses from the work and the cores it may use)."""
+
+    name = "N|auto"
+
+    def convert(self, value, param, ctx):
+        if value is None or (isinstance(value, str) and value.strip().lower() == "auto"):
+            return None
+        try:
+            number = int(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is neither 'auto' nor a number of workers (1 to {MAX_WORKERS})", param, ctx)
+        return click.IntRange(1, MAX_WORKERS).convert(number, param, ctx)
+
+
+def parallel_options(command, *, auto: bool = False):
+    """--workers and --scheduler, shared by the batch commands; ``auto``:
+    --workers defaults to ``auto`` (None), the command's choice."""
     command = click.option("--scheduler", metavar="ADDRESS",
                            help="run on a Dask distributed cluster (tcp://host:8786), or 'local' "
                                 "for a local Dask cluster of --workers processes; needs imgmtf[dask]")(command)
+    if auto:
+        return click.option("--workers", type=WorkerCount(), default="auto", show_default=True,
+                            help="parallel worker processes, each on one thread; auto: the cores this process "
+                                 "may use when the work is large enough to pay for them, else none")(command)
     return click.option("--workers", type=click.IntRange(1, MAX_WORKERS), default=1, show_default=True,
                         help="parallel worker processes, each on one thread")(command)
+
+
+def auto_parallel_options(command):
+    """:func:`parallel_options` with --workers ``auto`` by default."""
+    return parallel_options(command, auto=True)
 
 
 def reading_options(command):

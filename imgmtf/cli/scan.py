@@ -13,11 +13,11 @@ from .errors import closing, interrupt_code, option_errors, reported_errors, sig
 from .options import (
     FiniteFloat,
     MethodName,
+    auto_parallel_options,
     interval_options,
     interval_settings,
     length_option,
     optical_centre_option,
-    parallel_options,
     parse_pair,
     read_roi_file,
     roi_file_option,
@@ -95,7 +95,7 @@ WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.sce
                    "always hold every row)")
 @click.option("--progress/--no-progress", default=None, help="progress bar on stderr (default: on a terminal)")
 @interval_options
-@parallel_options
+@auto_parallel_options
 def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band, saturation, track_azimuth,
          roi_file, optical_centre, lens_frequencies, fit_stages, point_spacing, recursive, out_dir, edge_figures, store,
          acquired, platform, instrument, band_name, fmt, verbose, progress, interval_method, replicates, confidence,
@@ -144,7 +144,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     with reported_errors():
         from ..batch import expand_inputs
         from ..parallel import prestart_workers
-        from ..scene.series import outputs_folder, scan_scenes
+        from ..scene.series import outputs_folder, scan_scenes, scenes_workers
         from ..scene.settings import ScanSettings
         rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
         with option_errors():           # a malformed option: exit 2, before any work
@@ -166,7 +166,9 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                                    "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
             fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            prestart_workers(workers, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+            # workers chosen automatically for one scene wait for its candidates to be counted
+            prestart_workers(scenes_workers(len(paths)) if workers is None else workers,
+                             SCANNING_MODULES + (FITTING_MODULES if fitted else ())
                              + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:

@@ -46,10 +46,10 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     if rows.size < 2 * MIN_GROUP_ROWS:
         return [not_run("varying-blur", f"the {ev.name} crosses {rows.size} rows (at least "
                         f"{2 * MIN_GROUP_ROWS} needed to compare its halves)")], []
-    splits = [np.array_split(rows, parts) for parts in (2, 3) if rows.size >= parts * MIN_GROUP_ROWS]
+    splits = _splits(rows)
     # the five groups' fits run together (one fit's iterations on small
-    # arrays cost mostly the interpreter's time)
-    widths = iter(_group_widths(ev, [(ev.rows >= b[0]) & (ev.rows <= b[-1]) for bounds in splits for b in bounds]))
+    # arrays cost mostly the interpreter's time), or with other chips' (group_widths_many)
+    widths = iter(ev.blur_widths if ev.blur_widths is not None else _group_widths(ev, _group_masks(ev, splits)))
     worst = None
     for bounds in splits:
         parts = len(bounds)
@@ -58,7 +58,7 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
             continue
         for i in range(parts):
             for j in range(i + 1, parts):
-                (wi, vi), (wj, vj) = group[i], group[j]  # type: ignore[misc]
+                (wi, vi), (wj, vj) = group[i], group[j]
                 change = abs(wi - wj) / (0.5 * (wi + wj))
                 z = abs(wi - wj) / math.sqrt(vi + vj) if vi + vj > 0 else math.inf
                 if worst is None or (z >= WARN_SIGNIFICANCE, change) > (worst[1] >= WARN_SIGNIFICANCE, worst[0]):
@@ -82,6 +82,56 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     return [check], said
 
 
+def group_widths_many(evidence: list[Evidence]) -> list[list | None]:
+    """What :func:`uniform_blur` fits in each chip's halves and thirds
+    (:attr:`.evidence.Evidence.blur_widths`; None for a chip of too few
+    rows), the groups of chips whose samples are as many fitted together:
+    each width the same, to the bit, as its chip's own fit gives.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.evidence import evidence_of
+    >>> from imgmtf.estimate.pipeline import run
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
+    >>> m = run(EdgeKind(), chip.image, make_settings())
+    >>> ev = evidence_of(EdgeKind(), m.chip, m.located, m.estimate.samples, m.shape, m.noise)
+    >>> len(group_widths_many([ev])[0])         # two halves and three thirds
+    5
+    """
+    out: list[list | None] = [None] * len(evidence)
+    inputs = {}
+    for k, ev in enumerate(evidence):
+        rows = np.unique(ev.rows)
+        if rows.size >= 2 * MIN_GROUP_ROWS:
+            groups = _group_masks(ev, _splits(rows))
+            inputs[k] = (len(groups), _group_inputs(ev, groups))
+    buckets: dict[tuple[int, bool], list[int]] = {}
+    for k, (count, fitted) in inputs.items():
+        if fitted is None:
+            out[k] = [None] * count
+        else:       # stacked only with chips whose groups are padded alike: each fit's sums as alone
+            buckets.setdefault((fitted[1].shape[1], fitted[5]), []).append(k)
+    for (_, bar), members in buckets.items():
+        stacked = [inputs[k][1] for k in members]
+        fits = iter(_fit(_bar if bar else _step, *(np.concatenate([f[i] for f in stacked]) for i in (1, 2, 3, 4))))
+        for k, f in zip(members, stacked):
+            out[k] = _widths(inputs[k][0], f[0], [next(fits) for _ in f[0]])
+    return out
+
+
+def _splits(rows: np.ndarray) -> list[list[np.ndarray]]:
+    """The target's rows in halves and, with enough, in thirds."""
+    return [np.array_split(rows, parts) for parts in (2, 3) if rows.size >= parts * MIN_GROUP_ROWS]
+
+
+def _group_masks(ev: Evidence, splits: list[list[np.ndarray]]) -> list[np.ndarray]:
+    """Which samples lie in each group of rows."""
+    return [(ev.rows >= b[0]) & (ev.rows <= b[-1]) for bounds in splits for b in bounds]
+
+
 def _group_widths(ev: Evidence, groups: list[np.ndarray]) -> list[tuple[float, float] | None]:
     """The width (px) of each group's profile within the plateau of the
     centre, with its variance: the scale c of a Fermi step (an edge) or of
@@ -89,7 +139,17 @@ def _group_widths(ev: Evidence, groups: list[np.ndarray]) -> list[tuple[float, f
     neither shading nor a slight bend along the target passes for a change
     of blur.  The model need not be the blur's: it is the same for every
     group.  None where the fit fails."""
-    widths: list[tuple[float, float] | None] = [None] * len(groups)
+    fitted = _group_inputs(ev, groups)
+    if fitted is None:
+        return [None] * len(groups)
+    selected, s, v, w, start, bar = fitted
+    return _widths(len(groups), selected, _fit(_bar if bar else _step, s, v, w, start))
+
+
+def _group_inputs(ev: Evidence, groups: list[np.ndarray]):
+    """What :func:`_fit` fits for the groups with enough samples: their
+    indices, samples (s, v, w: padded to the longest with zero weights),
+    each one's start and whether the model is a bar's; None for none."""
     reach = max(ev.plateau_px, MIN_REACH_PX)
     selected = []
     for g, in_group in enumerate(groups):
@@ -98,7 +158,7 @@ def _group_widths(ev: Evidence, groups: list[np.ndarray]) -> list[tuple[float, f
         if np.count_nonzero(near) >= MIN_GROUP_SAMPLES:
             selected.append((g, s[near], ev.values[in_group][near]))
     if not selected:
-        return widths
+        return None
     # the groups side by side, padded to the longest with zero weights
     longest = max(s.size for _, s, _ in selected)
     s, v, w = (np.zeros((len(selected), longest)) for _ in range(3))
@@ -106,7 +166,13 @@ def _group_widths(ev: Evidence, groups: list[np.ndarray]) -> list[tuple[float, f
         s[k, : sk.size], v[k, : sk.size], w[k, : sk.size] = sk, vk, 1.0
     bar = ev.profile == "bar"
     start = np.array([ev.high - ev.low, 0.0, max(ev.scale_px, 0.2) * (0.5 if bar else 0.25), ev.low])
-    for (g, _, _), fitted in zip(selected, _fit(_bar if bar else _step, s, v, w, start)):
+    return [g for g, _, _ in selected], s, v, w, np.tile(start.astype(float), (len(selected), 1)), bar
+
+
+def _widths(groups: int, selected: list[int], fits: list) -> list[tuple[float, float] | None]:
+    """Each group's width and its variance from the fits of those selected."""
+    widths: list[tuple[float, float] | None] = [None] * groups
+    for g, fitted in zip(selected, fits):
         # a step with no blur leaves no fit to compare (fill, a clip)
         if fitted is not None and abs(fitted[0][2]) >= MIN_SCALE_PX:
             widths[g] = abs(float(fitted[0][2])), fitted[1]
@@ -150,12 +216,12 @@ def _solve_each(matrices: np.ndarray, vectors: np.ndarray) -> tuple[np.ndarray, 
 def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] | None]:
     """Levenberg-Marquardt least squares of ``model`` to each group's
     (s, v) (rows of equal length, weights ``w`` 1 for a sample and 0 for
-    padding) from ``start``, each group with its own damping and its own
+    padding) from its row of ``start``, each group with its own damping and its own
     stop: per group the parameters and the variance of the third (the
     scale), scaled by the residual variance.  None where it does not
     converge to finite numbers."""
     groups = s.shape[0]
-    p = np.tile(start.astype(float), (groups, 1))
+    p = np.array(start, float)
     fit, jac = model(s, p)
     cost = np.einsum("gn,gn->g", w * (v - fit), v - fit)
     damping = np.full(groups, 1e-3)

@@ -21,8 +21,10 @@ from .._blas import one_blas_thread
 from ..kinds.edge import EDGE
 from . import gate
 from .detection import describe, find_edge, meet_inside, parallel_within
-from .geometry import TargetGeometry, locate_edge
+from .fermi import FermiRows
+from .geometry import TargetGeometry, edge_rows, locate_edge
 from .kind import Shape, TargetKind
+from .many import run_many
 from .pipeline import run
 from .results import MTFResult, finite
 from .settings import Settings, make_settings
@@ -117,6 +119,12 @@ class EdgeKind(TargetKind):
 
     def locate(self, work, seed_x, transposed) -> TargetGeometry:
         return locate_edge(work, seed_x, transposed=transposed)
+
+    def fermi_rows(self, work, seed_x) -> FermiRows:
+        return edge_rows(work, seed_x)[1]
+
+    def locate_fitted(self, work, seed_x, transposed, fit) -> TargetGeometry:
+        return locate_edge(work, seed_x, transposed=transposed, fit=fit)
 
     def shape(self, grid, values, d, v, half_range) -> Shape:
         # the levels: the samples in the outer eighth of the range each side
@@ -219,6 +227,54 @@ class EdgeEstimator:
         with one_blas_thread():         # small matrices: threads cost more than they save
             m = run(EdgeKind(), image, self.settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
                     dtype=dtype, track_azimuth_deg=track_azimuth_deg)
+        return self._result(m)
+
+    def measure_many(self, images: list[np.ndarray], masks: list[np.ndarray | None], **keywords: Any
+                     ) -> list[EdgeResult | Exception]:
+        """Measure the edge in each image, the work alike across them made
+        together (:func:`imgmtf.estimate.many.run_many`): each the result of
+        this estimator's call on it, or the exception the call raises.
+
+        Parameters
+        ----------
+        images : list of numpy.ndarray
+            The chips (2-D arrays, DN).
+        masks : list of numpy.ndarray or None
+            Each chip's mask (True for its pixels), or None for all.
+        **keywords
+            What every call takes alike (``gsd_m``, ``saturation``,
+            ``dtype``, ``track_azimuth_deg``; see :func:`measure_edge`).
+
+        Returns
+        -------
+        list of EdgeResult or Exception
+            One per image, in order: a refusal is the exception the call
+            raises (an :class:`imgmtf.errors.ImgmtfError` for the data's).
+
+        Examples
+        --------
+        >>> import imgmtf
+        >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 40).image for a in (5.0, 8.0)]
+        >>> estimate = EdgeEstimator(intervals=imgmtf.Intervals("none"))
+        >>> [r.mtf_nyquist for r in estimate.measure_many(chips, [None, None])] == [estimate(c).mtf_nyquist
+        ...                                                                          for c in chips]
+        True
+        """
+        with one_blas_thread():
+            measured = run_many(EdgeKind(), images, self.settings, [{**keywords, "mask": m} for m in masks])
+        return [self._outcome(m) for m in measured]
+
+    def _outcome(self, m) -> EdgeResult | Exception:
+        """A measurement's result, or the exception it or its making raised."""
+        if isinstance(m, Exception):
+            return m
+        try:
+            return self._result(m)
+        except Exception as exc:        # as the call would have raised it
+            return exc
+
+    def _result(self, m) -> EdgeResult:
+        """The pipeline's measurement as this estimator's result."""
         left, right = m.estimate.lsf.side_levels_dn
         return EdgeResult(
             **m.result_fields(), method=self.settings.method, params=m.params,

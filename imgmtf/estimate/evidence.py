@@ -8,10 +8,15 @@ warnings, so that a new check is one module and one registration.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .geometry import TargetGeometry
+
+if TYPE_CHECKING:
+    from .kind import Shape, TargetKind
+    from .state import Chip, Located, Noise, Samples
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,6 +55,10 @@ class Evidence:
         "left background"...).
     geometry : TargetGeometry or None
         The target's line and its per-row locations.
+    blur_widths : list or None
+        The widths :func:`.blur_along.uniform_blur` reads in the target's
+        halves and thirds, when fitted with other chips'
+        (:func:`.blur_along.group_widths_many`); None: it fits them.
     """
 
     distance_px: np.ndarray
@@ -67,6 +76,7 @@ class Evidence:
     profile: str
     side_names: tuple[str, str]
     geometry: TargetGeometry | None = None
+    blur_widths: list | None = None     # the blur check's group widths, fitted among other chips' (blur_along)
 
     @property
     def contrast(self) -> float:
@@ -78,3 +88,16 @@ class Evidence:
         """A part of a bin mean's error that does not average down (DN): a
         noise-free quantised profile rounds neighbouring samples alike."""
         return self.quantum / np.sqrt(12.0) if self.pixel_noise < 0.5 * self.quantum else 0.0
+
+
+def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
+                blur_widths: list | None = None) -> Evidence:
+    """What the gate's profile checks read of a measured chip: its samples,
+    the shape read off them, its noise and its sides' names."""
+    offsets = samples.distance_px - shape.centre
+    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
+                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    return Evidence(samples.distance_px, samples.raw_dn, samples.rows, shape.centre, shape.scale_px, shape.plateau_px,
+                    shape.low, shape.high, noise.noise_dn, chip.quantum_dn, kind.tail_power, kind.name, kind.profile,
+                    (side_names[0], side_names[1]), located.geometry, blur_widths)

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import TargetNotFoundError, UnsuitableTargetError
 from .detection import Line
-from .fermi import fit_fermi
+from .fermi import FermiFit, FermiRows, fit_fermi
 from .resampling import sample_gap
 
 MIN_ANGLE_DEG = 1.0            # closer to an axis, rows share their phase
@@ -68,20 +68,19 @@ class TargetGeometry:
 
 
 def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = EDGE_FIT_HALF_WINDOW_PX,
-                transposed: bool = False) -> TargetGeometry:
+                transposed: bool = False, fit: FermiFit | None = None) -> TargetGeometry:
     """Fit the Fermi model in every row around ``seed_x`` (the seed edge
     column per row) and a robust line through the locations.
 
     Rows whose fit fails are dropped; the line is refitted after discarding
     locations more than 4 robust standard deviations (and 0.05 px) off it.
+    ``fit``: the rows' fit already made (:func:`edge_rows`, fitted among
+    other chips' by :func:`.fermi.fit_fermi_many`).
     """
     rows = np.arange(image.shape[0])
-    cols, values, inside = row_windows(image, seed_x, half_window)
-    usable = inside.sum(axis=1) >= half_window + 4
-    if usable.sum() < 5:
-        raise TargetNotFoundError("the edge does not cross enough rows of the image")
-    fit = fit_fermi(cols[usable].astype(float), values[usable], inside[usable].astype(float),
-                    seed_x[usable])
+    usable, fitted = edge_rows(image, seed_x, half_window)
+    if fit is None:
+        fit = fit_fermi(fitted.x, fitted.y, fitted.weight, fitted.b0)
     # a Fermi step a with width c under noise s locates its edge to about
     # s sqrt(30 c) / |a| (the location's Cramer-Rao bound on a 1-px grid)
     a, c = np.abs(fit.params[fit.ok, 0]), np.abs(fit.params[fit.ok, 2])
@@ -89,6 +88,23 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = EDGE_F
         sd = fit.rms[fit.ok] * np.sqrt(30.0 * np.maximum(c, 0.05)) / a
     expected = float(np.median(sd)) if sd.size else 0.0
     return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed, expected)
+
+
+def edge_rows(image: np.ndarray, seed_x: np.ndarray,
+              half_window: int = EDGE_FIT_HALF_WINDOW_PX) -> tuple[np.ndarray, FermiRows]:
+    """The rows :func:`locate_edge` fits (those with ``half_window`` + 4
+    pixels in their window about ``seed_x``) and what it fits in them.
+
+    Raises
+    ------
+    TargetNotFoundError
+        Fewer than 5 such rows.
+    """
+    cols, values, inside = row_windows(image, seed_x, half_window)
+    usable = inside.sum(axis=1) >= half_window + 4
+    if usable.sum() < 5:
+        raise TargetNotFoundError("the edge does not cross enough rows of the image")
+    return usable, FermiRows(cols[usable].astype(float), values[usable], inside[usable].astype(float), seed_x[usable])
 
 
 def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,

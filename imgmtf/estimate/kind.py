@@ -16,6 +16,7 @@ from ..kinds import Kind
 from . import gate
 from .bar_pair import PAIR_REASON
 from .detection import Line
+from .fermi import FermiFit, FermiRows
 from .geometry import EDGE_FIT_HALF_WINDOW_PX, TargetGeometry, row_windows
 from .intervals.width import WidthReading
 
@@ -58,6 +59,15 @@ class TargetKind:
     def locate(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool) -> TargetGeometry:
         """The target's line fitted through its per-row locations."""
         raise NotImplementedError
+
+    def fermi_rows(self, work: np.ndarray, seed_x: np.ndarray) -> FermiRows | None:
+        """The rows :meth:`locate` fits a Fermi step to, for fits stacked
+        across chips (:mod:`.prefit`); None for a kind that fits none."""
+        return None
+
+    def locate_fitted(self, work: np.ndarray, seed_x: np.ndarray, transposed: bool, fit: FermiFit) -> TargetGeometry:
+        """:meth:`locate` with the fit of its :meth:`fermi_rows` made."""
+        return self.locate(work, seed_x, transposed)
 
     def shape(self, grid: np.ndarray, values: np.ndarray, d: np.ndarray, v: np.ndarray,
               half_range: float) -> Shape:

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -47,10 +47,11 @@ from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
 from . import gate
 from .chip import prepare_chip
-from .evidence import Evidence
+from .evidence import Evidence, evidence_of
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
 from .intervals import Estimate, FigureIntervals, intervals
 from .kind import Shape, TargetKind, refuse_other_kind
+from .prefit import Prefit
 from .profile import read_profile, rebuild_staircase, widen_profile
 from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
@@ -159,7 +160,8 @@ class Measurement:
 
 def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[int, int, int, int] | None = None,
         mask: np.ndarray | None = None, gsd_m: float | None = None, saturation: tuple[float, float] | None = None,
-        dtype: DTypeLike | None = None, track_azimuth_deg: float | None = 0.0) -> Measurement:
+        dtype: DTypeLike | None = None, track_azimuth_deg: float | None = 0.0,
+        prefit: Prefit | None = None) -> Measurement:
     """Measure the target of ``kind`` in ``image`` (2-D array, DN).
 
     Parameters
@@ -188,6 +190,10 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
         Direction of the ground track in the image, degrees clockwise from
         the image's up direction (0: rows along track, as in L0/L1
         products); None when unknown (map-projected).
+    prefit : Prefit, optional
+        The chip's first stages made among other chips'
+        (:func:`.prefit.prefit_chips`, from these arguments): the same
+        result, sooner.
 
     Returns
     -------
@@ -209,10 +215,23 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
     >>> abs(m.estimate.spectrum.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002, m.located.rows_used
     (True, 60)
     """
-    chip = prepare_chip(image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
-                        track_azimuth_deg=track_azimuth_deg)
+    steps = run_steps(kind, image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
+                      track_azimuth_deg=track_azimuth_deg, prefit=prefit)
+    next(steps)
+    return finish_steps(steps)
+
+
+def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit: Prefit | None = None,
+              **chip_options: Any) -> Generator[Evidence, list | None, Measurement]:
+    """:func:`run` as a generator that pauses before the quality gate: it
+    yields what the gate's profile checks read (:class:`.evidence.Evidence`)
+    and takes the blur check's widths (:attr:`.evidence.Evidence.blur_widths`,
+    fitted among other chips' by :func:`.blur_along.group_widths_many`; None:
+    the check fits them), then returns the measurement (:func:`finish_steps`).
+    ``chip_options``: :func:`run`'s keywords of the chip (``roi``, ``mask``...)."""
+    chip = prefit.chip if prefit is not None else prepare_chip(image, settings, **chip_options)
     try:
-        located = locate_target(kind, chip, force=settings.force)
+        located = locate_target(kind, chip, force=settings.force, prefit=prefit)
         samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
         read, shape = read_profile(kind, samples, settings, located.checks)
         noise = measure_noise(kind, samples, shape, chip.quantum_dn)
@@ -220,7 +239,9 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
         profile = widen_profile(read, samples, shape, window, settings, kind.name)
         lsf = blend_tails(kind, samples, profile, shape, window)
         spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
-        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings)
+        blur_widths = yield evidence_of(kind, chip, located, samples, shape, noise)
+        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings,
+                                 blur_widths=blur_widths)
     except ImgmtfError as exc:
         raise _points_instead(exc, kind, chip, image) from None
     estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
@@ -236,6 +257,17 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
               "dequantised": samples.dequantised, **chip.left_out_px}
     return Measurement(chip, located, shape, noise, estimate, found, tuple(checks), tuple(warnings), params,
                        settings.frequencies_cy_px)
+
+
+def finish_steps(steps: Generator[Evidence, list | None, Measurement], blur_widths: list | None = None
+                 ) -> Measurement:
+    """The measurement of :func:`run_steps` paused at its gate, given the
+    blur check's ``blur_widths`` (None: it fits them)."""
+    try:
+        steps.send(blur_widths)
+    except StopIteration as done:
+        return done.value
+    raise RuntimeError("the pipeline's steps paused twice")      # pragma: no cover - a bug, never data
 
 
 def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: ArrayLike) -> ImgmtfError:
@@ -261,7 +293,7 @@ def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: Array
     return UnsuitableTargetError(f"no {kind.name} here: the chip holds {seen}, not a line", reason="points")
 
 
-def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Located:
+def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: Prefit | None = None) -> Located:
     """The kind's target in the chip: its seed line, its per-row locations
     and the robust line through them (in the vertical frame), every
     pixel's signed distance from that line as a profile sample, and the
@@ -280,6 +312,9 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
         The prepared chip.
     force : bool, optional
         Raise the failure itself rather than a failed earlier check.
+    prefit : Prefit, optional
+        The chip's seed and rows' fit made among other chips'
+        (:func:`.prefit.prefit_chips`).
 
     Returns
     -------
@@ -304,11 +339,12 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False) -> Locat
     """
     checks = list(chip.checks)
     try:
-        line, seed_checks = kind.seed(chip.pixels, chip.noise_dn)
+        line, seed_checks = kind.seed(chip.pixels, chip.noise_dn) if prefit is None else prefit.seeded()
         checks += seed_checks
         frame, seed_x, transposed = vertical_frame(chip.pixels, line)
         try:
-            geometry = kind.locate(frame, seed_x, transposed)
+            geometry = (kind.locate(frame, seed_x, transposed) if prefit is None or prefit.fit is None
+                        else kind.locate_fitted(frame, seed_x, transposed, prefit.fit))
             check_angle(geometry, kind.name)
             distance, values, rows, half_range = profile_samples(frame, geometry, kind.name)
         except (TargetNotFoundError, UnsuitableTargetError):
@@ -382,7 +418,8 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
 
 
 def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-          window: Window, spectrum: Spectrum, settings: Settings) -> tuple[list[gate.Check], list[str]]:
+          window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
+          ) -> tuple[list[gate.Check], list[str]]:
     """The quality gate: every check (saturation, the sides, SNR, MTF above
     its noise, the figures, then the registered profile checks) added to
     those run so far, enforced (failures raise unless ``settings.force``),
@@ -408,6 +445,9 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
         The MTF and its figures.
     settings : Settings
         The SNR threshold and ``force``.
+    blur_widths : list, optional
+        The blur check's widths fitted among other chips'
+        (:func:`.blur_along.group_widths_many`); None: the check fits them.
 
     Returns
     -------
@@ -451,9 +491,7 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    evidence = Evidence(distance, raw, samples.rows, centre, shape.scale_px, shape.plateau_px, shape.low, shape.high,
-                        noise.noise_dn, quantum_dn, kind.tail_power, kind.name, kind.profile,
-                        (side_names[0], side_names[1]), located.geometry)
+    evidence = evidence_of(kind, chip, located, samples, shape, noise, blur_widths)
     # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
     excess, sharpening_notes, _, _ = sharpening_check(
         gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)

@@ -103,11 +103,17 @@ def measure_batch(task) -> list[tuple[int, Record]]:
         verdicts = _quick_looks(read)
     except Exception as exc:           # ... and one batch's quick look, never the scan
         return out + [(plan.index, _failed(exc, raster, context)) for plan, _ in read]
+    estimator = _Estimator(context, raster) if read else None    # made once: its settings checked once
+    passed = [band for (_, band), verdict in zip(read, verdicts) if not verdict]
+    try:    # the estimates of all at once where the estimator can (the fits alike across them stacked)
+        estimates = iter(estimator.many([_chip(band) for band in passed]) if estimator and passed else [])
+    except Exception:                  # (each then estimated alone, its own failure its own)
+        estimates = iter([None] * len(passed))
     for (plan, band), verdict in zip(read, verdicts):
         if verdict:
             out.append((plan.index, _rejected(context, raster, band.site, *verdict, verdict_by="screen")))
         else:
-            out.append((plan.index, safely(measure_band, plan, band, raster, context)))
+            out.append((plan.index, safely(measure_band, plan, band, raster, context, estimator, next(estimates))))
     return out
 
 
@@ -167,19 +173,22 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
     return Band(data, (x, y), rows, cols, values, t, d, noise, site)
 
 
-def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
+def measure_band(plan: Plan, band: Band, raster, context: Context, estimator: _Estimator | None = None,
+                 estimate=None) -> Record:
     """A candidate's record from the gate's verdict on the estimate of its
-    ROI (``band``, which passed the quick look)."""
+    ROI (``band``, which passed the quick look): ``estimate`` made with the
+    batch's (:meth:`_Estimator.many`: a result, or the exception its
+    estimator raised), else made now by ``estimator`` (the batch's
+    :class:`_Estimator`, else one made for it)."""
     settings = context.settings
-    rows, cols = band.rows, band.cols
-    r0, c0 = rows[0], cols.min()
-    chip = band.data[r0:rows[-1] + 1, c0:cols.max() + 1]
-    chip_mask = np.zeros(chip.shape, bool)
-    chip_mask[rows - r0, cols - c0] = True
     try:
         # the quality gate refuses a chip before its intervals are computed
         # (imgmtf.estimate.pipeline.run): a rejected candidate never pays for them
-        result = _estimate(chip, chip_mask, raster, context, plan)
+        if estimate is None:
+            estimate = (estimator or _Estimator(context, raster))(*_chip(band))
+        elif isinstance(estimate, Exception):
+            raise estimate
+        result = estimate
     except ImgmtfError as exc:
         return _rejected(context, raster, band.site, exc.reason, _one_line(exc), verdict_by="gate",
                          **_gate_figures(getattr(exc, "checks", ())))
@@ -205,6 +214,17 @@ def measure_band(plan: Plan, band: Band, raster, context: Context) -> Record:
     return record
 
 
+def _chip(band: Band) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate's chip (its band's bounding box) and the mask of the
+    band's pixels in it."""
+    rows, cols = band.rows, band.cols
+    r0, c0 = rows[0], cols.min()
+    chip = band.data[r0:rows[-1] + 1, c0:cols.max() + 1]
+    mask = np.zeros(chip.shape, bool)
+    mask[rows - r0, cols - c0] = True
+    return chip, mask
+
+
 def _with_figure(record: Record, result, context: Context, plan: Plan) -> Record:
     """The accepted candidate's measurement figure saved (under its
     measuring order, renamed to its id later), or a warning saying why not."""
@@ -221,14 +241,32 @@ def _confident_snr(target: str, rows: int) -> float:
     return get_kind(target).load("measuring").confident_snr(rows)
 
 
-def _estimate(chip, mask, raster, context: Context, plan: Plan):
-    """The estimator's result on the masked chip."""
-    settings = context.settings
-    measuring = settings.measure_settings()
-    common = {"mask": mask, "gsd_m": raster.gsd_m, "dtype": raster.dtype,
-              "track_azimuth_deg": context.track_azimuth_deg,
-              "saturation": settings.saturation or saturation_levels(raster.dtype)}
-    return measuring.estimator()(chip, **measuring.target_keywords(raster), **common)
+class _Estimator:
+    """The estimator of a scan's candidates in one window of the scene:
+    made once for all of them (the settings' checks cost about a
+    millisecond), called on each masked chip."""
+
+    def __init__(self, context: Context, raster):
+        settings = context.settings
+        measuring = settings.measure_settings()
+        self.estimate = measuring.estimator()
+        self.keywords = {**measuring.target_keywords(raster), "gsd_m": raster.gsd_m, "dtype": raster.dtype,
+                         "track_azimuth_deg": context.track_azimuth_deg,
+                         "saturation": settings.saturation or saturation_levels(raster.dtype)}
+
+    def __call__(self, chip, mask):
+        """The estimator's result on the masked chip."""
+        return self.estimate(chip, mask=mask, **self.keywords)
+
+    def many(self, chips: list[tuple[np.ndarray, np.ndarray]]) -> list:
+        """The masked chips' estimates made together where the estimator can
+        (an edge's: :meth:`imgmtf.estimate.edge.EdgeEstimator.measure_many`),
+        each a result or the exception its call raises; None for each
+        where it cannot (each then estimated alone)."""
+        many = getattr(self.estimate, "measure_many", None)
+        if many is None:
+            return [None] * len(chips)
+        return many([chip for chip, _ in chips], [mask for _, mask in chips], **self.keywords)
 
 
 def _gate_figures(checks) -> dict:

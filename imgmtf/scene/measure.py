@@ -33,10 +33,10 @@ from ..estimate.geometry import direction_label
 from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
 from ..kinds import get_kind
-from ..parallel import run_tasks
+from ..parallel import auto_workers, run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
-from .detect import detect_segments
+from .detect import detect_segments, tile_windows
 from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
@@ -53,6 +53,12 @@ from .segments import (
     split_at_junctions,
 )
 from .settings import ScanSettings
+
+# with workers chosen automatically, a local pool measures the candidates when each worker has at least
+# this many (about 2-3 s of work against a pool's start of 0.2-0.5 s); fewer are measured here
+AUTO_PLANS_PER_WORKER = 100
+AUTO_TILES_PER_WORKER = 4       # ... and detection its tiles from this many a worker (0.2-0.3 s a tile)
+TASKS_PER_WORKER = 4            # a pool's candidates are split into this many tasks a worker: a late tile waits less
 
 
 def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
@@ -72,7 +78,7 @@ def in_image_axes(info: RasterInfo, settings: ScanSettings) -> bool:
 
 
 # -- the scan -------------------------------------------------------------------------
-def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int = 1,
+def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int | None = 1,
                scheduler: str | None = None, progress: bool | None = None,
                figures_dir: str | None = None) -> list[Record]:
     """Every candidate target of the scene as a record: accepted ones first
@@ -84,8 +90,13 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         The scene (any raster GDAL reads, up to 1 Gpx).
     settings : ScanSettings, optional
         How to scan (:class:`imgmtf.ScanSettings`; default its defaults).
-    workers : int, optional
-        Local worker processes (default 1: none, the work runs here).
+    workers : int or None, optional
+        Local worker processes (default 1: none, the work runs here); None
+        chooses: the available cores for the detection when each has
+        ``AUTO_TILES_PER_WORKER`` tiles to read, and for the candidates'
+        measurement when each has ``AUTO_PLANS_PER_WORKER`` of them
+        (:func:`imgmtf.parallel.auto_workers`), else none.  The records are
+        the same whatever the workers.
     scheduler : str, optional
         A Dask distributed scheduler's address, or ``"local"`` for a local
         Dask cluster (:func:`imgmtf.parallel.run_tasks`).
@@ -137,7 +148,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         # a strip or a one-pixel scene holds no chip: refused before any tile is read
         raise ImageContentError(f"{path}: the scene is {info.width} x {info.height} px; an edge or bar chip needs "
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
-    segments, fill_fraction = detect_segments(path, settings, workers=workers, scheduler=scheduler, progress=progress)
+    detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
+                 else workers)
+    segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
     sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
     halves = split_at_junctions(sampled, junctions, events, fill_fraction)
@@ -174,7 +187,10 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
             s = half.segment
             record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
         records.append(record)
+    measuring = auto_workers(len(plans), AUTO_PLANS_PER_WORKER) if workers is None else workers
     batches = _batches(plans, info, settings.tile_px)
+    if measuring > 1:
+        batches = _split_batches(batches, measuring * TASKS_PER_WORKER)
     halves = [half for half, _ in candidates]
 
     def lost(task, exc):
@@ -184,7 +200,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                 for plan in task[2]]
     try:
         for _, outcomes in run_tasks(measure_batch, [(context, window, batch) for window, batch in batches],
-                                     workers=workers, scheduler=scheduler, progress=progress,
+                                     workers=measuring, scheduler=scheduler, progress=progress,
                                      description="measuring targets", on_error=lost, ordered=False):
             for index, outcome in outcomes:
                 records[index] = _measured(records[index], outcome)
@@ -255,6 +271,16 @@ def _batches(plans: list[Plan], info: RasterInfo, tile_px: int) -> list[tuple[tu
         x1, y1 = (b[:, 0] + b[:, 2]).max(), (b[:, 1] + b[:, 3]).max()
         out.append(((int(x0), int(y0), int(x1 - x0), int(y1 - y0)), groups[key]))
     return out
+
+
+def _split_batches(batches: list[tuple[tuple[int, int, int, int], list[Plan]]], tasks: int
+                   ) -> list[tuple[tuple[int, int, int, int], list[Plan]]]:
+    """The batches cut into about ``tasks`` tasks of similar numbers of
+    plans, each piece keeping its batch's window: a candidate is read from
+    the same pixels, and measured alike, whichever piece holds it."""
+    total = sum(len(batch) for _, batch in batches)
+    size = max(1, math.ceil(total / max(tasks, 1)))
+    return [(window, batch[i: i + size]) for window, batch in batches for i in range(0, len(batch), size)]
 
 
 # -- records ----------------------------------------------------------------------------

@@ -24,6 +24,8 @@ from ..records import INTERNAL, Record
 from .settings import ScanSettings
 from .targetfit import DEFAULT_STAGES
 
+AUTO_SCENES_PER_WORKER = 2      # with workers chosen automatically, a pool scans several scenes from two a worker on
+
 
 @dataclass(frozen=True, eq=False)
 class SceneOutcome:
@@ -76,7 +78,7 @@ def acquisition_settings(settings: ScanSettings, stages: str | None) -> dict:
 
 
 def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, stages: str | None = DEFAULT_STAGES,
-                store: str | None = None, facts: Mapping[str, str | None] | None = None, workers: int = 1,
+                store: str | None = None, facts: Mapping[str, str | None] | None = None, workers: int | None = 1,
                 scheduler: str | None = None, progress: bool | None = None,
                 figures_dirs: Mapping[str, str] | None = None,
                 overviews: Mapping[str, str] | None = None) -> Iterator[SceneOutcome]:
@@ -100,8 +102,12 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
         What the files may not say, for every scene: ``acquired``,
         ``platform``, ``instrument``, ``band_name``
         (:func:`imgmtf.campaign.acquisitions.read_acquisition`).
-    workers : int, optional
-        Local worker processes (default 1: none, the work runs here).
+    workers : int or None, optional
+        Local worker processes (default 1: none, the work runs here); None
+        chooses: with several scenes, one worker per ``AUTO_SCENES_PER_WORKER``
+        scenes up to the available cores; with one, as
+        :func:`imgmtf.scene.measure.scan_scene` chooses for its candidates
+        and its fits.  The outcomes are the same whatever the workers.
     scheduler : str, optional
         A Dask distributed scheduler's address, or ``"local"`` for a local
         Dask cluster (:func:`imgmtf.parallel.run_tasks`).
@@ -158,9 +164,24 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
         return SceneOutcome(item[0], error=f"{item[0]}: internal error: {type(exc).__name__}: {exc}",
                             reason=INTERNAL)
     tasks = [(path, settings, stages, facts, figures_dirs.get(path), overviews.get(path)) for path in paths]
+    if workers is None:
+        workers = scenes_workers(len(paths))
     for _, outcome in run_tasks(_scan_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
                                 description="scanning scenes", on_error=lost, ordered=False):
         yield from _stored(outcome, store)
+
+
+def scenes_workers(scenes: int) -> int:
+    """The local workers chosen for ``scenes`` scenes scanned each on its
+    own worker (:func:`imgmtf.parallel.auto_workers`).
+
+    Examples
+    --------
+    >>> scenes_workers(1)
+    1
+    """
+    from ..parallel import auto_workers
+    return auto_workers(scenes, AUTO_SCENES_PER_WORKER) if scenes > 1 else 1
 
 
 def _scan_task(item) -> SceneOutcome:
@@ -169,7 +190,7 @@ def _scan_task(item) -> SceneOutcome:
 
 
 def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STAGES,
-             facts: Mapping[str, str | None] | None = None, *, workers: int = 1,
+             facts: Mapping[str, str | None] | None = None, *, workers: int | None = 1,
              scheduler: str | None = None, progress: bool | None = None,
              figures_dir: str | None = None, overview: str | None = None) -> SceneOutcome:
     """One scene scanned, its targets combined and fitted, and (with
@@ -208,7 +229,8 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         summaries = summarise_scan(records)
         summaries += section_rows(summaries)
         if get_kind(settings.target).fits_sensor and stages:
-            summaries += fit_targets(records, stages=stages, workers=workers, scheduler=scheduler, progress=progress)
+            summaries += fit_targets(records, stages=stages, workers=_fit_workers(records, workers),
+                                     scheduler=scheduler, progress=progress)
         summaries = recommend(summaries)
         if in_image_axes(raster_info(path), settings):
             records, summaries = _image_axes(records), _image_axes(summaries)
@@ -217,6 +239,16 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
                             reason=exc.reason)
     return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
+
+
+def _fit_workers(records: Sequence[Record], workers: int | None) -> int:
+    """The workers of a scene's fits: as given, or chosen (None) as its
+    candidates' were, by its accepted half-edges."""
+    if workers is not None:
+        return workers
+    from ..parallel import auto_workers
+    from .measure import AUTO_PLANS_PER_WORKER
+    return auto_workers(sum(r.ok for r in records), AUTO_PLANS_PER_WORKER)
 
 
 def _image_axes(records) -> list[Record]:
