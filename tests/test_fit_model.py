@@ -29,3 +29,24 @@ def test_the_sparse_jacobian_holds_exactly_the_dense_ones_entries(edges, monkeyp
     sparse = model.jacobian(z)
     assert sparse.shape == dense.shape and sparse.nnz == dense.shape[0] * (model.n_free + 3)
     np.testing.assert_array_equal(sparse.toarray(), dense)
+
+
+def test_edge_model_mtfs_are_each_edges_own(edges):
+    """The report's edges' model MTFs at Nyquist (with their bands) and
+    MTF50s, computed for all edges in arrays (in chunks), are what
+    model_mtf_band and first_crossing give edge by edge, bit for bit."""
+    from imgmtf.estimate.fit.report import edge_model_mtfs
+    from imgmtf.metrics import first_crossing
+    data = [edge_data(e, k, None) for k, e in enumerate(edges)]
+    model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    u = model.initial_vector()[: model.n_free]
+    covariance = np.diag(np.linspace(1e-4, 4e-4, model.n_free)) + 5e-5
+    sensors = fit_model.band_sensors(model, u)
+    bands, mtf50 = edge_model_mtfs(model, u, covariance, sensors, 0.9, chunk=3)
+    f = np.linspace(0.0, 2.0, 4001)
+    for e, d in enumerate(data):
+        own = fit_model.model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, 0.9,
+                                       sensors)
+        assert [float(v) for v in own] == bands[:, e].tolist()
+        assert bands[1, e] < bands[0, e] < bands[2, e]
+        assert mtf50[e] == first_crossing(f, np.abs(sensors[0].normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5)

@@ -8,7 +8,7 @@ from scipy.special import ndtr
 
 import imgmtf as im
 from imgmtf.sensor import stages as st
-from imgmtf.sensor.lines import PROBE_CY_PX, LineGrid, hermite, line_grid, reference_transfer
+from imgmtf.sensor.lines import PROBE_CY_PX, LineGrid, hermite, hermite_placement, line_grid, reference_transfer
 
 
 def test_hermite_is_exact_for_cubics_and_zero_beyond_the_grid():
@@ -191,3 +191,22 @@ def test_hermite_within_the_grid_and_beyond_alike():
         assert np.array_equal(a.reshape(2, 4), b[:, :4]) and not b[:, 4].any()
     np.testing.assert_allclose(within[0][0], d**3, atol=1e-12)
     np.testing.assert_allclose(within[1][0], 6 * d, atol=1e-12)
+
+
+def test_hermite_placement_interpolates_as_the_explicit_sum():
+    """The in-place gathers and sums give the four-term Hermite sum bit for
+    bit: one function or rows of them, with the curvature, some distances
+    beyond the grid."""
+    rng = np.random.default_rng(3)
+    values, slopes = rng.normal(size=(3, 40)), rng.normal(size=(3, 40))
+    d = rng.uniform(-1.0, 6.0, 25)
+    placement = hermite_placement(-0.5, 0.125, 40, d, curvature=True)
+    k, inside = placement.index, placement.inside
+    for rows in (values[0], values):
+        v, s = (rows, slopes[0]) if rows.ndim == 1 else (rows, slopes)
+        got = placement.interpolate(v, s, curvature=True)
+        for w, out in zip(placement.weights, got):
+            expected = np.zeros(v.shape[:-1] + d.shape)
+            expected[..., inside] = (w[0] * v[..., k] + w[1] * s[..., k] + w[2] * v[..., k + 1]
+                                     + w[3] * s[..., k + 1])
+            assert np.array_equal(out, expected)

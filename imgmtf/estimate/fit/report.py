@@ -3,11 +3,12 @@ each edge's misfit test, the MTF across and along track."""
 from __future__ import annotations
 
 import math
+from statistics import NormalDist
 
 import numpy as np
 
 from ...metrics import first_crossing
-from ...sensor.model import DIRECTIONS, direction_angle
+from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
 from .model import Model, band_sensors, model_mtf50_band, model_mtf_band, other_stages
@@ -63,6 +64,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
 
     edges, start_row = [], 0
     stepped = band_sensors(model, u)
+    nyquist_bands, model_mtf50s = edge_model_mtfs(model, u, covariance, stepped, confidence)
     for e, (d, r) in enumerate(zip(model.data, responses)):
         lo, hi, x0 = z[n + 3 * e: n + 3 * e + 3]
         bins = d.bins
@@ -71,14 +73,12 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
         chi = float(sample_chi_squares[e] / max(d.x.size - 3 - n / len(model.data), 1))
         # on the samples: the fit's bins, formed before x0 was known, straddle the misfit test's
         p, fraction = misfit_test(d.x - x0, sample_residuals[e], d.noise, abs(hi - lo), r)
-        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m,
-                                            confidence, stepped)
-        f = np.linspace(0.0, 2.0, 4001)
+        value, low, high = nyquist_bands[:, e]
         measured = d.measurement
         edge = EdgeFit(d.source, d.normal_angle_deg, direction_label(d.normal_angle_deg, 0.0),
                        "across" if abs(d.normal_angle_deg) < 45 else "along", d.gsd_m,
                        int(measured.rows_used), float(measured.snr), float(value), (float(low), float(high)),
-                       first_crossing(f, np.abs(sensor.normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5),
+                       float(model_mtf50s[e]),
                        float(np.interp(0.5, measured.frequencies_cy_px, measured.mtf)), d.noise, float(hi - lo),
                        (float(lo), float(hi)), float(x0), chi, p, fraction, bins.x, res, bins.count, measured)
         edges.append(edge)
@@ -113,6 +113,75 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     model.release()
     return SensorFit(sensor, start, tuple(parameters), tuple(correlations), reduced, tuple(edges), directions,
                      confidence, tuple(warnings), model, u, covariance)
+
+
+#: edges whose model MTFs :func:`edge_model_mtfs` computes in one array (rows of 4001 frequencies)
+EDGE_CHUNK = 64
+
+
+def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
+                    sensors: tuple[Sensor, list[tuple[float, Sensor]]], confidence: float,
+                    chunk: int = EDGE_CHUNK) -> tuple[np.ndarray, np.ndarray]:
+    """Each of ``model``'s edges' model MTF at Nyquist (0.5 cy/px) along
+    its normal with its delta-method band, and its model MTF50 (cy/px):
+    what :func:`.model.model_mtf_band` and :func:`imgmtf.metrics.first_crossing`
+    give edge by edge, the same numbers, with the transfers of many edges
+    computed in one array (a scene's thousands of edges: one call per
+    stage and chunk of edges, not per edge).
+
+    Parameters
+    ----------
+    model : Model
+        The fitted model.
+    u : numpy.ndarray
+        Its free stage coordinates.
+    covariance : numpy.ndarray
+        Their covariance (its first ``model.n_free`` rows and columns).
+    sensors : tuple
+        :func:`.model.band_sensors` of ``model`` and ``u``.
+    confidence : float
+        The band's confidence level.
+    chunk : int, optional
+        Edges per array of MTF50 frequencies (default :data:`EDGE_CHUNK`).
+
+    Returns
+    -------
+    bands : numpy.ndarray, shape (3, edges)
+        The MTF at Nyquist, its band's lower and upper bounds.
+    mtf50 : numpy.ndarray, shape (edges,)
+        The model's MTF50 along each edge's normal, cy/px (NaN where it
+        stays above 0.5 up to 2 cy/px).
+    """
+    sensor, steps = sensors
+    # as Sensor.normal_transfer forms them, edge by edge: f / GSD times the angle's cosine and sine
+    radians = [math.radians(check_angle(d.normal_angle_deg)) for d in model.data]
+    cos = np.array([math.cos(a) for a in radians])
+    sin = np.array([math.sin(a) for a in radians])
+    gsd = np.array([sensor._gsd(d.gsd_m) for d in model.data])
+
+    def mtf(s: Sensor, f: np.ndarray, rows: slice) -> np.ndarray:
+        f = f / (gsd[rows, None] if f.ndim > 1 else gsd[rows])
+        return np.abs(s.transfer(f * (cos[rows, None] if f.ndim > 1 else cos[rows]),
+                                 f * (sin[rows, None] if f.ndim > 1 else sin[rows])))
+
+    everyone = slice(None)
+    value = mtf(sensor, np.full(gsd.size, 0.5), everyone)
+    bands = np.stack([value, value, value])
+    n = model.n_free
+    if n:
+        grads = np.stack([(mtf(shifted, np.full(gsd.size, 0.5), everyone) - value) / h for h, shifted in steps],
+                         axis=-1)
+        # one edge's quadratic form at a time: batched, einsum may sum in another order
+        se = np.sqrt(np.maximum([np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g) for g in grads], 0.0))
+        z = NormalDist().inv_cdf(0.5 + confidence / 2)
+        bands[1], bands[2] = np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
+    f = np.linspace(0.0, 2.0, 4001)
+    mtf50 = np.empty(gsd.size)
+    for start in range(0, gsd.size, chunk):
+        rows = slice(start, start + chunk)
+        count = gsd[rows].size
+        mtf50[rows] = first_crossing(f, mtf(sensor, np.broadcast_to(f, (count, f.size)), rows), 0.5)
+    return bands, mtf50
 
 
 def value_error(stage: Stage, name: str, u: float, se_u: float, gsd: float) -> float:
