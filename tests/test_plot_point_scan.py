@@ -25,4 +25,4 @@ def test_each_target_is_marked_where_it_lies_kept_or_refused_and_counted_in_the_
     marks = {line.get_marker(): line.get_xydata().tolist() for line in ax.lines if line.get_marker() in ("o", "x")}
     assert marks == {"o": [[20.0, 40.0], [32.5, 40.0]], "x": [[44.0, 52.0]]}
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "target kept (2)" in legend and "target refused (1)\n1 faint" in legend
+    assert "target kept (2)" in legend and "target refused (1)\n  1 faint" in legend

@@ -199,3 +199,26 @@ def test_scenes_scanned_with_outputs_name_their_overviews_and_edge_figures_in_th
     plots = [row["plot"] for row in read_layer(store, "edges")]
     assert len(plots) == 2 and all(p.startswith("out/chip") and "/edges/" in p and figure_path(store, p).is_file()
                                    for p in plots)
+
+
+def test_scenes_finished_out_of_order_on_a_pool_are_yielded_in_the_order_given(monkeypatch):
+    from imgmtf import parallel
+    from imgmtf.scene.series import SceneOutcome, scan_scenes
+
+    def finishing_backwards(function, tasks, **options):     # a pool where the last scene ends first
+        for index in reversed(range(len(tasks))):
+            yield index, SceneOutcome(tasks[index][0], error="not scanned")
+    monkeypatch.setattr(parallel, "run_tasks", finishing_backwards)
+    paths = ["a.tif", "b.tif", "c.tif"]
+    assert [o.path for o in scan_scenes(paths, workers=2)] == paths
+
+    def interrupted_after_two(function, tasks, **options):  # c and b finish, then Ctrl-C
+        yield 2, SceneOutcome("c.tif", error="not scanned")
+        yield 1, SceneOutcome("b.tif", error="not scanned")
+        raise KeyboardInterrupt
+    monkeypatch.setattr(parallel, "run_tasks", interrupted_after_two)
+    seen = []
+    with pytest.raises(KeyboardInterrupt):
+        for outcome in scan_scenes(paths, workers=2):
+            seen.append(outcome.path)
+    assert seen == ["b.tif", "c.tif"]       # every finished scene reported before the interrupt goes on

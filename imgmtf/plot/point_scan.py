@@ -139,7 +139,8 @@ def plot_point_scan(overview: np.ndarray, scale: float, records: Iterable[Record
         handles.append(Line2D([], [], ls="none", marker="o", mfc="none", mec=ACCEPTED, ms=6,
                               label=f"target kept ({len(used)})"))
         if refused:
-            why = ", ".join(f"{n} {reason}" for reason, n in sorted(counts.items()))
+            # a reason a line: a star field's counts on one line ran off the figure
+            why = "\n".join(f"  {n} {reason}" for reason, n in sorted(counts.items()))
             handles.append(Line2D([], [], ls="none", marker="x", color=REFUSED_POINT, ms=6,
                                   label=f"target refused ({len(refused)})\n{why}"))
     quoted = ", ".join(f"{'*' if s.get('recommended') else ''}{_short(s)} "

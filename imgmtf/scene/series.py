@@ -123,7 +123,10 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
     Yields
     ------
     SceneOutcome
-        One per scene, in the order they complete (one scene: at once).
+        One per scene, in the order given (each stored as it is yielded;
+        a scene finished on a worker ahead of those before it waits for
+        them, except on Ctrl-C, when every finished scene is stored and
+        yielded at once).
 
     Raises
     ------
@@ -166,9 +169,24 @@ def scan_scenes(paths: Sequence[str], settings: ScanSettings | None = None, *, s
     tasks = [(path, settings, stages, facts, figures_dirs.get(path), overviews.get(path)) for path in paths]
     if workers is None:
         workers = scenes_workers(len(paths))
-    for _, outcome in run_tasks(_scan_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                                description="scanning scenes", on_error=lost, ordered=False):
-        yield from _stored(outcome, store)
+    # scenes finish in any order on a pool; each is stored and reported in
+    # the order given (what a reader of the output and of the docs expects),
+    # and on Ctrl-C every scene already finished is stored and reported
+    # before the interrupt goes on
+    finished: dict[int, SceneOutcome] = {}
+    following = 0
+    try:
+        for index, outcome in run_tasks(_scan_task, tasks, workers=workers, scheduler=scheduler,
+                                        progress=progress, description="scanning scenes", on_error=lost,
+                                        ordered=False):
+            finished[index] = outcome
+            while following in finished:
+                yield from _stored(finished.pop(following), store)
+                following += 1
+    except KeyboardInterrupt:
+        for index in sorted(finished):
+            yield from _stored(finished.pop(index), store)
+        raise
 
 
 def scenes_workers(scenes: int) -> int:
