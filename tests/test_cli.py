@@ -319,7 +319,7 @@ def test_band_all_on_an_rgba_photo_measures_the_colours_and_skips_alpha(run, tmp
     assert any("band 4 is alpha" in w for w in rows[0]["warnings"])
     text = run("measure", "--band", "all", tmp_path / "photo.png").stdout
     header = next(line for line in text.splitlines() if line.startswith("path "))
-    assert "band" in header.split() and "band 4 is alpha" in text
+    assert "band" in header.split() and "band 4 is alpha" in " ".join(text.split())    # warnings wrap at 120 columns
     assert not any("luminance" in w for row in rows for w in row["warnings"])
     row = json.loads(run("measure", "--format", "json", tmp_path / "photo.png").stdout)
     assert row["band"] == "luminance"
@@ -381,3 +381,13 @@ def test_the_closing_count_is_of_files_measured_not_of_a_point_array_s_direction
     result = run("measure", "--target", "points", "--intervals", "none", "--workers", 1, chip, tmp_path / "missing.tif")
     assert result.stdout.count("points.tif") == 2                  # two rows, across and along, of one file
     assert "1 measured, 1 failed" in result.stderr                 # it said "2 measured, 1 failed"
+
+
+def test_a_long_warning_under_a_row_wraps_to_the_table_width_under_its_words():
+    from imgmtf.cli.tables import TABLE_WIDTH, warning_text
+    warning = "the targets' sub-pixel phases are not spread evenly over the pixel " * 5 + "/a/very/long/path/" * 8
+    lines = warning_text(" " * 12, warning, hint=False).splitlines()
+    assert len(lines) > 2 and lines[0].startswith(" " * 12 + "warning: the targets'")
+    assert all(len(line) <= TABLE_WIDTH for line in lines[:-1])     # a path longer than a line is not cut
+    assert all(line.startswith(" " * 21) and line[21] != " " for line in lines[1:])
+    assert " ".join(" ".join(lines).split()[1:]) == " ".join(warning.split())

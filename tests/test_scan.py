@@ -161,7 +161,7 @@ def test_cli_scan_writes_csv_geojson_overview_and_edge_figures(tmp_path):
     rejected = [line for line in result.stdout.splitlines() if line.startswith("rejected ")]
     assert rejected and not any(f"{SCENE}:" in line for line in rejected)
     assert "warning: the image is not in sensor geometry" in result.stdout
-    assert "give the track's azimuth to label it (--track-azimuth DEG gives it)" in result.stdout
+    assert "give the track's azimuth to label it (--track-azimuth DEG gives it)" in " ".join(result.stdout.split())
     geo = json.loads((out / "targets.geojson").read_text())
     assert geo["imgmtf_coordinates"].startswith("longitude/latitude")
     first = geo["features"][0]

@@ -11,7 +11,7 @@ from .campaign import CampaignWriter, campaign_options
 from .errors import option_errors, reported_errors
 from .files import check_figure_file, check_output_file, save_figure
 from .options import FiniteFloat, length_option, parse_rois, read_roi_file, reading_options, roi_file_option
-from .tables import print_fit
+from .tables import print_fit, warning_text
 
 #: the kinds fit takes: those of the 1-D pipeline (points have their own)
 FIT_KINDS = tuple(name for name, kind in KINDS.items() if kind.measuring is not None)
@@ -207,6 +207,6 @@ def _fit_bars(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, ban
         click.echo(f"{source}: normal {angle:.2f} deg, model MTF at Nyquist {m:.4f} "
                    f"[{ci.low:.4f}, {ci.high:.4f}] ({confidence_pct}), MTF50 {f50:.4f} cy/px")
     for warning in result.warnings:
-        click.echo(f"  warning: {warning}")
+        click.echo(warning_text("  ", warning, hint=False))
     for path in written:
         click.echo(f"wrote {path}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from .hints import rejection_hint
-from .tables import SHORT_DIRECTIONS, interval_cell, num_cell, plural, snr_cell
+from .tables import SHORT_DIRECTIONS, interval_cell, num_cell, plural, snr_cell, warning_text
 
 
 def print_point_scan(scene, info, records, summaries, written, fmt) -> None:
@@ -38,7 +38,7 @@ def print_point_scan(scene, info, records, summaries, written, fmt) -> None:
                    f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {num_cell(r.get('fwhm_px'), 6, 3)} "
                    f"{num_cell(r.get('alias_weight'), 5, 2)}  {','.join(str(v) for v in r['roi'])}")
         for warning in r.get("warnings") or []:
-            click.echo(f"{'':>9} warning: {warning}")
+            click.echo(warning_text(" " * 10, warning, hint=False))
     for record in records:
         if not record.ok:
             r = record.to_dict()

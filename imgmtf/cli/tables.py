@@ -118,8 +118,18 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m" + ("" if fwhm is None else f", FWHM {fwhm:.4g} m"))
     if record["status"] == "untrusted":
         cells.append(f"{indent} error: {record['error']}")
-    cells += [f"{indent} warning: {hinted_warning(w)}" for w in record.get("warnings") or []]
+    cells += [warning_text(f"{indent} ", w) for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def warning_text(indent: str, warning: str, hint: bool = True) -> str:
+    """A warning (with its hint, unless ``hint`` is False) under a table's
+    row: wrapped to the table's :data:`TABLE_WIDTH` columns, its lines after
+    the first under its words (a whole warning on one line ran to 250
+    columns)."""
+    head = f"{indent}warning: "
+    return textwrap.fill(hinted_warning(warning) if hint else warning, TABLE_WIDTH, initial_indent=head,
+                         subsequent_indent=" " * len(head), break_long_words=False, break_on_hyphens=False)
 
 
 def direction_cell(direction: str | None) -> str:
@@ -228,7 +238,7 @@ def print_fit(result) -> None:
         click.echo(f"{names.get(name, name):<10} {d['mtf_nyquist']:7.4f} {f'[{lo:.4f},{hi:.4f}]':>17} "
                    f"{num_cell(d['mtf50_cy_px'], 11, 4)}{'' if d['constrained'] else '  (no edge: extrapolated)'}")
     for warning in result.warnings:
-        click.echo(f"warning: {hinted_warning(warning)}")
+        click.echo(warning_text("", warning))
 
 
 def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: bool = False) -> None:
@@ -260,7 +270,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
             click.echo(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
                        f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
             for warning in r.get("warnings") or []:
-                click.echo(f"{'':>{len(head)}} warning: {hinted_warning(warning)}")
+                click.echo(warning_text(" " * (len(head) + 1), warning))
         else:       # the scene's name heads the table: the message need not repeat it
             click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
     if not verbose:
@@ -347,7 +357,7 @@ def print_target_fits(fitted) -> None:
         for warning in r.get("warnings") or []:
             if warning not in warned:           # across and along share their fit's warnings
                 warned.add(warning)
-                click.echo(f"{'':>11} warning: {hinted_warning(warning)}")
+                click.echo(warning_text(" " * 12, warning))
                 if "does not fit" in warning and not hinted:
                     hinted = True
                     click.echo(f"{'':>11} (--fit-stages fits other stages; the combined and sections rows "
