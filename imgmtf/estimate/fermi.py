@@ -188,25 +188,12 @@ def _levenberg_marquardt(x, y, w, p, iterations, free=None):
     if held is not None:
         jac = jac * held
     for _ in range(iterations):
-        weighted = np.swapaxes(jac * w[..., None], 1, 2)
-        jtj = weighted @ jac
-        jtr = (weighted @ resid[..., None])[..., 0]
-        diag = np.einsum("rii->ri", jtj)
-        damped = jtj + (lam[:, None] * np.maximum(diag, 1e-12))[:, :, None] * np.eye(4)
-        try:
-            step = np.linalg.solve(damped, jtr[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            step = np.stack([np.linalg.lstsq(m, v, rcond=None)[0] for m, v in zip(damped, jtr)])
+        step = _solve_rows(*_damped_normal_equations(jac, w, resid, lam))
         trial = p + step
         trial_cost, trial_jac, trial_resid = _evaluate(x, y, w, trial)
         if held is not None:
             trial_jac = trial_jac * held
-        better = np.isfinite(trial_cost) & (trial_cost < cost)
-        p = np.where(better[:, None], trial, p)
-        cost = np.where(better, trial_cost, cost)
-        jac = np.where(better[:, None, None], trial_jac, jac)
-        resid = np.where(better[:, None], trial_resid, resid)
-        lam = np.where(better, lam / 3.0, lam * 4.0)
+        p, cost, jac, resid, lam = _accepted((p, cost, jac, resid), (trial, trial_cost, trial_jac, trial_resid), lam)
         # converged: no row proposes to move its edge by more than 1e-5 px
         if np.all((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5)):
             break
@@ -224,20 +211,9 @@ def _levenberg_marquardt_stacked(x, y, w, p, iterations, edges):
     cost, jac, resid = _evaluate(x, y, w, p)
     ids = edges
     for _ in range(iterations):
-        weighted = np.swapaxes(jac * w[..., None], 1, 2)
-        jtj = weighted @ jac
-        jtr = (weighted @ resid[..., None])[..., 0]
-        diag = np.einsum("rii->ri", jtj)
-        damped = jtj + (lam[:, None] * np.maximum(diag, 1e-12))[:, :, None] * np.eye(4)
-        step = _solve_by_edge(damped, jtr, ids)
+        step = _solve_by_edge(*_damped_normal_equations(jac, w, resid, lam), ids)
         trial = p + step
-        trial_cost, trial_jac, trial_resid = _evaluate(x, y, w, trial)
-        better = np.isfinite(trial_cost) & (trial_cost < cost)
-        p = np.where(better[:, None], trial, p)
-        cost = np.where(better, trial_cost, cost)
-        jac = np.where(better[:, None, None], trial_jac, jac)
-        resid = np.where(better[:, None], trial_resid, resid)
-        lam = np.where(better, lam / 3.0, lam * 4.0)
+        p, cost, jac, resid, lam = _accepted((p, cost, jac, resid), (trial, *_evaluate(x, y, w, trial)), lam)
         # an edge has converged when none of its rows proposes to move its edge by more than 1e-5 px
         moving = ~((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5))
         going = np.bincount(ids, weights=moving, minlength=int(edges[-1]) + 1)[ids] > 0
@@ -251,21 +227,48 @@ def _levenberg_marquardt_stacked(x, y, w, p, iterations, edges):
     return out
 
 
+def _damped_normal_equations(jac, w, resid, lam):
+    """Every row's Levenberg-Marquardt system: J'WJ damped by ``lam`` times
+    its diagonal, and J'Wr."""
+    weighted = np.swapaxes(jac * w[..., None], 1, 2)
+    jtj = weighted @ jac
+    jtr = (weighted @ resid[..., None])[..., 0]
+    diag = np.einsum("rii->ri", jtj)
+    return jtj + (lam[:, None] * np.maximum(diag, 1e-12))[:, :, None] * np.eye(4), jtr
+
+
+def _accepted(state, trial, lam):
+    """Each row's (parameters, cost, Jacobian, residuals) and damping after
+    a trial step: the trial's where it lowered the cost (damping / 3), the
+    row's own before where not (damping x 4)."""
+    p, cost, jac, resid = state
+    trial_p, trial_cost, trial_jac, trial_resid = trial
+    better = np.isfinite(trial_cost) & (trial_cost < cost)
+    return (np.where(better[:, None], trial_p, p), np.where(better, trial_cost, cost),
+            np.where(better[:, None, None], trial_jac, jac), np.where(better[:, None], trial_resid, resid),
+            np.where(better, lam / 3.0, lam * 4.0))
+
+
+def _solve_rows(damped: np.ndarray, jtr: np.ndarray) -> np.ndarray:
+    """Every row's step: all at once, or, where a matrix is singular, each
+    row by least squares."""
+    try:
+        return np.linalg.solve(damped, jtr[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.stack([np.linalg.lstsq(m, v, rcond=None)[0] for m, v in zip(damped, jtr)])
+
+
 def _solve_by_edge(damped: np.ndarray, jtr: np.ndarray, ids: np.ndarray) -> np.ndarray:
     """Every row's step, as its edge's own fit solves it: all at once, or,
-    where a matrix is singular, edge by edge (an edge with a singular row
-    solving each of its rows by least squares, as alone)."""
+    where a matrix is singular, edge by edge (:func:`_solve_rows`, as
+    alone)."""
     try:
         return np.linalg.solve(damped, jtr[..., None])[..., 0]
     except np.linalg.LinAlgError:
         step = np.empty_like(jtr)
         for edge in np.unique(ids):
             rows = ids == edge
-            try:
-                step[rows] = np.linalg.solve(damped[rows], jtr[rows][..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                step[rows] = np.stack([np.linalg.lstsq(m, v, rcond=None)[0]
-                                       for m, v in zip(damped[rows], jtr[rows])])
+            step[rows] = _solve_rows(damped[rows], jtr[rows])
         return step
 
 
