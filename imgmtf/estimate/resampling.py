@@ -165,8 +165,28 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     """``binomials`` applied to the correlations of ``moments`` (..., n, grid)
     with every power 0..n-1 of ``offsets``: (..., n, grid)."""
     n = moments.shape[-2]
-    shifted = np.stack([correlate1d(moments, offsets ** p) for p in range(n)], axis=-3)
+    # power p meets only the moments its binomials take (about half of
+    # them): the others' correlations are left at zero, which the product
+    # multiplies by a zero binomial as it did their values
+    shifted = np.zeros((*moments.shape[:-2], n, n, moments.shape[-1]))
+    for p, (lo, hi) in enumerate(_moments_met(binomials.tobytes(), n)):
+        if hi > lo:
+            shifted[..., p, lo: hi, :] = correlate1d(moments[..., lo: hi, :], offsets ** p)
     return binomials @ shifted.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
+
+
+@functools.lru_cache(maxsize=32)
+def _moments_met(binomials: bytes, n: int) -> tuple[tuple[int, int], ...]:
+    """For each power p of the offsets, the range [lo, hi) of the moments
+    j whose correlation with it a nonzero binomial takes (column p n + j
+    of the (n, n * n) matrix given as its bytes)."""
+    columns = np.frombuffer(binomials).reshape(n, n, n).any(axis=0)     # (p, j)
+    out = []
+    for met in columns:
+        j = np.nonzero(met)[0]
+        lo, hi = (int(j[0]), int(j[-1]) + 1) if j.size else (0, 0)
+        out.append((lo, hi))
+    return tuple(out)
 
 
 @functools.lru_cache(maxsize=32)
