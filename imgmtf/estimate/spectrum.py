@@ -23,6 +23,7 @@ frequencies where a divisor is smaller are reported as NaN.
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -77,8 +78,50 @@ def with_transfer(own: Callable[[np.ndarray], np.ndarray],
 
 def edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
     """Transfer of an edge estimator's own steps: the central difference
-    with ``step`` (sinc(2 f step)) times the resampling ``transfer``."""
-    return with_transfer(lambda f: np.sinc(2 * f * step), transfer)
+    with ``step`` (sinc(2 f step)) times the resampling ``transfer``.
+
+    Edges of one scan share their step and their resampling's transfer
+    (one per window width), and read the divisor on the same frequencies
+    (the transform's bins, the gate's grids): one divisor serves them all
+    and keeps its last values (:func:`remembered`)."""
+    return _edge_divisor(step, transfer)
+
+
+@functools.lru_cache(maxsize=64)
+def _edge_divisor(step: float, transfer: Callable | None) -> Callable[[np.ndarray], np.ndarray]:
+    return remembered(with_transfer(lambda f: np.sinc(2 * f * step), transfer))
+
+
+REMEMBERED = 8          # a divisor's frequency grids whose values it keeps
+
+
+def remembered(function: Callable[[np.ndarray], np.ndarray], size: int = REMEMBERED
+               ) -> Callable[[np.ndarray], np.ndarray]:
+    """``function`` of an array of frequencies (cy/px), elementwise, with
+    its values on the last ``size`` grids it was asked for kept: asked
+    again for the same frequencies it returns a copy of the same values.
+
+    Examples
+    --------
+    >>> calls = []
+    >>> square = remembered(lambda f: calls.append(1) or f * f)
+    >>> [float(v) for v in square(np.array([1.0, 2.0]))], [float(v) for v in square(np.array([1.0, 2.0]))]
+    ([1.0, 4.0], [1.0, 4.0])
+    >>> len(calls)
+    1
+    """
+    kept: dict[tuple, np.ndarray] = {}
+
+    def values(f):
+        f = np.atleast_1d(np.asarray(f, float))
+        key = (f.shape, f.tobytes())
+        found = kept.get(key)
+        if found is None:
+            found = kept[key] = function(f)
+            while len(kept) > size:
+                kept.pop(next(iter(kept)), None)
+        return found.copy()
+    return values
 
 
 def restore_lsf(profile: np.ndarray, x: np.ndarray, divisor: Callable,
