@@ -109,3 +109,18 @@ def test_penalised_spline_refuses_knots_too_close_and_the_resampler_merges_them(
     # the resampler takes samples within 1e-7 px as one knot
     r = resample_profile(x, y, method="spline", half_range=10)
     assert np.nanmax(np.abs(r.values - np.tanh(r.grid))) < 0.01
+
+
+def test_window_sums_skip_only_moments_no_binomial_takes():
+    # the correlations a zero binomial multiplies are left out: the same floats as all of them
+    from imgmtf.estimate._correlation import correlate1d
+    from imgmtf.estimate.resampling import _binomial_shifts, _shifted_powers
+    rng = np.random.default_rng(5)
+    offsets = np.arange(-3, 4) / 3.5
+    for moments, adjoint in ((rng.normal(size=(9, 60)), False), (rng.normal(size=(2, 5, 60)), True)):
+        n = moments.shape[-2]
+        binomials = _binomial_shifts(n, adjoint)
+        shifts = -offsets if adjoint else offsets
+        every = np.stack([correlate1d(moments, shifts ** p) for p in range(n)], axis=-3)
+        full = binomials @ every.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
+        assert _shifted_powers(moments, shifts, binomials).tobytes() == full.tobytes()

@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from ..errors import ImageContentError, TargetNotFoundError
+from ._order import median, percentile
 
 _THETA_STEP_DEG = 0.5          # the seed needs ~1 deg; the row fits refine it
 GAUSSIAN_TRUNCATE = 4.0        # the smoothing kernel reaches this many sigma (as scikit-image's)
@@ -87,14 +88,14 @@ def find_lines(image: np.ndarray, max_lines: int = 4, sigma: float = 2.0) -> lis
                      ln.votes)
                 for ln in find_lines(small, max_lines, sigma)]
     valid = np.isfinite(image)
-    lo, hi = np.percentile(image[valid], [1, 99])
+    lo, hi = percentile(image[valid], [1, 99])
     if not hi > lo:
         raise ImageContentError("the image is flat: no contrast to measure")
     dx, dy = _gradients(np.where(valid, (image - lo) / (hi - lo), 0.0), valid, sigma)
     inside = _interior(valid)
     edges = _canny(dx, dy, 0.1, 0.2, inside)
     if np.count_nonzero(edges) < 5:
-        low, high = np.percentile(np.hypot(dx, dy), [50.0, 80.0])      # weak edges: quantiles instead
+        low, high = percentile(np.hypot(dx, dy), [50.0, 80.0])      # weak edges: quantiles instead
         edges = _canny(dx, dy, float(low), float(high), inside)
     if np.count_nonzero(edges) < 5:
         return []
@@ -280,23 +281,9 @@ def robust_noise(image: np.ndarray) -> float:
     that their differences cannot wrap."""
     diff = np.diff(np.asarray(image, float), axis=1)
     diff = diff[np.isfinite(diff)]
-    mad = _median(np.abs(diff - _median(diff)))
+    mad = median(np.abs(diff - median(diff)))
     # a noise-free (or coarsely quantised) image has MAD 0: its noise is nil
     return max(float(1.4826 * mad / np.sqrt(2.0)), 1e-12)
-
-
-def _median(values: np.ndarray) -> float:
-    """``np.median`` of finite values, as it computes it (the middle value,
-    or the mean of the two middle ones), without its check for NaN: a
-    scan's thousand chips pay np.median's overhead, twice as long as the
-    partition itself, for nothing."""
-    n = values.size
-    if n == 0:
-        return np.median(values)          # NaN, with NumPy's warning
-    if n % 2:
-        return np.partition(values, n // 2)[n // 2]
-    middle = np.partition(values, (n // 2 - 1, n // 2))
-    return (middle[n // 2 - 1] + middle[n // 2]) / 2
 
 
 def step_contrast(image: np.ndarray, line: Line) -> float:

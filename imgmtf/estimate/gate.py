@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MultipleTargetsError, UnsuitableTargetError
+from ._order import median
 from .bar_pair import PAIR_REASON, pair_in_profile
 from .phase import without_phase_bias
 
@@ -291,7 +292,7 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
     fraction = kept.sum() / max(rows.size, 1)
     line = geometry.slope * rows[kept] + geometry.intercept
     resid = without_phase_bias(loc[kept] - line, line)
-    scatter = float(1.4826 * np.median(np.abs(resid))) if resid.size else math.inf
+    scatter = float(1.4826 * median(np.abs(resid))) if resid.size else math.inf
     limit = max(MAX_LINE_SCATTER_PX, 3.0 * expected_scatter_px)
     checks = [
         Check("not-straight", fraction >= MIN_ROWS_ON_LINE,

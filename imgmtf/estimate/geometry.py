@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TargetNotFoundError, UnsuitableTargetError
+from ._order import median, quantile
 from .detection import Line
 from .fermi import FermiFit, FermiRows, fit_fermi
 from .resampling import sample_gap
@@ -86,7 +87,7 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = EDGE_F
     a, c = np.abs(fit.params[fit.ok, 0]), np.abs(fit.params[fit.ok, 2])
     with np.errstate(divide="ignore", invalid="ignore"):
         sd = fit.rms[fit.ok] * np.sqrt(30.0 * np.maximum(c, 0.05)) / a
-    expected = float(np.median(sd)) if sd.size else 0.0
+    expected = float(median(sd)) if sd.size else 0.0
     return fit_line(rows[usable][fit.ok], fit.location[fit.ok], transposed, expected)
 
 
@@ -118,7 +119,7 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,
     for _ in range(4):
         slope, intercept = np.polyfit(y[keep], x[keep], 1)
         resid = x - (slope * y + intercept)
-        mad = 1.4826 * np.median(np.abs(resid[keep] - np.median(resid[keep])))
+        mad = 1.4826 * median(np.abs(resid[keep] - median(resid[keep])))
         new_keep = np.abs(resid) <= max(4.0 * mad, 0.05)
         if np.array_equal(new_keep, keep) or new_keep.sum() < 5:
             break
@@ -184,7 +185,7 @@ def profile_samples(work: np.ndarray, geometry: TargetGeometry,
     valid = np.isfinite(v)
     # how far each row's data reach on either side of the line (left-out pixels skipped)
     reach = np.minimum(-np.where(valid, d, np.inf).min(axis=1), np.where(valid, d, -np.inf).max(axis=1))
-    half_range = min(float(np.quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
+    half_range = min(float(quantile(reach, 0.25)), MAX_HALF_RANGE_PX)
     if half_range < MIN_HALF_RANGE_PX:
         raise UnsuitableTargetError(
             f"the {name} is {max(half_range, 0):.1f} px from the image border; at least "

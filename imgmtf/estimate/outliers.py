@@ -15,6 +15,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from ._order import percentile
+
 OUTLIER_NOISE = 8.0           # beyond every neighbour by this many noise sd...
 OUTLIER_CONTRAST = 0.1        # ...and by this fraction of the chip's contrast
 
@@ -38,7 +40,7 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
     finite = np.isfinite(data)
     if finite.sum() < 9:
         return np.zeros(data.shape, bool)
-    low, high = np.percentile(data[finite], [1.0, 99.0])
+    low, high = percentile(data[finite], [1.0, 99.0])
     margin = max(OUTLIER_NOISE * noise, OUTLIER_CONTRAST * (high - low))
     if not margin > 0:
         return np.zeros(data.shape, bool)

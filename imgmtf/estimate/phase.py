@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._order import median
+
 PHASE_HARMONICS = 2             # the bias as a function of sub-pixel phase: this many harmonics
 MIN_PHASE_ROWS = 20
 
@@ -38,7 +40,7 @@ def phase_bias(resid: np.ndarray, line: np.ndarray, fit: np.ndarray | None = Non
     for _ in range(3):
         coef, *_ = np.linalg.lstsq(design[fit] * weights[:, None], resid[fit] * weights, rcond=None)
         out = resid[fit] - design[fit] @ coef
-        scale = max(1.4826 * float(np.median(np.abs(out))), 1e-9)
+        scale = max(1.4826 * float(median(np.abs(out))), 1e-9)
         weights = 1.0 / np.sqrt(np.maximum(1.0, np.abs(out) / (1.5 * scale)))
     return design @ coef
 

@@ -11,6 +11,7 @@ from statistics import NormalDist
 
 import numpy as np
 
+from ._order import median
 from .gate import Check, not_run
 
 SATURATED_SIDE = 0.10           # fraction of a side's samples at a saturation limit
@@ -57,7 +58,7 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
     if monotone:
         halves = (distance < centre, distance > centre)      # the sides are listed left, right
         if contrast is None:
-            contrast = abs(float(np.median(values[halves[1]]) - np.median(values[halves[0]])))
+            contrast = abs(float(median(values[halves[1]]) - median(values[halves[0]])))
         for (name, mask, _), half, other in zip(sides, halves, halves[::-1]):
             held = _held_plateau(distance, values, half, other, centre, name, contrast, quantum)
             if held is not None:
@@ -70,7 +71,7 @@ def saturation_checks(distance, values, centre, rise_px, sides, limits, quantum,
                 checks.append(_pile_up(name, values, mask, quantum))
     if bright_core is not None and bright_core.sum() >= 5:
         v = values[bright_core]
-        background = float(np.median(values[~bright_core]))
+        background = float(median(values[~bright_core]))
         outward = 1.0 if v.mean() >= background else -1.0
         extreme = v.max() if outward > 0 else v.min()
         if limits is not None and (extreme <= limits[0] or extreme >= limits[1]):
@@ -96,7 +97,7 @@ def _held_plateau(distance, values, half, other, centre, name, contrast, quantum
     v, sv = values[half], s[half]
     if v.size < 5 or not other.any() or contrast <= 0:
         return None
-    outward = 1.0 if v.mean() >= np.median(values[other]) else -1.0
+    outward = 1.0 if v.mean() >= median(values[other]) else -1.0
     extreme = v.max() if outward > 0 else v.min()
     # r0: the nearest distance beyond which the side holds its extreme
     # (a generator's last-digit wobble near the plateau aside)
@@ -109,7 +110,7 @@ def _held_plateau(distance, values, half, other, centre, name, contrast, quantum
         return None
     r0 = float(sv[band >= first].min())
     so, vo = s[other], values[other]
-    level = float(np.median(vo[so >= 0.5 * (r0 + so.max())])) if (so >= r0).any() else float(np.median(vo))
+    level = float(median(vo[so >= 0.5 * (r0 + so.max())])) if (so >= r0).any() else float(median(vo))
     gap = _gap_at(so, vo, r0, level, contrast)
     if gap is None:
         return None
@@ -131,7 +132,7 @@ def _gap_at(distance, values, at_px, level, scale) -> float | None:
         near = np.abs(distance - at_px) <= width
     if not near.any():
         return None
-    return abs(float(np.median(values[near])) - level) / scale
+    return abs(float(median(values[near])) - level) / scale
 
 
 def _flat_top(peak_values, extreme, outward, height) -> Check:
@@ -172,7 +173,7 @@ def _held_top(distance, values, centre, extreme, outward, quantum, bar_edge_px=N
     if top.sum() < MIN_HELD_SAMPLES:
         return None
     far = s >= 0.75 * s.max()
-    background = float(np.median(values[far]))
+    background = float(median(values[far]))
     height = outward * (extreme - background)
     if height <= 0:
         return None
@@ -212,7 +213,7 @@ def _pile_up(name, values, mask, quantum, contrast=None) -> Check:
     sigma (phi(z) - z P(Z > z)) (a generator's last-digit wobble at a
     flat white level piles up so, harmlessly)."""
     v = values[mask]
-    outward = 1.0 if v.mean() >= np.median(values[~mask]) else -1.0
+    outward = 1.0 if v.mean() >= median(values[~mask]) else -1.0
     extreme = v.max() if outward > 0 else v.min()
     at_extreme = v == extreme
     inside = outward * (extreme - v)
@@ -225,7 +226,7 @@ def _pile_up(name, values, mask, quantum, contrast=None) -> Check:
     share = float(at_extreme.mean())
     clipped = share > 0.05 and ratio > PILE_UP
     if clipped and contrast and share < 0.5:
-        sigma = 1.4826 * float(np.median(np.abs(v - np.median(v))))
+        sigma = 1.4826 * float(median(np.abs(v - median(v))))
         z = NormalDist().inv_cdf(1.0 - share)
         clipped = sigma * (NormalDist().pdf(z) - z * share) > MIRROR_CLIP * contrast
     return Check("saturated", not clipped,
