@@ -31,3 +31,15 @@ def test_nan_and_empty_as_numpy():
         warnings.simplefilter("ignore", RuntimeWarning)
         assert np.isnan(median([1.0, np.nan, 2.0])) and np.isnan(median([]))
         assert np.isnan(quantile([1.0, np.nan, 2.0], [0.1, 0.9])).all()
+
+
+def test_distinct_is_numpys_unique():
+    from imgmtf.estimate._order import distinct
+    rng = np.random.default_rng(6)
+    for values in (rng.integers(0, 40, 300), rng.integers(-7, 7, 9).astype(np.int32), np.array([5]),
+                   rng.integers(0, 10**9, 20), rng.normal(size=12)):
+        ids, inverse = distinct(values, return_inverse=True)
+        want, want_inverse = np.unique(values, return_inverse=True)
+        assert ids.dtype == want.dtype and ids.tobytes() == want.tobytes()
+        assert inverse.dtype == want_inverse.dtype and inverse.tobytes() == want_inverse.tobytes()
+        assert distinct(values).tobytes() == want.tobytes()

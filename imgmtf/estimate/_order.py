@@ -117,3 +117,33 @@ def percentile(values: ArrayLike, q: ArrayLike) -> np.ndarray | np.float64:
     [1.0, 99.0]
     """
     return quantile(values, np.true_divide(np.asanyarray(q, float), 100))
+
+
+def distinct(values: np.ndarray, return_inverse: bool = False):
+    """``np.unique(values)`` of a 1-D array of integers (a profile's row
+    numbers), and with ``return_inverse`` each value's index among them:
+    counted in bins (np.unique sorts, and costs some 40 microseconds on
+    a chip's thousand samples).  Other arrays, and integers spread far
+    wider than they are many, are handed to np.unique.
+
+    Examples
+    --------
+    >>> distinct(np.array([3, 1, 3, 2]))
+    array([1, 2, 3])
+    >>> ids, inverse = distinct(np.array([3, 1, 3, 2]), return_inverse=True)
+    >>> ids[inverse].tolist()
+    [3, 1, 3, 2]
+    """
+    values = np.asarray(values)
+    if values.ndim != 1 or values.size == 0 or values.dtype.kind not in "iu":
+        return np.unique(values, return_inverse=return_inverse)
+    low, high = int(values.min()), int(values.max())
+    if high - low > 4 * values.size + 1024:
+        return np.unique(values, return_inverse=return_inverse)
+    offset = values - low
+    present = np.bincount(offset) > 0
+    ids = (np.flatnonzero(present) + low).astype(values.dtype, copy=False)
+    if not return_inverse:
+        return ids
+    index = np.cumsum(present) - 1
+    return ids, index[offset]

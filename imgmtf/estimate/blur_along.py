@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from ._order import distinct
 from .evidence import Evidence
 from .gate import Check, not_run
 
@@ -42,7 +43,7 @@ def uniform_blur(ev: Evidence) -> tuple[list[Check], list[str]]:
     Returns the ``varying-blur`` check and a warning for a small but
     significant change.
     """
-    rows = np.unique(ev.rows)
+    rows = distinct(ev.rows)
     if rows.size < 2 * MIN_GROUP_ROWS:
         return [not_run("varying-blur", f"the {ev.name} crosses {rows.size} rows (at least "
                         f"{2 * MIN_GROUP_ROWS} needed to compare its halves)")], []
@@ -104,7 +105,7 @@ def group_widths_many(evidence: list[Evidence]) -> list[list | None]:
     out: list[list | None] = [None] * len(evidence)
     inputs = {}
     for k, ev in enumerate(evidence):
-        rows = np.unique(ev.rows)
+        rows = distinct(ev.rows)
         if rows.size >= 2 * MIN_GROUP_ROWS:
             groups = _group_masks(ev, _splits(rows))
             inputs[k] = (len(groups), _group_inputs(ev, groups))

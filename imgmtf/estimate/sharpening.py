@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._order import distinct
 from .evidence import Evidence
 from .gate import MAX_MTF_EXCESS, Check
 
@@ -158,7 +159,7 @@ def _lobe_change(ev: Evidence) -> str | None:
     no side's overshoot can be compared (too few rows or samples), that is
     said too: an unchecked consistency is no evidence of one kernel."""
     s = ev.distance_px - ev.centre_px
-    rows = np.unique(ev.rows)
+    rows = distinct(ev.rows)
     unchecked = ("its overshoot could not be compared between the halves of its rows (too few rows or samples "
                  "near it): one kernel along it is not shown")
     if rows.size < 4:

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..._stats import t_quantile
 from ...errors import ParameterError
+from .._order import distinct
 from ..spectrum import NYQUIST
 from .interval import Estimate, FigureIntervals, Interval
 from .width import WidthReading
@@ -47,7 +48,7 @@ def influence_sd(influence: np.ndarray, rows: np.ndarray) -> tuple[float, int]:
 def influence_sds(influences: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, int]:
     """:func:`influence_sd` of every row of ``influences`` (estimates,
     samples) at once.  Returns (sds, number of rows)."""
-    ids, inverse = np.unique(rows, return_inverse=True)
+    ids, inverse = distinct(np.asarray(rows), return_inverse=True)
     n, m = ids.size, influences.shape[0]
     bins = (inverse[None, :] + n * np.arange(m)[:, None]).ravel()
     per_row = np.bincount(bins, weights=influences.ravel(), minlength=m * n).reshape(m, n)
