@@ -401,13 +401,14 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
         resid = v - design @ coef
         across, along_target = abs(coef[2]) * np.ptp(ss) / contrast, abs(coef[3]) * np.ptp(t) / contrast
         trend, way = max((across, "across"), (along_target, "along"))
-        texture = math.sqrt(max(np.var(resid) - pixel_noise ** 2, 0.0)) / contrast
+        scatter = np.var(resid)
+        texture = math.sqrt(max(scatter - pixel_noise ** 2, 0.0)) / contrast
         bands = np.floor(ss).astype(int)
         counts = np.bincount(bands)
         sums = np.bincount(bands, weights=resid)
         full = counts >= 10
         band_means = np.abs(sums[full] / counts[full])
-        band_noise = np.sqrt(np.var(resid) / counts[full])
+        band_noise = np.sqrt(scatter / counts[full])
         checks += [
             Check("non-uniform", trend <= MAX_SIDE_TREND,
                   f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast {way} the target (at "

@@ -233,7 +233,10 @@ def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray
     lead = features.shape[:-1]
     flat = features.reshape(-1, features.shape[-1])
     if flat.shape[0] <= 16:
-        sums = np.stack([np.bincount(bins, weights=f, minlength=n_bins) for f in flat])
+        # one count over every feature's bins side by side: each bin gathers
+        # its samples in their order, as a count of its feature alone does
+        where = (bins[None, :] + n_bins * np.arange(flat.shape[0])[:, None]).ravel()
+        sums = np.bincount(where, weights=flat.ravel(), minlength=flat.shape[0] * n_bins).reshape(-1, n_bins)
     else:
         from scipy import sparse  # only for stacks of weights (the bootstrap)
         onehot = sparse.csr_array((np.ones(bins.size), (np.arange(bins.size), bins)),
