@@ -1,6 +1,7 @@
 """The campaign report and the commands that fill a store: report's files,
 a self-contained page, the figures; measure and fit with --campaign."""
 import csv
+import dataclasses
 import re
 from types import SimpleNamespace
 
@@ -74,7 +75,7 @@ def test_the_report_writes_trends_and_a_self_contained_page(written):
     assert all(s.startswith("data:image/png;base64,") for s in sources)
     assert len(sources) == 2 + 1 + 5     # a figure per direction, the overview, each acquisition's edge figure
     assert "1 without an acquisition time" in page and "no time" in page
-    assert "Simsat-1, band pan: across-track, fit" in page
+    assert "Simsat-1, band pan: across-track, scene, fit" in page
 
 
 def test_a_baseline_sensor_gives_the_prelaunch_values(written):
@@ -118,7 +119,7 @@ def test_the_report_command(tmp_path):
     result = CliRunner().invoke(main, ["report", str(store), "--out", str(tmp_path / "per"),
                                        "--requirement", "across=0.25,along=0.1"])
     assert result.exit_code == 0, result.output
-    assert "drift: Simsat-1, band pan, across-track, fit: MTF at Nyquist -0.0200/year" in result.output
+    assert "drift: Simsat-1, band pan, across-track, scene, fit: MTF at Nyquist -0.0200/year" in result.output
     assert (tmp_path / "per" / "report.html").is_file() and (tmp_path / "per" / "trend.csv").is_file()
     missing = CliRunner().invoke(main, ["report", str(tmp_path / "none.gpkg"), "--out", str(tmp_path / "o")])
     assert missing.exit_code == 1 and "none.gpkg: no such campaign store" in missing.output
@@ -251,13 +252,13 @@ def test_the_drift_table_quotes_the_recommended_rows_and_marks_the_others(real_l
     assert re.findall(r'<span class="(pass|fail|undecided)">', table) == ["fail", "fail"]
     # one figure: the recommended series of Sat-A across track, and Sat-B's single point; nothing misfit drawn
     drawn = re.findall(r'<div class="figure"><h3>([^<]*)</h3>', page)
-    assert drawn == ["Sat-A: across-track, sections (bracket)", "Sat-B: across-track, combined"]
+    assert drawn == ["Sat-A: across-track, scene, sections (bracket)", "Sat-B: across-track, scene, combined"]
 
 
 def test_the_command_says_which_directions_have_only_misfit_rows(real_like):
     assert "note: Sat-A, along-track: only misfit rows, nothing to quote or trend" in real_like.output
     assert real_like.output.count("note:") == 1
-    assert "drift: Sat-A, across-track, sections: MTF at Nyquist -0.0200/year" in real_like.output
+    assert "drift: Sat-A, across-track, scene, sections: MTF at Nyquist -0.0200/year" in real_like.output
 
 
 def test_trend_csv_holds_every_group_with_method_assumption_recommended_and_misfit(real_like):
@@ -269,6 +270,27 @@ def test_trend_csv_holds_every_group_with_method_assumption_recommended_and_misf
                    ("Sat-A", "across-track", "sections", "bracket", "True", "False", True, "fail"),
                    ("Sat-A", "along-track", "fit", "", "False", "True", False, ""),
                    ("Sat-B", "across-track", "combined", "", "True", "False", False, "fail")]
+
+
+def test_a_scenes_and_a_targets_recommended_rows_are_told_apart_by_their_scope(tmp_path):
+    # a scan recommends one row per scope: here the scene's sections and its target's fit, equal values
+    store = tmp_path / "site.gpkg"
+    for k in range(3):
+        value = 0.3 - 0.01 * k
+        target = dataclasses.replace(direction_row("across-track", value, "fit", recommended=True),
+                                     site={"scope": "target", "target_id": 1})
+        rows = [direction_row("across-track", value, "sections", recommended=True, assumption="bracket"), target]
+        write_acquisition(store, Acquisition(f"a{k}", f"s{k}.tif", "0" * 64, f"{2020 + k}-06-01", "S"), [], rows)
+    written = write_report(store, tmp_path / "report")
+    assert sorted((t.scope, t.method) for t in written.trends if t.figure == "mtf_nyquist") == [
+        ("scene", "sections"), ("targets", "fit")]
+    page = open(written.report_html, encoding="utf-8").read()
+    table = page[page.index("<h2>Drift of the MTF at Nyquist"):page.index("<h2>Figures of merit")]
+    assert "<th>scope</th>" in table
+    assert [re.findall(r"<td>(scene|targets)</td>", row) for row in re.findall(r"<tr class.*?</tr>", table)] == [
+        ["scene"], ["targets"]]
+    with open(written.trend_csv, newline="") as fh:
+        assert {r["scope"] for r in csv.DictReader(fh)} == {"scene", "targets"}
 
 
 def test_a_single_acquisition_is_a_point_not_a_line():

@@ -171,7 +171,7 @@ def _group_title(trend: Trend) -> str:
     if trend.assumption:
         how += f" ({trend.assumption})"
     band = f", band {trend.band_name}" if trend.band_name else ""
-    return f"{trend.sensor}{band}: {trend.direction or 'unknown direction'}, {how}"
+    return f"{trend.sensor}{band}: {trend.direction or 'unknown direction'}, {trend.scope}, {how}"
 
 
 def _unnamed(points: Sequence[Mapping]) -> dict | None:
@@ -226,7 +226,7 @@ def _trend_figures(points: list[Mapping], found: Sequence[Trend], requirement: R
 def _order(found: Sequence[Trend]) -> list[Trend]:
     """Per sensor, band and direction: the recommended trend first, then the others, misfit ones last."""
     return sorted(found, key=lambda t: (str(t.sensor), str(t.band_name), str(t.direction), not t.recommended,
-                                        t.misfit, str(t.method), str(t.assumption)))
+                                        t.misfit, t.scope, str(t.method), str(t.assumption)))
 
 
 def _trend_row(t: Trend) -> dict:
@@ -239,7 +239,7 @@ def _trend_row(t: Trend) -> dict:
     if t.has_slope:
         interval = (f"[{t.slope_ci_low:+.4g}, {t.slope_ci_high:+.4g}]" if math.isfinite(t.slope_ci_low)
                     else "too few points")
-    return {"sensor": f"{t.sensor}{band}", "direction": _text(t.direction), "figure": t.figure,
+    return {"sensor": f"{t.sensor}{band}", "direction": _text(t.direction), "scope": t.scope, "figure": t.figure,
             "method": _text(t.method) + (f" ({t.assumption})" if t.assumption else ""), "span": span,
             "latest": _text(t.latest), "slope": f"{t.slope_per_year:+.4g}" if t.has_slope else None,
             "interval": interval, "drift": t.drift, "note": t.note, "because": t.recommended_because,

@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from ..atomic import atomic_output
 from ..errors import FileWriteError, ParameterError
 from ..estimate.geometry import AXIS_DIRECTIONS
-from ..records import CANDIDATE_SCOPE, SCENE_SCOPE
+from ..records import CANDIDATE_SCOPE, SCENE_SCOPE, TARGET_SCOPE
 
 YEAR_S = 365.25 * 86400.0
 # figure -> its interval's columns in the targets layer (None: it has none)
@@ -46,7 +46,8 @@ FIGURES = {
     "rer": None,
 }
 GROUP_KEYS = ("sensor", "band_name", "direction", "method", "assumption", "recommended", "misfit")
-TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "method", "assumption", "recommended", "misfit",
+TREND_COLUMNS = ("sensor", "platform", "band_name", "direction", "scope", "method", "assumption", "recommended",
+                 "misfit",
                  "recommended_because", "figure", "n_acquisitions", "n_points", "first_utc", "last_utc", "latest",
                  "latest_ci_low", "latest_ci_high", "value_at_first", "slope_per_year", "slope_ci_low",
                  "slope_ci_high", "confidence", "weights", "consistency", "drift", "requirement", "meets_requirement",
@@ -74,8 +75,10 @@ class Line:
 @dataclass(frozen=True)
 class Trend:
     """The drift of one figure of one sensor, band, direction, method and
-    assumption (the columns of ``trend.csv``): ``recommended`` when its
-    rows are the ones to quote, ``misfit`` when they are misfit fits (no
+    assumption (the columns of ``trend.csv``): ``scope`` what its points
+    summarise (:func:`points_scope`: the scene, its targets, measured
+    edges, or a mix across acquisitions); ``recommended`` when its rows
+    are the ones to quote in that scope, ``misfit`` when they are misfit fits (no
     slope then); ``latest`` the last acquisition's value with its
     interval; ``drift`` True when the slope's interval excludes 0; the
     slope NaN with one acquisition time (``note`` says why)."""
@@ -106,6 +109,7 @@ class Trend:
     consistency: float
     drift: bool
     note: str = ""
+    scope: str = ""
 
     @property
     def has_slope(self) -> bool:
@@ -236,6 +240,32 @@ def _by_normal(rows: Sequence[Mapping]) -> list[Mapping]:
     return out
 
 
+#: a trend's scope by the scopes of its points
+_SCOPE_NAMES = {SCENE_SCOPE: "scene", TARGET_SCOPE: "targets", CANDIDATE_SCOPE: "edges"}
+
+
+def points_scope(points: Sequence[Mapping]) -> str:
+    """What a trend's points summarise: ``scene`` (scene-wide rows),
+    ``targets`` (a target's rows, in acquisitions without a scene-wide
+    one), ``edges`` (measured chips), or these names joined by `` and ``
+    when acquisitions differ (an old store's row has no scope: ``unknown``).
+
+    A scan stores one recommended row per scope and direction, so the
+    scene's and a target's recommended rows may differ in method; the
+    scope tells their trends apart.
+
+    Examples
+    --------
+    >>> points_scope([{"scope": "scene"}, {"scope": "scene"}])
+    'scene'
+    >>> points_scope([{"scope": "target"}, {"scope": "scene"}, {}])
+    'scene and targets and unknown'
+    """
+    names = {_SCOPE_NAMES.get(str(p.get("scope")), "unknown") for p in points}
+    order = [*_SCOPE_NAMES.values(), "unknown"]
+    return " and ".join(sorted(names, key=order.index))
+
+
 def campaign_rows(targets: Iterable[Mapping], edges: Iterable[Mapping] = ()) -> list[Mapping]:
     """The rows a campaign's trends are made of: the targets layer's rows,
     and for an acquisition that has none (``imgmtf measure --campaign``)
@@ -275,6 +305,7 @@ def trends(rows: Iterable[Mapping], confidence: float = 0.95) -> list[Trend]:
             first, last = usable[0], usable[-1]
             low, high = (last.get(b) for b in bounds) if bounds else (None, None)
             common = dict(**group, platform=platform, recommended_because=last.get("recommended_because") or "",
+                          scope=points_scope(usable),
                           figure=figure,
                           n_acquisitions=len({p["acquisition_id"] for p in usable}), n_points=len(usable),
                           first_utc=times[0], last_utc=times[-1], latest=float(last[figure]),

@@ -39,7 +39,7 @@ def report(store, out_dir, requirement, baseline, confidence):
         click.echo(f"warning: {warning}", err=True)
     drifting = [t for t in written.trends if t.drift and t.figure == "mtf_nyquist" and t.recommended]
     for t in drifting:
-        click.echo(f"drift: {_named(t.sensor, t.band_name)}, {t.direction}, "
+        click.echo(f"drift: {_named(t.sensor, t.band_name)}, {t.direction}, {t.scope}, "
                    f"{t.method}: MTF at Nyquist {t.slope_per_year:+.4f}/year "
                    f"[{t.slope_ci_low:+.4f}, {t.slope_ci_high:+.4f}]")
     directions: dict[tuple, list] = {}
