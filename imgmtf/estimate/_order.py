@@ -12,6 +12,8 @@ which says so as it always has.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -53,7 +55,7 @@ def median(values: ArrayLike) -> np.float64:
     return np.add.reduce(part[half - 1: half + 1]) / 2
 
 
-def quantile(values: ArrayLike, q: ArrayLike) -> np.ndarray | np.float64:
+def quantile(values: ArrayLike, q: ArrayLike) -> Any:
     """``np.quantile(values, q)`` by its default ("linear") method, of all
     the values, flattened.
 
@@ -108,7 +110,7 @@ def quantile(values: ArrayLike, q: ArrayLike) -> np.ndarray | np.float64:
     return out[()] if out.ndim == 0 else out
 
 
-def percentile(values: ArrayLike, q: ArrayLike) -> np.ndarray | np.float64:
+def percentile(values: ArrayLike, q: ArrayLike) -> Any:
     """``np.percentile(values, q)`` (``q`` in percent; :func:`quantile`).
 
     Examples
@@ -119,7 +121,7 @@ def percentile(values: ArrayLike, q: ArrayLike) -> np.ndarray | np.float64:
     return quantile(values, np.true_divide(np.asanyarray(q, float), 100))
 
 
-def distinct(values: np.ndarray, return_inverse: bool = False):
+def distinct(values: np.ndarray, return_inverse: bool = False) -> Any:
     """``np.unique(values)`` of a 1-D array of integers (a profile's row
     numbers), and with ``return_inverse`` each value's index among them:
     counted in bins (np.unique sorts, and costs some 40 microseconds on
@@ -136,10 +138,10 @@ def distinct(values: np.ndarray, return_inverse: bool = False):
     """
     values = np.asarray(values)
     if values.ndim != 1 or values.size == 0 or values.dtype.kind not in "iu":
-        return np.unique(values, return_inverse=return_inverse)
+        return _unique(values, return_inverse)
     low, high = int(values.min()), int(values.max())
     if high - low > 4 * values.size + 1024:
-        return np.unique(values, return_inverse=return_inverse)
+        return _unique(values, return_inverse)
     offset = values - low
     present = np.bincount(offset) > 0
     ids = (np.flatnonzero(present) + low).astype(values.dtype, copy=False)
@@ -147,3 +149,7 @@ def distinct(values: np.ndarray, return_inverse: bool = False):
         return ids
     index = np.cumsum(present) - 1
     return ids, index[offset]
+
+
+def _unique(values: np.ndarray, return_inverse: bool) -> Any:
+    return np.unique(values, return_inverse=True) if return_inverse else np.unique(values)

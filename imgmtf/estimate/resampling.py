@@ -180,7 +180,7 @@ def _moments_met(binomials: bytes, n: int) -> tuple[tuple[int, int], ...]:
     """For each power p of the offsets, the range [lo, hi) of the moments
     j whose correlation with it a nonzero binomial takes (column p n + j
     of the (n, n * n) matrix given as its bytes)."""
-    columns = np.frombuffer(binomials).reshape(n, n, n).any(axis=0)     # (p, j)
+    columns = np.asarray(np.frombuffer(binomials).reshape(n, n, n).any(axis=0))     # (p, j)
     out = []
     for met in columns:
         j = np.nonzero(met)[0]
