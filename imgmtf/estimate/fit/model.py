@@ -36,6 +36,7 @@ from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
+from .angles import AngleGroup, angle_groups
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
@@ -184,6 +185,12 @@ class Model:
         self._last_responses: tuple = (None, [])
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
+        # many edges at nearby tilts: their responses interpolated from a few tilts' (:mod:`.angles`)
+        self.groups = [(members, AngleGroup([data[i].profile_angle_deg for i in members], data[members[0]].gsd_m,
+                                            max(self.reach(data[i]) for i in members)))
+                       for members in angle_groups([d.profile_angle_deg for d in data], [d.gsd_m for d in data])]
+        grouped = {i for members, _ in self.groups for i in members}
+        self.own = [i for i in range(len(data)) if i not in grouped]         # each its own response
         self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
@@ -289,8 +296,14 @@ class Model:
         key = (tuple(self.free), u.tobytes())
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
-            given = shared_transfers(self.edges, sensor.stages, sensor.gsd_m)
-            self._last_responses = (key, [edge.response(sensor, g) for edge, g in zip(self.edges, given)])
+            out: list = [None] * len(self.edges)
+            for members, group in self.groups:
+                for i, response in zip(members, group.responses(sensor)):
+                    out[i] = response
+            own = [self.edges[i] for i in self.own]
+            for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
+                out[i] = edge.response(sensor, g)
+            self._last_responses = (key, out)
         return self._last_responses[1]
 
     def release(self) -> None:
@@ -302,6 +315,8 @@ class Model:
         model evaluates as before, computing them again."""
         for edge in self.edges:
             edge.release()
+        for _, group in self.groups:
+            group.release()
         self._last_responses = (None, [])
         self._last_esfs = (None, None, None)
         self._last_samples = (None, [])
@@ -387,13 +402,7 @@ class Model:
             moved[k] += steps[k]
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
-        base, esf_change, lsf_change = [], [], []
-        given = shared_transfers(self.edges, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-        for edge, g in zip(self.edges, given):
-            response, esf_rows, lsf_rows = edge.changes(sensor, shifted, g)
-            base.append(response)
-            esf_change.append(esf_rows)
-            lsf_change.append(lsf_rows)
+        base, esf_change, lsf_change = self._changes(sensor, shifted)
         lo, hi, x0 = self.levels(z)
         d = self.bins.x - x0
         stacked = self.stacked(base)
@@ -421,6 +430,23 @@ class Model:
         indices, starts = self._jacobian_layout()
         values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
+
+    def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[list, list, list]:
+        """Each edge's response to ``sensor`` and its ESF's and LSF's
+        changes for each of the ``shifted`` sensors (its groups' or its own)."""
+        count = len(self.edges)
+        base: list = [None] * count
+        esf_change: list = [None] * count
+        lsf_change: list = [None] * count
+        for members, group in self.groups:
+            responses, esf_rows, lsf_rows = group.changes(sensor, shifted)
+            for j, i in enumerate(members):
+                base[i], esf_change[i], lsf_change[i] = responses[j], esf_rows[j], lsf_rows[j]
+        own = [self.edges[i] for i in self.own]
+        given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
+        for i, edge, g in zip(self.own, own, given):
+            base[i], esf_change[i], lsf_change[i] = edge.changes(sensor, shifted, g)
+        return base, esf_change, lsf_change
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
         """Each row's columns in a sparse Jacobian, the stage columns then
