@@ -67,10 +67,10 @@ def lagrange_weights(nodes: np.ndarray, at: np.ndarray) -> np.ndarray:
 
 
 def angle_groups(angles_deg: Sequence[float], gsds_m: Sequence[float], max_span_deg: float = MAX_SPAN_DEG,
-                 min_edges: int = MIN_EDGES) -> list[list[int]]:
+                 min_edges: int | None = None) -> list[list[int]]:
     """Edges (their indices) to interpolate together: of one GSD, their
-    tilts within ``max_span_deg``, at least ``min_edges`` of them; edges in
-    no group keep their own responses.
+    tilts within ``max_span_deg``, at least ``min_edges`` of them (default
+    :data:`MIN_EDGES`); edges in no group keep their own responses.
 
     Examples
     --------
@@ -78,6 +78,7 @@ def angle_groups(angles_deg: Sequence[float], gsds_m: Sequence[float], max_span_
     [[0, 3, 2], [1, 4]]
     """
     angles = np.asarray(angles_deg, float)
+    min_edges = MIN_EDGES if min_edges is None else min_edges
     groups = []
     for gsd in dict.fromkeys(gsds_m):
         members = [i for i in np.argsort(angles, kind="stable").tolist() if gsds_m[i] == gsd]
@@ -137,35 +138,43 @@ class AngleGroup:
         the last sensor asked for)."""
         return self._base(sensor)[2]
 
-    def changes(self, sensor: Sensor, shifted: Sequence[Sensor]) -> tuple[list[LineResponse], np.ndarray, np.ndarray]:
-        """Each edge's response to ``sensor`` and the changes of its ESF
-        and LSF for each of the ``shifted`` sensors, on the group's grid.
+    def remainders(self, sensor: Sensor) -> tuple[np.ndarray, np.ndarray]:
+        """The edges' ESF and LSF remainders for ``sensor``, one row each
+        (the arrays its :meth:`responses` are views of)."""
+        return self._base(sensor)[3]
+
+    def node_changes(self, sensor: Sensor, shifted: Sequence[Sensor]) -> tuple[np.ndarray, np.ndarray]:
+        """The changes of the nodes' ESF and LSF for each of the
+        ``shifted`` sensors, on the group's grid: each edge's are their
+        :meth:`combine`.
 
         Returns
         -------
-        responses : list of LineResponse
-            Per edge.
-        esf_changes, lsf_changes : numpy.ndarray, shape (edges, len(shifted), grid size)
-            Each edge's shifted responses less its own.
+        esf_changes, lsf_changes : numpy.ndarray, shape (nodes, len(shifted), grid size)
+            Each node's shifted responses less its own.
         """
-        grid, base, responses = self._base(sensor)
+        grid, base = self._base(sensor)[:2]
         spectra = np.stack([self._transfer(other, grid, keep=False) - base for other in shifted], axis=1)
-        esf, lsf = grid.remainders(spectra)                 # (nodes, shifted, size)
-        return responses, self._combine(esf), self._combine(lsf)
+        return grid.remainders(spectra)
 
-    def _combine(self, values: np.ndarray) -> np.ndarray:
-        """The edges' interpolation of the nodes' ``values`` (nodes first)."""
-        return (self.weights @ values.reshape(values.shape[0], -1)).reshape(-1, *values.shape[1:])
+    def combine(self, values: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """The edges' values interpolated from the nodes' ``values``
+        (shape (nodes, ...)): shape (edges, ...), into ``out`` when given."""
+        flat = values.reshape(values.shape[0], -1)
+        if out is None:
+            return (self.weights @ flat).reshape(-1, *values.shape[1:])
+        np.matmul(self.weights, flat, out=out.reshape(self.weights.shape[0], -1))
+        return out
 
-    def _base(self, sensor: Sensor) -> tuple[LineGrid, np.ndarray, list[LineResponse]]:
+    def _base(self, sensor: Sensor) -> tuple[LineGrid, np.ndarray, list[LineResponse], tuple[np.ndarray, np.ndarray]]:
         key = (sensor.gsd_m, sensor.stages)
         if self._last is None or self._last[0] != key:
             grid = self._grid(sensor)
             transfer = self._transfer(sensor, grid, keep=True)
             esf, lsf = grid.remainders(transfer - reference_transfer(grid.reference, grid.frequencies_cy_px))
-            esf, lsf = self._combine(esf), self._combine(lsf)
+            esf, lsf = self.combine(esf), self.combine(lsf)
             responses = [LineResponse(grid.start_px, grid.step_px, e, s, grid.reference) for e, s in zip(esf, lsf)]
-            self._last = (key, grid, transfer, responses)
+            self._last = (key, grid, transfer, responses, (esf, lsf))
         return self._last[1:]
 
     def _grid(self, sensor: Sensor) -> LineGrid:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
@@ -34,9 +35,9 @@ from ...metrics import first_crossing
 from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
+from .angles import AngleGroup, angle_groups
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
-from .angles import AngleGroup, angle_groups
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
@@ -182,7 +183,7 @@ class Model:
         self.values = dict(self.held_at)         # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
-        self._last_responses: tuple = (None, [])
+        self._last_responses: tuple = (None, [], None)
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         # many edges at nearby tilts: their responses interpolated from a few tilts' (:mod:`.angles`)
@@ -303,8 +304,31 @@ class Model:
             own = [self.edges[i] for i in self.own]
             for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
                 out[i] = edge.response(sensor, g)
-            self._last_responses = (key, out)
+            self._last_responses = (key, out, self._grid_layout(sensor, out) if self.groups else None)
         return self._last_responses[1]
+
+    def _grid_layout(self, sensor: Sensor, responses: list[LineResponse]) -> GridLayout:
+        """Where each edge's grid lies among the edges' grids side by side
+        when some are a group's (:mod:`.angles`): each group's rows in
+        turn, as its nodes' combination gives them, then the other edges'
+        grids; and the remainders so laid out."""
+        offsets = [0] * len(responses)
+        esf, lsf = [], []
+        start = 0
+        for members, group in self.groups:
+            rows = group.remainders(sensor)
+            size = rows[0].shape[-1]
+            for j, i in enumerate(members):
+                offsets[i] = start + j * size
+            esf.append(rows[0].ravel())
+            lsf.append(rows[1].ravel())
+            start += rows[0].size
+        for i in self.own:
+            offsets[i] = start
+            esf.append(responses[i].esf_remainder)
+            lsf.append(responses[i].lsf_remainder)
+            start += responses[i].esf_remainder.size
+        return GridLayout(offsets, start, (np.concatenate(esf), np.concatenate(lsf)))
 
     def release(self) -> None:
         """Drop what the evaluations keep (each edge's grids, transfers
@@ -317,7 +341,7 @@ class Model:
             edge.release()
         for _, group in self.groups:
             group.release()
-        self._last_responses = (None, [])
+        self._last_responses = (None, [], None)
         self._last_esfs = (None, None, None)
         self._last_samples = (None, [])
         self._stages_made.clear()
@@ -360,8 +384,14 @@ class Model:
         return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
 
     def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
-        """The edges' responses side by side, for their bins in turn (one edge's alone)."""
-        return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts)
+        """The edges' responses side by side, for their bins in turn (one edge's alone), their grids laid
+        out as :meth:`_grid_layout` lays them when some edges are a group's."""
+        if len(responses) == 1:
+            return responses[0]
+        layout = self._last_responses[2] if self._last_responses[1] is responses else None
+        if layout is None:
+            return StackedResponses(responses, self.counts)
+        return StackedResponses(responses, self.counts, layout.offsets, layout.remainders)
 
     def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``
@@ -402,7 +432,8 @@ class Model:
             moved[k] += steps[k]
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
-        base, esf_change, lsf_change = self._changes(sensor, shifted)
+        base = self.responses(u)
+        esf_change, lsf_change = self._changes(sensor, shifted)
         lo, hi, x0 = self.levels(z)
         d = self.bins.x - x0
         stacked = self.stacked(base)
@@ -411,13 +442,12 @@ class Model:
         else:
             placement = stacked.placement(d, curvature=True)
             esf = bin_esf(stacked, self.bins, x0, placement)
-        changes = esf_changes(stacked, self.side_by_side(esf_change), self.side_by_side(lsf_change), d, placement)
+        changes = esf_changes(stacked, esf_change, lsf_change, d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
         stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
         lsf = self.side_by_side([r.lsf(d[start: start + count])
                                  for r, start, count in zip(base, self.starts, self.counts)])
         blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
-        self._last_responses = ((tuple(self.free), u.tobytes()), base)
         columns = self.n_free + 3 * len(self.counts)
         if not self.sparse:
             jacobian = np.zeros((self.rows, columns))
@@ -431,22 +461,30 @@ class Model:
         values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
 
-    def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[list, list, list]:
-        """Each edge's response to ``sensor`` and its ESF's and LSF's
-        changes for each of the ``shifted`` sensors (its groups' or its own)."""
-        count = len(self.edges)
-        base: list = [None] * count
-        esf_change: list = [None] * count
-        lsf_change: list = [None] * count
-        for members, group in self.groups:
-            responses, esf_rows, lsf_rows = group.changes(sensor, shifted)
-            for j, i in enumerate(members):
-                base[i], esf_change[i], lsf_change[i] = responses[j], esf_rows[j], lsf_rows[j]
+    def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
+        """The changes of every edge's ESF and LSF for each of the
+        ``shifted`` sensors (a row each), the edges' grids side by side as
+        the responses at ``sensor`` lay them (:meth:`stacked`; its groups'
+        combined in place)."""
         own = [self.edges[i] for i in self.own]
         given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-        for i, edge, g in zip(self.own, own, given):
-            base[i], esf_change[i], lsf_change[i] = edge.changes(sensor, shifted, g)
-        return base, esf_change, lsf_change
+        rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
+        if not self.groups:
+            return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
+        layout = self._last_responses[2]
+        out = np.empty((2, len(shifted), layout.size))
+        start = 0
+        for _, group in self.groups:
+            for both, nodes in zip(out, group.node_changes(sensor, shifted)):
+                size = nodes.shape[-1] * group.weights.shape[0]
+                for row, node_rows in zip(both, nodes.transpose(1, 0, 2)):
+                    group.combine(node_rows, row[start: start + size])
+            start += size
+        for i, (esf, lsf) in zip(self.own, rows):
+            size = esf.shape[-1]
+            out[0, :, layout.offsets[i]: layout.offsets[i] + size] = esf
+            out[1, :, layout.offsets[i]: layout.offsets[i] + size] = lsf
+        return out[0], out[1]
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
         """Each row's columns in a sparse Jacobian, the stage columns then
@@ -535,6 +573,17 @@ class Model:
             if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
                 out[i] = width if np.isfinite(width) else math.inf
         return out
+
+
+@dataclass(frozen=True, eq=False)
+class GridLayout:
+    """The edges' grids side by side (:meth:`Model.stacked`): where each
+    edge's begins, their samples in all, and their ESF and LSF
+    remainders so laid out."""
+
+    offsets: list[int]
+    size: int
+    remainders: tuple[np.ndarray, np.ndarray]
 
 
 def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
