@@ -371,6 +371,12 @@ class StackedResponses:
                                 np.concatenate([r.lsf_remainder for r in self.responses]))
         return self._remainders
 
+    def esf(self, d_px: np.ndarray) -> np.ndarray:
+        """Each edge's :meth:`LineResponse.esf` at its distances, in turn."""
+        d = np.asarray(d_px, float)
+        value = self.placement(d).interpolate(*self.remainders())
+        return plus_reference_esf(value, self.kind, self._each([r.reference[1] for r in self.responses]), d)
+
     def esf_with_curvature(self, d_px: np.ndarray,
                            placement: HermitePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Each edge's :meth:`LineResponse.esf_with_curvature` at its distances, in turn."""
