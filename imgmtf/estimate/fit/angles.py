@@ -18,6 +18,7 @@ before, bit for bit.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -89,6 +90,25 @@ def angle_groups(angles_deg: Sequence[float], gsds_m: Sequence[float], max_span_
                 groups.append(members[:count])
             members = members[count:]
     return groups
+
+
+def grouped_edges(angles_deg: Sequence[float], gsds_m: Sequence[float], reaches_px: Sequence[float]
+                  ) -> tuple[list[tuple[list[int], AngleGroup]], list[int]]:
+    """A fit's edges' groups (:func:`angle_groups`), each with its
+    :class:`AngleGroup` (the farthest reach of its edges), and the edges in
+    none, which keep their own responses.
+
+    Examples
+    --------
+    >>> groups, own = grouped_edges([5.0, 95.0, 6.0], [1.0] * 3, [10.0, 12.0, 11.0])
+    >>> groups, own
+    ([], [0, 1, 2])
+    """
+    groups = [(members, AngleGroup([angles_deg[i] for i in members], gsds_m[members[0]],
+                                   max(reaches_px[i] for i in members)))
+              for members in angle_groups(angles_deg, gsds_m)]
+    grouped = {i for members, _ in groups for i in members}
+    return groups, [i for i in range(len(angles_deg)) if i not in grouped]
 
 
 class AngleGroup:
@@ -208,3 +228,62 @@ class AngleGroup:
             out = value if out is None else out * value
         return out if out is not None else np.ones((self.nodes.size, f.size))
 
+
+
+@dataclass(frozen=True, eq=False)
+class GridLayout:
+    """A fit's edges' grids side by side (:func:`grid_layout`): where each
+    edge's begins, their samples in all, and their ESF and LSF remainders
+    so laid out."""
+
+    offsets: list[int]
+    size: int
+    remainders: tuple[np.ndarray, np.ndarray]
+
+
+def grid_layout(groups: list[tuple[list[int], AngleGroup]], own: list[int], sensor: Sensor,
+                responses: list[LineResponse]) -> GridLayout:
+    """The edges' grids side by side when some are a group's: each group's
+    rows in turn, as its nodes' combination gives them, then the grids of
+    the edges ``own`` (their own ``responses``); and the remainders so laid
+    out (for :class:`.responses.StackedResponses`)."""
+    offsets = [0] * len(responses)
+    esf, lsf = [], []
+    start = 0
+    for members, group in groups:
+        rows = group.remainders(sensor)
+        size = rows[0].shape[-1]
+        for j, i in enumerate(members):
+            offsets[i] = start + j * size
+        esf.append(rows[0].ravel())
+        lsf.append(rows[1].ravel())
+        start += rows[0].size
+    for i in own:
+        offsets[i] = start
+        esf.append(responses[i].esf_remainder)
+        lsf.append(responses[i].lsf_remainder)
+        start += responses[i].esf_remainder.size
+    return GridLayout(offsets, start, (np.concatenate(esf), np.concatenate(lsf)))
+
+
+def laid_out_changes(groups: list[tuple[list[int], AngleGroup]], own: list[int],
+                     own_changes: list[tuple[np.ndarray, np.ndarray]], layout: GridLayout, sensor: Sensor,
+                     shifted: Sequence[Sensor]) -> tuple[np.ndarray, np.ndarray]:
+    """The changes of every edge's ESF and LSF for each of the ``shifted``
+    sensors (a row each), on the grids as ``layout`` lays them: the
+    groups' combined in place from their nodes', the edges ``own``'s
+    (``own_changes``, each edge's ESF and LSF changes) copied in."""
+    out = np.empty((2, len(shifted), layout.size))
+    start = 0
+    for _, group in groups:
+        size = 0
+        for both, nodes in zip(out, group.node_changes(sensor, shifted)):
+            size = nodes.shape[-1] * group.weights.shape[0]
+            for row, node_rows in zip(both, nodes.transpose(1, 0, 2)):
+                group.combine(node_rows, row[start: start + size])
+        start += size
+    for i, (esf, lsf) in zip(own, own_changes):
+        size = esf.shape[-1]
+        out[0, :, layout.offsets[i]: layout.offsets[i] + size] = esf
+        out[1, :, layout.offsets[i]: layout.offsets[i] + size] = lsf
+    return out[0], out[1]

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
@@ -35,7 +34,7 @@ from ...metrics import first_crossing
 from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
-from .angles import AngleGroup, angle_groups
+from .angles import grid_layout, grouped_edges, laid_out_changes
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
@@ -187,11 +186,8 @@ class Model:
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
         # many edges at nearby tilts: their responses interpolated from a few tilts' (:mod:`.angles`)
-        self.groups = [(members, AngleGroup([data[i].profile_angle_deg for i in members], data[members[0]].gsd_m,
-                                            max(self.reach(data[i]) for i in members)))
-                       for members in angle_groups([d.profile_angle_deg for d in data], [d.gsd_m for d in data])]
-        grouped = {i for members, _ in self.groups for i in members}
-        self.own = [i for i in range(len(data)) if i not in grouped]         # each its own response
+        self.groups, self.own = grouped_edges([d.profile_angle_deg for d in data], [d.gsd_m for d in data],
+                                              [self.reach(d) for d in data])
         self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
@@ -304,31 +300,8 @@ class Model:
             own = [self.edges[i] for i in self.own]
             for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
                 out[i] = edge.response(sensor, g)
-            self._last_responses = (key, out, self._grid_layout(sensor, out) if self.groups else None)
+            self._last_responses = (key, out, grid_layout(self.groups, self.own, sensor, out) if self.groups else None)
         return self._last_responses[1]
-
-    def _grid_layout(self, sensor: Sensor, responses: list[LineResponse]) -> GridLayout:
-        """Where each edge's grid lies among the edges' grids side by side
-        when some are a group's (:mod:`.angles`): each group's rows in
-        turn, as its nodes' combination gives them, then the other edges'
-        grids; and the remainders so laid out."""
-        offsets = [0] * len(responses)
-        esf, lsf = [], []
-        start = 0
-        for members, group in self.groups:
-            rows = group.remainders(sensor)
-            size = rows[0].shape[-1]
-            for j, i in enumerate(members):
-                offsets[i] = start + j * size
-            esf.append(rows[0].ravel())
-            lsf.append(rows[1].ravel())
-            start += rows[0].size
-        for i in self.own:
-            offsets[i] = start
-            esf.append(responses[i].esf_remainder)
-            lsf.append(responses[i].lsf_remainder)
-            start += responses[i].esf_remainder.size
-        return GridLayout(offsets, start, (np.concatenate(esf), np.concatenate(lsf)))
 
     def release(self) -> None:
         """Drop what the evaluations keep (each edge's grids, transfers
@@ -384,14 +357,14 @@ class Model:
         return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
 
     def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
-        """The edges' responses side by side, for their bins in turn (one edge's alone), their grids laid
-        out as :meth:`_grid_layout` lays them when some edges are a group's."""
-        if len(responses) == 1:
-            return responses[0]
+        """The edges' responses side by side, for their bins in turn (one edge's alone)."""
+        return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts,
+                                                                         *self._laid_out(responses))
+
+    def _laid_out(self, responses: list[LineResponse]) -> tuple:
+        """Where ``responses``' grids lie side by side, and their remainders, when some are a group's."""
         layout = self._last_responses[2] if self._last_responses[1] is responses else None
-        if layout is None:
-            return StackedResponses(responses, self.counts)
-        return StackedResponses(responses, self.counts, layout.offsets, layout.remainders)
+        return (layout.offsets, layout.remainders) if layout is not None else ()
 
     def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``
@@ -462,38 +435,20 @@ class Model:
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
 
     def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
-        """The changes of every edge's ESF and LSF for each of the
-        ``shifted`` sensors (a row each), the edges' grids side by side as
-        the responses at ``sensor`` lay them (:meth:`stacked`; its groups'
-        combined in place)."""
+        """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids side by side (:meth:`stacked`)."""
         own = [self.edges[i] for i in self.own]
         given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
         rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
         if not self.groups:
             return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
-        layout = self._last_responses[2]
-        out = np.empty((2, len(shifted), layout.size))
-        start = 0
-        for _, group in self.groups:
-            for both, nodes in zip(out, group.node_changes(sensor, shifted)):
-                size = nodes.shape[-1] * group.weights.shape[0]
-                for row, node_rows in zip(both, nodes.transpose(1, 0, 2)):
-                    group.combine(node_rows, row[start: start + size])
-            start += size
-        for i, (esf, lsf) in zip(self.own, rows):
-            size = esf.shape[-1]
-            out[0, :, layout.offsets[i]: layout.offsets[i] + size] = esf
-            out[1, :, layout.offsets[i]: layout.offsets[i] + size] = lsf
-        return out[0], out[1]
+        return laid_out_changes(self.groups, self.own, rows, self._last_responses[2], sensor, shifted)
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
         """Each row's columns in a sparse Jacobian, the stage columns then
         its edge's levels' and offset's (which act on its own bins only),
         and where each row starts among them: its compressed rows, written
         directly (its size grows with the edges, not with their square);
-        made once for the free parameters.  32-bit where they fit: the
-        solver's products with the Jacobian (LSMR's, a dozen per step)
-        read every index, a quarter less memory to read than 64-bit."""
+        made once for the free parameters; 32-bit where they fit (LSMR's products read a quarter less)."""
         if self._layout[0] != self.n_free:
             nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
             indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
@@ -551,8 +506,7 @@ class Model:
             lo, hi, x0 = (np.repeat(z[self.n_free + j::3], counts) for j in range(3))
             x, y = (np.concatenate([getattr(d, name) for d in self.data]) for name in ("x", "y"))
             # every edge's samples in one pass, each as its own response gives it (:class:`StackedResponses`)
-            layout = self._last_responses[2] if self._last_responses[1] is responses else None
-            stacked = StackedResponses(responses, counts, *((layout.offsets, layout.remainders) if layout else ()))
+            stacked = StackedResponses(responses, counts, *self._laid_out(responses))
             residuals = y - lo - (hi - lo) * stacked.esf(x - x0)
             self._last_samples = (key, np.split(residuals, np.cumsum(counts)[:-1]))
         return self._last_samples[1]
@@ -581,17 +535,6 @@ class Model:
             if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
                 out[i] = width if np.isfinite(width) else math.inf
         return out
-
-
-@dataclass(frozen=True, eq=False)
-class GridLayout:
-    """The edges' grids side by side (:meth:`Model.stacked`): where each
-    edge's begins, their samples in all, and their ESF and LSF
-    remainders so laid out."""
-
-    offsets: list[int]
-    size: int
-    remainders: tuple[np.ndarray, np.ndarray]
 
 
 def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
