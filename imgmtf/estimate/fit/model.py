@@ -549,20 +549,6 @@ def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: fl
     return value + 0.5 * bins.m2 * curvature
 
 
-def other_stages(stages) -> str:
-    """What to try when the model misfits: the long-tailed stages it lacks,
-    or, with all of them in, the non-parametric estimate."""
-    have = {s.name for s in stages}
-    real = [name for name in ("diffusion", "halo", "lag") if name not in have]
-    optical = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
-    if real:
-        return (f"try the stages real blur adds ({', '.join(real)}; stages 'auto' tries them)"
-                + (f" or others (e.g. {', '.join(optical)})" if optical else ""))
-    if optical:
-        return f"try other stages (e.g. {', '.join(optical)}), or quote the rows measured without a model"
-    return "quote the rows measured without a model, which assume no form of blur"
-
-
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
 
