@@ -7,7 +7,9 @@ measurement becomes an error record of reason ``internal`` for that file.
 from __future__ import annotations
 
 import functools
+import itertools
 import os
+from collections.abc import Generator
 from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
@@ -19,13 +21,16 @@ from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
 from .file_notes import file_notes as raster_notes
-from .io import open_raster, read_raster
+from .io import Raster, open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
-from .raster_estimate import edge_centre_px, in_image_axes, measure_raster
+from .raster_estimate import edge_centre_px, in_image_axes, measure_raster, measure_rasters
 from .records import Record, utc_now
 from .vectors import Unplaced, VectorROIs
 
+GROUP_FILES = 32           # files measured in one task at most: their small rasters estimated together
+GROUPS_PER_WORKER = 6      # tasks per worker at least, where there are files enough: workers end together
+POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
 
@@ -131,19 +136,34 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
         raise ParameterError(f"give settings or keyword options ({', '.join(options)}), not both")
     elif not isinstance(settings, MeasureSettings):
         raise ParameterError(f"settings must be a MeasureSettings, got {type(settings).__name__}")
-    path = os.fspath(path)
-    run_utc = run_utc or utc_now()
+    steps = _file_steps(os.fspath(path), settings, plot_path, run_utc or utc_now())
+    try:
+        raster = next(steps)
+        while True:
+            raster = steps.send(_measured(raster, settings))
+    except StopIteration as done:
+        return done.value
+
+
+def _file_steps(path: str, settings: MeasureSettings, plot_path, run_utc: str
+                ) -> Generator[Raster, Any, list[Record]]:
+    """:func:`measure_file` as a generator that yields each raster to
+    estimate (a band, a vector feature's window) and takes its estimate
+    (:func:`.raster_estimate.measure_raster`'s result or exception), so
+    that many files' rasters can be estimated together
+    (:func:`.raster_estimate.measure_rasters`); it returns the records."""
     with ExitStack() as stack:
         try:
             file = stack.enter_context(open_raster(path))       # once for the header and every band
             bands = file.info.bands(settings.band)
         except Exception as exc:               # the safety net: a record, never an abort
             return [settings.failed(path, settings.band, exc, run_utc)]
-        return _measure_bands(file, bands, settings, plot_path, run_utc)
+        return (yield from _bands_steps(file, bands, settings, plot_path, run_utc))
 
 
-def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: str) -> list[Record]:
-    """One record per band of an open file (see :func:`measure_file`)."""
+def _bands_steps(file, bands, settings: MeasureSettings, plot_path, run_utc: str
+                 ) -> Generator[Raster, Any, list[Record]]:
+    """One record per band of an open file (see :func:`_file_steps`)."""
     path, info = file.path, file.info
     skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
     # what the file's reading adds to its first record's warnings (and to its figure's count of them)
@@ -157,8 +177,8 @@ def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: s
     for index, band in enumerate(bands):
         for feature in windows:
             file_notes = skipped_note if index == 0 and feature is windows[0] else []
-            records.extend(_window_records(file, band, len(bands), feature, file_notes, settings, plot_path,
-                                           run_utc))
+            records.extend((yield from _window_steps(file, band, len(bands), feature, file_notes, settings,
+                                                     plot_path, run_utc)))
     return records
 
 
@@ -171,10 +191,12 @@ def _windows(info, settings: MeasureSettings) -> list:
     return [None]
 
 
-def _window_records(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc) -> list[Record]:
+def _window_steps(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc
+                  ) -> Generator[Raster, Any, list[Record]]:
     """The records of one band read through one window: the settings' own
     (``feature`` None), or a vector feature's (with its attributes), or the
-    error of a feature with no window."""
+    error of a feature with no window; the raster read is yielded for its
+    estimate (see :func:`_file_steps`)."""
     path = file.path
     fields = {} if feature is None else {"site": feature.record_fields()}
     if isinstance(feature, Unplaced):
@@ -183,7 +205,9 @@ def _window_records(file, band, n_bands, feature, file_notes, settings, plot_pat
     notes = [*file_notes, *(feature.notes() if feature is not None else [])]
     try:
         raster = file.read(band, window=window)
-        result = measure_raster(raster, settings)
+        result = yield raster
+        if isinstance(result, Exception):       # its estimate's error: the same record as raised here
+            raise result
         # one record per result, or per direction of a kind that measures several (points)
         summaries = result.summaries(curves=True)
         if in_image_axes(raster, settings.track_azimuth_deg):       # each direction, a points record's too
@@ -246,22 +270,86 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
                   run_utc: str | None = None, ordered: bool = True):
     """Measure every file (expand folders first with :func:`expand_inputs`);
     yields each file's list of records, in input order (with ``ordered``
-    false: ``(index, records)`` pairs as files complete).  A task that dies
-    with its worker process still gives its file an error record."""
+    false: ``(index, records)`` pairs as files complete).  Files go to the
+    workers in groups (:func:`group_sizes`), each group's small rasters
+    estimated together (:func:`_measure_group`): the same records as each
+    file's :func:`measure_file`.  A task that dies with its worker process
+    still gives each of its files an error record."""
     paths = list(paths)
     run_utc = run_utc or utc_now()
     plots = plot_paths(paths, plot_dir) if plot_dir else [None] * len(paths)
-    tasks = [(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
+    starts = list(itertools.accumulate(group_sizes(len(paths), workers), initial=0))
+    tasks = [(paths[a:b], settings, plots[a:b], run_utc) for a, b in itertools.pairwise(starts)]
 
     def lost(task, exc):
-        return [settings.failed(task[0], settings.band, exc, run_utc)]
-    yield from run_tasks(_measure_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                         description="measuring", on_error=lost, ordered=ordered)
+        return [[settings.failed(path, settings.band, exc, run_utc)] for path in task[0]]
+    groups = run_tasks(_measure_group, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                       description="measuring", on_error=lost, ordered=ordered)
+    if ordered:
+        for group in groups:
+            yield from group
+    else:
+        for index, group in groups:
+            yield from enumerate(group, starts[index])
 
 
-def _measure_task(task) -> list[Record]:
-    path, settings, plot, run_utc = task
-    return measure_file(path, settings, plot, run_utc=run_utc)
+def group_sizes(files: int, workers: int = 1) -> list[int]:
+    """How many files each task of a batch measures, in order: at most
+    :data:`GROUP_FILES`, and at least :data:`GROUPS_PER_WORKER` groups per
+    worker where there are files enough, so that workers finish together;
+    the sizes differ by one at most.
+
+    Examples
+    --------
+    >>> group_sizes(100), group_sizes(100, workers=2), group_sizes(3, workers=2), group_sizes(0)
+    ([17, 17, 17, 17, 16, 16], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8], [1, 1, 1], [])
+    """
+    if files <= 0:
+        return []
+    count = max(-(-files // GROUP_FILES), min(files, GROUPS_PER_WORKER * max(workers, 1)))
+    size, extra = divmod(files, count)
+    return [size + 1] * extra + [size] * (count - extra)
+
+
+def _measure_group(task) -> list[list[Record]]:
+    """Each file's records (:func:`measure_file`) of a group of files, their
+    small rasters (at most :data:`POOLED_MAX_PX`) estimated together
+    (:func:`.raster_estimate.measure_rasters`) a round at a time: every
+    file's first band (or window), then every file's next; a larger raster
+    is estimated on its own as it is read, so that a group holds no more
+    than a few small rasters at once."""
+    paths, settings, plots, run_utc = task
+    steps = [_file_steps(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
+    out: list[list[Record]] = [[] for _ in paths]
+    waiting: dict[int, Raster] = {}
+
+    def advance(i: int, outcome: Any = None, started: bool = True) -> None:
+        """File ``i``'s steps run on to its next small raster, or to its records."""
+        try:
+            raster = steps[i].send(outcome) if started else next(steps[i])
+            while raster.data.size > POOLED_MAX_PX:
+                raster = steps[i].send(_measured(raster, settings))
+            waiting[i] = raster
+        except StopIteration as done:
+            out[i] = done.value
+        except Exception as exc:        # as a task's failure would be: this file's error record only
+            out[i] = [settings.failed(paths[i], settings.band, exc, run_utc)]
+    for i in range(len(steps)):
+        advance(i, started=False)
+    while waiting:
+        rasters = dict(waiting)
+        waiting.clear()
+        for i, outcome in zip(rasters, measure_rasters(list(rasters.values()), settings)):
+            advance(i, outcome)
+    return out
+
+
+def _measured(raster: Raster, settings: MeasureSettings):
+    """:func:`.raster_estimate.measure_raster`'s result, or what it raised."""
+    try:
+        return measure_raster(raster, settings)
+    except Exception as exc:
+        return exc
 
 
 def plot_paths(paths, plot_dir: str) -> list[str]:
