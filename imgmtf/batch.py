@@ -295,18 +295,21 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
 
 def group_sizes(files: int, workers: int = 1) -> list[int]:
     """How many files each task of a batch measures, in order: at most
-    :data:`GROUP_FILES`, and at least :data:`GROUPS_PER_WORKER` groups per
-    worker where there are files enough, so that workers finish together;
-    the sizes differ by one at most.
+    :data:`GROUP_FILES`, and with several workers at least
+    :data:`GROUPS_PER_WORKER` groups per worker where there are files
+    enough, so that the workers finish together; the sizes differ by one at
+    most.
 
     Examples
     --------
     >>> group_sizes(100), group_sizes(100, workers=2), group_sizes(3, workers=2), group_sizes(0)
-    ([17, 17, 17, 17, 16, 16], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8], [1, 1, 1], [])
+    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8], [1, 1, 1], [])
     """
     if files <= 0:
         return []
-    count = max(-(-files // GROUP_FILES), min(files, GROUPS_PER_WORKER * max(workers, 1)))
+    count = -(-files // GROUP_FILES)
+    if workers > 1:
+        count = max(count, min(files, GROUPS_PER_WORKER * workers))
     size, extra = divmod(files, count)
     return [size + 1] * extra + [size] * (count - extra)
 
