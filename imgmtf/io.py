@@ -524,9 +524,9 @@ def _opened(path):
         if kind:
             raise ImageReadError(f"{path}: a {kind} file that is damaged or truncated "
                                  f"(GDAL: {_reason(exc)})") from None
-        raise ImageReadError(f"{path}: not an image GDAL can read ({_reason(exc)})") from None
+        raise ImageReadError(f"{path}: not an image GDAL can read ({_reason(exc, path)})") from None
     except OSError as exc:
-        raise ImageReadError(f"{path}: cannot read: {_reason(exc)}") from None
+        raise ImageReadError(f"{path}: cannot read: {_reason(exc, path)}") from None
 
 
 # leading bytes of the formats users bring, to tell a damaged image from a non-image
@@ -570,10 +570,15 @@ def _gsd_m(src) -> float | None:
     return None
 
 
-def _reason(exc: Exception) -> str:
+def _reason(exc: Exception, path: object = None) -> str:
     """GDAL's own first line; rasterio sometimes wraps it in "see previous
-    exception", whose text is the cause's."""
+    exception", whose text is the cause's.  GDAL names the file again
+    (``'x.tif' not recognized as ...``); the message already starts with
+    ``path``, so that repeat is dropped."""
     text = str(exc).strip() or type(exc).__name__
     if "previous exception" in text and exc.__cause__ is not None:
         text = str(exc.__cause__).strip() or text
-    return text.splitlines()[0]
+    text = text.splitlines()[0]
+    if path is not None:
+        text = text.replace(f"'{path}' ", "").replace(f"{path}: ", "")
+    return text

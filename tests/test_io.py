@@ -92,8 +92,9 @@ def test_read_errors_name_the_file(tmp_path):
         read_raster(tmp_path / "missing.tif")
     junk = tmp_path / "junk.tif"
     junk.write_text("not an image")
-    with pytest.raises(ImageReadError, match="junk.tif: not an image"):
+    with pytest.raises(ImageReadError, match="junk.tif: not an image") as refused:
         read_raster(junk)
+    assert str(refused.value).count("junk.tif") == 1           # GDAL's own repeat of the path dropped
     with pytest.raises(FileWriteError, match="cannot write"):
         write_geotiff(tmp_path / "no" / "dir.tif", np.zeros((4, 4), np.uint8))
 
