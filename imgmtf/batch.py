@@ -9,7 +9,7 @@ from __future__ import annotations
 import functools
 import itertools
 import os
-from collections.abc import Generator
+from collections.abc import Generator, Sequence
 from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
@@ -29,6 +29,7 @@ from .records import Record, utc_now
 from .vectors import Unplaced, VectorROIs
 
 GROUP_FILES = 32           # files measured in one task at most: their small rasters estimated together
+GROUP_BYTES = 4 * 2 ** 20  # and their bytes on disk at most: a larger file is a task of its own
 GROUPS_PER_WORKER = 6      # tasks per worker at least, where there are files enough: workers end together
 POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
@@ -278,7 +279,7 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
     paths = list(paths)
     run_utc = run_utc or utc_now()
     plots = plot_paths(paths, plot_dir) if plot_dir else [None] * len(paths)
-    starts = list(itertools.accumulate(group_sizes(len(paths), workers), initial=0))
+    starts = list(itertools.accumulate(group_sizes([_file_bytes(p) for p in paths], workers), initial=0))
     tasks = [(paths[a:b], settings, plots[a:b], run_utc) for a, b in itertools.pairwise(starts)]
 
     def lost(task, exc):
@@ -293,25 +294,46 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
             yield from enumerate(group, starts[index])
 
 
-def group_sizes(files: int, workers: int = 1) -> list[int]:
-    """How many files each task of a batch measures, in order: at most
-    :data:`GROUP_FILES`, and with several workers at least
-    :data:`GROUPS_PER_WORKER` groups per worker where there are files
-    enough, so that the workers finish together; the sizes differ by one at
-    most.
+def group_sizes(file_bytes: Sequence[int], workers: int = 1) -> list[int]:
+    """How many files each task of a batch measures, in order, given the
+    files' sizes on disk (bytes): at most :data:`GROUP_FILES` and
+    :data:`GROUP_BYTES` a group (a file larger alone), and with several
+    workers at least :data:`GROUPS_PER_WORKER` groups per worker where
+    there are files enough, so that the workers finish together.  Small
+    chips gain from being estimated together; large files would only keep
+    their rows (and, on an interrupt, what was measured) waiting.
 
     Examples
     --------
-    >>> group_sizes(100), group_sizes(100, workers=2), group_sizes(3, workers=2), group_sizes(0)
-    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8], [1, 1, 1], [])
+    >>> group_sizes([20_000] * 100), group_sizes([20_000] * 100, workers=2)
+    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8])
+    >>> group_sizes([20_000] * 3 + [50_000_000] + [20_000] * 2), group_sizes([])
+    ([3, 1, 2], [])
     """
-    if files <= 0:
+    files = len(file_bytes)
+    if files == 0:
         return []
     count = -(-files // GROUP_FILES)
     if workers > 1:
         count = max(count, min(files, GROUPS_PER_WORKER * workers))
     size, extra = divmod(files, count)
-    return [size + 1] * extra + [size] * (count - extra)
+    sizes = []
+    for target in [size + 1] * extra + [size] * (count - extra):
+        start = sum(sizes)
+        group = file_bytes[start: start + target]
+        # cut where the bytes would pass the budget: a group holds one file at least
+        taken = next((n for n in range(1, len(group)) if sum(group[:n + 1]) > GROUP_BYTES), len(group))
+        sizes.append(taken)
+        sizes += group_sizes(group[taken:], 1) if taken < len(group) else []
+    return sizes
+
+
+def _file_bytes(path: str) -> int:
+    """A file's size on disk, 0 where it cannot be told (its measurement says why)."""
+    try:
+        return os.stat(path).st_size if path else 0
+    except (OSError, ValueError):
+        return 0
 
 
 def _measure_group(task) -> list[list[Record]]:
