@@ -317,7 +317,7 @@ def group_sizes(file_bytes: Sequence[int], workers: int = 1) -> list[int]:
     if workers > 1:
         count = max(count, min(files, GROUPS_PER_WORKER * workers))
     size, extra = divmod(files, count)
-    sizes = []
+    sizes: list[int] = []
     for target in [size + 1] * extra + [size] * (count - extra):
         start = sum(sizes)
         group = file_bytes[start: start + target]
