@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
-from ._correlation import correlate1d
+from ._correlation import ROW_BY_ROW_TAPS, correlate1d
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,7 +165,14 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     """``binomials`` applied to the correlations of ``moments`` (..., n, grid)
     with every power 0..n-1 of ``offsets``: (..., n, grid)."""
     n = moments.shape[-2]
-    shifted = np.stack([correlate1d(moments, offsets ** p) for p in range(n)], axis=-3)
+    moments = np.ascontiguousarray(moments)     # one copy for every power, not one in each correlation
+    shifted = np.zeros((*moments.shape[:-2], n, n, moments.shape[-1]))
+    for p in range(n):
+        # only the moments whose correlation with offset^p a binomial takes (j <= n - 1 - p, or for
+        # the adjoint j >= p: about half of them), where each row's correlation is its own
+        used = np.flatnonzero(binomials[:, p * n: (p + 1) * n].any(axis=0))
+        lo, hi = (int(used[0]), int(used[-1]) + 1) if offsets.size < ROW_BY_ROW_TAPS and used.size else (0, n)
+        shifted[..., p, lo:hi, :] = correlate1d(moments[..., lo:hi, :], offsets ** p)
     return binomials @ shifted.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
 
 
