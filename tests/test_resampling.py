@@ -109,3 +109,16 @@ def test_penalised_spline_refuses_knots_too_close_and_the_resampler_merges_them(
     # the resampler takes samples within 1e-7 px as one knot
     r = resample_profile(x, y, method="spline", half_range=10)
     assert np.nanmax(np.abs(r.values - np.tanh(r.grid))) < 0.01
+
+
+@pytest.mark.parametrize("half_bins", [10, 30])        # 21 taps: row by row; 61: OpenCV's DFTs, every moment
+@pytest.mark.parametrize("adjoint", [False, True])
+def test_shifted_powers_are_every_moment_correlated_with_every_power(half_bins, adjoint):
+    from imgmtf.estimate._correlation import correlate1d
+    from imgmtf.estimate.resampling import _binomial_shifts, _shifted_powers
+    rng = np.random.default_rng(half_bins)
+    moments = rng.normal(size=(4, 9, 200)) * 10.0 ** rng.integers(-2, 4, size=(9, 1))
+    offsets = np.arange(-half_bins, half_bins + 1) / (half_bins + 0.5)
+    binomials = _binomial_shifts(9, adjoint)
+    every = np.stack([correlate1d(moments, offsets ** p) for p in range(9)], axis=-3).reshape(4, 81, 200)
+    np.testing.assert_array_equal(_shifted_powers(moments, offsets, binomials), binomials @ every)
