@@ -225,7 +225,9 @@ def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray
         sums = np.stack([np.bincount(bins, weights=f, minlength=n_bins) for f in flat])
     else:
         from scipy import sparse  # only for stacks of weights (the bootstrap)
-        onehot = sparse.csr_array((np.ones(bins.size), (np.arange(bins.size), bins)),
+        # one 1 per sample, in its bin's column: built as the compressed rows it is (a row pointer
+        # of 0, 1, 2...), not converted from coordinates, which sorts and sums what has no duplicates
+        onehot = sparse.csr_array((np.ones(bins.size), bins, np.arange(bins.size + 1)),
                                   shape=(bins.size, n_bins))
         sums = (onehot.T @ flat.T).T
     return sums.reshape(*lead, n_bins)
