@@ -167,14 +167,16 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     n = moments.shape[-2]
     moments = np.ascontiguousarray(moments)     # one copy for every power, not one in each correlation
     shifted = np.empty((*moments.shape[:-2], n, n, moments.shape[-1]))
+    # only the moments whose correlation with offset^p a binomial takes (j <= n - 1 - p, or for the
+    # adjoint j >= p: about half of them), where each row's correlation is its own
+    taken = binomials.reshape(-1, n, n).any(axis=0).tolist() if offsets.size < ROW_BY_ROW_TAPS else None
     for p in range(n):
-        # only the moments whose correlation with offset^p a binomial takes (j <= n - 1 - p, or for
-        # the adjoint j >= p: about half of them), where each row's correlation is its own
-        used = np.flatnonzero(binomials[:, p * n: (p + 1) * n].any(axis=0))
-        lo, hi = (int(used[0]), int(used[-1]) + 1) if offsets.size < ROW_BY_ROW_TAPS and used.size else (0, n)
+        lo, hi = (taken[p].index(True), n - taken[p][::-1].index(True)) if taken and any(taken[p]) else (0, n)
         shifted[..., p, lo:hi, :] = correlate1d(moments[..., lo:hi, :], offsets ** p)
-        shifted[..., p, :lo, :] = 0.0
-        shifted[..., p, hi:, :] = 0.0
+        if lo:
+            shifted[..., p, :lo, :] = 0.0
+        if hi < n:
+            shifted[..., p, hi:, :] = 0.0
     return binomials @ shifted.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
 
 
