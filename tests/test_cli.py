@@ -391,3 +391,23 @@ def test_a_long_warning_under_a_row_wraps_to_the_table_width_under_its_words():
     assert all(len(line) <= TABLE_WIDTH for line in lines[:-1])     # a path longer than a line is not cut
     assert all(line.startswith(" " * 21) and line[21] != " " for line in lines[1:])
     assert " ".join(" ".join(lines).split()[1:]) == " ".join(warning.split())
+    # never between a figure and its per cent sign
+    spaced = warning_text("", "the residuals are structured (0.25 % of the step) " * 6, hint=False).splitlines()
+    assert len(spaced) > 1 and not any(line.lstrip().startswith("%") for line in spaced)
+
+
+def test_a_scans_headings_and_rejection_lines_wrap_to_the_table_width(capsys):
+    from imgmtf.cli.tables import TABLE_WIDTH, echo_wrapped
+    echo_wrapped("rejected    6 fill (id 5, 6, 7, 8, 9 and 1 more): e.g. a boundary of fill or nodata along 100 % "
+                 "of its length (not an edge of the scene)", indent=" " * 14)
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 2 and all(len(line) <= TABLE_WIDTH for line in lines)
+    assert lines[1].startswith(" " * 14 + "edge of the scene")
+
+
+def test_a_long_error_row_of_the_measure_table_wraps_under_its_words():
+    from imgmtf.cli.tables import TABLE_WIDTH, text_row
+    error = "x.tif: two edges found (at normal 0.1 deg, 383 px from the top-left pixel and normal 8.0 deg) " * 2
+    lines = text_row({"path": "x.tif", "status": "error", "error": error, "reason": None}, "edge", 20).splitlines()
+    assert len(lines) == 3 and all(len(line) <= TABLE_WIDTH for line in lines)
+    assert lines[0].startswith("x.tif" + " " * 16 + "error: x.tif") and lines[1].startswith(" " * 28 + "deg) x.tif")

@@ -302,7 +302,8 @@ def test_the_text_table_tallies_rejections_by_reason_and_verbose_lists_every_can
     assert brief[0].endswith(f"{len(candidates)} candidate edges, 2 accepted")
     # one line per reason, the most frequent first; the option that moves a limit is named
     assert list(tally.values()) == sorted(tally.values(), reverse=True)
-    assert any("(--min-length sets the minimum)" in line for line in brief if " too-short " in line)
+    joined = "\n".join(brief).replace("\n" + " " * 14, " ")            # a long line wraps under its words
+    assert any("(--min-length sets the minimum)" in line for line in joined.splitlines() if " too-short " in line)
     verbose = CliRunner().invoke(main, ["scan", str(SCENE), "--fit-stages", "none", "--verbose"]).stdout
     lines = verbose.splitlines()
     listed = [line for line in lines if " rejected  " in line]

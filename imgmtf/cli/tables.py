@@ -97,7 +97,8 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     feature = feature_line(record, indent)
     if record["status"] == "error":
         hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
-        return f"{first} error: {record['error']}{hint}" + (f"\n{feature}" if feature else "")
+        return (_fill(f"error: {record['error']}{hint}", f"{first} ", " " * (len(first) + 8))
+                + (f"\n{feature}" if feature else ""))
     last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
@@ -117,9 +118,24 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m" + ("" if fwhm is None else f", FWHM {fwhm:.4g} m"))
     if record["status"] == "untrusted":
-        cells.append(f"{indent} error: {record['error']}")
+        cells.append(_fill(f"error: {record['error']}", f"{indent} ", " " * (len(indent) + 8)))
     cells += [warning_text(f"{indent} ", w) for w in record.get("warnings") or []]
     return "\n".join(cells)
+
+
+def echo_wrapped(text: str, indent: str = "    ") -> None:
+    """Print a table's heading or note wrapped to :data:`TABLE_WIDTH`
+    columns, its later lines indented by ``indent``."""
+    click.echo(_fill(text, "", indent))
+
+
+def _fill(text: str, first: str, later: str) -> str:
+    """``text`` wrapped to :data:`TABLE_WIDTH` columns after the indents
+    ``first`` and ``later``, never between a number and its per cent
+    sign ("0.25 %")."""
+    kept = text.replace(" %", "\N{NO-BREAK SPACE}%")
+    return textwrap.fill(kept, TABLE_WIDTH, initial_indent=first, subsequent_indent=later, break_long_words=False,
+                         break_on_hyphens=False).replace("\N{NO-BREAK SPACE}", " ")
 
 
 def warning_text(indent: str, warning: str, hint: bool = True) -> str:
@@ -128,8 +144,7 @@ def warning_text(indent: str, warning: str, hint: bool = True) -> str:
     the first under its words (a whole warning on one line ran to 250
     columns)."""
     head = f"{indent}warning: "
-    return textwrap.fill(hinted_warning(warning) if hint else warning, TABLE_WIDTH, initial_indent=head,
-                         subsequent_indent=" " * len(head), break_long_words=False, break_on_hyphens=False)
+    return _fill(hinted_warning(warning) if hint else warning, head, " " * len(head))
 
 
 def direction_cell(direction: str | None) -> str:
@@ -279,8 +294,8 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     sections = [r for r in summaries if r.figures.get("summary") == "sections"]
     fitted = [r for r in summaries if r.figures.get("summary") == "fit"]
     if combined:
-        click.echo("combined per target and per direction, weighted by precision (consistency over 1: "
-                   "the half-edges disagree beyond their intervals):")
+        echo_wrapped("combined per target and per direction, weighted by precision (consistency over 1: "
+                     "the half-edges disagree beyond their intervals):")
         click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
                    f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'FWHM':>6} {'consist.':>8}")
         for summary in combined:
@@ -336,8 +351,8 @@ def print_target_fits(fitted) -> None:
     """The sensor model fitted to each target's half-edges, across and along
     track, and why a fit is not to be trusted (its misfit) or failed."""
     stages: list[str] = next((r.figures["stages"] for r in fitted if r.figures.get("stages")), [])
-    click.echo(f"fitted per target, {axes_words(fitted)} (sensor model: {', '.join(stages) or '-'}; "
-               "misfit p: the smallest p-value of structure in its half-edges' residuals):")
+    echo_wrapped(f"fitted per target, {axes_words(fitted)} (sensor model: {', '.join(stages) or '-'}; "
+                 "misfit p: the smallest p-value of structure in its half-edges' residuals):")
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6} {'RER':>6} {'misfit p':>8}")
     warned: set[str] = set()
@@ -401,8 +416,8 @@ def print_recommended(rows) -> None:
         return
     if any(r.figures.get("recommended") for r in rows):
         pair = "horizontal/vertical" if axes_words(rows).startswith("horizontal") else "across/along"
-        click.echo(f"* the {pair} row to quote per target and direction: the model's fit when it fits and "
-                   "agrees with the sections, else the sections' assumption")
+        echo_wrapped(f"* the {pair} row to quote per target and direction: the model's fit when it fits and "
+                     "agrees with the sections, else the sections' assumption", indent="  ")
     directions: dict[tuple, list] = {}
     for r in rows:
         if r.ok and r.figures.get("direction") in SHORT_DIRECTIONS:
@@ -432,8 +447,8 @@ def print_rejections(rejected) -> None:
     for reason, group in sorted(by_reason.items(), key=lambda item: (-len(item[1]), item[0])):
         ids = [str(r.get("id")) for r in group[:MAX_EXAMPLE_IDS]]
         more = f" and {len(group) - MAX_EXAMPLE_IDS} more" if len(group) > MAX_EXAMPLE_IDS else ""
-        click.echo(f"rejected {len(group):>4} {reason} (id {', '.join(ids)}{more}): "
-                   f"e.g. {_rejection(group[0].to_dict())}")
+        echo_wrapped(f"rejected {len(group):>4} {reason} (id {', '.join(ids)}{more}): "
+                     f"e.g. {_rejection(group[0].to_dict())}", indent=" " * 14)
     if rejected:
         click.echo("  (--verbose lists every candidate)")
 
