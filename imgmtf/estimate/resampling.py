@@ -169,7 +169,9 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     shifted = np.empty((*moments.shape[:-2], n, n, moments.shape[-1]))
     # only the moments whose correlation with offset^p a binomial takes (j <= n - 1 - p, or for the
     # adjoint j >= p: about half of them), where each row's correlation is its own
-    taken = binomials.reshape(-1, n, n).any(axis=0).tolist() if offsets.size < ROW_BY_ROW_TAPS else None
+    taken: list[list[bool]] | None = None
+    if offsets.size < ROW_BY_ROW_TAPS:
+        taken = np.asarray(binomials.reshape(-1, n, n).any(axis=0)).tolist()
     for p in range(n):
         lo, hi = (taken[p].index(True), n - taken[p][::-1].index(True)) if taken and any(taken[p]) else (0, n)
         shifted[..., p, lo:hi, :] = correlate1d(moments[..., lo:hi, :], offsets ** p)
