@@ -7,9 +7,10 @@ measurement becomes an error record of reason ``internal`` for that file.
 from __future__ import annotations
 
 import functools
+import itertools
 import os
+from collections.abc import Generator, Sequence
 from contextlib import ExitStack
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -20,13 +21,17 @@ from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
 from .file_notes import file_notes as raster_notes
-from .inputs import saturation_levels
-from .io import open_raster, read_raster
+from .io import Raster, open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
+from .raster_estimate import edge_centre_px, in_image_axes, measure_raster, measure_rasters
 from .records import Record, utc_now
 from .vectors import Unplaced, VectorROIs
 
+GROUP_FILES = 32           # files measured in one task at most: their small rasters estimated together
+GROUP_BYTES = 4 * 2 ** 20  # and their bytes on disk at most: a larger file is a task of its own
+GROUPS_PER_WORKER = 6      # tasks per worker at least, where there are files enough: workers end together
+POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
 IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
                             ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
 
@@ -132,19 +137,34 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
         raise ParameterError(f"give settings or keyword options ({', '.join(options)}), not both")
     elif not isinstance(settings, MeasureSettings):
         raise ParameterError(f"settings must be a MeasureSettings, got {type(settings).__name__}")
-    path = os.fspath(path)
-    run_utc = run_utc or utc_now()
+    steps = _file_steps(os.fspath(path), settings, plot_path, run_utc or utc_now())
+    try:
+        raster = next(steps)
+        while True:
+            raster = steps.send(_measured(raster, settings))
+    except StopIteration as done:
+        return done.value
+
+
+def _file_steps(path: str, settings: MeasureSettings, plot_path, run_utc: str
+                ) -> Generator[Raster, Any, list[Record]]:
+    """:func:`measure_file` as a generator that yields each raster to
+    estimate (a band, a vector feature's window) and takes its estimate
+    (:func:`.raster_estimate.measure_raster`'s result or exception), so
+    that many files' rasters can be estimated together
+    (:func:`.raster_estimate.measure_rasters`); it returns the records."""
     with ExitStack() as stack:
         try:
             file = stack.enter_context(open_raster(path))       # once for the header and every band
             bands = file.info.bands(settings.band)
         except Exception as exc:               # the safety net: a record, never an abort
             return [settings.failed(path, settings.band, exc, run_utc)]
-        return _measure_bands(file, bands, settings, plot_path, run_utc)
+        return (yield from _bands_steps(file, bands, settings, plot_path, run_utc))
 
 
-def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: str) -> list[Record]:
-    """One record per band of an open file (see :func:`measure_file`)."""
+def _bands_steps(file, bands, settings: MeasureSettings, plot_path, run_utc: str
+                 ) -> Generator[Raster, Any, list[Record]]:
+    """One record per band of an open file (see :func:`_file_steps`)."""
     path, info = file.path, file.info
     skipped = info.alpha_bands if settings.band == "all" or (settings.band is None and info.is_grey_alpha) else []
     # what the file's reading adds to its first record's warnings (and to its figure's count of them)
@@ -158,8 +178,8 @@ def _measure_bands(file, bands, settings: MeasureSettings, plot_path, run_utc: s
     for index, band in enumerate(bands):
         for feature in windows:
             file_notes = skipped_note if index == 0 and feature is windows[0] else []
-            records.extend(_window_records(file, band, len(bands), feature, file_notes, settings, plot_path,
-                                           run_utc))
+            records.extend((yield from _window_steps(file, band, len(bands), feature, file_notes, settings,
+                                                     plot_path, run_utc)))
     return records
 
 
@@ -172,10 +192,12 @@ def _windows(info, settings: MeasureSettings) -> list:
     return [None]
 
 
-def _window_records(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc) -> list[Record]:
+def _window_steps(file, band, n_bands, feature, file_notes, settings, plot_path, run_utc
+                  ) -> Generator[Raster, Any, list[Record]]:
     """The records of one band read through one window: the settings' own
     (``feature`` None), or a vector feature's (with its attributes), or the
-    error of a feature with no window."""
+    error of a feature with no window; the raster read is yielded for its
+    estimate (see :func:`_file_steps`)."""
     path = file.path
     fields = {} if feature is None else {"site": feature.record_fields()}
     if isinstance(feature, Unplaced):
@@ -184,7 +206,9 @@ def _window_records(file, band, n_bands, feature, file_notes, settings, plot_pat
     notes = [*file_notes, *(feature.notes() if feature is not None else [])]
     try:
         raster = file.read(band, window=window)
-        result = measure_raster(raster, settings)
+        result = yield raster
+        if isinstance(result, Exception):       # its estimate's error: the same record as raised here
+            raise result
         # one record per result, or per direction of a kind that measures several (points)
         summaries = result.summaries(curves=True)
         if in_image_axes(raster, settings.track_azimuth_deg):       # each direction, a points record's too
@@ -242,67 +266,115 @@ def _untrusted_when_forced(record: Record, settings: MeasureSettings, checks) ->
     return record
 
 
-def measure_raster(raster, settings: MeasureSettings):
-    """The estimate of one raster (a window of the file when ``roi`` is
-    set), its ROI reported in the file's pixel coordinates, its direction
-    named by the image's axes when nothing places a track on it
-    (:func:`in_image_axes`)."""
-    estimator = settings.estimator()
-    track = settings.track_azimuth_deg
-    image_axes = in_image_axes(raster, track)
-    if track is None and not raster.map_projected:
-        track = 0.0                          # sensor geometry: rows along track (or the image's axes)
-    common = dict(gsd_m=raster.gsd_m, dtype=raster.dtype, track_azimuth_deg=track,
-                  saturation=settings.saturation or saturation_levels(raster.dtype))
-    result = estimator(raster.data, **settings.target_keywords(raster), **common)
-    x0, y0 = raster.origin
-    x, y, w, h = result.roi
-    result = replace(result, roi=(x + x0, y + y0, w, h))
-    if image_axes and isinstance(getattr(result, "direction", None), str):
-        from .estimate.geometry import image_axis_label
-        result = replace(result, direction=image_axis_label(result.direction))
-    return result
-
-
-def edge_centre_px(result) -> tuple[float, float]:
-    """The middle of a measured target's fitted line, in the file's pixels
-    (pixel centres at integers): the mean of the rows it was fitted on."""
-    geometry = result.geometry
-    along = float(np.mean(geometry.rows[geometry.kept]))
-    across = geometry.slope * along + geometry.intercept
-    x, y = (along, across) if geometry.transposed else (across, along)
-    return x + result.roi[0], y + result.roi[1]
-
-
-def in_image_axes(raster, track_azimuth_deg: float | None) -> bool:
-    """Whether a file's directions are named by its own axes (horizontal,
-    vertical): it has no georeference (no CRS, no pixel size) and no track
-    azimuth was given, so nothing says where a track lies (a camera's
-    photo; an L0 product says it with ``track_azimuth_deg=0``)."""
-    return track_azimuth_deg is None and not raster.map_projected and raster.gsd_m is None
-
-
 def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, scheduler: str | None = None,
                   plot_dir: str | None = None, progress: bool | None = None,
                   run_utc: str | None = None, ordered: bool = True):
     """Measure every file (expand folders first with :func:`expand_inputs`);
     yields each file's list of records, in input order (with ``ordered``
-    false: ``(index, records)`` pairs as files complete).  A task that dies
-    with its worker process still gives its file an error record."""
+    false: ``(index, records)`` pairs as files complete).  Files go to the
+    workers in groups (:func:`group_sizes`), each group's small rasters
+    estimated together (:func:`_measure_group`): the same records as each
+    file's :func:`measure_file`.  A task that dies with its worker process
+    still gives each of its files an error record."""
     paths = list(paths)
     run_utc = run_utc or utc_now()
     plots = plot_paths(paths, plot_dir) if plot_dir else [None] * len(paths)
-    tasks = [(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
+    starts = list(itertools.accumulate(group_sizes([_file_bytes(p) for p in paths], workers), initial=0))
+    tasks = [(paths[a:b], settings, plots[a:b], run_utc) for a, b in itertools.pairwise(starts)]
 
     def lost(task, exc):
-        return [settings.failed(task[0], settings.band, exc, run_utc)]
-    yield from run_tasks(_measure_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                         description="measuring", on_error=lost, ordered=ordered)
+        return [[settings.failed(path, settings.band, exc, run_utc)] for path in task[0]]
+    groups = run_tasks(_measure_group, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                       description="measuring", on_error=lost, ordered=ordered)
+    if ordered:
+        for group in groups:
+            yield from group
+    else:
+        for index, group in groups:
+            yield from enumerate(group, starts[index])
 
 
-def _measure_task(task) -> list[Record]:
-    path, settings, plot, run_utc = task
-    return measure_file(path, settings, plot, run_utc=run_utc)
+def group_sizes(file_bytes: Sequence[int], workers: int = 1) -> list[int]:
+    """How many files each task of a batch measures, in order, given the
+    files' sizes on disk (bytes): at most :data:`GROUP_FILES` and
+    :data:`GROUP_BYTES` a group (a file larger alone), and with several
+    workers at least :data:`GROUPS_PER_WORKER` groups per worker where
+    there are files enough, so that the workers finish together.  Small
+    chips gain from being estimated together; large files would only keep
+    their rows (and, on an interrupt, what was measured) waiting.
+
+    Examples
+    --------
+    >>> group_sizes([20_000] * 100), group_sizes([20_000] * 100, workers=2)
+    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8])
+    >>> group_sizes([20_000] * 3 + [50_000_000] + [20_000] * 2), group_sizes([])
+    ([3, 1, 2], [])
+    """
+    files = len(file_bytes)
+    if files == 0:
+        return []
+    count = -(-files // GROUP_FILES)
+    if workers > 1:
+        count = max(count, min(files, GROUPS_PER_WORKER * workers))
+    size, extra = divmod(files, count)
+    sizes: list[int] = []
+    for target in [size + 1] * extra + [size] * (count - extra):
+        start = sum(sizes)
+        group = file_bytes[start: start + target]
+        # cut where the bytes would pass the budget: a group holds one file at least
+        taken = next((n for n in range(1, len(group)) if sum(group[:n + 1]) > GROUP_BYTES), len(group))
+        sizes.append(taken)
+        sizes += group_sizes(group[taken:], 1) if taken < len(group) else []
+    return sizes
+
+
+def _file_bytes(path: str) -> int:
+    """A file's size on disk, 0 where it cannot be told (its measurement says why)."""
+    try:
+        return os.stat(path).st_size if path else 0
+    except (OSError, ValueError):
+        return 0
+
+
+def _measure_group(task) -> list[list[Record]]:
+    """Each file's records (:func:`measure_file`) of a group of files, their
+    small rasters (at most :data:`POOLED_MAX_PX`) estimated together
+    (:func:`.raster_estimate.measure_rasters`) a round at a time: every
+    file's first band (or window), then every file's next; a larger raster
+    is estimated on its own as it is read, so that a group holds no more
+    than a few small rasters at once."""
+    paths, settings, plots, run_utc = task
+    steps = [_file_steps(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
+    out: list[list[Record]] = [[] for _ in paths]
+    waiting: dict[int, Raster] = {}
+
+    def advance(i: int, outcome: Any = None, started: bool = True) -> None:
+        """File ``i``'s steps run on to its next small raster, or to its records."""
+        try:
+            raster = steps[i].send(outcome) if started else next(steps[i])
+            while raster.data.size > POOLED_MAX_PX:
+                raster = steps[i].send(_measured(raster, settings))
+            waiting[i] = raster
+        except StopIteration as done:
+            out[i] = done.value
+        except Exception as exc:        # as a task's failure would be: this file's error record only
+            out[i] = [settings.failed(paths[i], settings.band, exc, run_utc)]
+    for i in range(len(steps)):
+        advance(i, started=False)
+    while waiting:
+        rasters = dict(waiting)
+        waiting.clear()
+        for i, outcome in zip(rasters, measure_rasters(list(rasters.values()), settings)):
+            advance(i, outcome)
+    return out
+
+
+def _measured(raster: Raster, settings: MeasureSettings):
+    """:func:`.raster_estimate.measure_raster`'s result, or what it raised."""
+    try:
+        return measure_raster(raster, settings)
+    except Exception as exc:
+        return exc
 
 
 def plot_paths(paths, plot_dir: str) -> list[str]:

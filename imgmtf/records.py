@@ -426,9 +426,11 @@ def json_safe(value):
 
     Examples
     --------
-    >>> json_safe({"normal_angle_deg": -0.0, "mtf": [0.5, float("nan")]})
-    {'normal_angle_deg': 0.0, 'mtf': [0.5, None]}
+    >>> json_safe({"normal_angle_deg": -0.0, "mtf": [0.5, float("nan")], "misfit": np.bool_(False)})
+    {'normal_angle_deg': 0.0, 'mtf': [0.5, None], 'misfit': False}
     """
+    if isinstance(value, np.generic):           # a NumPy scalar (bool, integer) as the Python one JSON writes
+        value = value.item()
     if isinstance(value, float):
         return value + 0.0 if math.isfinite(value) else None
     if isinstance(value, dict):

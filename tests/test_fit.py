@@ -62,7 +62,7 @@ def test_diffraction_is_recovered_and_a_wrong_model_warns():
     assert "MISFIT" in figure.axes[0].get_title()
     assert "MISFIT" not in plot_fit(right)._suptitle.get_text()
     # the advice names stages the model lacks, never one it has
-    from imgmtf.estimate.fit.model import other_stages as _other_stages
+    from imgmtf.estimate.fit.choice import other_stages as _other_stages
     assert _other_stages(wrong.sensor.stages) == ("try the stages real blur adds (diffusion, halo, lag; stages "
                                                   "'auto' tries them) or others (e.g. diffraction, defocus, olpf)")
     assert _other_stages(right.sensor.stages).endswith("or others (e.g. defocus, olpf)")

@@ -50,3 +50,20 @@ def test_edge_model_mtfs_are_each_edges_own(edges):
         assert [float(v) for v in own] == bands[:, e].tolist()
         assert bands[1, e] < bands[0, e] < bands[2, e]
         assert mtf50[e] == first_crossing(f, np.abs(sensors[0].normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5)
+
+
+def test_edges_grouped_by_angle_fit_as_each_edge_alone(edges, monkeypatch):
+    """Edges whose responses are interpolated in angle (:mod:`.angles`,
+    here groups of two) give the residuals, Jacobian and optimum of each
+    edge's own response, far below their printed digits."""
+    from imgmtf.estimate.fit import angles
+    data = [edge_data(e, k, None) for k, e in enumerate(edges)]
+    own = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    monkeypatch.setattr(angles, "MIN_EDGES", 2)
+    monkeypatch.setattr(fit_model, "DENSE_EDGES", 0)          # the sparse Jacobian, as a scene's
+    grouped = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    assert sorted(i for members, _ in grouped.groups for i in members) == [0, 1, 2, 3] and not grouped.own
+    z = own.initial_vector()
+    np.testing.assert_allclose(grouped.residuals(z), own.residuals(z), rtol=0, atol=1e-7)
+    np.testing.assert_allclose(grouped.jacobian(z).toarray(), own.jacobian(z).toarray(), rtol=1e-7, atol=1e-7)
+    np.testing.assert_allclose(grouped.solve(z)[0], own.solve(z)[0], rtol=1e-7, atol=1e-7)

@@ -5,7 +5,13 @@ import numpy as np
 import pytest
 
 import imgmtf as im
-from imgmtf.estimate.fit.responses import KEPT_TRANSFERS, EdgeResponses, esf_changes, shared_transfers
+from imgmtf.estimate.fit.responses import (
+    KEPT_TRANSFERS,
+    EdgeResponses,
+    StackedResponses,
+    esf_changes,
+    shared_transfers,
+)
 from imgmtf.sensor import stages as st
 
 
@@ -127,3 +133,10 @@ def test_transfers_shared_by_edges_give_each_edge_its_own_responses_bit_for_bit(
             _, esf, lsf = edge.changes(sensor, shifted, g)
             _, own_esf, own_lsf = own.changes(sensor, shifted)
             assert np.array_equal(esf, own_esf) and np.array_equal(lsf, own_lsf)
+
+
+def test_stacked_esf_is_each_responses_own_bit_for_bit():
+    responses = [im.Sensor().line_response(angle, reach_px=reach) for angle, reach in ((5.0, 0.0), (80.0, 30.0))]
+    stacked = StackedResponses(responses, [3, 2])
+    d = np.array([-0.5, 0.25, 40.0, 0.5, -3.0])
+    np.testing.assert_array_equal(stacked.esf(d), [*responses[0].esf(d[:3]), *responses[1].esf(d[3:])])

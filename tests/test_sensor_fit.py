@@ -1,6 +1,7 @@
 """imgmtf.fit_sensor reads files as measure does (a window per file, nodata,
 the transfer curve, forced checks), measures a file named twice once, and
 its fitted sensor's TOML says whether the model fits."""
+import dataclasses
 import json
 
 import numpy as np
@@ -70,6 +71,9 @@ def test_files_are_measured_as_measure_measures_them(chips, tmp_path):
         measured = im.measure_file(path, transfer=transfer, intervals="none")[0]
         # (to the record's 6 digits)
         assert fit.edges[0].measured_mtf_nyquist == pytest.approx(measured.get("mtf_nyquist"), abs=5e-7)
+    # statistics as NumPy floats (as a fit gives them at p = 0): the verdict a bool JSON writes
+    numpy_stats = dataclasses.replace(fit.edges[0], misfit_p=np.float64(0.0), misfit_fraction=np.float64(0.5))
+    assert numpy_stats.misfit is True and json.loads(json.dumps(numpy_stats.to_dict()))["misfit"] is True
     assert im.fit_sensor([path], stages=STAGES, transfer="srgb").edges[0].measured_mtf_nyquist != \
         im.fit_sensor([path], stages=STAGES).edges[0].measured_mtf_nyquist
     # nodata declared by the file: measured around, as measure does

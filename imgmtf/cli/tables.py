@@ -97,8 +97,8 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     feature = feature_line(record, indent)
     if record["status"] == "error":
         hint = refusal_hint(record.get("reason"), record.get("error") or "", record["path"])
-        return (_fill(f"error: {record['error']}{hint}", f"{first} ", " " * (len(first) + 8))
-                + (f"\n{feature}" if feature else ""))
+        # an error stays on one line, whatever its length: one line to grep per file that failed
+        return f"{first} error: {record['error']}{hint}" + (f"\n{feature}" if feature else "")
     last = record.get(get_kind(kind).column.field)
     lo, hi = record.get("mtf_nyquist_ci") or (None, None)
     interval = f"[{lo:.4f},{hi:.4f}]" if lo is not None and hi is not None else "-"
@@ -118,7 +118,7 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
         cells.append(f"{indent} on the ground (GSD {record['gsd_m']:g} m): MTF50 "
                      f"{ground_cell(record.get('mtf50_cy_m'))} cy/m" + ("" if fwhm is None else f", FWHM {fwhm:.4g} m"))
     if record["status"] == "untrusted":
-        cells.append(_fill(f"error: {record['error']}", f"{indent} ", " " * (len(indent) + 8)))
+        cells.append(f"{indent} error: {record['error']}")
     cells += [warning_text(f"{indent} ", w) for w in record.get("warnings") or []]
     return "\n".join(cells)
 

@@ -118,3 +118,17 @@ def choose(fits, tried: int | None = None) -> tuple[int, str]:
     best = min(range(len(summaries)), key=lambda i: summaries[i].bic)
     return best, (f"none of the {tried} candidates fits: the lowest information criterion "
                   f"(BIC {summaries[best].bic:.0f})")
+
+
+def other_stages(stages) -> str:
+    """What to try when the model misfits: the long-tailed stages it lacks,
+    or, with all of them in, the non-parametric estimate."""
+    have = {s.name for s in stages}
+    real = [name for name in ("diffusion", "halo", "lag") if name not in have]
+    optical = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
+    if real:
+        return (f"try the stages real blur adds ({', '.join(real)}; stages 'auto' tries them)"
+                + (f" or others (e.g. {', '.join(optical)})" if optical else ""))
+    if optical:
+        return f"try other stages (e.g. {', '.join(optical)}), or quote the rows measured without a model"
+    return "quote the rows measured without a model, which assume no form of blur"

@@ -34,6 +34,7 @@ from ...metrics import first_crossing
 from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
+from .angles import grid_layout, grouped_edges, laid_out_changes
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
@@ -181,9 +182,12 @@ class Model:
         self.values = dict(self.held_at)         # coordinates of held parameters live here
         self.ties: dict[str, str] = {}
         self.free = list(self.keys)
-        self._last_responses: tuple = (None, [])
+        self._last_responses: tuple = (None, [], None)
         # each edge's grids, transfers and last response, kept across evaluations (and shared by copies)
         self.edges = [EdgeResponses(d.profile_angle_deg, d.gsd_m, self.reach(d)) for d in data]
+        # many edges at nearby tilts: their responses interpolated from a few tilts' (:mod:`.angles`)
+        self.groups, self.own = grouped_edges([d.profile_angle_deg for d in data], [d.gsd_m for d in data],
+                                              [self.reach(d) for d in data])
         self._last_esfs: tuple = (None, None, None)
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
@@ -289,8 +293,14 @@ class Model:
         key = (tuple(self.free), u.tobytes())
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
-            given = shared_transfers(self.edges, sensor.stages, sensor.gsd_m)
-            self._last_responses = (key, [edge.response(sensor, g) for edge, g in zip(self.edges, given)])
+            out: list = [None] * len(self.edges)
+            for members, group in self.groups:
+                for i, response in zip(members, group.responses(sensor)):
+                    out[i] = response
+            own = [self.edges[i] for i in self.own]
+            for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
+                out[i] = edge.response(sensor, g)
+            self._last_responses = (key, out, grid_layout(self.groups, self.own, sensor, out) if self.groups else None)
         return self._last_responses[1]
 
     def release(self) -> None:
@@ -302,7 +312,9 @@ class Model:
         model evaluates as before, computing them again."""
         for edge in self.edges:
             edge.release()
-        self._last_responses = (None, [])
+        for _, group in self.groups:
+            group.release()
+        self._last_responses = (None, [], None)
         self._last_esfs = (None, None, None)
         self._last_samples = (None, [])
         self._stages_made.clear()
@@ -346,7 +358,13 @@ class Model:
 
     def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
         """The edges' responses side by side, for their bins in turn (one edge's alone)."""
-        return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts)
+        return responses[0] if len(responses) == 1 else StackedResponses(responses, self.counts,
+                                                                         *self._laid_out(responses))
+
+    def _laid_out(self, responses: list[LineResponse]) -> tuple:
+        """Where ``responses``' grids lie side by side, and their remainders, when some are a group's."""
+        layout = self._last_responses[2] if self._last_responses[1] is responses else None
+        return (layout.offsets, layout.remainders) if layout is not None else ()
 
     def levels(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Each bin's edge's levels L and R (DN) and offset x0 (px) in ``z``
@@ -387,13 +405,8 @@ class Model:
             moved[k] += steps[k]
             shifted.append(self.sensor(moved))
         sensor = self.sensor(u)
-        base, esf_change, lsf_change = [], [], []
-        given = shared_transfers(self.edges, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-        for edge, g in zip(self.edges, given):
-            response, esf_rows, lsf_rows = edge.changes(sensor, shifted, g)
-            base.append(response)
-            esf_change.append(esf_rows)
-            lsf_change.append(lsf_rows)
+        base = self.responses(u)
+        esf_change, lsf_change = self._changes(sensor, shifted)
         lo, hi, x0 = self.levels(z)
         d = self.bins.x - x0
         stacked = self.stacked(base)
@@ -402,13 +415,12 @@ class Model:
         else:
             placement = stacked.placement(d, curvature=True)
             esf = bin_esf(stacked, self.bins, x0, placement)
-        changes = esf_changes(stacked, self.side_by_side(esf_change), self.side_by_side(lsf_change), d, placement)
+        changes = esf_changes(stacked, esf_change, lsf_change, d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
         stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
         lsf = self.side_by_side([r.lsf(d[start: start + count])
                                  for r, start, count in zip(base, self.starts, self.counts)])
         blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
-        self._last_responses = ((tuple(self.free), u.tobytes()), base)
         columns = self.n_free + 3 * len(self.counts)
         if not self.sparse:
             jacobian = np.zeros((self.rows, columns))
@@ -422,16 +434,27 @@ class Model:
         values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
 
+    def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
+        """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids side by side (:meth:`stacked`)."""
+        own = [self.edges[i] for i in self.own]
+        given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
+        rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
+        if not self.groups:
+            return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
+        return laid_out_changes(self.groups, self.own, rows, self._last_responses[2], sensor, shifted)
+
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
         """Each row's columns in a sparse Jacobian, the stage columns then
         its edge's levels' and offset's (which act on its own bins only),
         and where each row starts among them: its compressed rows, written
         directly (its size grows with the edges, not with their square);
-        made once for the free parameters."""
+        made once for the free parameters; 32-bit where they fit (LSMR's products read a quarter less)."""
         if self._layout[0] != self.n_free:
             nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
             indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
-            self._layout = (self.n_free, indices, np.arange(0, indices.size + 1, indices.shape[1]))
+            kind = np.int32 if indices.size < np.iinfo(np.int32).max else np.intp
+            self._layout = (self.n_free, indices.astype(kind),
+                            np.arange(0, indices.size + 1, indices.shape[1], dtype=kind))
         return self._layout[1:]
 
     @property
@@ -478,11 +501,14 @@ class Model:
         report ask at the same point)."""
         key = (tuple(self.free), z.tobytes())
         if self._last_samples[0] != key:
-            out = []
-            for e, (d, r) in enumerate(zip(self.data, self.responses(z[: self.n_free]))):
-                lo, hi, x0 = z[self.n_free + 3 * e: self.n_free + 3 * e + 3]
-                out.append(d.y - lo - (hi - lo) * r.esf(d.x - x0))
-            self._last_samples = (key, out)
+            responses = self.responses(z[: self.n_free])
+            counts = [d.x.size for d in self.data]
+            lo, hi, x0 = (np.repeat(z[self.n_free + j::3], counts) for j in range(3))
+            x, y = (np.concatenate([getattr(d, name) for d in self.data]) for name in ("x", "y"))
+            # every edge's samples in one pass, each as its own response gives it (:class:`StackedResponses`)
+            stacked = StackedResponses(responses, counts, *self._laid_out(responses))
+            residuals = y - lo - (hi - lo) * stacked.esf(x - x0)
+            self._last_samples = (key, np.split(residuals, np.cumsum(counts)[:-1]))
         return self._last_samples[1]
 
     def sample_chi_squares(self, z: np.ndarray) -> np.ndarray:
@@ -521,20 +547,6 @@ def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: fl
     distances placed on the response's grid with the curvature's weights."""
     value, curvature = response.esf_with_curvature(bins.x - x0, placement)
     return value + 0.5 * bins.m2 * curvature
-
-
-def other_stages(stages) -> str:
-    """What to try when the model misfits: the long-tailed stages it lacks,
-    or, with all of them in, the non-parametric estimate."""
-    have = {s.name for s in stages}
-    real = [name for name in ("diffusion", "halo", "lag") if name not in have]
-    optical = [name for name in ("diffraction", "defocus", "olpf") if name not in have]
-    if real:
-        return (f"try the stages real blur adds ({', '.join(real)}; stages 'auto' tries them)"
-                + (f" or others (e.g. {', '.join(optical)})" if optical else ""))
-    if optical:
-        return f"try other stages (e.g. {', '.join(optical)}), or quote the rows measured without a model"
-    return "quote the rows measured without a model, which assume no form of blur"
 
 
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:

@@ -11,7 +11,8 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
-from .model import Model, band_sensors, model_mtf50_band, model_mtf_band, other_stages
+from .choice import other_stages
+from .model import Model, band_sensors, model_mtf50_band, model_mtf_band
 from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test

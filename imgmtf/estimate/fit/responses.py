@@ -317,6 +317,12 @@ class StackedResponses:
         The edges' responses (of one sensor: one kind of reference).
     counts : sequence of int
         How many distances each edge has, in the order they come.
+    offsets : sequence of int, optional
+        Where each response's grid begins among the grids side by side
+        (default: one after the other, in turn).
+    remainders : (numpy.ndarray, numpy.ndarray), optional
+        Their ESF and LSF remainders so laid out, when the caller has them
+        (default: concatenated here).
 
     Raises
     ------
@@ -334,12 +340,18 @@ class StackedResponses:
     True
     """
 
-    def __init__(self, responses: Sequence[LineResponse], counts: Sequence[int]):
+    def __init__(self, responses: Sequence[LineResponse], counts: Sequence[int], offsets: Sequence[int] | None = None,
+                 remainders: tuple[np.ndarray, np.ndarray] | None = None):
         kinds = {r.reference[0] for r in responses}
         if len(kinds) != 1:
             raise ValueError(f"the responses' references are of several kinds: {', '.join(sorted(kinds))}")
         self.kind = kinds.pop()
         self.responses, self.counts = list(responses), list(counts)
+        if offsets is None:
+            sizes = [r.esf_remainder.size for r in self.responses]
+            offsets = np.cumsum([0, *sizes[:-1]]).tolist()
+        self.offsets = list(offsets)
+        self._remainders = remainders
 
     def _each(self, values: list) -> Any:
         """One value per distance, from one per edge (one for all when they agree)."""
@@ -350,7 +362,20 @@ class StackedResponses:
         sizes = [r.esf_remainder.size for r in self.responses]
         return hermite_placement(self._each([r.start_px for r in self.responses]),
                                  self._each([r.step_px for r in self.responses]), self._each(sizes), d_px,
-                                 curvature, self._each(np.cumsum([0, *sizes[:-1]]).tolist()))
+                                 curvature, self._each(self.offsets))
+
+    def remainders(self) -> tuple[np.ndarray, np.ndarray]:
+        """The responses' ESF and LSF remainders side by side (each at its offset)."""
+        if self._remainders is None:
+            self._remainders = (np.concatenate([r.esf_remainder for r in self.responses]),
+                                np.concatenate([r.lsf_remainder for r in self.responses]))
+        return self._remainders
+
+    def esf(self, d_px: np.ndarray) -> np.ndarray:
+        """Each edge's :meth:`LineResponse.esf` at its distances, in turn."""
+        d = np.asarray(d_px, float)
+        value = self.placement(d).interpolate(*self.remainders())
+        return plus_reference_esf(value, self.kind, self._each([r.reference[1] for r in self.responses]), d)
 
     def esf_with_curvature(self, d_px: np.ndarray,
                            placement: HermitePlacement | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -358,9 +383,7 @@ class StackedResponses:
         d = np.asarray(d_px, float)
         if placement is None:
             placement = self.placement(d, curvature=True)
-        value, curvature = placement.interpolate(np.concatenate([r.esf_remainder for r in self.responses]),
-                                                 np.concatenate([r.lsf_remainder for r in self.responses]),
-                                                 curvature=True)
+        value, curvature = placement.interpolate(*self.remainders(), curvature=True)
         width = self._each([r.reference[1] for r in self.responses])
         scale = self._each([reference_scale(r.reference) for r in self.responses])
         return (plus_reference_esf(value, self.kind, width, d),

@@ -140,7 +140,8 @@ class EdgeFit:
         """Whether the model does not fit this edge: its residuals are
         structured beyond the noise (p below :data:`MISFIT_P`) and beyond
         :data:`MISFIT_FRACTION` of the step."""
-        return self.misfit_p < MISFIT_P and self.misfit_fraction > MISFIT_FRACTION
+        # bool(): the statistics may be NumPy floats, whose comparison JSON cannot write
+        return bool(self.misfit_p < MISFIT_P and self.misfit_fraction > MISFIT_FRACTION)
 
     @property
     def misfit_tested(self) -> bool:
