@@ -136,3 +136,16 @@ def test_a_lack_of_tail_light_is_not_called_a_halo():
     lack, halo = tail_note(-0.043, 2.2), tail_note(0.043, 2.2)
     assert "4.3 % less" in lack and "halo" not in lack and "-" not in lack.split(":")[0]
     assert "4.3 % more" in halo and "halo" in halo
+
+
+def test_asking_a_textured_chip_for_points_loads_no_optimizer():
+    # a scan asks every edge refused for texture whether it holds points instead: finding none, it
+    # must not pay for loading SciPy's optimizer (a fifth of a second), which only a stamp's fit needs
+    import subprocess
+    import sys
+    code = ("import sys, numpy as np; from imgmtf.estimate.mtf2d.sources import points_seen; "
+            "print(points_seen(np.random.default_rng(0).normal(100.0, 2.0, (40, 40))), "
+            "'scipy.optimize' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["None", "False"]

@@ -13,6 +13,11 @@ from numpy.typing import ArrayLike
 
 from ..errors import ParameterError
 
+#: below this many taps cv2.filter2D correlates float64 rows one by one, each row's result its own
+#: whatever the rows beside it; from it on it goes through DFTs of blocks of rows, whose rounding
+#: depends on the block (tests/test_correlation.py checks both)
+ROW_BY_ROW_TAPS = 50
+
 
 def correlate1d(values: ArrayLike, weights: ArrayLike, axis: int = -1) -> np.ndarray:
     """Correlate ``values`` with ``weights`` along ``axis``:

@@ -279,7 +279,13 @@ def robust_noise(image: np.ndarray) -> float:
     horizontally adjacent pixels, which an edge barely affects (pairs with a
     left-out, NaN, pixel skipped).  Integer pixels are taken as floats, so
     that their differences cannot wrap."""
-    diff = np.diff(np.asarray(image, float), axis=1)
+    return noise_of_differences(np.diff(np.asarray(image, float), axis=1))
+
+
+def noise_of_differences(diff: np.ndarray) -> float:
+    """:func:`robust_noise` from the differences of the pixel pairs (DN, any
+    shape; NaN ones skipped): what a caller holding its pairs' differences
+    already (a scan's band of pixels) passes."""
     diff = diff[np.isfinite(diff)]
     mad = median(np.abs(diff - median(diff)))
     # a noise-free (or coarsely quantised) image has MAD 0: its noise is nil

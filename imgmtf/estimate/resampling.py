@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
-from ._correlation import correlate1d
+from ._correlation import ROW_BY_ROW_TAPS, correlate1d
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,28 +165,21 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     """``binomials`` applied to the correlations of ``moments`` (..., n, grid)
     with every power 0..n-1 of ``offsets``: (..., n, grid)."""
     n = moments.shape[-2]
-    # power p meets only the moments its binomials take (about half of
-    # them): the others' correlations are left at zero, which the product
-    # multiplies by a zero binomial as it did their values
-    shifted = np.zeros((*moments.shape[:-2], n, n, moments.shape[-1]))
-    for p, (lo, hi) in enumerate(_moments_met(binomials.tobytes(), n)):
-        if hi > lo:
-            shifted[..., p, lo: hi, :] = correlate1d(moments[..., lo: hi, :], offsets ** p)
+    moments = np.ascontiguousarray(moments)     # one copy for every power, not one in each correlation
+    shifted = np.empty((*moments.shape[:-2], n, n, moments.shape[-1]))
+    # only the moments whose correlation with offset^p a binomial takes (j <= n - 1 - p, or for the
+    # adjoint j >= p: about half of them), where each row's correlation is its own
+    taken: list[list[bool]] | None = None
+    if offsets.size < ROW_BY_ROW_TAPS:
+        taken = np.asarray(binomials.reshape(-1, n, n).any(axis=0)).tolist()
+    for p in range(n):
+        lo, hi = (taken[p].index(True), n - taken[p][::-1].index(True)) if taken and any(taken[p]) else (0, n)
+        shifted[..., p, lo:hi, :] = correlate1d(moments[..., lo:hi, :], offsets ** p)
+        if lo:
+            shifted[..., p, :lo, :] = 0.0
+        if hi < n:
+            shifted[..., p, hi:, :] = 0.0
     return binomials @ shifted.reshape(*moments.shape[:-2], n * n, moments.shape[-1])
-
-
-@functools.lru_cache(maxsize=32)
-def _moments_met(binomials: bytes, n: int) -> tuple[tuple[int, int], ...]:
-    """For each power p of the offsets, the range [lo, hi) of the moments
-    j whose correlation with it a nonzero binomial takes (column p n + j
-    of the (n, n * n) matrix given as its bytes)."""
-    columns = np.asarray(np.frombuffer(binomials).reshape(n, n, n).any(axis=0))     # (p, j)
-    out = []
-    for met in columns:
-        j = np.nonzero(met)[0]
-        lo, hi = (int(j[0]), int(j[-1]) + 1) if j.size else (0, 0)
-        out.append((lo, hi))
-    return tuple(out)
 
 
 @functools.lru_cache(maxsize=32)
@@ -239,7 +232,9 @@ def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray
         sums = np.bincount(where, weights=flat.ravel(), minlength=flat.shape[0] * n_bins).reshape(-1, n_bins)
     else:
         from scipy import sparse  # only for stacks of weights (the bootstrap)
-        onehot = sparse.csr_array((np.ones(bins.size), (np.arange(bins.size), bins)),
+        # one 1 per sample, in its bin's column: built as the compressed rows it is (a row pointer
+        # of 0, 1, 2...), not converted from coordinates, which sorts and sums what has no duplicates
+        onehot = sparse.csr_array((np.ones(bins.size), bins, np.arange(bins.size + 1)),
                                   shape=(bins.size, n_bins))
         sums = (onehot.T @ flat.T).T
     return sums.reshape(*lead, n_bins)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ImgmtfError
-from ..estimate.detection import robust_noise
+from ..estimate.detection import noise_of_differences
 from ..figures import with_figure
 from ..file_notes import file_notes
 from ..inputs import saturation_levels
@@ -156,20 +156,21 @@ def read_band(plan: Plan, raster, context: Context, fill_possible: bool = True) 
     inside = np.flatnonzero(band)            # (flat: faster than nonzero's pair of indices, the same order)
     rows, cols = np.divmod(inside, w)
     t, d = t.ravel()[inside], d.ravel()[inside]
-    fill = fill_mask(data, info.dtype) if fill_possible else np.zeros(data.shape, bool)
+    fill = fill_mask(data, info.dtype) if fill_possible else None
     extent = clear_extent(roi, t, d, x + cols, y + rows, fill, plan.partners, info)
     if isinstance(extent[0], str):
         return _rejected(context, raster, {"roi_polygon_px": roi.corners()}, *extent, verdict_by="screen")
     t0, t1 = extent
-    inside = (t >= t0) & (t < t1)
-    rows, cols, t, d = rows[inside], cols[inside], t[inside], d[inside]
+    if t0 > roi.t0_px or t1 <= roi.t1_px:         # (else the stretch holds the whole band: nothing to cut)
+        inside = (t >= t0) & (t < t1)
+        rows, cols, t, d = rows[inside], cols[inside], t[inside], d[inside]
     r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols.min(), cols.max() + 1      # (rows ascend: the band row by row)
     site = {"roi_polygon_px": roi.corners(t0, t1), "roi": [int(x + c0), int(y + r0), int(c1 - c0), int(r1 - r0)]}
     values = data[rows, cols]
     # the noise of the masked chip, from its horizontally adjacent pixels: in the band, row by row,
     # the pairs of consecutive pixels in one row and neighbouring columns
     adjacent = (rows[1:] == rows[:-1]) & (cols[1:] == cols[:-1] + 1)
-    noise = robust_noise(np.column_stack([values[:-1][adjacent], values[1:][adjacent]]))
+    noise = noise_of_differences((values[1:] - values[:-1])[adjacent])
     return Band(data, (x, y), rows, cols, values, t, d, noise, site)
 
 

@@ -128,20 +128,25 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
     for a boundary of the fill (fill along its sides) or an ROI the fill
     leaves too short, ``too-short`` otherwise.  ``t``, ``d``, ``xs``, ``ys``
     describe the ROI's pixels; ``fill`` is the fill of the window they
-    index (its top-left pixel at the smallest ``xs``, ``ys``).  The pixels
+    index (its top-left pixel at the smallest ``xs``, ``ys``), or None
+    where the window holds none.  The pixels
     come row by row (``ys`` ascending), as :func:`numpy.nonzero` gives them."""
     bins = max(math.ceil(roi.t1_px - roi.t0_px), 1)
-    # (np.minimum and np.maximum: np.clip's own overhead is most of a small array's cost)
-    k = np.minimum(np.maximum(np.floor(t - roi.t0_px).astype(int), 0), bins - 1)
+
+    def bin_of(pixels):
+        """The bins along the line of the ROI's ``pixels`` (an index or a mask): only those asked
+        for, mostly the few beside a partner.  (np.minimum and np.maximum: np.clip's own overhead
+        is most of a small array's cost.)"""
+        return np.minimum(np.maximum(np.floor(t[pixels] - roi.t0_px).astype(int), 0), bins - 1)
     bad = np.zeros(bins, bool)
     by_fill = np.zeros(bins, bool)
-    if fill.any():
+    if fill is not None and fill.any():
         r, c = ys - ys.min(), xs - xs.min()
         near_fill = fill[r, c] & (np.abs(d) <= FILL_SIDE_PX)
-        boundary = fill_screen(float(np.mean(np.bincount(k[near_fill], minlength=bins) > 0)))
+        boundary = fill_screen(float(np.mean(np.bincount(bin_of(near_fill), minlength=bins) > 0)))
         if boundary:
             return boundary
-        by_fill = np.bincount(k[grown(fill, FILL_CLEARANCE_PX)[r, c]], minlength=bins) > 0
+        by_fill = np.bincount(bin_of(grown(fill, FILL_CLEARANCE_PX)[r, c]), minlength=bins) > 0
         bad |= by_fill
     for p in np.asarray(partners, float).reshape(-1, 4).tolist():
         # only the pixels within the clearance of the partner's bounding box can be within it of the
@@ -155,7 +160,7 @@ def clear_extent(roi: Roi, t, d, xs, ys, fill, partners, info: RasterInfo):
                                       & (row_xs <= max(p[0], p[2]) + JUNCTION_CLEARANCE_PX))
         if near.size:
             close = distance_to_segment(xs[near], ys[near], p) <= JUNCTION_CLEARANCE_PX
-            bad[k[near[close]]] = True
+            bad[bin_of(near[close])] = True
     # the band's cross-section must lie inside the scene (checked when the rectangle, a pixel longer
     # at each end than the bins' centres reach, is not inside it whole)
     reach = roi._corners(roi.t0_px - 1.0, roi.t0_px + bins + 1.0)

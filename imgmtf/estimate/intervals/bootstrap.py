@@ -2,6 +2,7 @@
 re-estimated, the percentile interval of the re-estimates."""
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -33,14 +34,27 @@ def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.nda
     ``profiles``, sampled every ``step`` px): |DFT| normalised at zero,
     divided by |divisor(f)| (NaN where it is below ``MIN_TRANSFER``), as
     :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile."""
-    f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
-    x = np.arange(profiles.shape[-1]) * step
-    modulus = np.abs(profiles @ np.exp(-2j * np.pi * x[:, None] * f[None, :]))
+    f, basis = _fourier_basis(profiles.shape[-1], step)
+    modulus = np.abs(profiles @ basis)
     div = np.abs(divisor(f) / divisor(np.zeros(1)))
     with np.errstate(invalid="ignore", divide="ignore"):
         mtf = np.where(div >= MIN_TRANSFER, modulus / modulus[:, :1] / np.where(div > 0, div, 1), np.nan)
     nyquist = mtf[:, int(round(NYQUIST / FREQUENCY_STEP_CY_PX))]
     return nyquist, first_crossing(f, mtf, 0.5)
+
+
+@functools.lru_cache(maxsize=16)
+def _fourier_basis(n: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """The bootstrap's frequency grid (cy/px) and the DFT matrix of ``n``
+    samples ``step`` px apart on it, exp(-2 pi i x f), shape (n, frequencies):
+    made once per profile length and step (a scan's edges share a few), not
+    once per edge, where its complex exponentials cost as much as the
+    product they enter.  Read-only, being shared."""
+    f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
+    x = np.arange(n) * step
+    basis = np.exp(-2j * np.pi * x[:, None] * f[None, :])
+    f.flags.writeable = basis.flags.writeable = False
+    return f, basis
 
 
 def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:

@@ -24,7 +24,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, optimize, special
+from scipy import ndimage, special
 
 from ...errors import ParameterError
 
@@ -382,6 +382,9 @@ def fit_pixel_gaussian(stamp: np.ndarray):
     start = [total, np.clip(dx0, -0.9, 0.9), np.clip(dy0, -0.9, 0.9), 0.7, 0.7, level]
     low = [0.0, -radius, -radius, 0.02, 0.02, -np.inf]
     high = [np.inf, radius, radius, float(radius), float(radius), np.inf]
+    # (SciPy's optimizer loaded here, by the first stamp fitted: a scan's edge refused for texture asks
+    # points_seen whether it holds points, which finds none to fit, and needs not load it)
+    from scipy import optimize
     try:
         fit = optimize.least_squares(lambda p: (pixel_gaussian(p, n) - stamp).ravel(), start, bounds=(low, high),
                                      jac=lambda p: pixel_gaussian_jacobian(p, n), x_scale="jac", xtol=1e-12,
