@@ -85,8 +85,9 @@ def quantile(values: ArrayLike, q: ArrayLike) -> Any:
     if n == 0 or quantiles.size == 0:
         return np.quantile(flat, quantiles)
     virtual = np.asanyarray((n - 1) * quantiles)
-    previous = np.floor(virtual, out=...)
-    following = np.add(previous, 1, out=...)
+    # arrays even for one quantile (0-d), to be written below (out=... needs NumPy 2.1)
+    previous = np.array(np.floor(virtual))
+    following = np.array(previous + 1)
     above = virtual >= n - 1
     previous[above] = -1
     following[above] = -1
@@ -104,9 +105,8 @@ def quantile(values: ArrayLike, q: ArrayLike) -> Any:
     gamma = np.asanyarray(virtual - previous_i)
     # NumPy's lerp: from the lower value below gamma 1/2, from the upper one above
     diff = high - low
-    out = np.add(low, diff * gamma, out=...)
+    out = np.array(np.add(low, diff * gamma))
     np.subtract(high, diff * (1 - gamma), out=out, where=gamma >= 0.5, casting="unsafe")
-    out = np.asanyarray(out)
     return out[()] if out.ndim == 0 else out
 
 
