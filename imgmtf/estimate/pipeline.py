@@ -496,7 +496,8 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     excess, sharpening_notes, _, _ = sharpening_check(
         gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)
     checks.append(excess)
-    figures = _figures_check(spectrum)
+    first_hidden, nyquist_hidden = _divisor_zeros(spectrum)
+    figures = _figures_check(spectrum, first_hidden, nyquist_hidden)
     checks.append(figures)
     # the registered checks come last: a failure above (a sharpened halo) names the cause better
     profile_checks, profile_warnings = run_profile_checks(evidence)
@@ -504,7 +505,10 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     warnings = (list(gate.enforce(checks, settings.force)) + snr_warnings + sharpening_notes + profile_warnings
                 + list(chip.warnings))
     if kind.profile != "bar" and figures.passed and not math.isfinite(spectrum.mtf50_cy_px):
-        warnings.append(_hidden_mtf50(spectrum))
+        # hidden by the corrections (the check passed it as masked); a bar's sinc is its kind's to say
+        warnings.append(f"no MTF50: the MTF is still above 0.5 at {first_hidden:.2f} cy/px, where the "
+                        "profile's corrections hide it (a target sharper than the profile resolves, or not a "
+                        "clean one)")
     if window.cut:
         warnings.append(f"the LSF window's core ({window.core_px:.2f} px) is narrower than the {kind.name}'s width "
                         f"({shape.scale_px:.2f} px): it cuts the LSF, and the MTF reads high")
@@ -539,29 +543,23 @@ def normal_angle(geometry: TargetGeometry) -> float:
     return angle - 180.0 if angle > 90.0 else angle
 
 
-def _figures_check(spectrum: Spectrum) -> gate.Check:
-    """The figures' check, knowing where a divisor's zeros (a bar's sinc)
-    hide the MTF: a figure there is rightly missing."""
-    mtf, divisor = spectrum.mtf, spectrum.divisor
-    f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
-    hidden = np.abs(divisor(f_check) / divisor(np.zeros(1))) < MIN_TRANSFER
-    first_hidden = f_check[np.argmax(hidden)] if hidden.any() else math.inf
-    return gate.figures_check(
-        spectrum.mtf_nyquist, spectrum.mtf50_cy_px, spectrum.fwhm_px,
-        nyquist_masked=bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))]),
-        mtf50_masked=math.isfinite(first_hidden) and float(mtf(np.array([first_hidden - 0.01]))[0]) > 0.5)
-
-
-def _hidden_mtf50(spectrum: Spectrum) -> str:
-    """Why an edge has no MTF50 though its figures check passed: the MTF
-    is still above 0.5 where the divisor's first zero (the resampling's or
-    the derivative's transfer) hides it.  (A bar's sinc hiding its MTF50 is
-    its kind's to say.)"""
+def _divisor_zeros(spectrum: Spectrum) -> tuple[float, bool]:
+    """Where the divisor's zeros (a bar's sinc, the resampling's or the
+    derivative's transfer) hide the MTF: its first hidden frequency below
+    2 cy/px (inf where none), and whether Nyquist is hidden."""
     f_check = np.arange(0.0, 2.0, MASK_SCAN_STEP_CY_PX)
     hidden = np.abs(spectrum.divisor(f_check) / spectrum.divisor(np.zeros(1))) < MIN_TRANSFER
-    where = f"{f_check[np.argmax(hidden)]:.2f} cy/px" if hidden.any() else "2 cy/px"
-    return (f"no MTF50: the MTF is still above 0.5 at {where}, where the profile's corrections hide it "
-            "(a target sharper than the profile resolves, or not a clean one)")
+    first_hidden = float(f_check[np.argmax(hidden)]) if hidden.any() else math.inf
+    return first_hidden, bool(hidden[int(round(NYQUIST / MASK_SCAN_STEP_CY_PX))])
+
+
+def _figures_check(spectrum: Spectrum, first_hidden: float, nyquist_hidden: bool) -> gate.Check:
+    """The figures' check, knowing where the divisor's zeros
+    (:func:`_divisor_zeros`) hide the MTF: a figure there is rightly missing."""
+    return gate.figures_check(
+        spectrum.mtf_nyquist, spectrum.mtf50_cy_px, spectrum.fwhm_px, nyquist_masked=nyquist_hidden,
+        mtf50_masked=(math.isfinite(first_hidden)
+                      and float(spectrum.mtf(np.array([first_hidden - 0.01]))[0]) > 0.5))
 
 
 def _corrected_noise_sd(f: ArrayLike, *, white: Callable, divisor: Callable) -> np.ndarray:
