@@ -81,10 +81,10 @@ def fit_bar_files(paths: Sequence[str], *, target: str, pulse_width: tuple[float
     >>> abs(fit.mtf_nyquist[0] - float(chip.true_mtf(0.5))) < 0.005
     True
     """
-    from .batch import measure_raster
     from .estimate.intervals import Intervals
     from .io import open_raster
     from .measure_settings import MeasureSettings
+    from .raster_estimate import measure_raster
     if not get_kind(target).has_width:
         raise ParameterError(f"the bars' fit takes targets with a width, not a {target}")
     if not paths:

@@ -24,7 +24,7 @@ from .file_notes import file_notes as raster_notes
 from .io import Raster, open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
-from .raster_estimate import edge_centre_px, in_image_axes, measure_raster, measure_rasters
+from .raster_estimate import edge_centre_px, in_image_axes, measure_rasters
 from .records import Record, utc_now
 from .vectors import Unplaced, VectorROIs
 
@@ -141,7 +141,7 @@ def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = Non
     try:
         raster = next(steps)
         while True:
-            raster = steps.send(_measured(raster, settings))
+            raster = steps.send(measure_rasters([raster], settings)[0])
     except StopIteration as done:
         return done.value
 
@@ -353,7 +353,7 @@ def _measure_group(task) -> list[list[Record]]:
         try:
             raster = steps[i].send(outcome) if started else next(steps[i])
             while raster.data.size > POOLED_MAX_PX:
-                raster = steps[i].send(_measured(raster, settings))
+                raster = steps[i].send(measure_rasters([raster], settings)[0])
             waiting[i] = raster
         except StopIteration as done:
             out[i] = done.value
@@ -367,14 +367,6 @@ def _measure_group(task) -> list[list[Record]]:
         for i, outcome in zip(rasters, measure_rasters(list(rasters.values()), settings)):
             advance(i, outcome)
     return out
-
-
-def _measured(raster: Raster, settings: MeasureSettings):
-    """:func:`.raster_estimate.measure_raster`'s result, or what it raised."""
-    try:
-        return measure_raster(raster, settings)
-    except Exception as exc:
-        return exc
 
 
 def plot_paths(paths, plot_dir: str) -> list[str]:

@@ -265,12 +265,12 @@ def _measured_file(path: str, band: int | None, roi: Roi | None, gsd_m: float | 
                    saturation: tuple[float, float] | None) -> tuple[MeasuredEdge, list[str]]:
     """A file's edge measured as ``imgmtf measure`` measures it (no
     intervals: the fit makes its own), named by the file and its window."""
-    from .batch import measure_raster
     from .errors import ImgmtfError
     from .estimate.gate import untrusted_when_forced
     from .estimate.intervals import Intervals
     from .io import open_raster
     from .measure_settings import MeasureSettings
+    from .raster_estimate import measure_raster
     source = edge_sources([path], [roi])[0]
     settings = MeasureSettings("edge", band=band, roi=roi, intervals=Intervals("none"), force=force,
                                saturation=saturation, transfer=transfer)

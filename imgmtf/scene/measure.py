@@ -73,7 +73,7 @@ def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
 def in_image_axes(info: RasterInfo, settings: ScanSettings) -> bool:
     """Whether the scene's directions are named by its own axes
     (horizontal, vertical): no CRS, no pixel size and no track azimuth
-    given (a camera's photo), as :func:`imgmtf.batch.in_image_axes`."""
+    given (a camera's photo), as :func:`imgmtf.raster_estimate.in_image_axes`."""
     return settings.track_azimuth_deg is None and not info.crs and info.gsd_m is None
 
 
