@@ -114,3 +114,26 @@ def test_json_and_csv_hold_no_negative_zero():
     row = record.csv_row()
     assert str(row["normal_angle_deg"]) == "0.0" and row["mtf_nyquist_ci_low"] == 0.0
     assert str(row["mtf_nyquist_ci_low"]) == "0.0" and row["mtf_nyquist"] == ""
+
+
+def test_json_lines_match_the_values_made_safe_first():
+    """The encoder writes a row at once and makes it safe only when it holds a NaN, an infinity or a -0.0
+    as a value: the same text as json_safe before json.dumps, whatever the row holds (NumPy scalars and
+    arrays, such tokens inside strings, a repeated frequency grid equal but for -0.0, or of ints)."""
+    import numpy as np
+
+    from imgmtf.records import JsonRows, _json_default, json_safe
+    grid = [0.0, 0.25, 0.5]
+    figures = [
+        {"frequencies_cy_px": grid, "mtf": [1.0, 0.5, 0.1], "note": "a NaN, -0.0] and -Infinity} in text"},
+        {"frequencies_cy_px": [-0.0, 0.25, 0.5], "mtf": [1.0, float("nan"), -0.0], "tilt_deg": np.float64(-0.0)},
+        {"frequencies_cy_px": [0, 0.25, 0.5], "mtf": np.array([1.0, -0.0]), "misfit": np.bool_(True)},
+        {"frequencies_cy_px": grid, "n": np.int64(3), "levels_dn": (np.float32(-np.inf), 2.5), "x": -0.01},
+        {"frequencies_cy_px": list(grid), "mtf": [1.0, 0.4, 0.05], "checks": [{"value": None, "limit": 0.3}]},
+    ]
+    rows = JsonRows()
+    for extra in figures:
+        record = Record("a.tif", 1, "edge", "msg", "ok", figures=extra, params={"order": 4})
+        safe = json.dumps(json_safe(record.to_dict()), default=_json_default)
+        assert to_json(record) == safe
+        assert rows.line(record) == safe

@@ -263,8 +263,9 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     if fmt == "json":
         import sys
 
-        from ..records import to_json, write_whole
-        write_whole(sys.stdout, "".join(to_json(r) + "\n" for r in (*records, *summaries)))
+        from ..records import JsonRows, write_whole
+        rows = JsonRows()
+        write_whole(sys.stdout, "".join(rows.line(r) + "\n" for r in (*records, *summaries)))
         return
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
