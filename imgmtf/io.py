@@ -322,6 +322,28 @@ def open_raster(path: str | Path) -> Iterator[RasterFile]:
         yield RasterFile(path, src)
 
 
+@contextmanager
+def many_files() -> Iterator[None]:
+    """GDAL set to open many files in a row: without listing a file's
+    folder at each open (GDAL's default, to find its side-car files: a
+    folder of a thousand chips was listed a thousand times, 1-2 ms an
+    open), each side-car (a ``.tfw`` world file, ``.aux.xml``, ``.msk``) is
+    looked for by its name instead: the same files found.  A setting of
+    ``GDAL_DISABLE_READDIR_ON_OPEN`` the user made is kept.
+
+    Examples
+    --------
+    >>> from imgmtf.io import many_files
+    >>> with many_files():                               # doctest: +SKIP
+    ...     infos = [raster_info(p) for p in paths]
+    """
+    if "GDAL_DISABLE_READDIR_ON_OPEN" in os.environ:
+        yield
+        return
+    with rasterio.Env(GDAL_DISABLE_READDIR_ON_OPEN="TRUE"):
+        yield
+
+
 def raster_metadata(path: str | Path, band: int | None = None) -> dict[str, dict[str, str]]:
     """A raster file's metadata items as GDAL reports them, by domain:
     ``"default"`` (the dataset's own items and TIFF tags such as
