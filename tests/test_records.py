@@ -137,3 +137,20 @@ def test_json_lines_match_the_values_made_safe_first():
         safe = json.dumps(json_safe(record.to_dict()), default=_json_default)
         assert to_json(record) == safe
         assert rows.line(record) == safe
+
+
+def test_finite_values_are_the_floats_round_gives():
+    """A curve rounded at once: the very floats of round(v, 6) (signed zeros too), None where not finite,
+    near ties (where the product's own rounding could move the integer) and ties included."""
+    import numpy as np
+
+    from imgmtf.records import finite_values
+    rng = np.random.default_rng(5)
+    ties = (rng.integers(0, 10**7, 2000) + 0.5) / 1e6
+    values = np.concatenate([rng.uniform(-2, 2, 2000), 10.0 ** rng.uniform(-12, 12, 2000), ties,
+                             ties + rng.uniform(-1e-12, 1e-12, 2000), np.arange(4096) / 4096,
+                             [np.nan, np.inf, -np.inf, -0.0, 0.0, 1e300, -5e-7, 5e-7, 2.5e-6, -1e-9]])
+    got = finite_values(values)
+    want = [round(v, 6) if math.isfinite(v) else None for v in values.tolist()]
+    assert [(g, math.copysign(1, g)) if g is not None else None for g in got] == \
+           [(w, math.copysign(1, w)) if w is not None else None for w in want]

@@ -95,17 +95,3 @@ def test_the_summary_curve_weights_each_curve_as_its_nyquist_interval_earns():
     plain = [dataclasses.replace(r, figures={**r.figures, "mtf_nyquist_ci": [None, None]}) for r in weighted]
     assert summarise_scan(plain)[0].figures["mtf"][1] == pytest.approx(0.4)     # no intervals: equal weights
 
-
-def test_finite_values_are_the_floats_round_gives():
-    """A curve rounded at once: the very floats of round(v, 6) (signed zeros too), None where not finite,
-    near ties (where the product's own rounding could move the integer) and ties included."""
-    from imgmtf.scene.combine import finite_values
-    rng = np.random.default_rng(5)
-    ties = (rng.integers(0, 10**7, 2000) + 0.5) / 1e6
-    values = np.concatenate([rng.uniform(-2, 2, 2000), 10.0 ** rng.uniform(-12, 12, 2000), ties,
-                             ties + rng.uniform(-1e-12, 1e-12, 2000), np.arange(4096) / 4096,
-                             [np.nan, np.inf, -np.inf, -0.0, 0.0, 1e300, -5e-7, 5e-7, 2.5e-6, -1e-9]])
-    got = finite_values(values)
-    want = [round(v, 6) if math.isfinite(v) else None for v in values.tolist()]
-    assert [(g, math.copysign(1, g)) if g is not None else None for g in got] == \
-           [(w, math.copysign(1, w)) if w is not None else None for w in want]

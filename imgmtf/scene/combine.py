@@ -25,7 +25,7 @@ from .._stats import t_quantile
 from ..errors import ParameterError
 from ..estimate.geometry import direction_label
 from ..estimate.results import finite
-from ..records import SCENE_SCOPE, TARGET_SCOPE, Record
+from ..records import SCENE_SCOPE, TARGET_SCOPE, Record, finite_values
 
 FAMILY_SPREAD_DEG = 20.0        # normals of one direction family differ by at most this
 FAMILY_GAP_DEG = 10.0           # a gap this wide between sorted normals separates two families
@@ -287,41 +287,6 @@ def _summary(group: list[Record], site: dict) -> Record:
     return Record(first.path, first.band, first.target, first.method, "combined", figures=figures, site=where,
                   params={"intervals": first.params.get("intervals"), "track_azimuth_deg": track,
                           "scan": first.params.get("scan")}, run_utc=first.run_utc)
-
-
-#: beyond this, a value times 10^6 no longer holds its fraction to within the guard below
-_ROUNDING_MAX = 1e9
-_HALF_GUARD = 1e-5
-
-
-def finite_values(values: ArrayLike) -> list[float | None]:
-    """:func:`imgmtf.estimate.results.finite` of each value, a curve at
-    once: rounded to 6 decimals, None where not finite; the very floats
-    Python's ``round(v, 6)`` gives, in a fraction of its time (a dense
-    chart's summaries round a hundred thousand values).
-
-    ``round`` rounds the value's exact decimal expansion; here the value
-    times 10^6 is rounded to the nearest integer (ties to even, as
-    ``round``), then divided by 10^6 (correctly rounded: the double nearest
-    that decimal, as ``round`` returns).  The product's own rounding can
-    only change the integer for a value within its error of a tie: those
-    (and values too large to hold a fraction) go through ``round`` itself.
-
-    Examples
-    --------
-    >>> finite_values([0.12345649999, 1 / 3, float("nan"), -1e-9, 2.5e-6])
-    [0.123456, 0.333333, None, -0.0, 3e-06]
-    """
-    x = np.asarray(values, float).ravel()
-    with np.errstate(invalid="ignore", over="ignore"):
-        scaled = x * 1e6
-        whole = np.rint(scaled)
-        out = (whole / 1e6).tolist()
-        exact = (np.abs(scaled) < _ROUNDING_MAX) & (np.abs(np.abs(scaled - whole) - 0.5) > _HALF_GUARD)
-    for i in np.flatnonzero(~exact).tolist():
-        v = float(x[i])
-        out[i] = round(v, 6) if math.isfinite(v) else None
-    return out
 
 
 def _pair(interval) -> tuple[float, float]:
