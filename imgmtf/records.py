@@ -24,6 +24,7 @@ scan's screening codes (``angle``, ``too-short``, ``fill``, ``non-uniform``...),
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import math
 import re
@@ -307,21 +308,22 @@ class Record:
             Column -> value.
         """
         flat = self.to_dict()
-        columns = columns or CSV_COLUMNS
-        if any(c in _CURVE_COLUMN_FREQUENCY for c in columns):
+        plan, curve = _csv_plan(tuple(columns or CSV_COLUMNS))
+        if curve:
             flat.update(curve_values(flat.get("frequencies_cy_px"), flat.get("mtf")))
         row = {}
-        for column in columns:
-            source = _CSV_SOURCES.get(column, column)
-            if isinstance(source, tuple):
-                pair = flat.get(source[0]) or (None, None)
-                value = pair[source[1]]
-            else:
-                value = flat.get(source)
-            if isinstance(value, (list, tuple, dict)):
-                value = json.dumps(json_safe(value), sort_keys=True, default=_json_default)
-            elif isinstance(value, float):
-                value = json_safe(value)
+        for column, key, index in plan:
+            value = flat.get(key) if index is None else (flat.get(key) or (None, None))[index]
+            kind = type(value)          # the plain types first, by their exact type: 120 columns a row
+            if kind is float:
+                value = value + 0.0 if math.isfinite(value) else None       # as json_safe
+            elif kind is list or kind is tuple or kind is dict:
+                value = _dumps_sorted(value)
+            elif not (value is None or kind is str or kind is int or kind is bool):
+                if isinstance(value, (list, tuple, dict)):
+                    value = _dumps_sorted(value)
+                elif isinstance(value, float):
+                    value = json_safe(value)
             row[column] = "" if value is None else value
         return row
 
@@ -397,6 +399,18 @@ _CSV_SOURCES = {
 _CURVE_COLUMN_FREQUENCY = dict(zip(CURVE_COLUMNS, CURVE_FREQUENCIES_CY_PX))
 
 
+@functools.lru_cache(maxsize=16)
+def _csv_plan(columns: tuple[str, ...]) -> tuple[tuple[tuple[str, str, int | None], ...], bool]:
+    """Each CSV column's source in the flat record (its key, and the index
+    of an interval's bound), and whether the columns hold the curve's:
+    worked out once per schema rather than per row."""
+    plan = []
+    for column in columns:
+        source = _CSV_SOURCES.get(column, column)
+        plan.append((column, *source) if isinstance(source, tuple) else (column, source, None))
+    return tuple(plan), any(c in _CURVE_COLUMN_FREQUENCY for c in columns)
+
+
 def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
     """The MTF curve at :data:`CURVE_FREQUENCIES_CY_PX`, keyed by CSV
     column (linear between the curve's samples; None outside the curve or
@@ -467,6 +481,17 @@ def _unsafe(text: str) -> bool:
     """Whether JSON text written by json's encoder holds a NaN, an
     infinity or a -0.0 as a value (not within a string)."""
     return any(part in text for part in _UNSAFE_PARTS) and _UNSAFE_VALUE.search(text) is not None
+
+
+_SORTED_ENCODER = json.JSONEncoder(sort_keys=True, default=_json_default)
+
+
+def _dumps_sorted(value) -> str:
+    """``json.dumps(json_safe(value), sort_keys=True)``, as :func:`dumps_safe` (a CSV cell's list or mapping)."""
+    text = _SORTED_ENCODER.encode(value)
+    if _unsafe(text):
+        return json.dumps(json_safe(value), sort_keys=True, default=_json_default)
+    return text
 
 
 def to_json(record: Record) -> str:
@@ -600,12 +625,15 @@ class CsvWriter:
         except OSError as exc:
             self._output.__exit__(type(exc), exc, exc.__traceback__)
             raise FileWriteError(f"{self.path}: cannot write: {exc.strerror or exc}") from None
-        self._writer = csv.DictWriter(self._file, fieldnames=list(self.columns))
-        self._guarded(self._writer.writeheader)
+        # rows as lists in the columns' order (csv.DictWriter's check of each row's keys cost as much as
+        # the writing): what DictWriter writes
+        self._writer = csv.writer(self._file)
+        self._guarded(self._writer.writerow, self.columns)
         return self
 
     def write(self, record: Record) -> None:
-        self._guarded(self._writer.writerow, record.csv_row(self.columns))
+        row = record.csv_row(self.columns)
+        self._guarded(self._writer.writerow, [row[column] for column in self.columns])
         self.rows += 1
 
     def _guarded(self, action, *args) -> None:

@@ -9,7 +9,7 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import FileWriteError, ImageReadError
-from imgmtf.records import CSV_COLUMNS, SCAN_CSV_COLUMNS, CsvWriter, Record, to_json, utc_now
+from imgmtf.records import CSV_COLUMNS, SCAN_CSV_COLUMNS, CsvWriter, Record, curve_values, to_json, utc_now
 
 SUMMARY = {"target": "edge", "method": "msg", "angle_deg": 6.0, "snr": 120.0, "mtf_nyquist": 0.27,
            "mtf_nyquist_ci": [0.26, 0.28], "mtf50_cy_px": 0.36, "mtf50_ci_cy_px": [0.35, 0.37],
@@ -154,3 +154,27 @@ def test_finite_values_are_the_floats_round_gives():
     want = [round(v, 6) if math.isfinite(v) else None for v in values.tolist()]
     assert [(g, math.copysign(1, g)) if g is not None else None for g in got] == \
            [(w, math.copysign(1, w)) if w is not None else None for w in want]
+
+
+def test_csv_cells_are_the_values_made_safe_first():
+    """A CSV row's cells as json_safe and json.dumps(sort_keys=True) make them, whatever the row holds."""
+    import numpy as np
+
+    from imgmtf.records import _json_default, json_safe
+    figures = {"mtf_nyquist": np.float64(-0.0), "mtf_nyquist_ci": (0.25, float("nan")), "snr": float("inf"),
+               "rows_used": np.int64(40), "sharpened": np.bool_(False), "warnings": ["NaN, -0.0]"],
+               "levels_dn": [2.0, -0.0], "feature": {"b": 1, "a": float("nan")}, "fwhm_px": -0.0,
+               "frequencies_cy_px": [0.0, 0.5, 1.0], "mtf": [1.0, 0.25, None]}
+    record = Record("a.tif", 1, "edge", "msg", "ok", figures=figures, params={"order": 4})
+    flat = record.to_dict()
+    flat.update(curve_values(flat["frequencies_cy_px"], flat["mtf"]))
+    for column, cell in record.csv_row(SCAN_CSV_COLUMNS).items():
+        source = {"mtf_nyquist_ci_low": ("mtf_nyquist_ci", 0), "mtf_nyquist_ci_high": ("mtf_nyquist_ci", 1),
+                  "mtf50_ci_low_cy_px": ("mtf50_ci_cy_px", 0), "mtf50_ci_high_cy_px": ("mtf50_ci_cy_px", 1),
+                  "roi_px": "roi"}.get(column, column)
+        value = (flat.get(source[0]) or (None, None))[source[1]] if isinstance(source, tuple) else flat.get(source)
+        if isinstance(value, (list, tuple, dict)):
+            value = json.dumps(json_safe(value), sort_keys=True, default=_json_default)
+        elif isinstance(value, float):
+            value = json_safe(value)
+        assert repr(cell) == repr("" if value is None else value), column       # -0.0 == 0.0, not alike in CSV
