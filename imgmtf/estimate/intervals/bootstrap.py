@@ -34,8 +34,9 @@ def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.nda
     ``profiles``, sampled every ``step`` px): |DFT| normalised at zero,
     divided by |divisor(f)| (NaN where it is below ``MIN_TRANSFER``), as
     :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile."""
-    f, basis = _fourier_basis(profiles.shape[-1], step)
-    modulus = np.abs(profiles @ basis)
+    f, cosine, sine = _fourier_basis(profiles.shape[-1], step)
+    # the real profiles' transform as two real products: a complex one would multiply zeros too
+    modulus = np.hypot(profiles @ cosine, profiles @ sine)
     div = np.abs(divisor(f) / divisor(np.zeros(1)))
     with np.errstate(invalid="ignore", divide="ignore"):
         mtf = np.where(div >= MIN_TRANSFER, modulus / modulus[:, :1] / np.where(div > 0, div, 1), np.nan)
@@ -44,17 +45,19 @@ def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.nda
 
 
 @functools.lru_cache(maxsize=16)
-def _fourier_basis(n: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+def _fourier_basis(n: int, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The bootstrap's frequency grid (cy/px) and the DFT matrix of ``n``
-    samples ``step`` px apart on it, exp(-2 pi i x f), shape (n, frequencies):
-    made once per profile length and step (a scan's edges share a few), not
-    once per edge, where its complex exponentials cost as much as the
-    product they enter.  Read-only, being shared."""
+    samples ``step`` px apart on it, exp(-2 pi i x f), as its real and
+    imaginary parts cos(2 pi x f) and -sin(2 pi x f), shape (n,
+    frequencies): made once per profile length and step (a scan's edges
+    share a few), not once per edge, where its exponentials cost as much as
+    the product they enter.  Read-only, being shared."""
     f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
     x = np.arange(n) * step
     basis = np.exp(-2j * np.pi * x[:, None] * f[None, :])
-    f.flags.writeable = basis.flags.writeable = False
-    return f, basis
+    cosine, sine = np.ascontiguousarray(basis.real), np.ascontiguousarray(basis.imag)
+    f.flags.writeable = cosine.flags.writeable = sine.flags.writeable = False
+    return f, cosine, sine
 
 
 def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:
@@ -120,6 +123,18 @@ def bootstrap_figures(distance: np.ndarray, rows: np.ndarray, span_px: float, re
     return percentile_interval(nyquist, confidence), percentile_interval(fifty, confidence)
 
 
+def _tail_fits(u: np.ndarray, values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Every replicate's weighted least-squares line ``values ~ c0 + c1 u``
+    (a side's level and tail, u = 1 / |s|^p), shape (replicates, 2): the
+    weighted sums of the samples in one product, the 2 x 2 normal equations
+    (with 1e-12 added to their diagonal, as a guard against an empty side)
+    solved in closed form for all replicates at once."""
+    sums = weights @ np.stack([np.ones_like(u), u, u * u, values, u * values], axis=1)
+    s0, s1, s2 = sums[:, 0] + 1e-12, sums[:, 1], sums[:, 2] + 1e-12
+    det = s0 * s2 - s1 * s1
+    return np.stack([(s2 * sums[:, 3] - s1 * sums[:, 4]) / det, (s0 * sums[:, 4] - s1 * sums[:, 3]) / det], axis=1)
+
+
 def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replicates: int = 200,
                         seed: int = 0) -> FigureIntervals:
     """Bootstrap intervals for MTF at Nyquist and MTF50: every replicate
@@ -168,12 +183,8 @@ def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replica
     def windowed(grid_b, values_b, weights_of):
         coefs = []
         for mask in masks:
-            u = np.abs(offsets[mask]) ** -float(estimate.tail_power)
-            design = np.column_stack([np.ones_like(u), u])
-            wts = weights_of(mask)
-            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
-            rhs = np.einsum("ri,ij,i->rj", wts, design, values[mask])
-            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
+            coefs.append(_tail_fits(np.abs(offsets[mask]) ** -float(estimate.tail_power), values[mask],
+                                    weights_of(mask)))
         background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
         x_data, lsf_data, _ = estimate.lsf_of(grid_b, values_b, background[:, None])
         first = int(round((x_data[0] - x[0]) / step))
