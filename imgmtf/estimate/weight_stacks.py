@@ -7,8 +7,8 @@ per row).  The window sums of the local polynomial
 (:func:`imgmtf.estimate.resampling.local_polynomial`) are linear in the
 weights, so they are summed once per group of samples that share their
 weights, and every weighting's sums are one matrix product with the groups'
-weights, where correlating every weighting's per-bin sums costs about fifty
-times more.  The windows' normal equations are symmetric positive definite;
+weights, not a correlation of every weighting's per-bin sums with each power
+of the window's offsets.  The windows' normal equations are symmetric positive definite;
 only their first unknown (the fitted level) is wanted, which elimination
 from the last unknown up gives without back-substitution, for all windows in
 one pass of array operations rather than one LAPACK call each.  The floats
