@@ -44,32 +44,34 @@ def solve_pentadiagonal(diagonal: np.ndarray, first: np.ndarray, second: np.ndar
     True
     """
     n = diagonal.shape[1]
-    # the factor L (A = L L^T) by its bands, unknowns first: l0[i] = L[i, i], l1[i] = L[i + 1, i],
-    # l2[i] = L[i + 2, i]; a row of each is one step's values for every system
-    d0, d1, d2 = diagonal.T, _padded(first.T, n), _padded(second.T, n)
-    l0, l1, l2 = np.empty_like(d0), np.zeros_like(d0), np.zeros_like(d0)
+    # the factor L (A = L L^T) by its bands, one list entry per unknown holding every system's value:
+    # l0[i] = L[i, i], l1[i] = L[i + 1, i], l2[i] = L[i + 2, i] (lists of rows: a step is a few array operations)
+    d0, d1, d2 = list(diagonal.T), list(first.T), list(second.T)
+    zero = np.zeros(diagonal.shape[0])
+    l0, l1, l2 = [], [], []
     with np.errstate(invalid="ignore", divide="ignore"):
         for i in range(n):
-            pivot = d0[i] - (l1[i - 1] ** 2 if i >= 1 else 0.0) - (l2[i - 2] ** 2 if i >= 2 else 0.0)
-            l0[i] = np.sqrt(pivot)
-            l1[i] = (d1[i] - (l2[i - 1] * l1[i - 1] if i >= 1 else 0.0)) / l0[i]
-            l2[i] = d2[i] / l0[i]
-    b = np.moveaxis(rhs, 1, 0)                                 # unknowns first: (n, batch[, k])
-    tail = (slice(None), slice(None)) + (None,) * (b.ndim - 2)
-    l0, l1, l2 = l0[tail], l1[tail], l2[tail]
-    y = np.empty(b.shape)
-    for i in range(n):                                         # L y = b
-        value = b[i] - l1[i - 1] * y[i - 1] if i >= 1 else b[i]
-        y[i] = (value - l2[i - 2] * y[i - 2] if i >= 2 else value) / l0[i]
-    x = np.empty(b.shape)
-    for i in range(n - 1, -1, -1):                             # L^T x = y
-        value = y[i] - l1[i] * x[i + 1] if i + 1 < n else y[i]
-        x[i] = (value - l2[i] * x[i + 2] if i + 2 < n else value) / l0[i]
-    return np.moveaxis(x, 0, 1)
-
-
-def _padded(band: np.ndarray, n: int) -> np.ndarray:
-    """A band (length n - 1 or n - 2, first axis) padded with zeros to n."""
-    out = np.zeros((n, *band.shape[1:]))
-    out[: band.shape[0]] = band
-    return out
+            pivot = d0[i]
+            if i >= 1:
+                pivot = pivot - l1[i - 1] * l1[i - 1]
+            if i >= 2:
+                pivot = pivot - l2[i - 2] * l2[i - 2]
+            l0.append(np.sqrt(pivot))
+            if i + 1 < n:
+                l1.append(((d1[i] - l2[i - 1] * l1[i - 1]) if i >= 1 else d1[i]) / l0[i])
+            if i + 2 < n:
+                l2.append(d2[i] / l0[i])
+        l1.append(zero)
+        l2 += [zero, zero]
+        b = list(np.moveaxis(rhs, 1, 0))                       # unknowns first: n of (batch[, k])
+        if b[0].ndim == 2:
+            l0, l1, l2 = ([v[:, None] for v in band] for band in (l0, l1, l2))
+        y: list[np.ndarray] = []
+        for i in range(n):                                     # L y = b
+            value = b[i] - l1[i - 1] * y[i - 1] if i >= 1 else b[i]
+            y.append((value - l2[i - 2] * y[i - 2] if i >= 2 else value) / l0[i])
+        x: list[np.ndarray] = [zero] * n
+        for i in range(n - 1, -1, -1):                         # L^T x = y
+            value = y[i] - l1[i] * x[i + 1] if i + 1 < n else y[i]
+            x[i] = (value - l2[i] * x[i + 2] if i + 2 < n else value) / l0[i]
+    return np.stack(x, axis=1)
