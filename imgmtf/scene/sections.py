@@ -62,7 +62,8 @@ def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, schedu
         the same whatever the workers.
     scheduler : str, optional
         A Dask distributed scheduler's address, or ``"local"``
-        (:func:`imgmtf.parallel.run_tasks`).
+        (:func:`imgmtf.parallel.run_tasks`), for the targets' sections when
+        they take more than one worker.
     progress : bool, optional
         Show a progress bar on stderr (default False; None: when stderr is
         a terminal).
@@ -100,7 +101,7 @@ def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, schedu
     ordered = [group for _, group in sorted(groups.items(),
                                             key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
     chosen = sections_workers(len(ordered), workers)
-    if chosen == 1 and scheduler is None:
+    if chosen == 1:
         return [row for group in ordered for row in _group_rows(group)]
     from ..parallel import run_tasks
     tasks = [ordered[k: k + TARGETS_PER_TASK] for k in range(0, len(ordered), TARGETS_PER_TASK)]
