@@ -48,7 +48,9 @@ def solve_pentadiagonal(diagonal: np.ndarray, first: np.ndarray, second: np.ndar
     # l0[i] = L[i, i], l1[i] = L[i + 1, i], l2[i] = L[i + 2, i] (lists of rows: a step is a few array operations)
     d0, d1, d2 = list(diagonal.T), list(first.T), list(second.T)
     zero = np.zeros(diagonal.shape[0])
-    l0, l1, l2 = [], [], []
+    l0: list[np.ndarray] = []
+    l1: list[np.ndarray] = []
+    l2: list[np.ndarray] = []
     with np.errstate(invalid="ignore", divide="ignore"):
         for i in range(n):
             pivot = d0[i]

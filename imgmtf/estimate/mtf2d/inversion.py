@@ -361,7 +361,7 @@ def _penalty_bands(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One curve's smoothing matrix (:func:`_penalty`) by its three bands:
     the diagonal and the two beside it (the rest is zero)."""
     penalty = _penalty(1, size)
-    return tuple(np.diagonal(penalty, offset).copy() for offset in (0, 1, 2))
+    return np.diagonal(penalty).copy(), np.diagonal(penalty, 1).copy(), np.diagonal(penalty, 2).copy()
 
 
 def _interp(x: ArrayLike, nodes: np.ndarray, values: np.ndarray) -> np.ndarray:
