@@ -306,10 +306,12 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
         y, x = rows[kept].astype(float), loc[kept]
         t = (y - y.mean()) / max(np.ptp(y) / 2, 1.0)
         design = np.column_stack([np.ones_like(t), t, t * t - np.mean(t * t)])
-        coef, *_ = np.linalg.lstsq(design, x, rcond=None)
+        # ten or more distinct rows, centred and scaled to [-1, 1]: a regular, well-conditioned
+        # normal matrix, inverted once for the fit and its covariance
+        inverse = np.linalg.inv(design.T @ design)
+        coef = inverse @ (design.T @ x)
         sigma = math.sqrt(max(np.sum((x - design @ coef) ** 2) / max(x.size - 3, 1), 1e-12))
-        cov = np.linalg.pinv(design.T @ design) * sigma ** 2
-        sagitta, sd = abs(coef[2]), math.sqrt(cov[2, 2])
+        sagitta, sd = abs(coef[2]), math.sqrt(inverse[2, 2] * sigma ** 2)
         bowed = sagitta > MAX_SAGITTA_PX and sagitta > 4 * sd
         checks.append(Check("not-straight", not bowed,
                             f"the {name} bows by {sagitta:.2f} px over its length (at most "
