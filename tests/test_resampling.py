@@ -124,7 +124,9 @@ def test_shifted_powers_are_every_moment_correlated_with_every_power(half_bins, 
     expected = binomials @ every
     # correlated power by power (stacks of weightings): the same sums in the same order
     np.testing.assert_array_equal(_shifted_powers_by_power(moments, offsets, binomials), expected)
-    # one product with the folded kernel: the same sums in another order, to rounding
-    scale = np.abs(moments).max(axis=-1, keepdims=True).max(axis=-2, keepdims=True)
-    np.testing.assert_allclose(_shifted_powers(moments, offsets, binomials) / scale, expected / scale,
-                               rtol=0, atol=1e-13 * (half_bins + 1))
+    # one weighting's moments: one product with the folded kernel, the same sums in another order
+    for one, sums in zip(moments, expected):
+        scale = np.abs(one).max()
+        np.testing.assert_allclose(_shifted_powers(one, offsets, binomials) / scale, sums / scale,
+                                   rtol=0, atol=1e-13 * (half_bins + 1))
+    np.testing.assert_array_equal(_shifted_powers(moments, offsets, binomials), expected)    # a stack

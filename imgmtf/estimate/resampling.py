@@ -176,12 +176,13 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     taps (:func:`_folded_kernel`): each window's sums are then one matrix
     product of that (n, n taps) kernel with the moments shifted by every
     tap, for every grid point at once, where one correlation per power and
-    the binomials' product cost about twice as much.  A stack of
-    weightings whose shifted copies would fill more than
-    ``SHIFTED_ELEMENTS`` is correlated power by power instead."""
+    the binomials' product cost about twice as much.  Stacks (the adjoint's
+    grid weights, the bootstrap's weightings), whose shifted copies leave
+    the cache, and moments whose copies would fill more than
+    ``SHIFTED_ELEMENTS``, are correlated power by power instead."""
     n, size = moments.shape[-2], moments.shape[-1]
     taps = offsets.size
-    if moments.size * taps > SHIFTED_ELEMENTS:
+    if moments.ndim > 2 or moments.size * taps > SHIFTED_ELEMENTS:
         return _shifted_powers_by_power(moments, offsets, binomials)
     kernel = _folded_kernel(binomials.tobytes(), n, offsets.tobytes())
     half = taps // 2
@@ -192,8 +193,8 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     return kernel @ shifted.reshape(*moments.shape[:-2], n * taps, size)
 
 
-#: the moments' shifted copies (weightings x moments x taps x grid) up to which the window sums are
-#: one product with the folded kernel (16 MB); beyond, one correlation per power
+#: the moments' shifted copies (moments x taps x grid) up to which the window sums are one product
+#: with the folded kernel (16 MB); beyond, one correlation per power
 SHIFTED_ELEMENTS = 1 << 21
 
 
