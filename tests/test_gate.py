@@ -364,15 +364,10 @@ def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
     assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")
 
 
-def test_closed_form_fits_match_numpy():
-    # the rows' line (geometry) and the sides' Legendre columns (settling) in closed form: NumPy's to rounding
-    from numpy.polynomial.legendre import legvander
-
+def test_closed_form_line_matches_numpy():
+    # the rows' line (geometry) in closed form: NumPy's to rounding
     from imgmtf.estimate.geometry import _straight_line
-    from imgmtf.estimate.settling import SMOOTH_DEGREE, _legendre
     rng = np.random.default_rng(3)
     rows = np.arange(7.0, 93.0)
     locations = 0.17 * rows + 41.3 + rng.normal(0.0, 0.2, rows.size)
     np.testing.assert_allclose(_straight_line(rows, locations), np.polyfit(rows, locations, 1), rtol=1e-12)
-    t = np.linspace(-1.0, 1.0, 13)
-    np.testing.assert_allclose(_legendre(t), legvander(t, SMOOTH_DEGREE), rtol=0, atol=1e-15)

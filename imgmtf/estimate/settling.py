@@ -153,29 +153,16 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     means = sums[full] / counted
     error2 = sigma2 / counted + ev.rounding_floor ** 2
     t = 2.0 * (centres - centres[0]) / max(centres[-1] - centres[0], 1e-9) - 1.0
-    basis = _legendre(t)
-    weighted = basis.T * (1.0 / np.maximum(error2, 1e-300))
-    normal_b = weighted @ basis
-    try:        # (a cubic through more than four band means: its normal matrix is regular)
-        cov = np.linalg.inv(normal_b)
-    except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(normal_b)
-    curve = basis @ (cov @ (weighted @ means))
+    basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
+    weights = 1.0 / np.maximum(error2, 1e-300)
+    normal_b = (basis * weights[:, None]).T @ basis
+    # (the same arithmetic as ever: on a flat side the curve is rounding, and where it peaks is said)
+    cov = np.linalg.pinv(normal_b)
+    smooth_coef = cov @ (basis * weights[:, None]).T @ means
+    curve = basis @ smooth_coef
     worst = int(np.argmax(np.abs(curve)))
     sd = math.sqrt(max(float(basis[worst] @ cov @ basis[worst]), 0.0))
     return {"departure": (float(abs(curve[worst])), sd, float(centres[worst])), "unsettled": unsettled}
-
-
-def _legendre(t: np.ndarray) -> np.ndarray:
-    """The Legendre polynomials 0..``SMOOTH_DEGREE`` at ``t`` (in [-1, 1]),
-    one column each, by their three-term recurrence (NumPy's legvander,
-    without its checks and copies)."""
-    out = np.empty((t.size, SMOOTH_DEGREE + 1))
-    out[:, 0] = 1.0
-    out[:, 1] = t
-    for k in range(2, SMOOTH_DEGREE + 1):
-        out[:, k] = ((2 * k - 1) * t * out[:, k - 1] - (k - 1) * out[:, k - 2]) / k
-    return out
 
 
 def _towards_target(ev: Evidence, left: bool) -> float:
