@@ -38,6 +38,7 @@ MAX_UNSETTLED = 0.08            # ...with this much of the contrast still to com
 WARN_TAIL_ASYMMETRY = 0.03      # said, with...
 WARN_UNSETTLED = 0.04           # ...this much still to come (a gamma-encoded camera edge shows up to 6.5 %)
 SIGNIFICANCE = 5.0             # in standard deviations of the noise
+ROUNDING_SHARE = 1e-12         # of the contrast: a smaller departure is the arithmetic's rounding
 
 
 def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
@@ -160,6 +161,10 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     cov = np.linalg.pinv(normal_b)
     smooth_coef = cov @ (basis * weights[:, None]).T @ means
     curve = basis @ smooth_coef
+    if np.max(np.abs(curve)) <= ROUNDING_SHARE * abs(ev.contrast):
+        # a flat side (noise-free): the curve is the arithmetic's rounding, and where it peaks would
+        # move with any change of the arithmetic before it; no departure, said at the side's start
+        curve = np.zeros_like(curve)
     worst = int(np.argmax(np.abs(curve)))
     sd = math.sqrt(max(float(basis[worst] @ cov @ basis[worst]), 0.0))
     return {"departure": (float(abs(curve[worst])), sd, float(centres[worst])), "unsettled": unsettled}
