@@ -373,15 +373,15 @@ def test_closed_form_line_matches_numpy():
     np.testing.assert_allclose(_straight_line(rows, locations), np.polyfit(rows, locations, 1), rtol=1e-12)
 
 
-def test_flat_side_departure_is_said_where_rounding_cannot_move_it():
-    # a noise-free side's smooth departure is rounding: where it "peaks" must not move with a change
-    # of the arithmetic before it (here 1e-9 DN on the pixels), so it is said at the side's start
-    chip = im.render(im.Sensor(), im.Target("edge", 5.0, 100.0, 1100.0), 60).image.astype(float)
+def test_every_message_of_a_noise_free_chip_stands_under_rounding(monkeypatch):
+    # trends, band means and tail shares of a flat side are rounding: which is larger, their sign and
+    # where they peak must not move with a change of the arithmetic before them (here the rows' line
+    # by np.polyfit instead of in closed form: the same line to about 1e-16)
+    from imgmtf.estimate import geometry
+    chips = [im.render(im.Sensor(), im.Target("edge", angle, 100.0, 1100.0), 60).image for angle in (5.0, 7.0)]
 
-    def departures(image):
-        return [c.message for c in im.measure_edge(image).checks if "settled level" in c.message]
-    plain = departures(chip)
-    assert plain and all("by 0.0 %" in message for message in plain)
-    rng = np.random.default_rng(0)
-    for _ in range(4):
-        assert departures(chip + 1e-9 * rng.standard_normal(chip.shape)) == plain
+    def messages():
+        return [c.message for chip in chips for c in im.measure_edge(chip).checks]
+    plain = messages()
+    monkeypatch.setattr(geometry, "_straight_line", lambda y, x: tuple(float(v) for v in np.polyfit(y, x, 1)))
+    assert messages() == plain

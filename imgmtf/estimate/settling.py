@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from .evidence import Evidence
-from .gate import Check, not_run
+from .gate import ROUNDING_SHARE, Check, beyond_rounding, not_run
 
 MIN_SIDE_SAMPLES = 40
 MIN_SIDE_EXTENT_PX = 4.0       # a side spanning less beyond the plateau's start is too short to see curve...
@@ -38,7 +38,6 @@ MAX_UNSETTLED = 0.08            # ...with this much of the contrast still to com
 WARN_TAIL_ASYMMETRY = 0.03      # said, with...
 WARN_UNSETTLED = 0.04           # ...this much still to come (a gamma-encoded camera edge shows up to 6.5 %)
 SIGNIFICANCE = 5.0             # in standard deviations of the noise
-ROUNDING_SHARE = 1e-12         # of the contrast: a smaller departure is the arithmetic's rounding
 
 
 def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
@@ -140,7 +139,8 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     start_u = ev.plateau_px ** -float(ev.tail_power)
     towards = _towards_target(ev, left=bool(side[0] < 0))
     tail_cov = sigma2 / spread                      # the slope's variance, (M^-1)[1, 1] sigma^2
-    unsettled = (towards * coef[1] * start_u / ev.contrast, math.sqrt(tail_cov) * start_u / ev.contrast)
+    unsettled = (beyond_rounding(towards * coef[1] * start_u / ev.contrast),
+                 math.sqrt(tail_cov) * start_u / ev.contrast)
 
     nearest = float(reach.min())
     band = ((reach - nearest) / BAND_PX).astype(int)       # (non-negative: truncation is the floor)
