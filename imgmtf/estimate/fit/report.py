@@ -11,8 +11,9 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
+from .bands import band_sensors, model_mtf50_band, model_mtf_band
 from .choice import other_stages
-from .model import Model, band_sensors, model_mtf50_band, model_mtf_band
+from .model import Model
 from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test
@@ -125,7 +126,7 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
                     chunk: int = EDGE_CHUNK) -> tuple[np.ndarray, np.ndarray]:
     """Each of ``model``'s edges' model MTF at Nyquist (0.5 cy/px) along
     its normal with its delta-method band, and its model MTF50 (cy/px):
-    what :func:`.model.model_mtf_band` and :func:`imgmtf.metrics.first_crossing`
+    what :func:`.bands.model_mtf_band` and :func:`imgmtf.metrics.first_crossing`
     give edge by edge, the same numbers, with the transfers of many edges
     computed in one array (a scene's thousands of edges: one call per
     stage and chunk of edges, not per edge).
@@ -139,7 +140,7 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
     covariance : numpy.ndarray
         Their covariance (its first ``model.n_free`` rows and columns).
     sensors : tuple
-        :func:`.model.band_sensors` of ``model`` and ``u``.
+        :func:`.bands.band_sensors` of ``model`` and ``u``.
     confidence : float
         The band's confidence level.
     chunk : int, optional
