@@ -187,6 +187,8 @@ class Model:
         self.groups, self.own = grouped_edges([d.profile_angle_deg for d in data], [d.gsd_m for d in data],
                                               [self.reach(d) for d in data])
         self._last_esfs: tuple = (None, None, None)
+        # the responses and ESFs at the last Jacobian's point (:meth:`jacobian`)
+        self._solution: tuple = ((None, [], None), (None, None, None))
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
 
@@ -289,6 +291,8 @@ class Model:
         ones kept, since the solver asks for the residuals and then the
         Jacobian at the same point."""
         key = (tuple(self.free), u.tobytes())
+        if self._last_responses[0] != key and self._solution[0][0] == key:
+            self._last_responses = self._solution[0]
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
             out: list = [None] * len(self.edges)
@@ -314,6 +318,7 @@ class Model:
             group.release()
         self._last_responses = (None, [], None)
         self._last_esfs = (None, None, None)
+        self._solution = ((None, [], None), (None, None, None))
         self._last_samples = (None, [])
         self._stages_made.clear()
         self._stacked_bins = None
@@ -346,12 +351,17 @@ class Model:
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
         u = z[: self.n_free]
         lo, hi, x0 = self.levels(z)
-        stacked = self.stacked(responses or self.responses(u))
-        placement = stacked.placement(self.bins.x - x0, curvature=True)
-        esf = bin_esf(stacked, self.bins, x0, placement)
+        responses = responses or self.responses(u)
+        key = (tuple(self.free), z.tobytes())
+        if self._solution[1][0] == key and self._last_responses[1] is responses:
+            esf, placement = self._solution[1][1:]          # the last Jacobian's point: the solution's, asked again
+        else:
+            stacked = self.stacked(responses)
+            placement = stacked.placement(self.bins.x - x0, curvature=True)
+            esf = bin_esf(stacked, self.bins, x0, placement)
         # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its
         # columns', and their bins' places on the grids those of the changes
-        self._last_esfs = ((tuple(self.free), z.tobytes()), esf, placement)
+        self._last_esfs = (key, esf, placement)
         return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
 
     def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
@@ -413,6 +423,9 @@ class Model:
         else:
             placement = stacked.placement(d, curvature=True)
             esf = bin_esf(stacked, self.bins, x0, placement)
+        # the solver stops at the last point it took a Jacobian at, where the covariance, the chi-square
+        # and the report ask for the responses and residuals again after the rejected trials that followed
+        self._solution = (self._last_responses, ((tuple(self.free), z.tobytes()), esf, placement))
         changes = esf_changes(stacked, esf_change, lsf_change, d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
         stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
