@@ -35,7 +35,7 @@ from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
-from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
+from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers, stacked_changes
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -448,10 +448,17 @@ class Model:
     def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
         """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids side by side (:meth:`stacked`)."""
         own = [self.edges[i] for i in self.own]
-        given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-        rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
-        if not self.groups:
-            return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
+        together = stacked_changes(own, sensor, shifted)
+        if together is not None and not self.groups:
+            return together
+        if together is not None:            # each edge's rows: views of the grids side by side
+            sizes = np.cumsum([edge._on[1] for edge in own])[:-1]
+            rows = list(zip(*(np.split(changes, sizes, axis=-1) for changes in together)))
+        else:
+            given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
+            rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
+            if not self.groups:
+                return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
         return laid_out_changes(self.groups, self.own, rows, self._last_responses[2], sensor, shifted)
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
