@@ -44,6 +44,7 @@ from ...sensor.lines import (
     plus_reference_curvature,
     plus_reference_esf,
     reference_scale,
+    reference_transfer,
 )
 from ...sensor.model import Sensor
 from ...sensor.stages import Stage
@@ -154,19 +155,29 @@ class EdgeResponses:
 
     def _base(self, sensor: Sensor, given: Given | None = None) -> tuple[LineGrid, np.ndarray, LineResponse]:
         """The grid, transfer and response of ``sensor``, the last one's kept."""
-        key = (sensor.gsd_m, sensor.stages)
-        if self._last is None or self._last[0] != key:
-            tailed = sensor.tail_length_m() > 0
-            reach = self.reach_px if tailed else 0.0
-            # without a tail the grid's reference reads the transfer at the probe, which comes with
-            # the transfer on the last grid's frequencies: the next grid's, but when its size changes
-            transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
-            grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
-                             transfer_at_probe=None if transfer is None else float(transfer[0].real))
-            if self._use(grid) or transfer is None:
-                transfer = self._transfer(sensor, keep=True, given=given)
-            self._last = (key, grid, transfer[1:], grid.response(transfer[1:]))
+        made = self._grid_transfer(sensor, given)
+        if made is not None:
+            key, grid, transfer = made
+            self._last = (key, grid, transfer, grid.response(transfer))
         return self._last[1:]
+
+    def _grid_transfer(self, sensor: Sensor, given: Given | None = None) -> tuple[tuple, LineGrid, np.ndarray] | None:
+        """The key, grid and transfer (at the grid's frequencies) of a
+        ``sensor`` that is not the last one, what its response is made of;
+        None for the last one (its response kept)."""
+        key = (sensor.gsd_m, sensor.stages)
+        if self._last is not None and self._last[0] == key:
+            return None
+        tailed = sensor.tail_length_m() > 0
+        reach = self.reach_px if tailed else 0.0
+        # without a tail the grid's reference reads the transfer at the probe, which comes with
+        # the transfer on the last grid's frequencies: the next grid's, but when its size changes
+        transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
+        grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
+                         transfer_at_probe=None if transfer is None else float(transfer[0].real))
+        if self._use(grid) or transfer is None:
+            transfer = self._transfer(sensor, keep=True, given=given)
+        return key, grid, transfer[1:]
 
     def _use(self, grid: LineGrid) -> bool:
         """Make ``grid``'s frequencies those transfers are computed at
@@ -265,6 +276,54 @@ def shared_transfers(edges: Sequence[EdgeResponses], stages: Iterable[Stage], gs
             out[e][key] = (on, values[start: start + fx.size])
             start += fx.size
     return out
+
+
+def responses_together(edges: Sequence[EdgeResponses], sensor: Sensor,
+                       given: Sequence[Given] | None = None) -> list[LineResponse]:
+    """Each edge's :meth:`EdgeResponses.response` to ``sensor``, bit for
+    bit, the inverse FFTs of the edges whose grids have one step and size
+    made in one call (each edge's row its own transform, with its own
+    reference taken out).
+
+    Parameters
+    ----------
+    edges : sequence of EdgeResponses
+        The edges.
+    sensor : Sensor
+        The sensor.
+    given : sequence of dict, optional
+        Per edge, stages' transfers computed for several edges at once
+        (:func:`shared_transfers`).
+
+    Returns
+    -------
+    list of LineResponse
+        Each edge's response (the last one's kept, as :meth:`EdgeResponses.response` keeps it).
+
+    Examples
+    --------
+    >>> from imgmtf import Sensor
+    >>> together = responses_together([EdgeResponses(a, 1.0, 20.0) for a in (5.0, 80.0)], Sensor())
+    >>> alone = [EdgeResponses(a, 1.0, 20.0).response(Sensor()) for a in (5.0, 80.0)]
+    >>> all(np.array_equal(t.esf_remainder, a.esf_remainder) for t, a in zip(together, alone))
+    True
+    """
+    given = list(given) if given is not None else [None] * len(edges)
+    made = [edge._grid_transfer(sensor, g) for edge, g in zip(edges, given)]
+    alike: dict[tuple[float, int], list[int]] = {}
+    for e, m in enumerate(made):
+        if m is not None:
+            alike.setdefault((m[1].step_px, m[1].size), []).append(e)
+    for members in alike.values():
+        grids = [made[e][1] for e in members]                  # type: ignore[index]
+        spectra = np.stack([made[e][2] - reference_transfer(g.reference, g.frequencies_cy_px)  # type: ignore[index]
+                            for e, g in zip(members, grids)])
+        esf, lsf = grids[0].remainders(spectra)
+        for row, (e, g) in enumerate(zip(members, grids)):
+            key, _, transfer = made[e]                          # type: ignore[misc]
+            edges[e]._last = (key, g, transfer,
+                              LineResponse(g.start_px, g.step_px, esf[row], lsf[row], g.reference))
+    return [edge._last[3] for edge in edges]                    # type: ignore[index]
 
 
 def stacked_changes(edges: Sequence[EdgeResponses], sensor: Sensor,
