@@ -35,14 +35,7 @@ from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
-from .responses import (
-    EdgeResponses,
-    StackedResponses,
-    esf_changes,
-    responses_together,
-    shared_transfers,
-    stacked_changes,
-)
+from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -307,9 +300,8 @@ class Model:
                 for i, response in zip(members, group.responses(sensor)):
                     out[i] = response
             own = [self.edges[i] for i in self.own]
-            for i, response in zip(self.own, responses_together(own, sensor,
-                                                                 shared_transfers(own, sensor.stages, sensor.gsd_m))):
-                out[i] = response
+            for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
+                out[i] = edge.response(sensor, g)
             self._last_responses = (key, out, grid_layout(self.groups, self.own, sensor, out) if self.groups else None)
         return self._last_responses[1]
 
@@ -456,17 +448,10 @@ class Model:
     def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
         """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids side by side (:meth:`stacked`)."""
         own = [self.edges[i] for i in self.own]
-        together = stacked_changes(own, sensor, shifted)
-        if together is not None and not self.groups:
-            return together
-        if together is not None:            # each edge's rows: views of the grids side by side
-            sizes = np.cumsum([edge._on[1] for edge in own])[:-1]
-            rows = list(zip(*(np.split(changes, sizes, axis=-1) for changes in together)))
-        else:
-            given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-            rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
-            if not self.groups:
-                return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
+        given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
+        rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
+        if not self.groups:
+            return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
         return laid_out_changes(self.groups, self.own, rows, self._last_responses[2], sensor, shifted)
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:

@@ -44,7 +44,6 @@ from ...sensor.lines import (
     plus_reference_curvature,
     plus_reference_esf,
     reference_scale,
-    reference_transfer,
 )
 from ...sensor.model import Sensor
 from ...sensor.stages import Stage
@@ -155,29 +154,19 @@ class EdgeResponses:
 
     def _base(self, sensor: Sensor, given: Given | None = None) -> tuple[LineGrid, np.ndarray, LineResponse]:
         """The grid, transfer and response of ``sensor``, the last one's kept."""
-        made = self._grid_transfer(sensor, given)
-        if made is not None:
-            key, grid, transfer = made
-            self._last = (key, grid, transfer, grid.response(transfer))
-        return self._last[1:]
-
-    def _grid_transfer(self, sensor: Sensor, given: Given | None = None) -> tuple[tuple, LineGrid, np.ndarray] | None:
-        """The key, grid and transfer (at the grid's frequencies) of a
-        ``sensor`` that is not the last one, what its response is made of;
-        None for the last one (its response kept)."""
         key = (sensor.gsd_m, sensor.stages)
-        if self._last is not None and self._last[0] == key:
-            return None
-        tailed = sensor.tail_length_m() > 0
-        reach = self.reach_px if tailed else 0.0
-        # without a tail the grid's reference reads the transfer at the probe, which comes with
-        # the transfer on the last grid's frequencies: the next grid's, but when its size changes
-        transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
-        grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
-                         transfer_at_probe=None if transfer is None else float(transfer[0].real))
-        if self._use(grid) or transfer is None:
-            transfer = self._transfer(sensor, keep=True, given=given)
-        return key, grid, transfer[1:]
+        if self._last is None or self._last[0] != key:
+            tailed = sensor.tail_length_m() > 0
+            reach = self.reach_px if tailed else 0.0
+            # without a tail the grid's reference reads the transfer at the probe, which comes with
+            # the transfer on the last grid's frequencies: the next grid's, but when its size changes
+            transfer = None if tailed or self._on is None else self._transfer(sensor, keep=True, given=given)
+            grid = line_grid(sensor, self.angle_deg, self.gsd_m, reach_px=reach,
+                             transfer_at_probe=None if transfer is None else float(transfer[0].real))
+            if self._use(grid) or transfer is None:
+                transfer = self._transfer(sensor, keep=True, given=given)
+            self._last = (key, grid, transfer[1:], grid.response(transfer[1:]))
+        return self._last[1:]
 
     def _use(self, grid: LineGrid) -> bool:
         """Make ``grid``'s frequencies those transfers are computed at
@@ -276,116 +265,6 @@ def shared_transfers(edges: Sequence[EdgeResponses], stages: Iterable[Stage], gs
             out[e][key] = (on, values[start: start + fx.size])
             start += fx.size
     return out
-
-
-def responses_together(edges: Sequence[EdgeResponses], sensor: Sensor,
-                       given: Sequence[Given] | None = None) -> list[LineResponse]:
-    """Each edge's :meth:`EdgeResponses.response` to ``sensor``, bit for
-    bit, the inverse FFTs of the edges whose grids have one step and size
-    made in one call (each edge's row its own transform, with its own
-    reference taken out).
-
-    Parameters
-    ----------
-    edges : sequence of EdgeResponses
-        The edges.
-    sensor : Sensor
-        The sensor.
-    given : sequence of dict, optional
-        Per edge, stages' transfers computed for several edges at once
-        (:func:`shared_transfers`).
-
-    Returns
-    -------
-    list of LineResponse
-        Each edge's response (the last one's kept, as :meth:`EdgeResponses.response` keeps it).
-
-    Examples
-    --------
-    >>> from imgmtf import Sensor
-    >>> together = responses_together([EdgeResponses(a, 1.0, 20.0) for a in (5.0, 80.0)], Sensor())
-    >>> alone = [EdgeResponses(a, 1.0, 20.0).response(Sensor()) for a in (5.0, 80.0)]
-    >>> all(np.array_equal(t.esf_remainder, a.esf_remainder) for t, a in zip(together, alone))
-    True
-    """
-    given = list(given) if given is not None else [None] * len(edges)
-    made = [edge._grid_transfer(sensor, g) for edge, g in zip(edges, given)]
-    alike: dict[tuple[float, int], list[int]] = {}
-    for e, m in enumerate(made):
-        if m is not None:
-            alike.setdefault((m[1].step_px, m[1].size), []).append(e)
-    for members in alike.values():
-        grids = [made[e][1] for e in members]                  # type: ignore[index]
-        spectra = np.stack([made[e][2] - reference_transfer(g.reference, g.frequencies_cy_px)  # type: ignore[index]
-                            for e, g in zip(members, grids)])
-        esf, lsf = grids[0].remainders(spectra)
-        for row, (e, g) in enumerate(zip(members, grids)):
-            key, _, transfer = made[e]                          # type: ignore[misc]
-            edges[e]._last = (key, g, transfer,
-                              LineResponse(g.start_px, g.step_px, esf[row], lsf[row], g.reference))
-    return [edge._last[3] for edge in edges]                    # type: ignore[index]
-
-
-def stacked_changes(edges: Sequence[EdgeResponses], sensor: Sensor,
-                    shifted: Sequence[Sensor]) -> tuple[np.ndarray, np.ndarray] | None:
-    """Every edge's ESF and LSF changes for the ``shifted`` sensors
-    (:meth:`EdgeResponses.changes`' ``esf_changes`` and ``lsf_changes``,
-    bit for bit), the edges' grids side by side, made together when their
-    grids have one step and size: each stage's transfer on all their
-    frequencies at once, each shifted sensor's spectra in one product, and
-    all the rows in one inverse FFT (a target's four edges' sixteen rows:
-    a few dozen NumPy calls, not a few hundred).
-
-    Parameters
-    ----------
-    edges : sequence of EdgeResponses
-        The edges, evaluated at ``sensor`` or not yet.
-    sensor : Sensor
-        The sensor.
-    shifted : sequence of Sensor
-        Its shifted copies (same GSD, same chain).
-
-    Returns
-    -------
-    (esf_changes, lsf_changes) or None
-        Each shape (len(shifted), edges x grid size), the edges' grids in
-        turn; None for fewer than two edges or grids of several sizes
-        (:meth:`EdgeResponses.changes` then makes each edge's).
-
-    Examples
-    --------
-    >>> from imgmtf import Sensor
-    >>> edges = [EdgeResponses(angle, 1.0, 20.0) for angle in (5.0, 80.0)]
-    >>> shifted = [Sensor(optics_sigma_x_m=0.5), Sensor(detector_width_y_m=1.1)]
-    >>> esf, lsf = stacked_changes(edges, Sensor(), shifted)
-    >>> alone = [EdgeResponses(angle, 1.0, 20.0).changes(Sensor(), shifted)[1] for angle in (5.0, 80.0)]
-    >>> bool(np.array_equal(esf, np.concatenate(alone, axis=-1)))
-    True
-    """
-    if len(edges) < 2:
-        return None
-    bases = [edge._base(sensor)[:2] for edge in edges]
-    grid = bases[0][0]
-    if any(edge._on != edges[0]._on for edge in edges):
-        return None
-    gsd = sensor.gsd_m
-    fx, fy = (np.concatenate([edge._normal[j] for edge in edges]) for j in (0, 1))
-    values: dict[tuple[Stage, float], np.ndarray] = {}
-    for other in shifted:
-        for stage in other.stages:
-            key = (stage, gsd)
-            if key not in values:
-                kept = [edge._transfers.get(key) for edge in edges]
-                # an edge's kept transfer is what the stage gives on its frequencies, computed alone or with others
-                values[key] = (np.concatenate(kept) if all(k is not None for k in kept)
-                               else stage.transfer(fx, fy, gsd))
-    base = np.stack([b for _, b in bases])
-    spectra = np.empty((len(shifted), *base.shape), base.dtype)     # complex for a one-sided stage
-    for row, other in zip(spectra, shifted):
-        product = reduce(operator.mul, [values[(stage, gsd)] for stage in other.stages])
-        np.subtract(product.reshape(len(edges), -1)[:, 1:], base, out=row)    # each edge's probe left out
-    esf, lsf = grid.remainders(spectra)
-    return esf.reshape(len(shifted), -1), lsf.reshape(len(shifted), -1)
 
 
 def esf_changes(response: LineResponse | StackedResponses, esf: np.ndarray, lsf: np.ndarray, d_px: np.ndarray,
