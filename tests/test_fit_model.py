@@ -1,4 +1,7 @@
 """estimate/fit: how the model's Jacobian is stored changes no fitted value."""
+import math
+from statistics import NormalDist
+
 import numpy as np
 import pytest
 
@@ -51,6 +54,11 @@ def test_edge_model_mtfs_are_each_edges_own(edges):
         assert [float(v) for v in own] == bands[:, e].tolist()
         assert bands[1, e] < bands[0, e] < bands[2, e]
         assert mtf50[e] == first_crossing(f, np.abs(sensors[0].normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5)
+        # the band's stepped sensors' shared stages computed once: each sensor's own transfer, bit for bit
+        value = np.abs(sensors[0].normal_transfer(0.5, d.normal_angle_deg, d.gsd_m))
+        grads = [(np.abs(s.normal_transfer(0.5, d.normal_angle_deg, d.gsd_m)) - value) / h for h, s in sensors[1]]
+        se = math.sqrt(max(float(np.einsum("i,ij,j->", grads, covariance, grads)), 0.0))
+        assert own[0] == value and abs(own[2] - own[1] - 2 * NormalDist().inv_cdf(0.95) * se) < 1e-15
 
 
 def test_edges_grouped_by_angle_fit_as_each_edge_alone(edges, monkeypatch):
