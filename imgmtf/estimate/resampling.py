@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
+from . import weight_stacks
 from ._correlation import ROW_BY_ROW_TAPS, correlate1d
 
 
@@ -94,10 +95,6 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     scale = (half_bins + 0.5) * step      # local coordinates in [-1, 1]
     u = (d - grid[bins]) / scale
     nk = 2 * order + 1
-    powers = np.vander(u, nk, increasing=True).T
-    features = np.concatenate([powers, powers[: order + 1] * v])
-    sums = _bin_sums(bins, grid.size, features if weights is None else w[..., None, :] * features)
-    s, t = sums[..., :nk, :], sums[..., nk:, :]
     offsets = np.arange(-half_bins, half_bins + 1) * step / scale
 
     def window_sums(moments):
@@ -106,10 +103,18 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         one correlation per power of the offset for all moments at once,
         combined by one product with the binomials."""
         return _shifted_powers(moments, offsets, _binomial_shifts(moments.shape[-2], False))
-    m = window_sums(s)
-    rhs = np.moveaxis(window_sums(t), -1, -2)
+    # a stack of weightings (the bootstrap) sums its windows per group of equally weighted samples
+    stacked = weight_stacks.window_sums(d, v, w, bins, grid, scale, half_bins, order) if w.ndim > 1 else None
+    if stacked is not None:
+        m, rhs = stacked
+    else:
+        powers = np.vander(u, nk, increasing=True).T
+        features = np.concatenate([powers, powers[: order + 1] * v])
+        sums = _bin_sums(bins, grid.size, features if weights is None else w[..., None, :] * features)
+        s, t = sums[..., :nk, :], sums[..., nk:, :]
+        m = window_sums(s)
+        rhs = np.moveaxis(window_sums(t), -1, -2)
     idx = np.arange(order + 1)
-    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
     # a window needs enough samples, spread over it (uniform spread gives
     # a variance of 1/3 in window coordinates), for a well-posed fit
     count = np.where(m[..., 0, :] > 0, m[..., 0, :], 1.0)
@@ -132,11 +137,12 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     if w.ndim > 1:      # a stack of weightings (the bootstrap): solve each window directly
         level = np.full(valid.shape, np.nan)
         if valid.any():
-            level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
+            level[valid] = weight_stacks.first_levels(m, rhs, valid)
         return Resampled(out, level[..., trim: trim + out.size], transfer, params)
     # one weighting: each window's equivalent-kernel coefficients M^-1 e0,
     # which give the fitted level and, transposed, every sample's weight
     coef = np.zeros((grid.size, order + 1))
+    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
     if valid.any():
         coef[valid] = np.linalg.solve(normal[valid], np.eye(order + 1)[0][None, :, None]
                                       .repeat(valid.sum(), axis=0))[..., 0]
