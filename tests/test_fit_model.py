@@ -1,8 +1,12 @@
 """estimate/fit: how the model's Jacobian is stored changes no fitted value."""
+import math
+from statistics import NormalDist
+
 import numpy as np
 import pytest
 
 import imgmtf as im
+from imgmtf.estimate.fit import bands as fit_bands
 from imgmtf.estimate.fit import model as fit_model
 from imgmtf.estimate.fit.data import edge_data
 from imgmtf.estimate.fit.model import Model, initial_stages
@@ -41,15 +45,20 @@ def test_edge_model_mtfs_are_each_edges_own(edges):
     model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
     u = model.initial_vector()[: model.n_free]
     covariance = np.diag(np.linspace(1e-4, 4e-4, model.n_free)) + 5e-5
-    sensors = fit_model.band_sensors(model, u)
+    sensors = fit_bands.band_sensors(model, u)
     bands, mtf50 = edge_model_mtfs(model, u, covariance, sensors, 0.9, chunk=3)
     f = np.linspace(0.0, 2.0, 4001)
     for e, d in enumerate(data):
-        own = fit_model.model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, 0.9,
+        own = fit_bands.model_mtf_band(model, u, covariance, np.array(0.5), d.normal_angle_deg, d.gsd_m, 0.9,
                                        sensors)
         assert [float(v) for v in own] == bands[:, e].tolist()
         assert bands[1, e] < bands[0, e] < bands[2, e]
         assert mtf50[e] == first_crossing(f, np.abs(sensors[0].normal_transfer(f, d.normal_angle_deg, d.gsd_m)), 0.5)
+        # the band's stepped sensors' shared stages computed once: each sensor's own transfer, bit for bit
+        value = np.abs(sensors[0].normal_transfer(0.5, d.normal_angle_deg, d.gsd_m))
+        grads = [(np.abs(s.normal_transfer(0.5, d.normal_angle_deg, d.gsd_m)) - value) / h for h, s in sensors[1]]
+        se = math.sqrt(max(float(np.einsum("i,ij,j->", grads, covariance, grads)), 0.0))
+        assert own[0] == value and abs(own[2] - own[1] - 2 * NormalDist().inv_cdf(0.95) * se) < 1e-15
 
 
 def test_edges_grouped_by_angle_fit_as_each_edge_alone(edges, monkeypatch):

@@ -362,3 +362,26 @@ def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
     second = [c for c in checks if c.reason == "two-targets"]
     assert len(second) == 2 and all(c.outcome == "not-run" for c in second)
     assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")
+
+
+def test_closed_form_line_matches_numpy():
+    # the rows' line (geometry) in closed form: NumPy's to rounding
+    from imgmtf.estimate.geometry import _straight_line
+    rng = np.random.default_rng(3)
+    rows = np.arange(7.0, 93.0)
+    locations = 0.17 * rows + 41.3 + rng.normal(0.0, 0.2, rows.size)
+    np.testing.assert_allclose(_straight_line(rows, locations), np.polyfit(rows, locations, 1), rtol=1e-12)
+
+
+def test_every_message_of_a_noise_free_chip_stands_under_rounding(monkeypatch):
+    # trends, band means and tail shares of a flat side are rounding: which is larger, their sign and
+    # where they peak must not move with a change of the arithmetic before them (here the rows' line
+    # by np.polyfit instead of in closed form: the same line to about 1e-16)
+    from imgmtf.estimate import geometry
+    chips = [im.render(im.Sensor(), im.Target("edge", angle, 100.0, 1100.0), 60).image for angle in (5.0, 7.0)]
+
+    def messages():
+        return [c.message for chip in chips for c in im.measure_edge(chip).checks]
+    plain = messages()
+    monkeypatch.setattr(geometry, "_straight_line", lambda y, x: tuple(float(v) for v in np.polyfit(y, x, 1)))
+    assert messages() == plain

@@ -38,3 +38,17 @@ def test_spectral_figures_of_a_gaussian_lsf_match_closed_forms():
     nyquist, fifty = spectral_figures(np.stack([lsf, 2 * lsf]), step, lambda f: np.ones_like(f))
     np.testing.assert_allclose(nyquist, math.exp(-2 * math.pi**2 * sigma**2 * 0.25), atol=1e-9)
     np.testing.assert_allclose(fifty, math.sqrt(math.log(2) / 2) / (math.pi * sigma), rtol=2e-4)
+
+
+def test_spectral_figures_of_a_profile_in_parts_equal_those_of_the_whole():
+    step = 0.05
+    x = np.arange(-6, 6 + step / 2, step)
+    lsf = np.exp(-x**2 / (2 * 0.6**2)) + 0.01 / (1 + x**2)
+    w = np.clip(2.5 - np.abs(x), 0, 1)                 # a window: 1 within 1.5 px, 0 beyond 2.5 px
+    held = np.flatnonzero(w)
+    shapes = (1 - w) * np.stack([x < 0, x >= 0]) / (1 + x**2)
+    amplitudes = np.array([[0.01, 0.01], [0.02, 0.005]])
+    whole = amplitudes @ shapes + w * lsf
+    parts = spectral_figures(np.stack([lsf, lsf])[:, held] * w[held], step, lambda f: np.ones_like(f),
+                             start=held[0], length=x.size, amplitudes=amplitudes, shapes=shapes)
+    np.testing.assert_allclose(parts, spectral_figures(whole, step, lambda f: np.ones_like(f)), rtol=1e-12)

@@ -210,3 +210,25 @@ def test_hermite_placement_interpolates_as_the_explicit_sum():
             expected[..., inside] = (w[0] * v[..., k] + w[1] * s[..., k] + w[2] * v[..., k + 1]
                                      + w[3] * s[..., k + 1])
             assert np.array_equal(out, expected)
+
+
+@pytest.mark.parametrize("size", [4096, 4095], ids=["even", "odd"])
+def test_the_lsf_remainder_alone_is_the_responses_bit_for_bit(size):
+    """What a FWHM reads (LineGrid.lsf_remainder, half the inverse FFTs)
+    is the full response's LSF remainder, for a real and a one-sided
+    (complex) transfer; Sensor.normal_lsf is the line response's LSF."""
+    grid = LineGrid(0.01, size, ("gaussian", 0.6))
+    for sensor in (im.Sensor(1.0, [st.GaussianOptics(0.4, 0.5), st.Detector(1.0, 0.9)]),
+                   im.Sensor(1.0, [st.GaussianOptics(0.4, 0.5), st.Lag(0.8, 0.3)])):
+        transfer = sensor.normal_transfer(grid.frequencies_cy_px, 20.0)
+        assert np.array_equal(grid.lsf_remainder(transfer), grid.response(transfer).lsf_remainder)
+        x, lsf = sensor.normal_lsf(20.0)
+        half = 4 * sensor.support_radius_m()
+        assert np.array_equal(lsf, sensor.line_response(20.0, reach_px=half, step_px=1 / 400).lsf(x))
+
+
+def test_underflowing_exp_is_exp_bit_for_bit():
+    from imgmtf.sensor.lines import underflowing_exp
+    x = np.concatenate([-np.linspace(700.0, 760.0, 6001), [0.0, -0.5, -np.inf, np.nan, 3.0]])
+    assert np.array_equal(underflowing_exp(x), np.exp(x), equal_nan=True)
+    assert underflowing_exp(-2.0) == np.exp(-2.0) and np.ndim(underflowing_exp(-2.0)) == 0

@@ -23,6 +23,9 @@ def test_rows_interpolated_as_numpy_interpolates_each():
         assert np.array_equal(out[k], np.interp(x[k], nodes[k], values[k]), equal_nan=True)
     shared = interp_rows(x, nodes[0], values)
     assert all(np.array_equal(shared[k], np.interp(x[k], nodes[0], values[k]), equal_nan=True) for k in range(6))
+    same_points = interp_rows(x[0], nodes[0], values)             # one search for every row
+    assert all(np.array_equal(same_points[k], np.interp(x[0], nodes[0], values[k]), equal_nan=True)
+               for k in range(6))
 
 
 def test_many_models_sections_are_each_models_own():

@@ -115,10 +115,18 @@ def test_penalised_spline_refuses_knots_too_close_and_the_resampler_merges_them(
 @pytest.mark.parametrize("adjoint", [False, True])
 def test_shifted_powers_are_every_moment_correlated_with_every_power(half_bins, adjoint):
     from imgmtf.estimate._correlation import correlate1d
-    from imgmtf.estimate.resampling import _binomial_shifts, _shifted_powers
+    from imgmtf.estimate.resampling import _binomial_shifts, _shifted_powers, _shifted_powers_by_power
     rng = np.random.default_rng(half_bins)
     moments = rng.normal(size=(4, 9, 200)) * 10.0 ** rng.integers(-2, 4, size=(9, 1))
     offsets = np.arange(-half_bins, half_bins + 1) / (half_bins + 0.5)
     binomials = _binomial_shifts(9, adjoint)
     every = np.stack([correlate1d(moments, offsets ** p) for p in range(9)], axis=-3).reshape(4, 81, 200)
-    np.testing.assert_array_equal(_shifted_powers(moments, offsets, binomials), binomials @ every)
+    expected = binomials @ every
+    # correlated power by power (stacks of weightings): the same sums in the same order
+    np.testing.assert_array_equal(_shifted_powers_by_power(moments, offsets, binomials), expected)
+    # one weighting's moments: one product with the folded kernel, the same sums in another order
+    for one, sums in zip(moments, expected):
+        scale = np.abs(one).max()
+        np.testing.assert_allclose(_shifted_powers(one, offsets, binomials) / scale, sums / scale,
+                                   rtol=0, atol=1e-13 * (half_bins + 1))
+    np.testing.assert_array_equal(_shifted_powers(moments, offsets, binomials), expected)    # a stack

@@ -156,3 +156,28 @@ def test_the_real_chips_quote_sections_not_their_misfit_fits(name, stages):
         assert 0.06 < r.figures["mtf_nyquist"] < 0.2
     fits = [r for r in outcome.summaries if r.figures.get("summary") == "fit"]
     assert fits and all(r.figures["misfit"] and not r.figures["recommended"] for r in fits)
+
+
+def test_the_sections_on_workers_are_the_sections_here(monkeypatch):
+    """Targets sent to two workers in tasks of one (the task runner's own
+    pool is tested with it; here its tasks run in turn): the same rows in
+    the same order (targets by id, then the scene) as worked out here."""
+    import imgmtf.parallel
+    import imgmtf.scene.sections as sections
+    summaries = [combined(normal, target=k) for k in (2, 1) for normal in (16.8, -73.2)]
+    summaries += [combined(16.8, "scene"), combined(-73.2, "scene")]
+    here = section_rows(summaries)
+    asked = []
+
+    def in_turn(function, items, workers, **options):
+        asked.append((workers, len(items)))
+        return map(function, items)
+    monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
+    monkeypatch.setattr(sections, "AUTO_TARGETS_PER_WORKER", 1)
+    monkeypatch.setattr(sections, "TARGETS_PER_TASK", 1)
+    there = section_rows(summaries, workers=2)
+    assert asked == [(2, 3)]
+    assert [(r.site, r.figures) for r in there] == [(r.site, r.figures) for r in here]
+    assert [r.site.get("target_id") for r in there[::6]] == [1, 2, None]
+    with pytest.raises(ParameterError, match="workers"):
+        section_rows(summaries, workers=0)

@@ -306,10 +306,12 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
         y, x = rows[kept].astype(float), loc[kept]
         t = (y - y.mean()) / max(np.ptp(y) / 2, 1.0)
         design = np.column_stack([np.ones_like(t), t, t * t - np.mean(t * t)])
-        coef, *_ = np.linalg.lstsq(design, x, rcond=None)
+        # ten or more distinct rows, centred and scaled to [-1, 1]: a regular, well-conditioned
+        # normal matrix, inverted once for the fit and its covariance
+        inverse = np.linalg.inv(design.T @ design)
+        coef = inverse @ (design.T @ x)
         sigma = math.sqrt(max(np.sum((x - design @ coef) ** 2) / max(x.size - 3, 1), 1e-12))
-        cov = np.linalg.pinv(design.T @ design) * sigma ** 2
-        sagitta, sd = abs(coef[2]), math.sqrt(cov[2, 2])
+        sagitta, sd = abs(coef[2]), math.sqrt(inverse[2, 2] * sigma ** 2)
         bowed = sagitta > MAX_SAGITTA_PX and sagitta > 4 * sd
         checks.append(Check("not-straight", not bowed,
                             f"the {name} bows by {sagitta:.2f} px over its length (at most "
@@ -376,6 +378,24 @@ def kind_check(kind: str, wanted: str, values: np.ndarray | None = None, grid: n
     return Check(reason, False, message)
 
 
+#: a share of the contrast below this is the arithmetic's rounding (a noise-free side's trend, band
+#: mean or departure): taken as none, so that what a message says of it (its sign, where it peaks,
+#: which of two is larger) cannot move with a change of the arithmetic before it
+ROUNDING_SHARE = 1e-12
+
+
+def beyond_rounding(share: float) -> float:
+    """``share`` (of the contrast), or 0.0 where it is within the
+    arithmetic's rounding (``ROUNDING_SHARE``).
+
+    Examples
+    --------
+    >>> beyond_rounding(3e-17), beyond_rounding(-3e-17), beyond_rounding(0.02)
+    (0.0, 0.0, 0.02)
+    """
+    return float(share) if abs(share) > ROUNDING_SHARE else 0.0
+
+
 def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power,
                 names: tuple[str, str] = ("left", "right")) -> list[Check]:
     """Uniform sides: each side's samples beyond ``start_px`` from the
@@ -399,7 +419,8 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
         design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
         coef, *_ = np.linalg.lstsq(design, v, rcond=None)
         resid = v - design @ coef
-        across, along_target = abs(coef[2]) * np.ptp(ss) / contrast, abs(coef[3]) * np.ptp(t) / contrast
+        across, along_target = (beyond_rounding(abs(coef[2]) * np.ptp(ss) / contrast),
+                                beyond_rounding(abs(coef[3]) * np.ptp(t) / contrast))
         trend, way = max((across, "across"), (along_target, "along"))
         scatter = np.var(resid)
         texture = math.sqrt(max(scatter - pixel_noise ** 2, 0.0)) / contrast
@@ -408,6 +429,7 @@ def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise
         sums = np.bincount(bands, weights=resid)
         full = counts >= 10
         band_means = np.abs(sums[full] / counts[full])
+        band_means[band_means <= ROUNDING_SHARE * abs(contrast)] = 0.0     # a flat side's: rounding, no feature
         band_noise = np.sqrt(scatter / counts[full])
         checks += [
             Check("non-uniform", trend <= MAX_SIDE_TREND,

@@ -117,15 +117,25 @@ def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,
         raise TargetNotFoundError("the per-row fits failed: no clear target profile in the rows")
     keep = np.ones(y.size, bool)
     for _ in range(4):
-        slope, intercept = np.polyfit(y[keep], x[keep], 1)
+        slope, intercept = _straight_line(y[keep], x[keep])
         resid = x - (slope * y + intercept)
         mad = 1.4826 * median(np.abs(resid[keep] - median(resid[keep])))
         new_keep = np.abs(resid) <= max(4.0 * mad, 0.05)
         if np.array_equal(new_keep, keep) or new_keep.sum() < 5:
             break
         keep = new_keep
-    slope, intercept = np.polyfit(y[keep], x[keep], 1)
+    slope, intercept = _straight_line(y[keep], x[keep])
     return TargetGeometry(float(slope), float(intercept), y, x, keep, transposed, location_sd_px)
+
+
+def _straight_line(y: np.ndarray, x: np.ndarray) -> tuple[float, float]:
+    """The least-squares line x = m y + k, (m, k), in closed form about the
+    mean of ``y`` (rows: distinct, so never degenerate), as np.polyfit
+    gives it to rounding without its SVD."""
+    mean_y = float(y.sum()) / y.size
+    centred = y - mean_y
+    slope = float(centred @ x) / float(centred @ centred)
+    return slope, float(x.sum()) / x.size - slope * mean_y
 
 
 def row_windows(image: np.ndarray, centre_x: np.ndarray,

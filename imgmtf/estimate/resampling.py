@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
+from . import weight_stacks
 from ._correlation import ROW_BY_ROW_TAPS, correlate1d
 
 
@@ -94,10 +95,6 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     scale = (half_bins + 0.5) * step      # local coordinates in [-1, 1]
     u = (d - grid[bins]) / scale
     nk = 2 * order + 1
-    powers = np.vander(u, nk, increasing=True).T
-    features = np.concatenate([powers, powers[: order + 1] * v])
-    sums = _bin_sums(bins, grid.size, w[..., None, :] * features)
-    s, t = sums[..., :nk, :], sums[..., nk:, :]
     offsets = np.arange(-half_bins, half_bins + 1) * step / scale
 
     def window_sums(moments):
@@ -106,17 +103,28 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         one correlation per power of the offset for all moments at once,
         combined by one product with the binomials."""
         return _shifted_powers(moments, offsets, _binomial_shifts(moments.shape[-2], False))
-    m = window_sums(s)
-    rhs = np.moveaxis(window_sums(t), -1, -2)
+    # a stack of weightings (the bootstrap) sums its windows per group of equally weighted samples
+    stacked = weight_stacks.window_sums(d, v, w, bins, grid, scale, half_bins, order) if w.ndim > 1 else None
+    if stacked is not None:
+        m, rhs = stacked
+    else:
+        powers = np.vander(u, nk, increasing=True).T
+        features = np.concatenate([powers, powers[: order + 1] * v])
+        sums = _bin_sums(bins, grid.size, features if weights is None else w[..., None, :] * features)
+        s, t = sums[..., :nk, :], sums[..., nk:, :]
+        m = window_sums(s)
+        rhs = np.moveaxis(window_sums(t), -1, -2)
     idx = np.arange(order + 1)
-    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
     # a window needs enough samples, spread over it (uniform spread gives
     # a variance of 1/3 in window coordinates), for a well-posed fit
     count = np.where(m[..., 0, :] > 0, m[..., 0, :], 1.0)
     spread = m[..., 2, :] / count - (m[..., 1, :] / count) ** 2
     # ... and order + 1 distinct sample positions (occupied bins), without
     # which its normal matrix is singular (sample lattices, partial windows)
-    occupied = _bin_sums(bins, grid.size, (w > 0)[..., None, :].astype(float))[..., 0, :] > 0
+    if weights is None:     # unit weights: a bin is occupied where it counts a sample
+        occupied = s[..., 0, :] > 0
+    else:
+        occupied = _bin_sums(bins, grid.size, (w > 0)[..., None, :].astype(float))[..., 0, :] > 0
     distinct = correlate1d(occupied.astype(float), np.ones(2 * half_bins + 1))
     trim = (grid.size - out.size) // 2
     inner = np.zeros(grid.size, bool)
@@ -129,11 +137,12 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
     if w.ndim > 1:      # a stack of weightings (the bootstrap): solve each window directly
         level = np.full(valid.shape, np.nan)
         if valid.any():
-            level[valid] = np.linalg.solve(normal[valid], rhs[valid][..., None])[:, 0, 0]
+            level[valid] = weight_stacks.first_levels(m, rhs, valid)
         return Resampled(out, level[..., trim: trim + out.size], transfer, params)
     # one weighting: each window's equivalent-kernel coefficients M^-1 e0,
     # which give the fitted level and, transposed, every sample's weight
     coef = np.zeros((grid.size, order + 1))
+    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
     if valid.any():
         coef[valid] = np.linalg.solve(normal[valid], np.eye(order + 1)[0][None, :, None]
                                       .repeat(valid.sum(), axis=0))[..., 0]
@@ -151,19 +160,64 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
         # power p of the offset only meets the coefficients j >= p
         g = _shifted_powers(a, -offsets, _binomial_shifts(order + 1, True))   # (..., order + 1, n_grid)
-        kept = np.einsum("...mi,im->...i", g[..., bins], u0) * w
+        kept = np.einsum("...mi,im->...i", g[..., bins], u0)
+        if weights is not None:
+            kept = kept * w
         result = np.zeros((*h.shape[:-1], distance.size))
         result[..., keep] = kept
         return result
 
     leverage = np.zeros(distance.size)
-    leverage[keep] = np.einsum("ij,ij->i", coef[bins], u0) * w
+    leverage[keep] = np.einsum("ij,ij->i", coef[bins], u0) if weights is None else np.einsum(
+        "ij,ij->i", coef[bins], u0) * w
     return Resampled(out, level[trim: trim + out.size], transfer, params, adjoint, leverage)
 
 
 def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndarray) -> np.ndarray:
     """``binomials`` applied to the correlations of ``moments`` (..., n, grid)
-    with every power 0..n-1 of ``offsets``: (..., n, grid)."""
+    with every power 0..n-1 of ``offsets``: (..., n, grid).
+
+    Both steps are linear, so they fold into one kernel per output and
+    input moment, ``sum_p binomials[k, p n + j] offsets ** p`` over the
+    taps (:func:`_folded_kernel`): each window's sums are then one matrix
+    product of that (n, n taps) kernel with the moments shifted by every
+    tap, for every grid point at once, where one correlation per power and
+    the binomials' product cost about twice as much.  Stacks (the adjoint's
+    grid weights, the bootstrap's weightings), whose shifted copies leave
+    the cache, and moments whose copies would fill more than
+    ``SHIFTED_ELEMENTS``, are correlated power by power instead."""
+    n, size = moments.shape[-2], moments.shape[-1]
+    taps = offsets.size
+    if moments.ndim > 2 or moments.size * taps > SHIFTED_ELEMENTS:
+        return _shifted_powers_by_power(moments, offsets, binomials)
+    kernel = _folded_kernel(binomials.tobytes(), n, offsets.tobytes())
+    half = taps // 2
+    padded = np.zeros((*moments.shape[:-1], size + 2 * half))
+    padded[..., half: half + size] = moments
+    # shifted[..., j, o, g] = moments[..., j, g + o - half], zeros beyond the ends
+    shifted = np.lib.stride_tricks.sliding_window_view(padded, size, axis=-1)
+    return kernel @ shifted.reshape(*moments.shape[:-2], n * taps, size)
+
+
+#: the moments' shifted copies (moments x taps x grid) up to which the window sums are one product
+#: with the folded kernel (16 MB); beyond, one correlation per power
+SHIFTED_ELEMENTS = 1 << 21
+
+
+@functools.lru_cache(maxsize=64)
+def _folded_kernel(binomials_bytes: bytes, n: int, offsets_bytes: bytes) -> np.ndarray:
+    """The (n, n * taps) matrix whose row k, column j taps + o, is
+    sum_p binomials[k, p n + j] offsets[o] ** p (from the arrays' bytes:
+    the profiles of a scan share their offsets and binomials)."""
+    binomials = np.frombuffer(binomials_bytes).reshape(n, n, n)      # (k, p, j)
+    offsets = np.frombuffer(offsets_bytes)
+    powers = offsets[None, :] ** np.arange(n)[:, None]                # (p, taps)
+    return np.einsum("kpj,po->kjo", binomials, powers).reshape(n, n * offsets.size)
+
+
+def _shifted_powers_by_power(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndarray) -> np.ndarray:
+    """:func:`_shifted_powers` by one correlation per power of the offsets
+    (for stacks of weightings: no shifted copies)."""
     n = moments.shape[-2]
     moments = np.ascontiguousarray(moments)     # one copy for every power, not one in each correlation
     shifted = np.empty((*moments.shape[:-2], n, n, moments.shape[-1]))

@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from .evidence import Evidence
-from .gate import Check, not_run
+from .gate import ROUNDING_SHARE, Check, beyond_rounding, not_run
 
 MIN_SIDE_SAMPLES = 40
 MIN_SIDE_EXTENT_PX = 4.0       # a side spanning less beyond the plateau's start is too short to see curve...
@@ -107,19 +107,21 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     the chip (too few samples, too short a span beyond ``plateau_px``:
     a level still changing there reads as blur, and nothing would
     show it), not run where the fit is ill-conditioned."""
-    count = int(np.count_nonzero(mask))
-    extent = float(np.ptp(np.abs(s[mask]))) if count else 0.0
+    side = s[mask]
+    count = side.size
+    reach = np.abs(side)
+    extent = float(reach.max() - reach.min()) if count else 0.0
     if count < MIN_SIDE_SAMPLES or extent < MIN_PLATEAU_PX:
         return Check("non-uniform", False,
                      f"the {{name}} side holds no plateau within the chip: {count} samples over {extent:.1f} px lie "
                      f"beyond {ev.plateau_px:.1f} px from the {ev.name} (at least {MIN_SIDE_SAMPLES} over "
                      f"{MIN_PLATEAU_PX:g} px needed to see it settle): its level may still be changing "
                      "(illumination, a slope) and would read as blur; crop wider or choose a flatter side")
-    reach, v = np.abs(s[mask]), ev.values[mask]
+    v = ev.values[mask]
     u = reach ** -float(ev.tail_power)
     # the straight line in u in closed form about its mean: the normal
     # matrix [[n, sum u], [sum u, sum u^2]] has determinant n * spread
-    mean_u = float(np.mean(u))
+    mean_u = float(u.sum()) / count
     centred = u - mean_u
     spread = float(centred @ centred)
     n = u.size
@@ -130,31 +132,39 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
                        "too little of the tail): its settling not judged")
     coef = np.empty(2)
     coef[1] = float(centred @ v) / spread
-    coef[0] = float(np.mean(v)) - coef[1] * mean_u
+    coef[0] = float(v.sum()) / count - coef[1] * mean_u
     resid = v - (coef[0] + coef[1] * u)
     sigma2 = max(float(resid @ resid) / max(resid.size - 2, 1), ev.quantum ** 2 / 12.0)
     # the model's own noise: its tail at the side's start, towards the target's other level
     start_u = ev.plateau_px ** -float(ev.tail_power)
-    towards = _towards_target(ev, left=bool(s[mask][0] < 0))
+    towards = _towards_target(ev, left=bool(side[0] < 0))
     tail_cov = sigma2 / spread                      # the slope's variance, (M^-1)[1, 1] sigma^2
-    unsettled = (towards * coef[1] * start_u / ev.contrast, math.sqrt(tail_cov) * start_u / ev.contrast)
+    unsettled = (beyond_rounding(towards * coef[1] * start_u / ev.contrast),
+                 math.sqrt(tail_cov) * start_u / ev.contrast)
 
-    band = np.floor((reach - reach.min()) / BAND_PX).astype(int)
+    nearest = float(reach.min())
+    band = ((reach - nearest) / BAND_PX).astype(int)       # (non-negative: truncation is the floor)
     counts = np.bincount(band)
     sums = np.bincount(band, weights=resid)
     full = counts >= MIN_BAND_SAMPLES
     if full.sum() <= SMOOTH_DEGREE + 1 or extent < MIN_SIDE_EXTENT_PX:
         return {"departure": None, "unsettled": unsettled}
-    centres = reach.min() + (np.nonzero(full)[0] + 0.5) * BAND_PX
-    means = sums[full] / counts[full]
-    error2 = sigma2 / counts[full] + ev.rounding_floor ** 2
+    centres = nearest + (np.nonzero(full)[0] + 0.5) * BAND_PX
+    counted = counts[full]
+    means = sums[full] / counted
+    error2 = sigma2 / counted + ev.rounding_floor ** 2
     t = 2.0 * (centres - centres[0]) / max(centres[-1] - centres[0], 1e-9) - 1.0
     basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
     weights = 1.0 / np.maximum(error2, 1e-300)
     normal_b = (basis * weights[:, None]).T @ basis
+    # (the same arithmetic as ever: on a flat side the curve is rounding, and where it peaks is said)
     cov = np.linalg.pinv(normal_b)
     smooth_coef = cov @ (basis * weights[:, None]).T @ means
     curve = basis @ smooth_coef
+    if np.max(np.abs(curve)) <= ROUNDING_SHARE * abs(ev.contrast):
+        # a flat side (noise-free): the curve is the arithmetic's rounding, and where it peaks would
+        # move with any change of the arithmetic before it; no departure, said at the side's start
+        curve = np.zeros_like(curve)
     worst = int(np.argmax(np.abs(curve)))
     sd = math.sqrt(max(float(basis[worst] @ cov @ basis[worst]), 0.0))
     return {"departure": (float(abs(curve[worst])), sd, float(centres[worst])), "unsettled": unsettled}

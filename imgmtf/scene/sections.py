@@ -37,9 +37,15 @@ SECTIONS = "sections"
 POINTS = "points"
 #: draws of the families' curves for the sections' intervals
 DRAWS = 100
+#: targets per worker before the sections take the workers (a target's sections take 20-60 ms; a pool's
+#: start and the records' travel cost a few hundred ms)
+AUTO_TARGETS_PER_WORKER = 16
+#: targets per task sent to a worker (fewer, larger tasks: less pickling and waiting per target)
+TARGETS_PER_TASK = 8
 
 
-def section_rows(summaries: Sequence[Record]) -> list[Record]:
+def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, scheduler: str | None = None,
+                 progress: bool | None = False) -> list[Record]:
     """The across- and along-track rows of every target and of the scene
     whose combined rows (``summary`` "combined") span two orientations at
     least 30 deg apart.
@@ -48,6 +54,19 @@ def section_rows(summaries: Sequence[Record]) -> list[Record]:
     ----------
     summaries : list of Record
         A scan's summaries (:func:`imgmtf.scene.combine.summarise_scan`).
+    workers : int or None, optional
+        Local worker processes for the targets' sections (default 1: none,
+        the work runs here); None chooses them, one per
+        ``AUTO_TARGETS_PER_WORKER`` targets up to the available cores.  Fewer
+        are used when the targets are too few to pay for them; the rows are
+        the same whatever the workers.
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"``
+        (:func:`imgmtf.parallel.run_tasks`), for the targets' sections when
+        they take more than one worker.
+    progress : bool, optional
+        Show a progress bar on stderr (default False; None: when stderr is
+        a terminal).
 
     Returns
     -------
@@ -62,7 +81,8 @@ def section_rows(summaries: Sequence[Record]) -> list[Record]:
     Raises
     ------
     ParameterError
-        ``summaries`` is not a list of Records.
+        ``summaries`` is not a list of Records, or ``workers`` is not an
+        integer from 1 to :data:`imgmtf.parallel.MAX_WORKERS`.
 
     Examples
     --------
@@ -78,10 +98,42 @@ def section_rows(summaries: Sequence[Record]) -> list[Record]:
     groups: dict[tuple, list[Record]] = {}
     for r in combined:
         groups.setdefault((r.site.get("scope"), r.site.get("target_id")), []).append(r)
-    out: list[Record] = []
-    for _, group in sorted(groups.items(), key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0)):
-        out += _group_rows(group)
-    return out
+    ordered = [group for _, group in sorted(groups.items(),
+                                            key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
+    chosen = sections_workers(len(ordered), workers)
+    if chosen == 1:
+        return [row for group in ordered for row in _group_rows(group)]
+    from ..parallel import run_tasks
+    tasks = [ordered[k: k + TARGETS_PER_TASK] for k in range(0, len(ordered), TARGETS_PER_TASK)]
+    return [row for rows in run_tasks(_task_rows, tasks, workers=chosen, scheduler=scheduler, progress=progress,
+                                      description="2-D sections") for row in rows]
+
+
+def sections_workers(targets: int, workers: int | None) -> int:
+    """The workers for the sections of ``targets`` targets: ``workers``
+    (None: the available cores), but no more than give each worker
+    ``AUTO_TARGETS_PER_WORKER`` targets, and at least 1.
+
+    Raises
+    ------
+    ParameterError
+        ``workers`` is neither None nor an integer from 1 to
+        :data:`imgmtf.parallel.MAX_WORKERS`.
+
+    Examples
+    --------
+    >>> sections_workers(484, 2), sections_workers(5, 2), sections_workers(40, 1)
+    (2, 1, 1)
+    """
+    from ..parallel import MAX_WORKERS, auto_workers
+    if workers is not None and not (isinstance(workers, int) and 1 <= workers <= MAX_WORKERS):
+        raise ParameterError(f"workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}")
+    return auto_workers(targets, AUTO_TARGETS_PER_WORKER, cores=workers)
+
+
+def _task_rows(groups: list[list[Record]]) -> list[Record]:
+    """One worker's task: the rows of a few targets, in their order."""
+    return [row for group in groups for row in _group_rows(group)]
 
 
 def _group_rows(group: list[Record]) -> list[Record]:

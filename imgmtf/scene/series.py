@@ -245,7 +245,7 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                 raise
             return SceneOutcome(path, _reported(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
-        summaries += section_rows(summaries)
+        summaries += section_rows(summaries, workers=workers, scheduler=scheduler, progress=progress)
         if get_kind(settings.target).fits_sensor and stages:
             summaries += fit_targets(records, stages=stages, workers=_fit_workers(records, workers),
                                      scheduler=scheduler, progress=progress)

@@ -273,7 +273,8 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
         figures["fwhm_m"] = finite(fwhm_px * figures["gsd_m"])
     frequencies = first.figures.get("frequencies_cy_px")
     if frequencies:
-        curve, _, _ = fit.mtf_band(np.asarray(frequencies, float), angle)
+        # the model's curve alone (its band, not reported, would cost a transfer per parameter)
+        curve = np.abs(sensor.normal_transfer(np.asarray(frequencies, float), angle, gsd))
         figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
     return Record(first.path, first.band, first.target, first.method, "fitted", figures=figures, site=site,
                   params=_params(first, stages), run_utc=first.run_utc)

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike
 from ..errors import ConfigError, ParameterError
 from ..inputs import check_number
 from ..metrics import first_crossing, fwhm
-from .lines import LineResponse, line_grid
+from .lines import LineResponse, line_grid, line_spread
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
 from .toml_text import sensor_toml_lines, write_toml_lines
 
@@ -296,10 +296,12 @@ class Sensor:
         """
         gsd = self._gsd(gsd_m)
         half = 4 * self.support_radius_m() / gsd
-        response = self.line_response(angle_deg, gsd, reach_px=half, step_px=1.0 / samples_per_px)
+        # the line response's LSF (its ESF unused: half the inverse FFTs of :meth:`line_response`)
+        grid = line_grid(self, angle_deg, gsd, reach_px=half, step_px=1.0 / samples_per_px)
+        remainder = grid.lsf_remainder(self.normal_transfer(grid.frequencies_cy_px, angle_deg, gsd))
         n = 2 * int(math.ceil(half * samples_per_px)) + 1
         x = (np.arange(n) - n // 2) / samples_per_px
-        return x, response.lsf(x)
+        return x, line_spread(grid.start_px, grid.step_px, remainder, grid.reference, x)
 
     def lsf(self, direction: str = "across") -> tuple[np.ndarray, np.ndarray]:
         """Line spread function across or along track: ``(x_m, lsf)``,

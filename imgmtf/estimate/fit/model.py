@@ -25,12 +25,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from statistics import NormalDist
 
 import numpy as np
 
 from ...errors import ImgmtfError, ParameterError
-from ...metrics import first_crossing
 from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
@@ -189,6 +187,8 @@ class Model:
         self.groups, self.own = grouped_edges([d.profile_angle_deg for d in data], [d.gsd_m for d in data],
                                               [self.reach(d) for d in data])
         self._last_esfs: tuple = (None, None, None)
+        # the responses and ESFs at the last Jacobian's point (:meth:`jacobian`)
+        self._solution: tuple = ((None, [], None), (None, None, None))
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
 
@@ -291,6 +291,8 @@ class Model:
         ones kept, since the solver asks for the residuals and then the
         Jacobian at the same point."""
         key = (tuple(self.free), u.tobytes())
+        if self._last_responses[0] != key and self._solution[0][0] == key:
+            self._last_responses = self._solution[0]
         if self._last_responses[0] != key:
             sensor = self.sensor(u)
             out: list = [None] * len(self.edges)
@@ -308,7 +310,7 @@ class Model:
         and responses, the last responses, ESFs, samples' residuals and
         stages made, the edges' bins side by side and the Jacobian's
         layout), which a finished fit no longer uses: what it still asks
-        (:func:`model_mtf_band`, the sensor's transfer) is made afresh.  The
+        (:func:`.bands.model_mtf_band`, the sensor's transfer) is made afresh.  The
         model evaluates as before, computing them again."""
         for edge in self.edges:
             edge.release()
@@ -316,6 +318,7 @@ class Model:
             group.release()
         self._last_responses = (None, [], None)
         self._last_esfs = (None, None, None)
+        self._solution = ((None, [], None), (None, None, None))
         self._last_samples = (None, [])
         self._stages_made.clear()
         self._stacked_bins = None
@@ -348,12 +351,17 @@ class Model:
     def residuals(self, z: np.ndarray, responses=None) -> np.ndarray:
         u = z[: self.n_free]
         lo, hi, x0 = self.levels(z)
-        stacked = self.stacked(responses or self.responses(u))
-        placement = stacked.placement(self.bins.x - x0, curvature=True)
-        esf = bin_esf(stacked, self.bins, x0, placement)
+        responses = responses or self.responses(u)
+        key = (tuple(self.free), z.tobytes())
+        if self._solution[1][0] == key and self._last_responses[1] is responses:
+            esf, placement = self._solution[1][1:]          # the last Jacobian's point: the solution's, asked again
+        else:
+            stacked = self.stacked(responses)
+            placement = stacked.placement(self.bins.x - x0, curvature=True)
+            esf = bin_esf(stacked, self.bins, x0, placement)
         # the solver asks for the Jacobian where it last asked for the residuals: their ESFs are its
         # columns', and their bins' places on the grids those of the changes
-        self._last_esfs = ((tuple(self.free), z.tobytes()), esf, placement)
+        self._last_esfs = (key, esf, placement)
         return self.weight * (self.bins.y - (lo + (hi - lo) * esf))
 
     def stacked(self, responses: list[LineResponse]) -> LineResponse | StackedResponses:
@@ -415,6 +423,9 @@ class Model:
         else:
             placement = stacked.placement(d, curvature=True)
             esf = bin_esf(stacked, self.bins, x0, placement)
+        # the solver stops at the last point it took a Jacobian at, where the covariance, the chi-square
+        # and the report ask for the responses and residuals again after the rejected trials that followed
+        self._solution = (self._last_responses, ((tuple(self.free), z.tobytes()), esf, placement))
         changes = esf_changes(stacked, esf_change, lsf_change, d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
         stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
@@ -551,44 +562,3 @@ def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: fl
 
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
-
-
-def band_sensors(model: Model, u: np.ndarray) -> tuple[Sensor, list[tuple[float, Sensor]]]:
-    """The sensor at ``u`` and, for each free parameter, its step and the
-    sensor with it stepped: what :func:`model_mtf_band` differentiates,
-    the same at every angle (made once for a scene's thousands of edges,
-    each made again per edge had cost a dense chart's scene fit a tenth
-    of its time)."""
-    n = model.n_free
-    upper = model.bounds()[1] if n else np.zeros(0)
-    steps = []
-    for k in range(n):
-        h = 1e-4 * max(u[k], 0.05 * upper[k] ** 0.5)
-        h = -h if u[k] + h > upper[k] else h
-        shifted = u.copy()
-        shifted[k] += h
-        steps.append((h, model.sensor(shifted)))
-    return model.sensor(u), steps
-
-
-def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
-              gsd: float, confidence: float, sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None = None):
-    """The model's MTF at ``f`` along ``angle_deg`` and its delta-method
-    band; ``sensors`` (:func:`band_sensors` of ``model`` and ``u``) when
-    several angles are asked for."""
-    sensor, steps = band_sensors(model, u) if sensors is None else sensors
-    value = np.abs(sensor.normal_transfer(f, angle_deg, gsd))
-    n = model.n_free
-    if n == 0:
-        return value, value, value
-    grads = [(np.abs(shifted.normal_transfer(f, angle_deg, gsd)) - value) / h for h, shifted in steps]
-    g = np.stack(grads, axis=-1)
-    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g), 0.0))
-    z = NormalDist().inv_cdf(0.5 + confidence / 2)
-    return value, np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
-
-
-def model_mtf50_band(model, u, covariance, angle_deg, gsd, confidence, sensors=None):
-    f = np.linspace(0.0, 2.0, 4001)
-    value, low, high = model_mtf_band(model, u, covariance, f, angle_deg, gsd, confidence, sensors)
-    return first_crossing(f, value, 0.5), (first_crossing(f, low, 0.5), first_crossing(f, high, 0.5))

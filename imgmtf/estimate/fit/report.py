@@ -11,8 +11,9 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
+from .bands import band_sensors, model_mtf50_band, model_mtf_band, sensor_transfers
 from .choice import other_stages
-from .model import Model, band_sensors, model_mtf50_band, model_mtf_band
+from .model import Model
 from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test
@@ -125,7 +126,7 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
                     chunk: int = EDGE_CHUNK) -> tuple[np.ndarray, np.ndarray]:
     """Each of ``model``'s edges' model MTF at Nyquist (0.5 cy/px) along
     its normal with its delta-method band, and its model MTF50 (cy/px):
-    what :func:`.model.model_mtf_band` and :func:`imgmtf.metrics.first_crossing`
+    what :func:`.bands.model_mtf_band` and :func:`imgmtf.metrics.first_crossing`
     give edge by edge, the same numbers, with the transfers of many edges
     computed in one array (a scene's thousands of edges: one call per
     stage and chunk of edges, not per edge).
@@ -139,7 +140,7 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
     covariance : numpy.ndarray
         Their covariance (its first ``model.n_free`` rows and columns).
     sensors : tuple
-        :func:`.model.band_sensors` of ``model`` and ``u``.
+        :func:`.bands.band_sensors` of ``model`` and ``u``.
     confidence : float
         The band's confidence level.
     chunk : int, optional
@@ -165,13 +166,14 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
         return np.abs(s.transfer(f * (cos[rows, None] if f.ndim > 1 else cos[rows]),
                                  f * (sin[rows, None] if f.ndim > 1 else sin[rows])))
 
-    everyone = slice(None)
-    value = mtf(sensor, np.full(gsd.size, 0.5), everyone)
-    bands = np.stack([value, value, value])
     n = model.n_free
+    nyquist = np.full(gsd.size, 0.5) / gsd
+    # the stepped sensors' unstepped stages computed once (as mtf() gives them, bit for bit)
+    value, *stepped = (np.abs(t) for t in sensor_transfers([sensor] + [s for _, s in steps[:n]],
+                                                             nyquist * cos, nyquist * sin))
+    bands = np.stack([value, value, value])
     if n:
-        grads = np.stack([(mtf(shifted, np.full(gsd.size, 0.5), everyone) - value) / h for h, shifted in steps],
-                         axis=-1)
+        grads = np.stack([(mtf - value) / h for (h, _), mtf in zip(steps, stepped)], axis=-1)
         # one edge's quadratic form at a time: batched, einsum may sum in another order
         se = np.sqrt(np.maximum([np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g) for g in grads], 0.0))
         z = NormalDist().inv_cdf(0.5 + confidence / 2)

@@ -10,7 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...sensor.model import Sensor
-from .model import Model, model_mtf_band
+from .bands import model_mtf_band
+from .model import Model
 from .record import write_fitted_sensor
 
 if TYPE_CHECKING:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
@@ -29,13 +30,30 @@ def row_weights(rows: np.ndarray, replicates: int, rng: np.random.Generator):
     return weights_of
 
 
-def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.ndarray, np.ndarray]:
-    """MTF at Nyquist and MTF50 (cy/px) of every windowed profile (rows of
-    ``profiles``, sampled every ``step`` px): |DFT| normalised at zero,
-    divided by |divisor(f)| (NaN where it is below ``MIN_TRANSFER``), as
-    :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile."""
-    f, basis = _fourier_basis(profiles.shape[-1], step)
-    modulus = np.abs(profiles @ basis)
+def spectral_figures(profiles: np.ndarray, step: float, divisor, *, start: int = 0, length: int | None = None,
+                     amplitudes: np.ndarray | None = None, shapes: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """MTF at Nyquist and MTF50 (cy/px) of every windowed profile, sampled
+    every ``step`` px: |DFT| normalised at zero, divided by |divisor(f)|
+    (NaN where it is below ``MIN_TRANSFER``), as
+    :func:`imgmtf.estimate.spectrum.corrected_mtf` does for one profile.
+
+    A profile is the row of ``profiles`` on the samples ``start`` to
+    ``start + profiles.shape[1]`` of a lattice of ``length`` samples (by
+    default those of ``profiles``, from 0), zero elsewhere, plus
+    ``amplitudes @ shapes`` (replicates, k) times (k, length): the parts
+    whose shapes every replicate shares (the tails' model), transformed once
+    rather than once a replicate.
+    """
+    length = profiles.shape[-1] + start if length is None else length
+    f, cosine, sine = _fourier_basis(length, step)
+    on = slice(start, start + profiles.shape[-1])
+    # the real profiles' transform as real products: a complex one would multiply zeros too
+    real, imaginary = profiles @ cosine[on], profiles @ sine[on]
+    if amplitudes is not None and shapes is not None:
+        real += amplitudes @ (shapes @ cosine)
+        imaginary += amplitudes @ (shapes @ sine)
+    modulus = np.hypot(real, imaginary)
     div = np.abs(divisor(f) / divisor(np.zeros(1)))
     with np.errstate(invalid="ignore", divide="ignore"):
         mtf = np.where(div >= MIN_TRANSFER, modulus / modulus[:, :1] / np.where(div > 0, div, 1), np.nan)
@@ -44,17 +62,19 @@ def spectral_figures(profiles: np.ndarray, step: float, divisor) -> tuple[np.nda
 
 
 @functools.lru_cache(maxsize=16)
-def _fourier_basis(n: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+def _fourier_basis(n: int, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The bootstrap's frequency grid (cy/px) and the DFT matrix of ``n``
-    samples ``step`` px apart on it, exp(-2 pi i x f), shape (n, frequencies):
-    made once per profile length and step (a scan's edges share a few), not
-    once per edge, where its complex exponentials cost as much as the
-    product they enter.  Read-only, being shared."""
+    samples ``step`` px apart on it, exp(-2 pi i x f), as its real and
+    imaginary parts cos(2 pi x f) and -sin(2 pi x f), shape (n,
+    frequencies): made once per profile length and step (a scan's edges
+    share a few), not once per edge, where its exponentials cost as much as
+    the product they enter.  Read-only, being shared."""
     f = np.arange(0.0, 1.0 + 1e-9, FREQUENCY_STEP_CY_PX)
     x = np.arange(n) * step
     basis = np.exp(-2j * np.pi * x[:, None] * f[None, :])
-    f.flags.writeable = basis.flags.writeable = False
-    return f, basis
+    cosine, sine = np.ascontiguousarray(basis.real), np.ascontiguousarray(basis.imag)
+    f.flags.writeable = cosine.flags.writeable = sine.flags.writeable = False
+    return f, cosine, sine
 
 
 def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:
@@ -68,6 +88,21 @@ def percentile_interval(samples: np.ndarray, confidence: float) -> Interval:
     tail = 50.0 * (1.0 - confidence)
     low, high = np.percentile(finite, [tail, 100.0 - tail])
     return Interval(float(low), float(high))
+
+
+class Windowed(NamedTuple):
+    """Every replicate's windowed profile on a lattice of n samples:
+    ``inner`` (replicates, m) on samples ``start`` to ``start + m`` (where
+    the window holds the measured profile), zero elsewhere, plus
+    ``amplitudes @ shapes`` ((replicates, k) times (k, n): the model of the
+    tails where the window lets it in); ``complete`` says which replicates
+    have every value finite."""
+
+    inner: np.ndarray
+    start: int
+    amplitudes: np.ndarray
+    shapes: np.ndarray
+    complete: np.ndarray
 
 
 def bootstrap_figures(distance: np.ndarray, rows: np.ndarray, span_px: float, resample: Callable,
@@ -88,10 +123,10 @@ def bootstrap_figures(distance: np.ndarray, rows: np.ndarray, span_px: float, re
         estimator's own resampling of the samples selected by ``keep``
         under a stack of ``weights``.
     windowed_profile : callable
-        ``(grid, values, weights_of) -> profiles``: the estimator's
-        windowed LSF (or PRF) of each replicate, shape (replicates, n);
-        ``weights_of(mask)`` gives the replicates' weights of the samples
-        selected by ``mask`` (see :func:`row_weights`).
+        ``(grid, values, weights_of) -> Windowed``: the estimator's
+        windowed LSF (or PRF) of each replicate; ``weights_of(mask)``
+        gives the replicates' weights of the samples selected by ``mask``
+        (see :func:`row_weights`).
     step : float
         The profile's sample step (px).
     divisor : callable
@@ -112,12 +147,27 @@ def bootstrap_figures(distance: np.ndarray, rows: np.ndarray, span_px: float, re
     keep = np.abs(distance) <= span_px + 2.0
     weights_of = row_weights(rows, replicates, rng)
     resampled = resample(keep, weights_of(keep), span_px)
-    profiles = windowed_profile(resampled.grid, resampled.values, weights_of)
-    complete = np.isfinite(profiles).all(axis=1)
-    nyquist, fifty = spectral_figures(np.where(complete[:, None], profiles, 0.0), step, divisor)
+    found = windowed_profile(resampled.grid, resampled.values, weights_of)
+    complete = found.complete
+    nyquist, fifty = spectral_figures(np.where(complete[:, None], found.inner, 0.0), step, divisor,
+                                      start=found.start, length=found.shapes.shape[-1],
+                                      amplitudes=np.where(complete[:, None], found.amplitudes, 0.0),
+                                      shapes=found.shapes)
     nyquist[~complete] = np.nan
     fifty[~complete] = np.nan
     return percentile_interval(nyquist, confidence), percentile_interval(fifty, confidence)
+
+
+def _tail_fits(u: np.ndarray, values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Every replicate's weighted least-squares line ``values ~ c0 + c1 u``
+    (a side's level and tail, u = 1 / |s|^p), shape (replicates, 2): the
+    weighted sums of the samples in one product, the 2 x 2 normal equations
+    (with 1e-12 added to their diagonal, as a guard against an empty side)
+    solved in closed form for all replicates at once."""
+    sums = weights @ np.stack([np.ones_like(u), u, u * u, values, u * values], axis=1)
+    s0, s1, s2 = sums[:, 0] + 1e-12, sums[:, 1], sums[:, 2] + 1e-12
+    det = s0 * s2 - s1 * s1
+    return np.stack([(s2 * sums[:, 3] - s1 * sums[:, 4]) / det, (s0 * sums[:, 4] - s1 * sums[:, 3]) / det], axis=1)
 
 
 def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replicates: int = 200,
@@ -168,23 +218,23 @@ def bootstrap_intervals(estimate: Estimate, *, confidence: float = 0.95, replica
     def windowed(grid_b, values_b, weights_of):
         coefs = []
         for mask in masks:
-            u = np.abs(offsets[mask]) ** -float(estimate.tail_power)
-            design = np.column_stack([np.ones_like(u), u])
-            wts = weights_of(mask)
-            normal = np.einsum("ri,ij,ik->rjk", wts, design, design)
-            rhs = np.einsum("ri,ij,i->rj", wts, design, values[mask])
-            coefs.append(np.linalg.solve(normal + 1e-12 * np.eye(2), rhs[..., None])[..., 0])
+            coefs.append(_tail_fits(np.abs(offsets[mask]) ** -float(estimate.tail_power), values[mask],
+                                    weights_of(mask)))
         background = 0.5 * (coefs[0][:, 0] + coefs[1][:, 0])
         x_data, lsf_data, _ = estimate.lsf_of(grid_b, values_b, background[:, None])
         first = int(round((x_data[0] - x[0]) / step))
-        profiles = np.zeros((lsf_data.shape[0], x.size))
-        profiles[:, first: first + x_data.size] = lsf_data
         in_data = np.zeros(x.size, bool)
         in_data[first: first + x_data.size] = True
-        amp = [coefs[i] @ to_amplitude[i] for i in range(2)]
+        amplitudes = np.stack([coefs[i] @ to_amplitude[i] for i in range(2)], axis=1)
         w = flat_top_window(x, centre, window.core_px, window.taper_px) * in_data
-        model = np.where(from_centre < 0, amp[0][:, None], amp[1][:, None]) * lsf.tail_shape
-        return w * profiles + (1.0 - w) * model
+        # the profile w * lsf + (1 - w) * model, the model a tail shape times each side's amplitude:
+        # the measured part only where the window holds it, the model's two shapes shared by every replicate
+        held = np.flatnonzero(w)
+        lo, hi = (held[0], held[-1] + 1) if held.size else (first, first)
+        inner = w[lo:hi] * lsf_data[:, lo - first: hi - first]
+        shapes = (1.0 - w) * lsf.tail_shape * np.stack([from_centre < 0, from_centre >= 0])
+        complete = np.isfinite(lsf_data).all(axis=1) & np.isfinite(amplitudes).all(axis=1)
+        return Windowed(inner, int(lo), amplitudes, shapes, complete)
     nyquist, fifty = bootstrap_figures(distance, samples.rows, float(estimate.profile.grid[-1]),
                                        estimate.resample, windowed, step, estimate.spectrum.divisor,
                                        confidence=confidence, replicates=replicates, seed=seed)

@@ -18,11 +18,11 @@ from .inversion import EllipticalModel, SeparableModel
 
 
 def interp_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
-    """:func:`numpy.interp` of each row: ``x`` (k, n) on nodes ``xp``
-    ((k, m), or (m,) shared) with values ``fp`` (k, m), bit for bit as
-    ``np.interp(x[i], xp[i], fp[i])`` (its rule on NaN values included:
-    a value on a node is that node's; a NaN slope is tried from the
-    right node too).  ``xp`` rows increase strictly.
+    """:func:`numpy.interp` of each row: ``x`` ((k, n), or (n,) shared) on
+    nodes ``xp`` ((k, m), or (m,) shared) with values ``fp`` (k, m): (k,
+    n), bit for bit as ``np.interp(x[i], xp[i], fp[i])`` (its rule on NaN
+    values included: a value on a node is that node's; a NaN slope is
+    tried from the right node too).  ``xp`` rows increase strictly.
 
     Examples
     --------
@@ -33,12 +33,20 @@ def interp_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
     """
     x = np.asarray(x, float)
     fp = np.asarray(fp, float)
-    xp = np.broadcast_to(np.asarray(xp, float), fp.shape)
     k, m = fp.shape
-    row = np.arange(k)[:, None]
-    j = _search_rows(x, xp, row)
-    low, high = np.clip(j, 0, m - 2), np.clip(j + 1, 1, m - 1)
-    x_low, x_high, y_low, y_high = xp[row, low], xp[row, high], fp[row, low], fp[row, high]
+    xp = np.asarray(xp, float)
+    if x.ndim == 1 and xp.ndim == 1:
+        # the same points on the same nodes for every row: one search, the rows' values taken by column
+        j = np.searchsorted(xp, x, side="right") - 1
+        low, high = np.clip(j, 0, m - 2), np.clip(j + 1, 1, m - 1)
+        x_low, x_high, y_low, y_high = xp[low], xp[high], fp[:, low], fp[:, high]
+    else:
+        x = np.broadcast_to(x, (k, x.shape[-1]))
+        xp = np.broadcast_to(xp, fp.shape)
+        row = np.arange(k)[:, None]
+        j = _search_rows(x, xp, row)
+        low, high = np.clip(j, 0, m - 2), np.clip(j + 1, 1, m - 1)
+        x_low, x_high, y_low, y_high = xp[row, low], xp[row, high], fp[row, low], fp[row, high]
     with np.errstate(invalid="ignore", divide="ignore"):
         slope = (y_high - y_low) / (x_high - x_low)
         out = slope * (x - x_low) + y_low
@@ -102,8 +110,7 @@ def transfers(models: Sequence[SeparableModel] | Sequence[EllipticalModel], u: n
         nodes = _shared_nodes(separable)
         log_x = np.array([m.log_x for m in separable])
         log_y = np.array([m.log_y for m in separable])
-        return np.exp(_interp_inside(np.broadcast_to(np.abs(u), (rows, u.size)), nodes, log_x)
-                      + _interp_inside(np.broadcast_to(np.abs(v), (rows, v.size)), nodes, log_y))
+        return np.exp(_interp_inside(np.abs(u), nodes, log_x) + _interp_inside(np.abs(v), nodes, log_y))
     if len(elliptical) == rows:
         aspects = np.array([m.aspect for m in elliptical])[:, None]
         w = np.hypot(u, v / aspects)

@@ -82,9 +82,7 @@ def gram(h: Hats, weight: np.ndarray) -> np.ndarray:
     >>> bool(np.allclose(gram(h, np.ones(2))[0], dense(h)[0].T @ dense(h)[0]))
     True
     """
-    lower, upper = weight * (1.0 - h.frac), weight * h.frac
-    diagonal = _scatter(h.low, lower * lower, h.size) + _scatter(h.low + 1, upper * upper, h.size)
-    beside = _scatter(h.low, lower * upper, h.size)[:, :-1]
+    diagonal, beside = _gram_bands(h, weight)
     batch, nodes = diagonal.shape
     out = np.zeros((batch, nodes, nodes))
     k = np.arange(nodes)
@@ -92,6 +90,28 @@ def gram(h: Hats, weight: np.ndarray) -> np.ndarray:
     out[:, k[:-1], k[1:]] = beside
     out[:, k[1:], k[:-1]] = beside
     return out[:, 1:, 1:]
+
+
+def gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`gram`'s two bands, its diagonal (batch, size - 1) and the
+    one beside it (batch, size - 2), without the matrix.
+
+    Examples
+    --------
+    >>> h = hats(np.array([[0.25, 1.5]]), 3)
+    >>> diagonal, beside = gram_bands(h, np.ones(2))
+    >>> bool(np.array_equal(diagonal, np.diagonal(gram(h, np.ones(2)), axis1=1, axis2=2)))
+    True
+    """
+    diagonal, beside = _gram_bands(h, weight)
+    return diagonal[:, 1:], beside[:, 1:]
+
+
+def _gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Gram matrix's bands with the first node: (batch, size), (batch, size - 1)."""
+    lower, upper = weight * (1.0 - h.frac), weight * h.frac
+    diagonal = _scatter(h.low, lower * lower, h.size) + _scatter(h.low + 1, upper * upper, h.size)
+    return diagonal, _scatter(h.low, lower * upper, h.size)[:, :-1]
 
 
 def transposed(h: Hats, values: np.ndarray) -> np.ndarray:

@@ -56,6 +56,8 @@ from .inversion import (
 
 _GRID = np.round(np.arange(0.0, REACH_CY_PX + 1e-9, 0.01), 2)
 _FWHM_X = np.linspace(0.0, 4.0, 801)       # where the LSF is evaluated for its FWHM, px
+# the across (u, 0) then the along (0, v) section's points, cy/px
+_ACROSS_ALONG = (np.concatenate([_GRID, 0.0 * _GRID]), np.concatenate([0.0 * _GRID, _GRID]))
 
 
 @dataclass(frozen=True)
@@ -262,26 +264,37 @@ def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tupl
     sections redrawn by ``shifts`` (draws x sections) and inverted again."""
     normals, f, m, sd = inputs
     curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
-    across = along = None
-    if shifts is not None:
-        # every draw's sections in one pass (a call per draw was a third of a dense chart's sections)
-        again = drawn_models(assumption, model, normals, f, m, sd, shifts)
-        across, along = transfers(again, _GRID, 0.0 * _GRID), transfers(again, 0.0 * _GRID, _GRID)
-    return (_section("across-track", curves[0], across, confidence),
-            _section("along-track", curves[1], along, confidence))
+    if shifts is None:
+        return (_section("across-track", curves[0], None, confidence),
+                _section("along-track", curves[1], None, confidence))
+    # every draw's sections in one pass (a call per draw was a third of a dense chart's sections), across
+    # and along together (u then v): one interpolation, one quantile, one MTF50 search for both
+    again = drawn_models(assumption, model, normals, f, m, sd, shifts)
+    both = transfers(again, _ACROSS_ALONG[0], _ACROSS_ALONG[1])
+    tail = (1 - confidence) / 2
+    low, high = np.quantile(both, [tail, 1 - tail], axis=0)
+    drawn = (both[:, : _GRID.size], both[:, _GRID.size:])
+    fifty = mtf50_rows(_GRID, np.concatenate(drawn))
+    return tuple(_section(direction, curves[k], drawn[k], confidence,   # type: ignore[return-value]
+                          (low[k * _GRID.size: (k + 1) * _GRID.size], high[k * _GRID.size: (k + 1) * _GRID.size],
+                           fifty[k * len(shifts): (k + 1) * len(shifts)]))
+                 for k, direction in enumerate(("across-track", "along-track")))
 
 
-def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float) -> TrackSection:
+def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float,
+             spread: tuple = ()) -> TrackSection:
+    """One section and its intervals from its ``drawn`` redraws (draws x
+    grid; None: no intervals), their pointwise quantiles (low, high) and
+    MTF50s in ``spread``."""
     tail = (1 - confidence) / 2
     if drawn is None:
         low = high = np.full_like(curve, np.nan)
         nyq_ci = fifty_ci = (math.nan, math.nan)
     else:
         # NaN where a draw does not reach (beyond the sections' reach)
-        low, high = np.quantile(drawn, [tail, 1 - tail], axis=0)
+        low, high, fifty = spread
         low, high = np.minimum(low, curve), np.maximum(high, curve)
         nyquist = drawn[:, _GRID.searchsorted(0.5)]
-        fifty = mtf50_rows(_GRID, drawn)
         nyq_ci = _quantiles(nyquist, tail, curve[_GRID.searchsorted(0.5)])
         fifty_ci = _quantiles(fifty, tail, _mtf50(curve))
     return TrackSection(direction, _GRID.copy(), curve, low, high, float(curve[_GRID.searchsorted(0.5)]), nyq_ci,
