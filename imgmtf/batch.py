@@ -21,7 +21,7 @@ from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
 from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
 from .file_notes import file_notes as raster_notes
-from .io import Raster, open_raster, read_raster
+from .io import Raster, many_files, open_raster, read_raster
 from .measure_settings import MeasureSettings
 from .parallel import run_tasks
 from .raster_estimate import edge_centre_px, in_image_axes, measure_rasters
@@ -344,6 +344,11 @@ def _measure_group(task) -> list[list[Record]]:
     is estimated on its own as it is read, so that a group holds no more
     than a few small rasters at once."""
     paths, settings, plots, run_utc = task
+    with many_files():
+        return _measured_group(paths, settings, plots, run_utc)
+
+
+def _measured_group(paths, settings: MeasureSettings, plots, run_utc: str) -> list[list[Record]]:
     steps = [_file_steps(path, settings, plot, run_utc) for path, plot in zip(paths, plots)]
     out: list[list[Record]] = [[] for _ in paths]
     waiting: dict[int, Raster] = {}

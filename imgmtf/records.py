@@ -24,7 +24,7 @@ scan's screening codes (``angle``, ``too-short``, ``fill``, ``non-uniform``...),
 from __future__ import annotations
 
 import csv
-import json
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -36,6 +36,15 @@ import numpy as np
 from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
 from .kinds import KINDS
+from .safe_json import (  # noqa: F401  (json_safe, dumps_safe, finite_values: imported from here too)
+    ENCODER,
+    _json_default,
+    dumps_safe,
+    dumps_sorted,
+    finite_values,
+    has_unsafe_value,
+    json_safe,
+)
 from .version import __version__
 
 OK_STATUSES = ("ok", "accepted", "combined", "fitted")
@@ -305,21 +314,22 @@ class Record:
             Column -> value.
         """
         flat = self.to_dict()
-        columns = columns or CSV_COLUMNS
-        if any(c in _CURVE_COLUMN_FREQUENCY for c in columns):
+        plan, curve = _csv_plan(tuple(columns or CSV_COLUMNS))
+        if curve:
             flat.update(curve_values(flat.get("frequencies_cy_px"), flat.get("mtf")))
         row = {}
-        for column in columns:
-            source = _CSV_SOURCES.get(column, column)
-            if isinstance(source, tuple):
-                pair = flat.get(source[0]) or (None, None)
-                value = pair[source[1]]
-            else:
-                value = flat.get(source)
-            if isinstance(value, (list, tuple, dict)):
-                value = json.dumps(json_safe(value), sort_keys=True, default=_json_default)
-            elif isinstance(value, float):
-                value = json_safe(value)
+        for column, key, index in plan:
+            value: Any = flat.get(key) if index is None else (flat.get(key) or (None, None))[index]
+            kind = type(value)          # the plain types first, by their exact type: 120 columns a row
+            if kind is float:
+                value = value + 0.0 if math.isfinite(value) else None       # as json_safe
+            elif kind is list or kind is tuple or kind is dict:
+                value = dumps_sorted(value)
+            elif not (value is None or kind is str or kind is int or kind is bool):
+                if isinstance(value, (list, tuple, dict)):
+                    value = dumps_sorted(value)
+                elif isinstance(value, float):
+                    value = json_safe(value)
             row[column] = "" if value is None else value
         return row
 
@@ -395,6 +405,18 @@ _CSV_SOURCES = {
 _CURVE_COLUMN_FREQUENCY = dict(zip(CURVE_COLUMNS, CURVE_FREQUENCIES_CY_PX))
 
 
+@functools.lru_cache(maxsize=16)
+def _csv_plan(columns: tuple[str, ...]) -> tuple[tuple[tuple[str, str, int | None], ...], bool]:
+    """Each CSV column's source in the flat record (its key, and the index
+    of an interval's bound), and whether the columns hold the curve's:
+    worked out once per schema rather than per row."""
+    plan = []
+    for column in columns:
+        source = _CSV_SOURCES.get(column, column)
+        plan.append((column, *source) if isinstance(source, tuple) else (column, source, None))
+    return tuple(plan), any(c in _CURVE_COLUMN_FREQUENCY for c in columns)
+
+
 def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
     """The MTF curve at :data:`CURVE_FREQUENCIES_CY_PX`, keyed by CSV
     column (linear between the curve's samples; None outside the curve or
@@ -408,36 +430,64 @@ def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
     return {c: round(float(v), 6) if math.isfinite(v) else None for c, v in zip(CURVE_COLUMNS, values)}
 
 
-def _json_default(value):
-    """NumPy scalars and arrays, which records may hold, as plain JSON."""
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
-
-
 def to_json(record: Record) -> str:
-    """One JSON Lines line (no newline); NaN and infinities as null."""
-    return json.dumps(json_safe(record.to_dict()), default=_json_default)
+    """One JSON Lines line (no newline); NaN and infinities as null, -0.0
+    as 0.0 (:func:`json_safe`)."""
+    return dumps_safe(record.to_dict())
 
 
-def json_safe(value):
-    """``value`` with NaN and infinities (at any depth) as None, and -0.0 as
-    0.0 (a normal at -0.00 deg is at 0), for JSON and CSV.
+class JsonRows:
+    """Records as JSON Lines (:func:`to_json`, the same text), the
+    frequency grid that every row of a run repeats (101 values, a third of
+    a dense chart's encoding) encoded once.
 
     Examples
     --------
-    >>> json_safe({"normal_angle_deg": -0.0, "mtf": [0.5, float("nan")], "misfit": np.bool_(False)})
-    {'normal_angle_deg': 0.0, 'mtf': [0.5, None], 'misfit': False}
+    >>> rows = JsonRows()
+    >>> r = Record("a.tif", 1, "edge", "msg", "ok", figures={"frequencies_cy_px": [0.0, 0.5], "mtf": [1.0, 0.3]})
+    >>> rows.line(r) == to_json(r) == rows.line(r)
+    True
     """
-    if isinstance(value, np.generic):           # a NumPy scalar (bool, integer) as the Python one JSON writes
-        value = value.item()
-    if isinstance(value, float):
-        return value + 0.0 if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_safe(v) for v in value]
-    return value
+
+    #: keys whose value, a list of floats, is the same in row after row
+    REPEATED = ("frequencies_cy_px",)
+
+    def __init__(self) -> None:
+        self._known: dict[str, tuple[list, str]] = {}
+
+    def line(self, record: Record) -> str:
+        """One JSON Lines line (no newline), as :func:`to_json` writes it."""
+        row = record.to_dict()
+        if not any(key in row for key in self.REPEATED):
+            return dumps_safe(row)
+        pieces, run = [], {}
+        for key, value in row.items():
+            known = self._text(key, value) if key in self.REPEATED else None
+            if known is None:
+                run[key] = value
+                continue
+            if run:
+                pieces.append(ENCODER.encode(run)[1:-1])
+                run = {}
+            pieces.append(known)
+        if run:
+            pieces.append(ENCODER.encode(run)[1:-1])
+        text = "{" + ", ".join(pieces) + "}"
+        # a NaN, infinity or -0.0 among the other values: the whole row the safe way
+        return dumps_safe(row) if has_unsafe_value(text) else text
+
+    def _text(self, key: str, value) -> str | None:
+        """``"key": value`` as JSON when ``value`` is a list of floats,
+        from the last such list under ``key`` when it is equal (floats
+        only: 1 == 1.0 == True, which JSON writes apart; -0.0 == 0.0, which
+        json_safe writes alike), else None."""
+        if type(value) is not list or not value or set(map(type, value)) != {float}:
+            return None
+        known = self._known.get(key)
+        if known is None or known[0] != value:
+            known = (list(value), f"{ENCODER.encode(key)}: {dumps_safe(value)}")
+            self._known[key] = known
+        return known[1]
 
 
 class CsvWriter:
@@ -464,12 +514,15 @@ class CsvWriter:
         except OSError as exc:
             self._output.__exit__(type(exc), exc, exc.__traceback__)
             raise FileWriteError(f"{self.path}: cannot write: {exc.strerror or exc}") from None
-        self._writer = csv.DictWriter(self._file, fieldnames=list(self.columns))
-        self._guarded(self._writer.writeheader)
+        # rows as lists in the columns' order (csv.DictWriter's check of each row's keys cost as much as
+        # the writing): what DictWriter writes
+        self._writer = csv.writer(self._file)
+        self._guarded(self._writer.writerow, self.columns)
         return self
 
     def write(self, record: Record) -> None:
-        self._guarded(self._writer.writerow, record.csv_row(self.columns))
+        row = record.csv_row(self.columns)
+        self._guarded(self._writer.writerow, [row[column] for column in self.columns])
         self.rows += 1
 
     def _guarded(self, action, *args) -> None:
@@ -490,9 +543,10 @@ class JsonLinesWriter:
 
     def __init__(self, stream: IO[str]):
         self.stream = stream
+        self._rows = JsonRows()
 
     def write(self, record: Record) -> None:
-        write_whole(self.stream, to_json(record) + "\n")
+        write_whole(self.stream, self._rows.line(record) + "\n")
 
 
 def write_whole(stream: IO[str], text: str) -> None:

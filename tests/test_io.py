@@ -138,3 +138,20 @@ def test_luminance_is_what_the_reader_computes_and_arrays_of_colour_are_pointed_
         im.measure_edge(np.moveaxis(rgba, 0, -1))
     with pytest.raises(im.ImageContentError, match="shape"):
         im.luminance(np.zeros((20, 20)))
+
+
+def test_many_files_opens_without_listing_the_folder_and_finds_the_same_side_cars(tmp_path, monkeypatch):
+    """Set for a batch: a world file beside a GeoTIFF without a georeference is still read."""
+    from imgmtf.io import many_files, raster_info
+    path = tmp_path / "plain.tif"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, "w", driver="GTiff", width=8, height=8, count=1, dtype="uint8") as dst:
+            dst.write(np.zeros((1, 8, 8), np.uint8))
+    (tmp_path / "plain.tfw").write_text("2.0\n0\n0\n-2.0\n100\n200\n")
+    with many_files():
+        assert rasterio.env.getenv()["GDAL_DISABLE_READDIR_ON_OPEN"] == "TRUE"
+        assert raster_info(path).gsd_m == 2.0
+    monkeypatch.setenv("GDAL_DISABLE_READDIR_ON_OPEN", "EMPTY_DIR")       # the user's own setting stays
+    with many_files():
+        assert raster_info(path).gsd_m is None

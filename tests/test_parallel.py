@@ -116,3 +116,16 @@ def test_a_signal_inside_a_deferred_block_is_handled_after_it():
             steps.append("after the signal")        # the block is not cut short
     assert steps == ["after the signal"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_the_fork_server_preloads_what_every_worker_set_up_imports(monkeypatch):
+    """Workers forked from the server start with the modules their set-up imports (threadpoolctl) loaded,
+    beside those asked for, rather than each importing them as it starts."""
+    from multiprocessing import forkserver
+
+    from imgmtf import parallel
+    preloaded = []
+    monkeypatch.setattr(forkserver, "set_forkserver_preload", preloaded.extend)
+    monkeypatch.setattr(forkserver, "ensure_running", lambda: None)
+    parallel._start_fork_server(("imgmtf.batch",))
+    assert preloaded == ["imgmtf.batch", *parallel.WORKER_MODULES] and "threadpoolctl" in preloaded

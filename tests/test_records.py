@@ -9,7 +9,7 @@ import pytest
 
 import imgmtf as im
 from imgmtf.errors import FileWriteError, ImageReadError
-from imgmtf.records import CSV_COLUMNS, SCAN_CSV_COLUMNS, CsvWriter, Record, to_json, utc_now
+from imgmtf.records import CSV_COLUMNS, SCAN_CSV_COLUMNS, CsvWriter, Record, curve_values, to_json, utc_now
 
 SUMMARY = {"target": "edge", "method": "msg", "angle_deg": 6.0, "snr": 120.0, "mtf_nyquist": 0.27,
            "mtf_nyquist_ci": [0.26, 0.28], "mtf50_cy_px": 0.36, "mtf50_ci_cy_px": [0.35, 0.37],
@@ -114,3 +114,67 @@ def test_json_and_csv_hold_no_negative_zero():
     row = record.csv_row()
     assert str(row["normal_angle_deg"]) == "0.0" and row["mtf_nyquist_ci_low"] == 0.0
     assert str(row["mtf_nyquist_ci_low"]) == "0.0" and row["mtf_nyquist"] == ""
+
+
+def test_json_lines_match_the_values_made_safe_first():
+    """The encoder writes a row at once and makes it safe only when it holds a NaN, an infinity or a -0.0
+    as a value: the same text as json_safe before json.dumps, whatever the row holds (NumPy scalars and
+    arrays, such tokens inside strings, a repeated frequency grid equal but for -0.0, or of ints)."""
+    import numpy as np
+
+    from imgmtf.records import JsonRows, _json_default, json_safe
+    grid = [0.0, 0.25, 0.5]
+    figures = [
+        {"frequencies_cy_px": grid, "mtf": [1.0, 0.5, 0.1], "note": "a NaN, -0.0] and -Infinity} in text"},
+        {"frequencies_cy_px": [-0.0, 0.25, 0.5], "mtf": [1.0, float("nan"), -0.0], "tilt_deg": np.float64(-0.0)},
+        {"frequencies_cy_px": [0, 0.25, 0.5], "mtf": np.array([1.0, -0.0]), "misfit": np.bool_(True)},
+        {"frequencies_cy_px": grid, "n": np.int64(3), "levels_dn": (np.float32(-np.inf), 2.5), "x": -0.01},
+        {"frequencies_cy_px": list(grid), "mtf": [1.0, 0.4, 0.05], "checks": [{"value": None, "limit": 0.3}]},
+    ]
+    rows = JsonRows()
+    for extra in figures:
+        record = Record("a.tif", 1, "edge", "msg", "ok", figures=extra, params={"order": 4})
+        safe = json.dumps(json_safe(record.to_dict()), default=_json_default)
+        assert to_json(record) == safe
+        assert rows.line(record) == safe
+
+
+def test_finite_values_are_the_floats_round_gives():
+    """A curve rounded at once: the very floats of round(v, 6) (signed zeros too), None where not finite,
+    near ties (where the product's own rounding could move the integer) and ties included."""
+    import numpy as np
+
+    from imgmtf.records import finite_values
+    rng = np.random.default_rng(5)
+    ties = (rng.integers(0, 10**7, 2000) + 0.5) / 1e6
+    values = np.concatenate([rng.uniform(-2, 2, 2000), 10.0 ** rng.uniform(-12, 12, 2000), ties,
+                             ties + rng.uniform(-1e-12, 1e-12, 2000), np.arange(4096) / 4096,
+                             [np.nan, np.inf, -np.inf, -0.0, 0.0, 1e300, -5e-7, 5e-7, 2.5e-6, -1e-9]])
+    got = finite_values(values)
+    want = [round(v, 6) if math.isfinite(v) else None for v in values.tolist()]
+    assert [(g, math.copysign(1, g)) if g is not None else None for g in got] == \
+           [(w, math.copysign(1, w)) if w is not None else None for w in want]
+
+
+def test_csv_cells_are_the_values_made_safe_first():
+    """A CSV row's cells as json_safe and json.dumps(sort_keys=True) make them, whatever the row holds."""
+    import numpy as np
+
+    from imgmtf.records import _json_default, json_safe
+    figures = {"mtf_nyquist": np.float64(-0.0), "mtf_nyquist_ci": (0.25, float("nan")), "snr": float("inf"),
+               "rows_used": np.int64(40), "sharpened": np.bool_(False), "warnings": ["NaN, -0.0]"],
+               "levels_dn": [2.0, -0.0], "feature": {"b": 1, "a": float("nan")}, "fwhm_px": -0.0,
+               "frequencies_cy_px": [0.0, 0.5, 1.0], "mtf": [1.0, 0.25, None]}
+    record = Record("a.tif", 1, "edge", "msg", "ok", figures=figures, params={"order": 4})
+    flat = record.to_dict()
+    flat.update(curve_values(flat["frequencies_cy_px"], flat["mtf"]))
+    for column, cell in record.csv_row(SCAN_CSV_COLUMNS).items():
+        source = {"mtf_nyquist_ci_low": ("mtf_nyquist_ci", 0), "mtf_nyquist_ci_high": ("mtf_nyquist_ci", 1),
+                  "mtf50_ci_low_cy_px": ("mtf50_ci_cy_px", 0), "mtf50_ci_high_cy_px": ("mtf50_ci_cy_px", 1),
+                  "roi_px": "roi"}.get(column, column)
+        value = (flat.get(source[0]) or (None, None))[source[1]] if isinstance(source, tuple) else flat.get(source)
+        if isinstance(value, (list, tuple, dict)):
+            value = json.dumps(json_safe(value), sort_keys=True, default=_json_default)
+        elif isinstance(value, float):
+            value = json_safe(value)
+        assert repr(cell) == repr("" if value is None else value), column       # -0.0 == 0.0, not alike in CSV

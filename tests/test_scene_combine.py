@@ -94,3 +94,4 @@ def test_the_summary_curve_weights_each_curve_as_its_nyquist_interval_earns():
     assert summary.figures["mtf"] == pytest.approx([1.0, (4 * 0.5 + 0.3) / 5, 0.2])   # a masked value leaves the other
     plain = [dataclasses.replace(r, figures={**r.figures, "mtf_nyquist_ci": [None, None]}) for r in weighted]
     assert summarise_scan(plain)[0].figures["mtf"][1] == pytest.approx(0.4)     # no intervals: equal weights
+

@@ -13,6 +13,7 @@ from .campaign import CampaignWriter, campaign_options
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .files import check_figure_file, check_output_file
 from .options import (
+    CLI_MODULES,
     FiniteFloat,
     MethodOption,
     interval_options,
@@ -34,7 +35,7 @@ from .tables import TextRows
 # file (batch imports the estimators only where it measures, so that a batch's
 # parent, which collects records, stays light)
 MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", "numpy.fft", "numpy.ma",
-                     "numpy.polynomial")
+                     "numpy.polynomial", *CLI_MODULES)
 
 
 

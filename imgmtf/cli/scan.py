@@ -11,6 +11,7 @@ from ..errors import ParameterError
 from ..kinds import get_kind, kind_names
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
+    CLI_MODULES,
     FiniteFloat,
     MethodName,
     auto_parallel_options,
@@ -31,7 +32,8 @@ DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it fo
 # of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
 # Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
 SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
-                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial")
+                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial",
+                    *CLI_MODULES)
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
 # with several scenes each worker runs whole scans, the segment graph's SciPy included: loaded once by
 # the fork server rather than by every worker as its first scene starts

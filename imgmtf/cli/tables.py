@@ -123,6 +123,12 @@ def text_row(record: dict, kind: str, path_width: int = 32, bands: bool = False,
     return "\n".join(cells)
 
 
+def echo_lines(lines: list[str]) -> None:
+    """Print ``lines`` with one echo (as an echo each would: none for no line)."""
+    if lines:
+        click.echo("\n".join(lines))
+
+
 def echo_wrapped(text: str, indent: str = "    ") -> None:
     """Print a table's heading or note wrapped to :data:`TABLE_WIDTH`
     columns, its later lines indented by ``indent``."""
@@ -263,8 +269,9 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
     if fmt == "json":
         import sys
 
-        from ..records import to_json, write_whole
-        write_whole(sys.stdout, "".join(to_json(r) + "\n" for r in (*records, *summaries)))
+        from ..records import JsonRows, write_whole
+        rows = JsonRows()
+        write_whole(sys.stdout, "".join(rows.line(r) + "\n" for r in (*records, *summaries)))
         return
     accepted = sum(r.ok for r in records)
     click.echo(f"{scene}: {info.width} x {info.height} px, {plural(len(records), f'candidate {kind}')}, "
@@ -275,6 +282,7 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
         click.echo(f"{'id':>4} {'rank':>4} {'tgt':>3} {'dir':>7} {'normal':>7} {'len':>5} {'SNR':>5} {'MTF@Nyq':>7} "
                    f"{'interval':>15} {'MTF50':>7}  ROI x,y,w,h / reason")
         click.echo(f"{'':>4} {'':>4} {'':>3} {'':>7} {'deg':>7} {'px':>5} {'':>5} {'':>7} {'':>15} {'cy/px':>7}")
+    lines = []          # one echo for the table (an echo a row cost more than the row: a dense chart has thousands)
     for record in shown:
         r = record.to_dict()
         head = (f"{r['id']:>4} {r.get('rank') or '':>4} {r.get('target_id') or '':>3} "
@@ -282,12 +290,13 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
                 f"{num_cell(r.get('normal_angle_deg'), 7, 2)} {r['length_px']:5.0f}")
         if record.ok:
             roi = ",".join(str(v) for v in r["roi"])
-            click.echo(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
-                       f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
+            lines.append(f"{head} {snr_cell(r.get('snr'))} {num_cell(r.get('mtf_nyquist'), 7, 4)} "
+                         f"{interval_cell(r.get('mtf_nyquist_ci')):>15} {num_cell(r.get('mtf50_cy_px'), 7, 4)}  {roi}")
             for warning in r.get("warnings") or []:
-                click.echo(warning_text(" " * (len(head) + 1), warning))
+                lines.append(warning_text(" " * (len(head) + 1), warning))
         else:       # the scene's name heads the table: the message need not repeat it
-            click.echo(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
+            lines.append(f"{head} {'rejected':>37}  {r['reason']}: {_rejection(r)}")
+    echo_lines(lines)
     if not verbose:
         print_rejections([r for r in records if not r.ok])
     combined = [r for r in summaries if r.figures.get("summary") not in ("fit", "sections")]
@@ -298,14 +307,17 @@ def print_scan(scene, info, kind, records, summaries, written, fmt, verbose: boo
                      "the half-edges disagree beyond their intervals):")
         click.echo(f"{'scope':>6} {'tgt':>3} {'dir':>7} {'normal':>7} {'edges':>5} {'MTF@Nyq':>7} "
                    f"{'interval':>15} {'MTF50':>7} {'interval':>15} {'FWHM':>6} {'consist.':>8}")
+        lines = []
         for summary in combined:
             r = summary.to_dict()
-            click.echo(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
-                       f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} "
-                       f"{num_cell(r['normal_angle_deg'], 7, 2)} "
-                       f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
-                       f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
-                       f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('consistency'), 8, 2)}")
+            lines.append(f"{r['scope']:>6} {r.get('target_id') or '':>3} "
+                         f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} "
+                         f"{num_cell(r['normal_angle_deg'], 7, 2)} "
+                         f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} "
+                         f"{interval_cell(r['mtf_nyquist_ci']):>15} "
+                         f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
+                         f"{num_cell(r.get('fwhm_px'), 6, 3)} {num_cell(r.get('consistency'), 8, 2)}")
+        echo_lines(lines)
     if sections:
         print_sections(sections)
     if fitted:
@@ -387,18 +399,20 @@ def print_sections(sections) -> None:
     click.echo(f" {'scope':>6} {'tgt':>3} {'dir':>7} {'assumption':>10} {'edges':>5} {'MTF@Nyq':>7} {'interval':>15} "
                f"{'MTF50':>7} {'interval':>15} {'FWHM':>6}")
     said: set[tuple] = set()
+    lines = []
     for summary in sections:
         r = summary.to_dict()
         key = (r["scope"], r.get("target_id"))
-        click.echo(f"{_mark(r)}{r['scope']:>6} {r.get('target_id') or '':>3} "
-                   f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} {r['assumption']:>10} "
-                   f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
-                   f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
-                   f"{num_cell(r.get('fwhm_px'), 6, 3)}")
+        lines.append(f"{_mark(r)}{r['scope']:>6} {r.get('target_id') or '':>3} "
+                     f"{SHORT_DIRECTIONS.get(r['direction'], r['direction']):>7} {r['assumption']:>10} "
+                     f"{r['n_edges']:>5} {num_cell(r['mtf_nyquist'], 7, 4)} {interval_cell(r['mtf_nyquist_ci']):>15} "
+                     f"{num_cell(r.get('mtf50_cy_px'), 7, 4)} {interval_cell(r.get('mtf50_ci_cy_px')):>15} "
+                     f"{num_cell(r.get('fwhm_px'), 6, 3)}")
         if key not in said and r["assumption"] == r.get("chosen_assumption") and r["direction"] in ("along-track",
                                                                                                      "vertical"):
             said.add(key)
-            click.echo(f"{'':>11} {r['chosen_assumption']}: {r.get('assumption_because')}")
+            lines.append(f"{'':>11} {r['chosen_assumption']}: {r.get('assumption_because')}")
+    echo_lines(lines)
 
 
 def axes_words(rows) -> str:

@@ -25,7 +25,7 @@ from .._stats import t_quantile
 from ..errors import ParameterError
 from ..estimate.geometry import direction_label
 from ..estimate.results import finite
-from ..records import SCENE_SCOPE, TARGET_SCOPE, Record
+from ..records import SCENE_SCOPE, TARGET_SCOPE, Record, finite_values
 
 FAMILY_SPREAD_DEG = 20.0        # normals of one direction family differ by at most this
 FAMILY_GAP_DEG = 10.0           # a gap this wide between sorted normals separates two families
@@ -218,8 +218,12 @@ def precision_weights(intervals: ArrayLike, rows: ArrayLike, confidence: float =
     4.0
     """
     bounds = np.asarray(intervals, float).reshape(-1, 2)
-    quantile = np.array([t_quantile(0.5 + confidence / 2, max(int(n) - 1, 1) if math.isfinite(n) else 1)
-                         for n in np.asarray(rows, float)])
+    counts = np.asarray(rows, float).tolist()
+    # each distinct count's quantile once: a scene's thousands of half-edges share a few hundred (a NaN
+    # count is found again as the same object)
+    quantiles = {n: t_quantile(0.5 + confidence / 2, max(int(n) - 1, 1) if math.isfinite(n) else 1)
+                 for n in set(counts)}
+    quantile = np.array([quantiles[n] for n in counts])
     sd = (bounds[:, 1] - bounds[:, 0]) / 2 / quantile
     if not (np.isfinite(sd).all() and (sd > 0).all()):
         return None
@@ -229,7 +233,8 @@ def precision_weights(intervals: ArrayLike, rows: ArrayLike, confidence: float =
 def _weighted_average(values, weights) -> np.ndarray:
     """Mean over the first axis of ``values`` (None or NaN where a half-edge
     has none) with ``weights`` (equal when None); NaN where none is finite."""
-    x = np.array([[math.nan if v is None else v for v in np.atleast_1d(row)] for row in values], float)
+    x = np.array(values, float)         # None as NaN, without a Python step per value (a curve has 101)
+    x = x.reshape(len(x), -1)
     w = np.ones(x.shape[0]) if weights is None else np.asarray(weights, float)
     w = np.where(np.isfinite(x), w[:, None], 0.0)
     total = w.sum(axis=0)
@@ -274,7 +279,7 @@ def _summary(group: list[Record], site: dict) -> Record:
     curves = [r.figures.get("mtf") or [] for r in group]
     if frequencies and all(len(c) == len(frequencies) for c in curves):
         curve = _weighted_average(curves, weights)
-        figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
+        figures.update(frequencies_cy_px=list(frequencies), mtf=finite_values(curve))
     where = dict(site)
     if site["scope"] == TARGET_SCOPE:
         ends = np.array([[r.site[k] for k in ("x0_px", "y0_px", "x1_px", "y1_px")] for r in group]).reshape(-1, 2)
