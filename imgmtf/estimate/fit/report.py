@@ -153,6 +153,20 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
     mtf50 : numpy.ndarray, shape (edges,)
         The model's MTF50 along each edge's normal, cy/px (NaN where it
         stays above 0.5 up to 2 cy/px).
+
+    Examples
+    --------
+    >>> import imgmtf as im
+    >>> from imgmtf.estimate.fit.bands import band_sensors
+    >>> from imgmtf.estimate.fit.data import edge_data
+    >>> from imgmtf.estimate.fit.model import Model, initial_stages
+    >>> edges = [im.measure_edge(im.render(im.Sensor(), im.Target("edge", a), 60).image) for a in (5.0, 84.0)]
+    >>> model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0),
+    ...               [edge_data(e, k, None) for k, e in enumerate(edges)])
+    >>> u = model.initial_vector()[: model.n_free]
+    >>> bands, mtf50 = edge_model_mtfs(model, u, np.eye(model.n_free) * 1e-4, band_sensors(model, u), 0.95)
+    >>> bands.shape, bool(np.all((bands[1] < bands[0]) & (bands[0] < bands[2]))), bool(np.all(mtf50 > 0.0))
+    ((3, 2), True, True)
     """
     sensor, steps = sensors
     # as Sensor.normal_transfer forms them, edge by edge: f / GSD times the angle's cosine and sine
