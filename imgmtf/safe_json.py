@@ -107,15 +107,7 @@ def json_safe(value):
     >>> json_safe({"normal_angle_deg": -0.0, "mtf": [0.5, float("nan")], "misfit": np.bool_(False)})
     {'normal_angle_deg': 0.0, 'mtf': [0.5, None], 'misfit': False}
     """
-    # the plain types by their exact type first (a row holds hundreds of values): a subclass (a NumPy
-    # float64, an OrderedDict) takes the general path below
-    kind = type(value)
-    if kind is float:
-        return value + 0.0 if math.isfinite(value) else None
-    if kind is dict:
-        return {k: json_safe(v) for k, v in value.items()}
-    if kind is list or kind is tuple:
-        return [json_safe(v) for v in value]
+    kind = type(value)      # the leaves that need nothing, by their exact type, before any isinstance
     if kind is str or kind is int or kind is bool or value is None:
         return value
     if isinstance(value, np.generic):           # a NumPy scalar (bool, integer) as the Python one JSON writes
