@@ -36,9 +36,8 @@ import numpy as np
 from .atomic import atomic_output
 from .errors import FileWriteError, ImgmtfError
 from .kinds import KINDS
-from .safe_json import (  # noqa: F401  (json_safe, dumps_safe, finite_values: imported from here too)
+from .safe_json import (  # json_safe and dumps_safe are imported from here too
     ENCODER,
-    _json_default,
     dumps_safe,
     dumps_sorted,
     finite_values,
@@ -427,7 +426,7 @@ def curve_values(frequencies_cy_px, mtf) -> dict[str, float | None]:
     m = np.array([np.nan if v is None else v for v in mtf], float)
     wanted = np.asarray(CURVE_FREQUENCIES_CY_PX)
     values = np.where((wanted >= f[0] - 1e-9) & (wanted <= f[-1] + 1e-9), np.interp(wanted, f, m), np.nan)
-    return {c: round(float(v), 6) if math.isfinite(v) else None for c, v in zip(CURVE_COLUMNS, values)}
+    return dict(zip(CURVE_COLUMNS, finite_values(values)))
 
 
 def to_json(record: Record) -> str:

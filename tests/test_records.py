@@ -122,7 +122,8 @@ def test_json_lines_match_the_values_made_safe_first():
     arrays, such tokens inside strings, a repeated frequency grid equal but for -0.0, or of ints)."""
     import numpy as np
 
-    from imgmtf.records import JsonRows, _json_default, json_safe
+    from imgmtf.records import JsonRows, json_safe
+    from imgmtf.safe_json import _json_default
     grid = [0.0, 0.25, 0.5]
     figures = [
         {"frequencies_cy_px": grid, "mtf": [1.0, 0.5, 0.1], "note": "a NaN, -0.0] and -Infinity} in text"},
@@ -160,7 +161,8 @@ def test_csv_cells_are_the_values_made_safe_first():
     """A CSV row's cells as json_safe and json.dumps(sort_keys=True) make them, whatever the row holds."""
     import numpy as np
 
-    from imgmtf.records import _json_default, json_safe
+    from imgmtf.records import json_safe
+    from imgmtf.safe_json import _json_default
     figures = {"mtf_nyquist": np.float64(-0.0), "mtf_nyquist_ci": (0.25, float("nan")), "snr": float("inf"),
                "rows_used": np.int64(40), "sharpened": np.bool_(False), "warnings": ["NaN, -0.0]"],
                "levels_dn": [2.0, -0.0], "feature": {"b": 1, "a": float("nan")}, "fwhm_px": -0.0,

@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..safe_json import finite_values
 from ..version import __version__
 from .geometry import TargetGeometry
 from .intervals import Interval
@@ -204,7 +205,7 @@ class MTFResult:
         }
         if curves:
             out["frequencies_cy_px"] = [float(f) for f in self.frequencies_cy_px]
-            out["mtf"] = [finite(m) for m in self.mtf]
+            out["mtf"] = finite_values(self.mtf)
         return out
 
 

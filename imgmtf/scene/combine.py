@@ -25,7 +25,8 @@ from .._stats import t_quantile
 from ..errors import ParameterError
 from ..estimate.geometry import direction_label
 from ..estimate.results import finite
-from ..records import SCENE_SCOPE, TARGET_SCOPE, Record, finite_values
+from ..records import SCENE_SCOPE, TARGET_SCOPE, Record
+from ..safe_json import finite_values
 
 FAMILY_SPREAD_DEG = 20.0        # normals of one direction family differ by at most this
 FAMILY_GAP_DEG = 10.0           # a gap this wide between sorted normals separates two families

@@ -39,6 +39,7 @@ from ..inputs import MIN_SIZE_PX, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
 from ..kinds import get_kind
 from ..records import CANDIDATE_SCOPE, SCENE_SCOPE, Record, utc_now
+from ..safe_json import finite_values
 from .combine import combine, precision_weights
 from .settings import ScanSettings
 
@@ -417,7 +418,7 @@ def _scene_row(group: list[Record]) -> Record:
     curves = [r.figures.get("mtf") or [] for r in group]
     if frequencies and all(len(c) == len(frequencies) for c in curves):
         figures.update(frequencies_cy_px=list(frequencies),
-                       mtf=[finite(float(v)) for v in _average(curves, weights)])
+                       mtf=finite_values(_average(curves, weights)))
     return Record(first.path, first.band, first.target, first.method, "combined", figures=figures,
                   site={"scope": SCENE_SCOPE},
                   params={"intervals": first.params.get("intervals"),

@@ -30,6 +30,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..estimate.results import finite
 from ..records import TARGET_SCOPE, Record
+from ..safe_json import finite_values
 
 ACROSS, ALONG = "across-track", "along-track"
 SECTIONS = "sections"
@@ -204,7 +205,7 @@ def _row(records: list[Record], result, assumption: str, axis: int, track: float
         "rows_used": int(sum(r.figures.get("rows_used") or 0 for r in records)),
         "snr_min": finite(min(snrs, default=math.nan)), "gsd_m": gsd,
         "frequencies_cy_px": [float(f) for f in section.frequencies_cy_px],
-        "mtf": [finite(v) for v in section.mtf],
+        "mtf": finite_values(section.mtf),
         "warnings": [f"across/along from {len(records)} orientations: {result.because}"]
                     if assumption == result.assumption else [],
     }

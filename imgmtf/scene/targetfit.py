@@ -37,6 +37,7 @@ from ..errors import ImgmtfError, ParameterError
 from ..estimate.results import finite
 from ..kinds import get_kind
 from ..records import CANDIDATE_SCOPE, SCENE_SCOPE, TARGET_SCOPE, Record
+from ..safe_json import finite_values
 
 #: the stages fitted to a target's half-edges by default: the simplest
 #: candidate that fits (:mod:`imgmtf.estimate.fit.choice`): blur and pixel
@@ -275,7 +276,7 @@ def _direction_row(fit, direction: str, records: list[Record], site: dict, stage
     if frequencies:
         # the model's curve alone (its band, not reported, would cost a transfer per parameter)
         curve = np.abs(sensor.normal_transfer(np.asarray(frequencies, float), angle, gsd))
-        figures.update(frequencies_cy_px=list(frequencies), mtf=[finite(float(v)) for v in curve])
+        figures.update(frequencies_cy_px=list(frequencies), mtf=finite_values(curve))
     return Record(first.path, first.band, first.target, first.method, "fitted", figures=figures, site=site,
                   params=_params(first, stages), run_utc=first.run_utc)
 

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError, TargetNotFoundError, UnsuitableTargetError
+from ...safe_json import finite_values
 from ...version import __version__
 from ..intervals import Intervals, as_intervals
 from ..results import finite
@@ -190,7 +191,7 @@ class PointsResult(SourceTally):
             }
             if curves:
                 row["frequencies_cy_px"] = [round(float(f), 4) for f in section.frequencies_cy_px]
-                row["mtf"] = [finite(v) for v in section.mtf]
+                row["mtf"] = finite_values(section.mtf)
             out.append(row)
         return out
 

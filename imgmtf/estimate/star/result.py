@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ParameterError
+from ...safe_json import finite_values
 from ...version import __version__
 from ..intervals import Interval
 from ..results import finite
@@ -194,7 +195,7 @@ class StarResult:
             }
             if curves:
                 row["frequencies_cy_px"] = [round(float(f), 4) for f in d.frequencies_cy_px]
-                row["mtf"] = [finite(v) for v in d.mtf]
+                row["mtf"] = finite_values(d.mtf)
             out.append(row)
         return out
 
