@@ -168,8 +168,8 @@ def local_polynomial(distance, values, step: float, half_range: float, *,
         return result
 
     leverage = np.zeros(distance.size)
-    leverage[keep] = np.einsum("ij,ij->i", coef[bins], u0) if weights is None else np.einsum(
-        "ij,ij->i", coef[bins], u0) * w
+    own = np.einsum("ij,ij->i", coef[bins], u0)
+    leverage[keep] = own if weights is None else own * w
     return Resampled(out, level[trim: trim + out.size], transfer, params, adjoint, leverage)
 
 

@@ -157,7 +157,6 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
     weights = 1.0 / np.maximum(error2, 1e-300)
     normal_b = (basis * weights[:, None]).T @ basis
-    # (the same arithmetic as ever: on a flat side the curve is rounding, and where it peaks is said)
     cov = np.linalg.pinv(normal_b)
     smooth_coef = cov @ (basis * weights[:, None]).T @ means
     curve = basis @ smooth_coef
