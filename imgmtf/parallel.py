@@ -151,8 +151,7 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     [2, 1, 3]
     """
     items = list(items)
-    if not (isinstance(workers, int) and 1 <= workers <= MAX_WORKERS):
-        raise ParameterError(f"workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}")
+    check_workers(workers)
     if progress is None:
         progress = len(items) > 1 and _stderr_is_terminal()
     completed = _completed(function, items, workers, scheduler, on_error)
@@ -167,6 +166,27 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
             yield from completed
     finally:
         completed.close()       # on an interrupt or an early stop: workers stopped now
+
+
+def check_workers(workers) -> None:
+    """Refuse a count of workers that is not an integer from 1 to
+    :data:`MAX_WORKERS`.
+
+    Raises
+    ------
+    ParameterError
+        ``workers`` is out of range or not an integer.
+
+    Examples
+    --------
+    >>> check_workers(2)
+    >>> check_workers(0)
+    Traceback (most recent call last):
+    ...
+    imgmtf.errors.ParameterError: workers must be an integer from 1 to 64, got 0
+    """
+    if not (isinstance(workers, int) and 1 <= workers <= MAX_WORKERS):
+        raise ParameterError(f"workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}")
 
 
 def available_cores() -> int:

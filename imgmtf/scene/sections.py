@@ -126,9 +126,9 @@ def sections_workers(targets: int, workers: int | None) -> int:
     >>> sections_workers(484, 2), sections_workers(5, 2), sections_workers(40, 1)
     (2, 1, 1)
     """
-    from ..parallel import MAX_WORKERS, auto_workers
-    if workers is not None and not (isinstance(workers, int) and 1 <= workers <= MAX_WORKERS):
-        raise ParameterError(f"workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}")
+    from ..parallel import auto_workers, check_workers
+    if workers is not None:
+        check_workers(workers)
     return auto_workers(targets, AUTO_TARGETS_PER_WORKER, cores=workers)
 
 
