@@ -115,7 +115,7 @@ def test_penalised_spline_refuses_knots_too_close_and_the_resampler_merges_them(
 @pytest.mark.parametrize("adjoint", [False, True])
 def test_shifted_powers_are_every_moment_correlated_with_every_power(half_bins, adjoint):
     from imgmtf.estimate._correlation import correlate1d
-    from imgmtf.estimate.resampling import _binomial_shifts, _shifted_powers, _shifted_powers_by_power
+    from imgmtf.estimate._window_sums import _binomial_shifts, _shifted_powers, _shifted_powers_by_power
     rng = np.random.default_rng(half_bins)
     moments = rng.normal(size=(4, 9, 200)) * 10.0 ** rng.integers(-2, 4, size=(9, 1))
     offsets = np.arange(-half_bins, half_bins + 1) / (half_bins + 0.5)
