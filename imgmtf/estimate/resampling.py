@@ -21,42 +21,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ImageContentError, ParameterError
-from . import weight_stacks
-from ._correlation import correlate1d
-from ._window_sums import _binomial_shifts, _local_polynomial_transfer, _shifted_powers
+from .local_polynomial import local_polynomial
+from .resampled import Resampled, _bin_sums, _bins, _grid, _weights, sample_gap
 
-
-@dataclass(frozen=True, eq=False)
-class Resampled:
-    """A profile on a uniform grid.
-
-    ``grid`` (px) and ``values`` (DN) have equal length; ``transfer(f)`` is
-    the method's transfer function at ``f`` cycles/pixel; ``params`` the
-    settings actually used (recorded as provenance).  The resampling is
-    linear in the sample values, ``values = S v``: ``adjoint(h)`` returns
-    ``S^T h`` for grid weights ``h`` (..., grid size), one weight per input
-    sample, and ``leverage`` each sample's weight in the fit at its own
-    position (about S[i, i]).  Both are for the linearised intervals
-    (:mod:`imgmtf.estimate.intervals`); they are None for stacked weights.
-    """
-
-    grid: np.ndarray
-    values: np.ndarray
-    transfer: Callable[[np.ndarray], np.ndarray]
-    params: dict = field(default_factory=dict)
-    adjoint: Callable[[np.ndarray], np.ndarray] | None = None
-    leverage: np.ndarray | None = None
-
-    @property
-    def step(self) -> float:
-        return float(self.grid[1] - self.grid[0])
+__all__ = ["METHODS", "Resampled", "ResamplingMethod", "binned", "check_method", "local_polynomial",
+           "penalised_spline", "resample_profile", "sample_gap", "smoothing_spline"]
 
 
 @dataclass(frozen=True)
@@ -65,155 +41,6 @@ class ResamplingMethod:
     function: Callable[..., Resampled]
     defaults: dict
     description: str
-
-
-def local_polynomial(distance, values, step: float, half_range: float, *,
-                     order: int = 4, window_px: float = 1.0, weights=None) -> Resampled:
-    """Least-squares polynomial of ``order`` fitted to the samples within
-    ``window_px`` (centred) of each grid point, evaluated there.
-
-    Samples are binned on the output grid and the window is a whole number
-    of bins, so every window's moment sums are convolutions of per-bin
-    moments (binomial expansion about the grid point): the cost is linear in
-    the number of samples, with no loop over grid points.  ``weights`` (see
-    :func:`resample_profile`) enter the moment sums linearly, so a stack of
-    weight vectors is fitted in one pass.
-    """
-    if order < 0 or order > 8:
-        raise ParameterError(f"local polynomial order must be 0..8, got {order}")
-    # at angles whose sample positions repeat (tan a = 1/q), a window must
-    # still hold order + 2 distinct positions for a well-posed fit
-    window_px = max(window_px, (order + 1.5) * sample_gap(distance))
-    half_bins = max(int(round((window_px / step - 1) / 2)), 1)
-    # bins reach half a window beyond the output grid so that its end
-    # points see full windows
-    out = _grid(step, half_range)
-    grid = _grid(step, half_range + half_bins * step)
-    bins, keep = _bins(distance, grid, step)
-    d, v = distance[keep], values[keep]
-    w = _weights(weights, distance.size)[..., keep]
-    scale = (half_bins + 0.5) * step      # local coordinates in [-1, 1]
-    u = (d - grid[bins]) / scale
-    nk = 2 * order + 1
-    offsets = np.arange(-half_bins, half_bins + 1) * step / scale
-
-    def window_sums(moments):
-        """Sum over each grid point's window of (u + offset)^k for every k,
-        from the per-bin sums of u^j: sum_j C(k, j) (offset^(k-j) * S_j),
-        one correlation per power of the offset for all moments at once,
-        combined by one product with the binomials."""
-        return _shifted_powers(moments, offsets, _binomial_shifts(moments.shape[-2], False))
-    # a stack of weightings (the bootstrap) sums its windows per group of equally weighted samples
-    stacked = weight_stacks.window_sums(d, v, w, bins, grid, scale, half_bins, order) if w.ndim > 1 else None
-    if stacked is not None:
-        m, rhs = stacked
-    else:
-        powers = np.vander(u, nk, increasing=True).T
-        features = np.concatenate([powers, powers[: order + 1] * v])
-        sums = _bin_sums(bins, grid.size, features if weights is None else w[..., None, :] * features)
-        s, t = sums[..., :nk, :], sums[..., nk:, :]
-        m = window_sums(s)
-        rhs = np.moveaxis(window_sums(t), -1, -2)
-    idx = np.arange(order + 1)
-    # a window needs enough samples, spread over it (uniform spread gives
-    # a variance of 1/3 in window coordinates), for a well-posed fit
-    count = np.where(m[..., 0, :] > 0, m[..., 0, :], 1.0)
-    spread = m[..., 2, :] / count - (m[..., 1, :] / count) ** 2
-    # ... and order + 1 distinct sample positions (occupied bins), without
-    # which its normal matrix is singular (sample lattices, partial windows)
-    if weights is None:     # unit weights: a bin is occupied where it counts a sample
-        occupied = s[..., 0, :] > 0
-    else:
-        occupied = _bin_sums(bins, grid.size, (w > 0)[..., None, :].astype(float))[..., 0, :] > 0
-    distinct = correlate1d(occupied.astype(float), np.ones(2 * half_bins + 1))
-    trim = (grid.size - out.size) // 2
-    inner = np.zeros(grid.size, bool)
-    inner[trim: trim + out.size] = True
-    valid = ((m[..., 0, :] >= 2 * (order + 1) * _unit_weight(w)) & (spread > 0.05)
-             & (distinct >= order + 1) & inner)
-    width = (2 * half_bins + 1) * step
-    params = {"order": order, "window_px": width, "step_px": step}
-    transfer = _local_polynomial_transfer(order, width)
-    if w.ndim > 1:      # a stack of weightings (the bootstrap): solve each window directly
-        level = np.full(valid.shape, np.nan)
-        if valid.any():
-            level[valid] = weight_stacks.first_levels(m, rhs, valid)
-        return Resampled(out, level[..., trim: trim + out.size], transfer, params)
-    # one weighting: each window's equivalent-kernel coefficients M^-1 e0,
-    # which give the fitted level and, transposed, every sample's weight
-    coef = np.zeros((grid.size, order + 1))
-    normal = np.moveaxis(m[..., idx[:, None] + idx[None, :], :], -1, -3)
-    if valid.any():
-        coef[valid] = np.linalg.solve(normal[valid], np.eye(order + 1)[0][None, :, None]
-                                      .repeat(valid.sum(), axis=0))[..., 0]
-    level = np.where(valid, np.einsum("kj,kj->k", coef, rhs), np.nan)
-    u0 = np.vander(u, order + 1, increasing=True)                 # (n_kept, order + 1)
-
-    def adjoint(h):
-        """Sample weights S^T h of grid weights ``h`` (..., n_out): what
-        each sample contributes to sum_k h_k level_k, per unit value."""
-        h = np.asarray(h, float)
-        full = np.zeros((*h.shape[:-1], grid.size))
-        full[..., trim: trim + out.size] = np.where(valid[trim: trim + out.size], h, 0.0)
-        a = full[..., None, :] * coef.T                          # (..., order + 1, n_grid)
-        # sum over the windows holding a sample's bin of a_k^(j) (u0 + offset)^j,
-        # expanded binomially: G_m = sum_j C(j, m) (a^(j) convolved with offset^(j-m))
-        # power p of the offset only meets the coefficients j >= p
-        g = _shifted_powers(a, -offsets, _binomial_shifts(order + 1, True))   # (..., order + 1, n_grid)
-        kept = np.einsum("...mi,im->...i", g[..., bins], u0)
-        if weights is not None:
-            kept = kept * w
-        result = np.zeros((*h.shape[:-1], distance.size))
-        result[..., keep] = kept
-        return result
-
-    leverage = np.zeros(distance.size)
-    own = np.einsum("ij,ij->i", coef[bins], u0)
-    leverage[keep] = own if weights is None else own * w
-    return Resampled(out, level[trim: trim + out.size], transfer, params, adjoint, leverage)
-
-
-def _bins(distance, grid, step):
-    """Nearest grid index of every sample, and which samples fall on the grid."""
-    bins = np.rint((distance - grid[0]) / step).astype(int)
-    keep = (bins >= 0) & (bins < grid.size)
-    return bins[keep], keep
-
-
-def _weights(weights, n: int) -> np.ndarray:
-    """Sample weights as an array of shape (n,) or (replicates, n)."""
-    if weights is None:
-        return np.ones(n)
-    w = np.asarray(weights, float)
-    if w.shape[-1] != n or w.ndim > 2:
-        raise ParameterError(f"weights must have shape ({n},) or (replicates, {n}), got {w.shape}")
-    return w
-
-
-def _unit_weight(w: np.ndarray):
-    """The weight one sample counts with: 1 for counts, the mean otherwise,
-    so that minimum-count rules mean samples whatever the weights' scale."""
-    mean = w.mean(axis=-1, keepdims=True) if w.size else np.ones(1)
-    return np.where(mean > 0, mean, 1.0)
-
-
-def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray:
-    """Per-bin sums of ``features`` (..., F, n_samples) -> (..., F, n_bins)."""
-    lead = features.shape[:-1]
-    flat = features.reshape(-1, features.shape[-1])
-    if flat.shape[0] <= 16:
-        # one count over every feature's bins side by side: each bin gathers
-        # its samples in their order, as a count of its feature alone does
-        where = (bins[None, :] + n_bins * np.arange(flat.shape[0])[:, None]).ravel()
-        sums = np.bincount(where, weights=flat.ravel(), minlength=flat.shape[0] * n_bins).reshape(-1, n_bins)
-    else:
-        from scipy import sparse  # only for stacks of weights (the bootstrap)
-        # one 1 per sample, in its bin's column: built as the compressed rows it is (a row pointer
-        # of 0, 1, 2...), not converted from coordinates, which sorts and sums what has no duplicates
-        onehot = sparse.csr_array((np.ones(bins.size), bins, np.arange(bins.size + 1)),
-                                  shape=(bins.size, n_bins))
-        sums = (onehot.T @ flat.T).T
-    return sums.reshape(*lead, n_bins)
 
 
 def smoothing_spline(distance, values, step: float, half_range: float, *,
@@ -374,19 +201,6 @@ def _local_density(distance: np.ndarray, weights: np.ndarray) -> np.ndarray:
     return np.maximum(counts[edges], 1e-12)
 
 
-def sample_gap(distance: np.ndarray, near_px: float = 2.0) -> float:
-    """Largest gap (px) between consecutive sample distances within
-    ``near_px`` of the edge: the coarsest sampling of the profile where it
-    matters.  A slope tan a = 1/q puts the samples on a lattice 1/q apart."""
-    near = np.sort(distance[np.abs(distance) < near_px])
-    if near.size < 2:
-        return 2.0 * near_px
-    return float(np.diff(np.concatenate([[-near_px], near, [near_px]])).max())
-
-
-def _grid(step: float, half_range: float) -> np.ndarray:
-    n = int(math.floor(half_range / step))
-    return np.arange(-n, n + 1) * step
 
 
 METHODS: dict[str, ResamplingMethod] = {
