@@ -132,3 +132,29 @@ def _equivalent_kernel_transfer(order: int, scaled: np.ndarray) -> np.ndarray:
     # the kernel is even and the nodes symmetric: twice the half at u > 0
     half = u > 0
     return np.cos(2 * np.pi * scaled[:, None] * u[None, half]) @ (2 * kernel[half])
+
+
+def window_sums_each(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndarray) -> np.ndarray:
+    """:func:`_shifted_powers` of 2-D ``moments`` (n, grid) with every grid
+    point's sums its own, whatever the columns beside it (many profiles'
+    grids side by side give each the sums it has alone): one correlation
+    per power of the offsets, row by row (fewer than ``ROW_BY_ROW_TAPS``
+    taps), and the binomials' non-zero terms added one by one, where a
+    matrix product rounds by the blocks its library cuts."""
+    n = moments.shape[-2]
+    if offsets.size >= ROW_BY_ROW_TAPS:
+        raise ValueError(f"{offsets.size} taps: the correlations round by blocks of rows")   # pragma: no cover
+    terms = [np.flatnonzero(row) for row in binomials]
+    powers = sorted({int(c) // n for row in terms for c in row})
+    correlated = {}
+    for p in powers:
+        rows = sorted({int(c) % n for row in terms for c in row if int(c) // n == p})
+        lo, hi = rows[0], rows[-1] + 1
+        correlated[p] = (lo, correlate1d(moments[lo:hi], offsets ** p))
+    out = np.zeros_like(moments)
+    for k, row in enumerate(terms):
+        for c in row:
+            p, j = divmod(int(c), n)
+            lo, values = correlated[p]
+            out[k] += binomials[k, c] * values[j - lo]
+    return out

@@ -281,11 +281,29 @@ def resample_profile(distance: np.ndarray, values: np.ndarray, *, method: str = 
     >>> round(float(np.interp(0.0, r.grid, r.values)), 3), round(r.step, 3)
     (0.5, 0.05)
     """
+    spec, chosen = method_options(method, step, options)
+    return spec.function(np.asarray(distance, float), np.asarray(values, float), step,
+                         half_range, weights=weights, **chosen)
+
+
+def method_options(method: str, step: float, options: dict[str, Any]) -> tuple[ResamplingMethod, dict[str, Any]]:
+    """The registered method of that name and its options (its defaults
+    overridden by ``options``), checked as :func:`resample_profile` checks them.
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or option, or a step that is not positive.
+
+    Examples
+    --------
+    >>> method_options("msg", 0.05, {"window_px": 2.0})[1]
+    {'order': 4, 'window_px': 2.0}
+    """
     spec = check_method(method)
     if not step > 0:
         raise ParameterError(f"resampling step must be > 0 px, got {step}")
     unknown = set(options) - set(spec.defaults)
     if unknown:
         raise ParameterError(f"method {method!r} takes no option(s) {', '.join(sorted(unknown))}")
-    return spec.function(np.asarray(distance, float), np.asarray(values, float), step,
-                         half_range, weights=weights, **{**spec.defaults, **options})
+    return spec, {**spec.defaults, **options}

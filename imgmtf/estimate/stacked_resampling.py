@@ -1,13 +1,16 @@
 """Many chips' profiles resampled at once (the ``resample`` ask of
 :mod:`.asks`): each answer the same as :func:`.resampling.resample_profile`
-gives that chip's samples alone."""
+gives that chip's samples alone.  The local polynomial's fits (``msg``,
+``sliding``) are made together (:func:`.local_polynomial.local_polynomial_many`);
+the other methods' one by one."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .resampling import Resampled, resample_profile
+from .local_polynomial import LocalFit, local_polynomial, local_polynomial_many
+from .resampling import Resampled, method_options
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,11 +62,18 @@ def resample_many(requests: list[ResampleRequest]) -> list[Resampled | Exception
     >>> [r.grid.size for r in resample_many([ResampleRequest(d, d, 1.0), ResampleRequest(d, d, 2.0)])]
     [41, 81]
     """
-    out: list[Resampled | Exception] = []
-    for r in requests:
+    out: list[Resampled | Exception | None] = [None] * len(requests)
+    local: list[tuple[int, LocalFit]] = []
+    for k, r in enumerate(requests):
         try:
-            out.append(resample_profile(r.distance, r.values, method=r.method, step=r.step,
-                                        half_range=r.half_range, **r.options))
+            spec, options = method_options(r.method, r.step, r.options)
+            distance, values = np.asarray(r.distance, float), np.asarray(r.values, float)
+            if spec.function is local_polynomial:
+                local.append((k, LocalFit(distance, values, r.step, r.half_range, **options)))
+            else:
+                out[k] = spec.function(distance, values, r.step, r.half_range, **options)
         except Exception as exc:        # its own resampling raises it: returned in its place
-            out.append(exc)
-    return out
+            out[k] = exc
+    for (k, _), fitted in zip(local, local_polynomial_many([fit for _, fit in local])):
+        out[k] = fitted
+    return out      # type: ignore[return-value]   # every place filled
