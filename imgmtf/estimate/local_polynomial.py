@@ -14,6 +14,8 @@ from ._correlation import ROW_BY_ROW_TAPS, correlate1d
 from ._window_sums import _binomial_shifts, _local_polynomial_transfer, _shifted_powers, window_sums_each
 from .resampled import Resampled, _bin_sums, _bins, _grid, _unit_weight, _weights, sample_gap
 
+SIDE_BY_SIDE = 32      # profiles fitted side by side at once: their arrays (9 x 32 x ~440 bins) stay in cache
+
 
 class LocalFit(NamedTuple):
     """One profile's local polynomial fit (:func:`local_polynomial`'s
@@ -126,19 +128,25 @@ def local_polynomial_many(fits: list[LocalFit]) -> list[Resampled | Exception]:
         # wide windows' correlations round by blocks of rows: such a profile is fitted alone
         alike = 2 * win.half_bins + 1 < ROW_BY_ROW_TAPS
         groups.setdefault((fit.order, fit.step, win.half_bins) if alike else (k,), []).append((k, win))
-    for members in groups.values():
-        first = fits[members[0][0]]
-        try:
-            fitted: list = _fit_side_by_side([(win, fits[k].weights is not None) for k, win in members],
-                                             first.order, first.step)
-        except Exception as exc:
-            if len(members) > 1:    # which of them: each alone
-                fitted = [local_polynomial_many([fits[k]])[0] for k, _ in members]
-            else:
-                fitted = [exc]
-        for (k, _), result in zip(members, fitted):
-            out[k] = result
+    for group in groups.values():
+        for start in range(0, len(group), SIDE_BY_SIDE):
+            _fit_members(fits, group[start: start + SIDE_BY_SIDE], out)
     return out
+
+
+def _fit_members(fits: list[LocalFit], members: list[tuple[int, _Windows]], out: list) -> None:
+    """``out[k]`` for the ``members`` (fit k and its binned samples) fitted side by side."""
+    first = fits[members[0][0]]
+    try:
+        fitted: list = _fit_side_by_side([(win, fits[k].weights is not None) for k, win in members],
+                                         first.order, first.step)
+    except Exception as exc:
+        if len(members) > 1:    # which of them: each alone
+            fitted = [local_polynomial_many([fits[k]])[0] for k, _ in members]
+        else:
+            fitted = [exc]
+    for (k, _), result in zip(members, fitted):
+        out[k] = result
 
 
 def _check_order(order: int) -> None:
