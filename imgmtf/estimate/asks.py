@@ -11,7 +11,15 @@ same for one chip (batches of one): one code path for one chip and many.
 
 An answer that is an exception is raised in its chip's generator where it
 asked (its own run would have raised it there); a chip whose generator
-raised gets its exception in its place.
+raised gets its exception in its place.  An answering function must give
+each chip's answer as its own (the same to the bit whatever else is in the
+list), so that one chip's result never depends on its company.
+
+A new batchable stage: its function over a list of payloads in the module
+of its arithmetic (which does not import this one: arrows point down), one
+entry in :data:`ANSWERS`, and ``answer = yield Ask(name, payload)`` in the
+stage's generator (:mod:`.pipeline`, :mod:`.profile`: ``yield from`` down
+to it).
 
 Asks
 ----
