@@ -220,3 +220,12 @@ def test_a_scan_detecting_on_workers_has_their_fork_server_load_its_tasks_module
     assert scan_scene(str(path), settings, workers=None) == []
     assert started == [(2, measure.WORKER_MODULES)]
     assert all(importlib.util.find_spec(name) is not None for name in measure.WORKER_MODULES)
+
+
+def test_the_scan_module_loads_without_scipy_so_the_workers_fork_server_starts_first():
+    # the segment graph's SciPy is imported by scan_scene once the workers' fork server has started,
+    # so that the two imports overlap rather than follow each other
+    import subprocess
+    import sys
+    code = "import sys, imgmtf.scene.measure; print(sorted(m for m in sys.modules if m.split('.')[0] == 'scipy'))"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout == "[]\n"

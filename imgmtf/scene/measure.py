@@ -21,10 +21,9 @@ import math
 import os
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from ..atomic import ensure_folder
 from ..errors import ImageContentError, ParameterError
@@ -41,18 +40,10 @@ from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
-from .segments import (
-    BAR_MAX_SEPARATION_PX,
-    HalfEdge,
-    SampledSegments,
-    Segment,
-    find_junctions,
-    pair_bars,
-    parallel_clearance,
-    segment_rows,
-    split_at_junctions,
-)
 from .settings import ScanSettings
+
+if TYPE_CHECKING:
+    from .segments import HalfEdge, Segment
 
 # with workers chosen automatically, a local pool measures the candidates when each worker has at least
 # this many (about 2-3 s of work against a pool's start of 0.2-0.5 s); fewer are measured here
@@ -156,7 +147,16 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
                  else workers)
     if scheduler is None and detecting > 1:
-        prestart_workers(detecting, WORKER_MODULES)     # (their imports overlap the overview's read)
+        prestart_workers(detecting, WORKER_MODULES)
+    # the segment graph's SciPy (0.3-0.5 s to import) loads while the workers' fork server loads theirs
+    from .segments import (
+        BAR_MAX_SEPARATION_PX,
+        SampledSegments,
+        find_junctions,
+        parallel_clearance,
+        segment_rows,
+        split_at_junctions,
+    )
     segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
     sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
@@ -249,6 +249,7 @@ def _candidates(halves: list[HalfEdge], settings: ScanSettings) -> list[tuple[Ha
     """The half-edges as candidates of the scan's target: for edges, lone
     half-edges and bars alike (the gate tells an edge from a bar); for
     pulses, bars, and lone half-edges rejected as ``not-a-bar``."""
+    from .segments import HalfEdge, pair_bars
     long_enough = [h for h in halves if h.line_length_px >= settings.min_length_px / 2]
     lone, bars = pair_bars([h.segment for h in long_enough])
     out: list[tuple[HalfEdge, tuple[str, str] | None]] = []
@@ -325,6 +326,7 @@ def _rounded_ends(segments: list[Segment]) -> list[list[float]]:
     pass; a bar's centre line's as Python's ``round`` does (the nearest of
     the exact value), as the records always had them (the two differ where
     a value lies within rounding of a half-step)."""
+    from .segments import segment_rows
     by_numpy = np.round(segment_rows(segments), 2).tolist()
     return [[round(v, 2) for v in (s.x0, s.y0, s.x1, s.y1)] if s.width_px > 0 else by_numpy[k]
             for k, s in enumerate(segments)]
@@ -336,6 +338,7 @@ def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:
     the identity (pixel coordinates are all it has)."""
     if info.transform.is_identity or not segments:
         return None
+    from .segments import segment_rows
     ends = segment_rows(segments) + 0.5
     x0, y0 = info.transform @ (ends[:, 0], ends[:, 1])
     x1, y1 = info.transform @ (ends[:, 2], ends[:, 3])
@@ -359,6 +362,8 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     were accepted) joined through the junctions they share; each target
     with an accepted half-edge gets a ``target_id`` (1, 2... in the order
     of its best rank is assigned after ranking, see :func:`_ranked`)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
     reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
     owners: dict[int, list[int]] = {}
     for i in reached:
