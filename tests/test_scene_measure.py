@@ -229,3 +229,22 @@ def test_the_scan_module_loads_without_scipy_so_the_workers_fork_server_starts_f
     import sys
     code = "import sys, imgmtf.scene.measure; print(sorted(m for m in sys.modules if m.split('.')[0] == 'scipy'))"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout == "[]\n"
+
+
+def test_a_scan_interrupted_before_any_outcome_keeps_every_candidate_unmeasured_ones_interrupted(
+        quadrant_scans, monkeypatch):
+    # the candidates' records are made as the first outcome arrives: an interrupt before it still gets them all
+    import imgmtf.scene.measure as measure
+    _, records, _ = quadrant_scans[False]
+
+    def interrupted(*args, **options):
+        raise KeyboardInterrupt
+        yield
+    monkeypatch.setattr(measure, "run_tasks", interrupted)
+    with pytest.raises(KeyboardInterrupt) as caught:
+        scan_scene(records[0].path)
+    kept = caught.value.records
+    assert len(kept) == len(records) and not any(r.ok for r in kept)
+    assert {r.reason for r in kept if r.site.get("verdict_by") != "screen"} == {"interrupted"}
+    assert sorted(r.reason for r in kept if r.site.get("verdict_by") == "screen") == sorted(
+        r.reason for r in records if r.site.get("verdict_by") == "screen" and "roi_polygon_px" not in r.site)

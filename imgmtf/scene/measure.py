@@ -177,23 +177,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
                                             roi_margin_px(settings) + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
-    records: list[Record] = []
-    plans: list[Plan] = []
-    rounded = _rounded_ends([half.segment for half, _ in candidates])
-    centre = resolve_centre(settings.optical_centre, info.width, info.height)
-    mapped = _map_ends([half.segment for half, _ in candidates], info)
-    for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
-        verdict = verdict or _beside_screen(half, clearance)
-        if not verdict:
-            partners = segment_rows(half.partners)
-            plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
-        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
-        if features[k] is not None:
-            record = record.with_(site=features[k].record_fields())
-        if centre is not None:          # where the candidate lies in a lens's field
-            s = half.segment
-            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
-        records.append(record)
+    verdicts = [verdict or _beside_screen(half, clearance) for (half, verdict), clearance in zip(candidates, beside)]
+    plans = [Plan(k, plan_roi(half, settings, clearance), segment_rows(half.partners), half.segment.width_px)
+             for k, ((half, _), clearance, verdict) in enumerate(zip(candidates, beside, verdicts)) if not verdict]
     measuring = auto_workers(len(plans), AUTO_PLANS_PER_WORKER) if workers is None else workers
     batches = _batches(plans, info, settings.tile_px)
     if measuring > 1:
@@ -205,13 +191,18 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         return [(plan.index, Record.failed(path, settings.band, settings.target, settings.method, exc,
                                            params=context.params, run_utc=run_utc, status="rejected"))
                 for plan in task[2]]
+    records: list[Record] = []
     try:
         for _, outcomes in run_tasks(measure_batch, [(context, window, batch) for window, batch in batches],
                                      workers=measuring, scheduler=scheduler, progress=progress,
                                      description="measuring targets", on_error=lost, ordered=False):
+            # the candidates' records made once the first outcome is in: on a pool, while its
+            # workers measure the tasks queued for them
+            records = records or _candidate_records(halves, verdicts, features, context)
             for index, outcome in outcomes:
                 records[index] = _measured(records[index], outcome)
     except KeyboardInterrupt as exc:
+        records = records or _candidate_records(halves, verdicts, features, context)
         pending = {plan.index for _, batch in batches for plan in batch}
         for i in pending:
             if records[i].status == "candidate":
@@ -219,7 +210,30 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                               error=f"{path}: not measured: the scan was interrupted")
         exc.records = _named_figures(_ranked(_grouped(records, halves)))  # type: ignore[attr-defined]  # kept
         raise
+    records = records or _candidate_records(halves, verdicts, features, context)
     return _named_figures(_ranked(_grouped(records, halves)))
+
+
+def _candidate_records(halves: list[HalfEdge], verdicts: list, features: list, context: Context) -> list[Record]:
+    """Each candidate's record before it is measured (:func:`_candidate_record`):
+    rejected by its screen's verdict, or a candidate; with the site of the
+    vector layer's feature it crosses, and where it lies in a lens's field,
+    where the scan has them."""
+    info, settings = context.info, context.settings
+    segments = [half.segment for half in halves]
+    rounded = _rounded_ends(segments)
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
+    mapped = _map_ends(segments, info)
+    records = []
+    for k, (half, verdict) in enumerate(zip(halves, verdicts)):
+        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
+        if features[k] is not None:
+            record = record.with_(site=features[k].record_fields())
+        if centre is not None:          # where the candidate lies in a lens's field
+            s = half.segment
+            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
+        records.append(record)
+    return records
 
 
 def _named_figures(records: list[Record]) -> list[Record]:
