@@ -14,13 +14,19 @@ measures m(f) = M(f cos theta, f sin theta), f in cy/px along the normal.
   (:func:`elliptical_model`).
 
 Both are solved for many redrawn sections at once (:func:`drawn_models`):
-one design and its weights (the central sections'), many right-hand sides.
+one design and its weights (the central sections'), many right-hand sides;
+and for many targets at once: :class:`SeparableProblem` and
+:class:`EllipticalProblem` take their sections stacked along a leading
+target axis (:func:`stacked_inputs`), each target's used samples padded to
+one length with zero weights, and give their models stacked
+(:func:`model_row` takes one out).
 """
 from __future__ import annotations
 
 import functools
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -55,11 +61,12 @@ class SeparableModel:
 
 @dataclass(frozen=True)
 class EllipticalModel:
-    """log g on ``nodes`` (cy/px of the across-track axis) and the aspect."""
+    """log g on ``nodes`` (cy/px of the across-track axis) and the aspect
+    (stacked models, :func:`model_row`: an array, one per model)."""
 
     nodes: np.ndarray
     log_g: np.ndarray
-    aspect: float
+    aspect: float | np.ndarray
 
     def transfer(self, u: ArrayLike, v: ArrayLike) -> np.ndarray:
         u, v = np.asarray(u, float), np.asarray(v, float)
@@ -83,7 +90,8 @@ def separable_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: 
     >>> round(float(model.transfer(0.5, 0.0)), 3), round(float(truth(0.5, 0.0)), 3)
     (0.607, 0.607)
     """
-    return model_row(SeparableProblem(*_one(prepared(normals_deg, frequencies_cy_px, mtfs, sd))).models(), 0)
+    return cast(SeparableModel,
+                model_row(SeparableProblem(*_one(prepared(normals_deg, frequencies_cy_px, mtfs, sd))).models(), 0))
 
 
 def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
@@ -104,7 +112,7 @@ def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs:
     """
     problem = EllipticalProblem(*_one(prepared(normals_deg, frequencies_cy_px, mtfs, sd)))
     log_aspect = problem.search() if aspect is None else np.array([math.log(aspect)])
-    return model_row(problem.model(log_aspect), 0)
+    return cast(EllipticalModel, model_row(problem.model(log_aspect), 0))
 
 
 def model_row(models: SeparableModel | EllipticalModel, k: int) -> SeparableModel | EllipticalModel:

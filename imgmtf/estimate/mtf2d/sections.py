@@ -19,6 +19,11 @@ then gives both and the ``bracket`` spanning them.  A third orientation is
 predicted from the two nearest the axes under each assumption and compared
 with its measurement; the assumption it does not reject is chosen.
 
+Many targets' sections are inverted together
+(:func:`mtf2d_from_sections_many`; one target's is a batch of one): every
+step takes a leading target axis, each target's numbers those it gives
+alone.
+
 Intervals: each section's uncertainty (one standard deviation per
 frequency) is drawn as a whole-curve shift (the noise of one edge's MTF is
 correlated across frequency), every draw inverted, and the percentiles
@@ -30,6 +35,7 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -303,20 +309,18 @@ def _inverted(inputs: tuple, drawn: bool, assumption: str, draws: int, confidenc
     arguments checked and stacked (normals (T, n) deg, f (T, F), m and sd
     (T, n, F))."""
     normals, _, m, spread = inputs
-    problems = {SEPARABLE: SeparableProblem(*stacked_inputs(*inputs)),
-                ELLIPTICAL: EllipticalProblem(*stacked_inputs(*inputs))}
-    central = {SEPARABLE: problems[SEPARABLE].models(),
-               ELLIPTICAL: problems[ELLIPTICAL].model(problems[ELLIPTICAL].search())}
+    separable, elliptical = SeparableProblem(*stacked_inputs(*inputs)), EllipticalProblem(*stacked_inputs(*inputs))
+    central: dict[str, Any] = {SEPARABLE: separable.models(), ELLIPTICAL: elliptical.model(elliptical.search())}
     count, n = normals.shape
     models = [{a: model_row(central[a], t) for a in ASSUMPTIONS} for t in range(count)]
+    aspects = [float(a) for a in np.asarray(central[ELLIPTICAL].aspect).tolist()]
     chosen = _chosen(inputs, central[ELLIPTICAL], assumption, draws, seed)
     shifts = np.random.default_rng(seed).standard_normal((draws, n)) if drawn and draws > 0 else None
-    again: dict[str, object] = dict.fromkeys(ASSUMPTIONS)
+    again: dict[str, Any] = dict.fromkeys(ASSUMPTIONS)
     if shifts is not None:
         many = m[:, None] + shifts[None, :, :, None] * spread[:, None]
-        again[SEPARABLE] = problems[SEPARABLE].models(many)
-        near = np.array([math.log(models[t][ELLIPTICAL].aspect) for t in range(count)])
-        again[ELLIPTICAL] = problems[ELLIPTICAL].models(many, near)
+        again[SEPARABLE] = separable.models(many)
+        again[ELLIPTICAL] = elliptical.models(many, np.array([math.log(a) for a in aspects]))
     sections = {a: _sections(central[a], again[a], confidence) for a in ASSUMPTIONS}
     out = []
     for t in range(count):
@@ -325,7 +329,7 @@ def _inverted(inputs: tuple, drawn: bool, assumption: str, draws: int, confidenc
         alternatives[BRACKET] = (_bracket(sep_across, ell_across), _bracket(sep_along, ell_along))
         name, because, tests = chosen[t]
         across, along = alternatives[name]
-        out.append(MTF2D(name, because, across, along, alternatives, models[t], models[t][ELLIPTICAL].aspect,
+        out.append(MTF2D(name, because, across, along, alternatives, models[t], aspects[t],
                          tuple(float(x) for x in normals[t]), tests))
     return out
 
