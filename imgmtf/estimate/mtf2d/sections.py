@@ -255,8 +255,14 @@ def mtf2d_from_sections_many(sections: Sequence[tuple], *, assumption: str = "au
         :func:`mtf2d_from_sections` takes them.  Targets of different
         shapes (normals, frequencies) or with and without ``sd`` are
         inverted in groups of one shape.
-    assumption, draws, confidence, seed
-        As :func:`mtf2d_from_sections`, for every target.
+    assumption : str, optional
+        As :func:`mtf2d_from_sections`, for every target ("auto" default).
+    draws : int, optional
+        Draws of each target's sections for its intervals (default 100).
+    confidence : float, optional
+        Of the intervals (default 0.95).
+    seed : int, optional
+        Of the draws (each target's the same as alone).
 
     Returns
     -------
