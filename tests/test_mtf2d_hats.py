@@ -39,7 +39,7 @@ def test_the_draws_vertices_are_each_draws_own():
     costs = (trials[:, None] - rng.uniform(-0.5, 0.5, 40)) ** 2 + rng.uniform(0, 1e-3, (13, 40))
     costs[:, 0] = 1.0                                          # flat: the first trial
     costs[6:9, 1] = 0.5                                        # a tie
-    together = _vertices(trials, costs)
+    together = _vertices(trials[None], costs[None])[0]
     assert np.array_equal(together, [_vertex(trials, costs[:, k]) for k in range(costs.shape[1])])
 
 

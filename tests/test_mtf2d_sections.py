@@ -155,25 +155,61 @@ def test_sections_it_cannot_invert_are_refused():
 
 def test_the_draws_elliptical_models_solved_together_are_each_ones_own():
     """The redrawn sections' elliptical models, every draw's normal
-    equations solved in one call, are those solved draw by draw (nodes,
-    reach and log g to 1e-12), and so are the misfits of many aspects."""
-    from imgmtf.estimate.mtf2d.inversion import EllipticalProblem, prepared
+    equations solved in one call (by bands), are those solved draw by
+    draw (dense: nodes, reach and log g to 1e-12), and so are the misfits
+    of many aspects, of many targets at once and of each alone."""
+    from imgmtf.estimate.mtf2d.inversion import EllipticalProblem, _one, prepared
     f = np.linspace(0, 1, 101)
     normals = [16.8, -73.2, 40.0]
     c, s = np.cos(np.radians(normals))[:, None], np.sin(np.radians(normals))[:, None]
     m = np.sinc(f * c) * np.sinc(f * s) / (1 + 9 * f ** 2 * (c ** 2 + (s / 0.7) ** 2))
     sd = np.full_like(m, 0.01)
-    problem = EllipticalProblem(*prepared(normals, f, m, sd))
+    problem = EllipticalProblem(*_one(prepared(normals, f, m, sd)))
     rng = np.random.default_rng(3)
-    targets = problem.remainders(m[None] + rng.standard_normal((20, 3))[:, :, None] * sd[None])
-    log_aspects = np.log(0.7) + rng.uniform(-0.3, 0.3, 20)
-    for together, alone in zip(problem.each_model(log_aspects, targets),
-                               [problem.model(a, targets[:, k]) for k, a in enumerate(log_aspects)]):
-        assert together.aspect == alone.aspect
-        assert np.allclose(together.nodes, alone.nodes, rtol=0, atol=1e-12)
-        assert np.array_equal(np.isnan(together.log_g), np.isnan(alone.log_g))
-        assert np.allclose(together.log_g, alone.log_g, rtol=0, atol=1e-12, equal_nan=True)
-    # and the misfits of many aspects at once, of one target and of many, are each aspect's own
-    for target in (problem.log_r, targets):
-        alone = np.array([problem._fit(a, target)[0] for a in log_aspects])
-        assert np.allclose(problem.costs(log_aspects, target), alone, rtol=1e-10, atol=0)
+    targets = problem.remainders((m[None] + rng.standard_normal((60, 3))[:, :, None] * sd[None])[None])
+    log_aspects = np.log(0.7) + rng.uniform(-0.3, 0.3, (1, 60))
+    together = problem.each_model(log_aspects, targets)
+    for k, a in enumerate(log_aspects[0]):
+        alone = problem.each_model(np.array([[a]]), targets[:, :, k:k + 1])
+        assert together.aspect[k] == alone.aspect[0]
+        assert np.allclose(together.nodes[k], alone.nodes[0], rtol=0, atol=1e-12)
+        assert np.array_equal(np.isnan(together.log_g[k]), np.isnan(alone.log_g[0]))
+        assert np.allclose(together.log_g[k], alone.log_g[0], rtol=0, atol=1e-12, equal_nan=True)
+    # and the misfits of many aspects at once, of many right-hand sides and of one, are each aspect's own
+    many = problem.costs(log_aspects[:, :13], targets[:, :, :5])
+    for k in range(5):
+        assert np.allclose(many[:, :, k], problem.costs(log_aspects[:, :13], targets[:, :, k]), rtol=1e-10, atol=0)
+
+def test_many_targets_inverted_together_are_each_alone():
+    """Targets of mixed shapes (two and three orientations, other
+    frequencies, no intervals, one refused) inverted in one call: each
+    result is the one its target gives alone, and the refusal its error."""
+    from imgmtf.estimate.mtf2d import mtf2d_from_sections_many
+    rng = np.random.default_rng(11)
+
+    def target(normals, f, width):
+        t = np.radians(normals)[:, None]
+        u, v = f * np.cos(t), f * np.sin(t)
+        m = np.sinc(u) * np.sinc(v) * np.exp(-2 * np.pi ** 2 * (width * u) ** 2 - 5 * v ** 2)
+        m = m + rng.normal(0, 0.004, m.shape)
+        return normals, f, m, sd_from_nyquist([0.01] * len(normals), f)
+
+    coarse = np.linspace(0, 1, 51)
+    inputs = [target(BAOTOU, F, 0.3), target([5.0, 80.0], F, 0.5), target([16.8, -73.2, 40.0], F, 0.35),
+              target(BAOTOU, coarse, 0.4)[:3], target([16.8], F, 0.3), target([-10.0, 70.0], F, 0.2)]
+    together = mtf2d_from_sections_many(inputs, draws=20)
+    with pytest.raises(ParameterError, match="two normals"):
+        mtf2d_from_sections(*inputs[4], draws=20)
+    assert isinstance(together[4], ParameterError)
+    for k, item in enumerate(inputs):
+        if k == 4:
+            continue
+        alone, both = mtf2d_from_sections(*item, draws=20), together[k]
+        assert (both.assumption, both.because, both.tests, both.aspect) == \
+            (alone.assumption, alone.because, alone.tests, alone.aspect)
+        for name in alone.alternatives:
+            for one, other in zip(alone.alternatives[name], both.alternatives[name]):
+                for field in ("mtf", "low", "high"):
+                    assert np.array_equal(getattr(one, field), getattr(other, field), equal_nan=True)
+                figures = [[*s.mtf_nyquist_ci, s.mtf50_cy_px, *s.mtf50_ci_cy_px, s.fwhm_px] for s in (one, other)]
+                assert np.array_equal(*figures, equal_nan=True)

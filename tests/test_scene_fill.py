@@ -35,7 +35,8 @@ def test_a_window_may_hold_fill_wherever_any_part_of_it_is_fill():
     rng = np.random.default_rng(1)
     ground = 900.0 + rng.normal(0, 5, (40, 40))
     assert not may_hold_fill(ground, "uint16") and not may_hold_fill(ground, "float32")
-    for value, dtype in [(0.0, "uint16"), (np.nan, "float32"), (-9999.0, "float32"), (65535.0, "uint16")]:
+    for value, dtype in [(0.0, "uint16"), (np.nan, "float32"), (np.inf, "float32"), (-9999.0, "float32"),
+                         (65535.0, "uint16")]:
         window = ground.copy()
         window[30:, 30:] = value                 # a corner of fill: part of the window is fill
         assert fill_mask(window[20:, 20:], dtype)[10:, 10:].all()

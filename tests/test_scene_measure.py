@@ -200,3 +200,51 @@ def test_the_records_are_the_same_measured_in_the_pieces_a_pool_of_workers_gets(
         return [{k: v for k, v in json.loads(to_json(r)).items() if k != "run_utc"} for r in rs]
     assert plain(scan_scene(records[0].path)) == plain(records)
     assert len(pieces) > 1 and all(len(batch) == 1 for _, batch in pieces)
+
+
+def test_a_scan_detecting_on_workers_has_their_fork_server_load_its_tasks_modules_first(tmp_path, monkeypatch):
+    # the workers' imports start with the scan, once, not in each pool as its first task arrives;
+    # a scan in this process starts none
+    import importlib.util
+
+    import imgmtf.parallel as parallel
+    import imgmtf.scene.measure as measure
+    path = tmp_path / "scene.tif"
+    im.write_geotiff(path, (texture((600, 1000), 300, seed=2) + 3000).astype(np.uint16))
+    started = []
+    monkeypatch.setattr(parallel, "available_cores", lambda: 2)
+    monkeypatch.setattr(measure, "prestart_workers", lambda *a: started.append(a))
+    monkeypatch.setattr(measure, "detect_segments", lambda *a, **k: (np.zeros((0, 4)), np.zeros(0)))
+    settings = ScanSettings(tile_px=256)            # 15 tiles: two workers
+    assert scan_scene(str(path), settings, workers=1) == [] and started == []
+    assert scan_scene(str(path), settings, workers=None) == []
+    assert started == [(2, measure.WORKER_MODULES)]
+    assert all(importlib.util.find_spec(name) is not None for name in measure.WORKER_MODULES)
+
+
+def test_the_scan_module_loads_without_scipy_so_the_workers_fork_server_starts_first():
+    # the segment graph's SciPy is imported by scan_scene once the workers' fork server has started,
+    # so that the two imports overlap rather than follow each other
+    import subprocess
+    import sys
+    code = "import sys, imgmtf.scene.measure; print(sorted(m for m in sys.modules if m.split('.')[0] == 'scipy'))"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout == "[]\n"
+
+
+def test_a_scan_interrupted_before_any_outcome_keeps_every_candidate_unmeasured_ones_interrupted(
+        quadrant_scans, monkeypatch):
+    # the candidates' records are made as the first outcome arrives: an interrupt before it still gets them all
+    import imgmtf.scene.measure as measure
+    _, records, _ = quadrant_scans[False]
+
+    def interrupted(*args, **options):
+        raise KeyboardInterrupt
+        yield
+    monkeypatch.setattr(measure, "run_tasks", interrupted)
+    with pytest.raises(KeyboardInterrupt) as caught:
+        scan_scene(records[0].path)
+    kept = caught.value.records
+    assert len(kept) == len(records) and not any(r.ok for r in kept)
+    assert {r.reason for r in kept if r.site.get("verdict_by") != "screen"} == {"interrupted"}
+    assert sorted(r.reason for r in kept if r.site.get("verdict_by") == "screen") == sorted(
+        r.reason for r in records if r.site.get("verdict_by") == "screen" and "roi_polygon_px" not in r.site)

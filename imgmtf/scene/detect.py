@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ImgmtfError
 from ..inputs import check_magnitude, saturation_levels
 from ..io import RasterInfo, raster_info, read_raster
-from .fill import FILL_SIDE_PX, fill_mask
+from .fill import FILL_SIDE_PX, fill_mask, may_hold_fill
 from .geometry import sample_points, unit_vectors
 from .settings import ScanSettings
 
@@ -81,13 +81,16 @@ def tile_segments(task) -> tuple[np.ndarray, np.ndarray]:
     if found is None:
         return np.zeros((0, 4)), np.zeros(0)
     found = found.reshape(-1, 4).astype(float)
-    return found + np.array([x, y, x, y], float), _fill_beside(found, fill_mask(tile, dtype))
+    # (two reductions tell a tile that cannot hold fill, sparing it fill_mask's five passes)
+    fill = fill_mask(tile, dtype) if may_hold_fill(tile, dtype) else None
+    return found + np.array([x, y, x, y], float), _fill_beside(found, fill)
 
 
-def _fill_beside(pieces: np.ndarray, fill: np.ndarray) -> np.ndarray:
+def _fill_beside(pieces: np.ndarray, fill: np.ndarray | None) -> np.ndarray:
     """Per piece (tile coordinates), the fraction of 1-px steps along it
-    with fill within ``FILL_SIDE_PX`` on either side."""
-    if not fill.any() or len(pieces) == 0:
+    with fill within ``FILL_SIDE_PX`` on either side (none where ``fill``
+    is None: the tile holds none)."""
+    if fill is None or not fill.any() or len(pieces) == 0:
         return np.zeros(len(pieces))
     points, owner = sample_points(pieces, 1.0)
     units = unit_vectors(pieces)[owner]

@@ -62,7 +62,8 @@ def may_hold_fill(window: np.ndarray, dtype: DTypeLike) -> bool:
     """False when no part of ``window`` can hold fill or nodata
     (:func:`fill_mask` of any part of it is empty): it has no NaN, and
     every value lies above 0 (the least fill value, negative sentinels
-    included) and, for an integer type, below its greatest value.  Two
+    included) and below infinity and, for an integer type, below its
+    greatest value.  Two
     reductions of a batch's window spare each of its candidates its own
     :func:`fill_mask`.
 
@@ -75,7 +76,7 @@ def may_hold_fill(window: np.ndarray, dtype: DTypeLike) -> bool:
     if window.size == 0:
         return False
     low, high = float(window.min()), float(window.max())
-    if not low > 0:                     # a NaN, 0, or a negative value
+    if not low > 0 or high == np.inf:   # a NaN, 0, a negative value, or an infinity (nodata to fill_mask)
         return True
     return bool(np.issubdtype(np.dtype(dtype), np.integer) and high >= np.iinfo(np.dtype(dtype)).max)
 

@@ -21,10 +21,9 @@ import math
 import os
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from ..atomic import ensure_folder
 from ..errors import ImageContentError, ParameterError
@@ -33,7 +32,7 @@ from ..estimate.geometry import direction_label
 from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
 from ..kinds import get_kind
-from ..parallel import auto_workers, run_tasks
+from ..parallel import auto_workers, prestart_workers, run_tasks
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments, tile_windows
@@ -41,24 +40,21 @@ from .features import crossing, placed_windows
 from .fill import fill_screen
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
-from .segments import (
-    BAR_MAX_SEPARATION_PX,
-    HalfEdge,
-    SampledSegments,
-    Segment,
-    find_junctions,
-    pair_bars,
-    parallel_clearance,
-    segment_rows,
-    split_at_junctions,
-)
 from .settings import ScanSettings
+
+if TYPE_CHECKING:
+    from .segments import HalfEdge, Segment
 
 # with workers chosen automatically, a local pool measures the candidates when each worker has at least
 # this many (about 2-3 s of work against a pool's start of 0.2-0.5 s); fewer are measured here
 AUTO_PLANS_PER_WORKER = 100
 AUTO_TILES_PER_WORKER = 4       # ... and detection its tiles from this many a worker (0.2-0.3 s a tile)
 TASKS_PER_WORKER = 4            # a pool's candidates are split into this many tasks a worker: a late tile waits less
+# what the scan's own tasks (the tiles' detection, the candidates' measurement) import: loaded once, as the
+# scan starts, by the workers' fork server (parallel.prestart_workers), not by every worker of each of its
+# two pools as its first task arrives (0.5-0.6 s each time, while the scan waits)
+WORKER_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.estimate.edge", "imgmtf.estimate.pulse",
+                  "numpy.fft", "numpy.ma", "numpy.polynomial")
 
 
 def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
@@ -150,6 +146,17 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
     detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
                  else workers)
+    if scheduler is None and detecting > 1:
+        prestart_workers(detecting, WORKER_MODULES)
+    # the segment graph's SciPy (0.3-0.5 s to import) loads while the workers' fork server loads theirs
+    from .segments import (
+        BAR_MAX_SEPARATION_PX,
+        SampledSegments,
+        find_junctions,
+        parallel_clearance,
+        segment_rows,
+        split_at_junctions,
+    )
     segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
     sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
@@ -170,23 +177,9 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     beside = np.full(len(candidates), np.inf)
     beside[unscreened] = parallel_clearance([candidates[i][0].segment for i in unscreened], sampled,
                                             roi_margin_px(settings) + JUNCTION_CLEARANCE_PX + BAR_MAX_SEPARATION_PX)
-    records: list[Record] = []
-    plans: list[Plan] = []
-    rounded = _rounded_ends([half.segment for half, _ in candidates])
-    centre = resolve_centre(settings.optical_centre, info.width, info.height)
-    mapped = _map_ends([half.segment for half, _ in candidates], info)
-    for k, ((half, verdict), clearance) in enumerate(zip(candidates, beside)):
-        verdict = verdict or _beside_screen(half, clearance)
-        if not verdict:
-            partners = segment_rows(half.partners)
-            plans.append(Plan(len(records), plan_roi(half, settings, clearance), partners, half.segment.width_px))
-        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
-        if features[k] is not None:
-            record = record.with_(site=features[k].record_fields())
-        if centre is not None:          # where the candidate lies in a lens's field
-            s = half.segment
-            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
-        records.append(record)
+    verdicts = [verdict or _beside_screen(half, clearance) for (half, verdict), clearance in zip(candidates, beside)]
+    plans = [Plan(k, plan_roi(half, settings, clearance), segment_rows(half.partners), half.segment.width_px)
+             for k, ((half, _), clearance, verdict) in enumerate(zip(candidates, beside, verdicts)) if not verdict]
     measuring = auto_workers(len(plans), AUTO_PLANS_PER_WORKER) if workers is None else workers
     batches = _batches(plans, info, settings.tile_px)
     if measuring > 1:
@@ -198,13 +191,18 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         return [(plan.index, Record.failed(path, settings.band, settings.target, settings.method, exc,
                                            params=context.params, run_utc=run_utc, status="rejected"))
                 for plan in task[2]]
+    records: list[Record] = []
     try:
         for _, outcomes in run_tasks(measure_batch, [(context, window, batch) for window, batch in batches],
                                      workers=measuring, scheduler=scheduler, progress=progress,
                                      description="measuring targets", on_error=lost, ordered=False):
+            # the candidates' records made once the first outcome is in: on a pool, while its
+            # workers measure the tasks queued for them
+            records = records or _candidate_records(halves, verdicts, features, context)
             for index, outcome in outcomes:
                 records[index] = _measured(records[index], outcome)
     except KeyboardInterrupt as exc:
+        records = records or _candidate_records(halves, verdicts, features, context)
         pending = {plan.index for _, batch in batches for plan in batch}
         for i in pending:
             if records[i].status == "candidate":
@@ -212,7 +210,30 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                               error=f"{path}: not measured: the scan was interrupted")
         exc.records = _named_figures(_ranked(_grouped(records, halves)))  # type: ignore[attr-defined]  # kept
         raise
+    records = records or _candidate_records(halves, verdicts, features, context)
     return _named_figures(_ranked(_grouped(records, halves)))
+
+
+def _candidate_records(halves: list[HalfEdge], verdicts: list, features: list, context: Context) -> list[Record]:
+    """Each candidate's record before it is measured (:func:`_candidate_record`):
+    rejected by its screen's verdict, or a candidate; with the site of the
+    vector layer's feature it crosses, and where it lies in a lens's field,
+    where the scan has them."""
+    info, settings = context.info, context.settings
+    segments = [half.segment for half in halves]
+    rounded = _rounded_ends(segments)
+    centre = resolve_centre(settings.optical_centre, info.width, info.height)
+    mapped = _map_ends(segments, info)
+    records = []
+    for k, (half, verdict) in enumerate(zip(halves, verdicts)):
+        record = _candidate_record(half, context, rounded[k], None if mapped is None else mapped[k], verdict)
+        if features[k] is not None:
+            record = record.with_(site=features[k].record_fields())
+        if centre is not None:          # where the candidate lies in a lens's field
+            s = half.segment
+            record = record.with_(site=field_position((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, s.normal_angle_deg, centre))
+        records.append(record)
+    return records
 
 
 def _named_figures(records: list[Record]) -> list[Record]:
@@ -242,6 +263,7 @@ def _candidates(halves: list[HalfEdge], settings: ScanSettings) -> list[tuple[Ha
     """The half-edges as candidates of the scan's target: for edges, lone
     half-edges and bars alike (the gate tells an edge from a bar); for
     pulses, bars, and lone half-edges rejected as ``not-a-bar``."""
+    from .segments import HalfEdge, pair_bars
     long_enough = [h for h in halves if h.line_length_px >= settings.min_length_px / 2]
     lone, bars = pair_bars([h.segment for h in long_enough])
     out: list[tuple[HalfEdge, tuple[str, str] | None]] = []
@@ -318,6 +340,7 @@ def _rounded_ends(segments: list[Segment]) -> list[list[float]]:
     pass; a bar's centre line's as Python's ``round`` does (the nearest of
     the exact value), as the records always had them (the two differ where
     a value lies within rounding of a half-step)."""
+    from .segments import segment_rows
     by_numpy = np.round(segment_rows(segments), 2).tolist()
     return [[round(v, 2) for v in (s.x0, s.y0, s.x1, s.y1)] if s.width_px > 0 else by_numpy[k]
             for k, s in enumerate(segments)]
@@ -329,6 +352,7 @@ def _map_ends(segments: list, info: RasterInfo) -> list[list[float]] | None:
     the identity (pixel coordinates are all it has)."""
     if info.transform.is_identity or not segments:
         return None
+    from .segments import segment_rows
     ends = segment_rows(segments) + 0.5
     x0, y0 = info.transform @ (ends[:, 0], ends[:, 1])
     x1, y1 = info.transform @ (ends[:, 2], ends[:, 3])
@@ -352,6 +376,8 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     were accepted) joined through the junctions they share; each target
     with an accepted half-edge gets a ``target_id`` (1, 2... in the order
     of its best rank is assigned after ranking, see :func:`_ranked`)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
     reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
     owners: dict[int, list[int]] = {}
     for i in reached:

@@ -103,7 +103,7 @@ def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, schedu
                                             key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
     chosen = sections_workers(len(ordered), workers)
     if chosen == 1:
-        return [row for group in ordered for row in _group_rows(group)]
+        return _task_rows(ordered)
     from ..parallel import run_tasks
     tasks = [ordered[k: k + TARGETS_PER_TASK] for k in range(0, len(ordered), TARGETS_PER_TASK)]
     return [row for rows in run_tasks(_task_rows, tasks, workers=chosen, scheduler=scheduler, progress=progress,
@@ -133,12 +133,27 @@ def sections_workers(targets: int, workers: int | None) -> int:
 
 
 def _task_rows(groups: list[list[Record]]) -> list[Record]:
-    """One worker's task: the rows of a few targets, in their order."""
-    return [row for group in groups for row in _group_rows(group)]
+    """The rows of a few targets (a worker's task) or of all of them, in
+    their order: their sections inverted together
+    (:func:`imgmtf.estimate.mtf2d.mtf2d_from_sections_many`), a call per
+    confidence level."""
+    from ..estimate.mtf2d import mtf2d_from_sections_many
+    inputs = [_group_inputs(group) for group in groups]
+    results: list = [None] * len(groups)
+    levels: dict[float, list[int]] = {}
+    for k, (*_, confidence) in enumerate(inputs):
+        levels.setdefault(confidence, []).append(k)
+    for confidence, members in levels.items():
+        found = mtf2d_from_sections_many([inputs[k][1] for k in members], draws=DRAWS, confidence=confidence)
+        for k, result in zip(members, found):
+            results[k] = result
+    return [row for (curves, _, track, _), result in zip(inputs, results) for row in _group_rows(curves, result, track)]
 
 
-def _group_rows(group: list[Record]) -> list[Record]:
-    from ..estimate.mtf2d import BRACKET, mtf2d_from_sections
+def _group_inputs(group: list[Record]) -> tuple[list[Record], tuple, float, float]:
+    """A target's combined rows that share the first's frequencies, the
+    sections to invert (normals in the sensor's frame, frequencies, MTFs,
+    standard deviations), the track azimuth and the intervals' confidence."""
     first = group[0]
     frequencies = first.figures.get("frequencies_cy_px") or []
     curves = [r for r in group if len(r.figures.get("frequencies_cy_px") or []) == len(frequencies)]
@@ -147,11 +162,15 @@ def _group_rows(group: list[Record]) -> list[Record]:
     mtfs = np.array([[math.nan if v is None else v for v in r.figures["mtf"]] for r in curves], float)
     sd = _sd(curves, np.asarray(frequencies, float))
     confidence = float((first.params.get("intervals") or {}).get("confidence") or 0.95)
-    try:
-        result = mtf2d_from_sections(normals, frequencies, mtfs, sd, draws=DRAWS if sd is not None else 0,
-                                     confidence=confidence)
-    except ParameterError:
-        return []           # one orientation, or two too close: nothing to invert
+    return curves, (normals, frequencies, mtfs, sd), track, confidence
+
+
+def _group_rows(curves: list[Record], result, track: float) -> list[Record]:
+    """A target's rows from its sections' ``result`` (none when they were
+    refused: one orientation, or two too close, nothing to invert)."""
+    from ..estimate.mtf2d import BRACKET
+    if isinstance(result, ParameterError):
+        return []
     shown = ("separable", "elliptical", *((BRACKET,) if result.assumption == BRACKET else ()))
     return [_row(curves, result, assumption, k, track) for assumption in shown for k in (0, 1)]
 

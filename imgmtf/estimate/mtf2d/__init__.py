@@ -17,6 +17,7 @@ from .sections import (
     SEPARABLE,
     TrackSection,
     mtf2d_from_sections,
+    mtf2d_from_sections_many,
     sd_from_nyquist,
 )
 
@@ -52,6 +53,7 @@ __all__ = [
     "elliptical_model",
     "measure_points",
     "mtf2d_from_sections",
+    "mtf2d_from_sections_many",
     "sd_from_nyquist",
     "separable_model",
 ]

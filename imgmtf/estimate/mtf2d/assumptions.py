@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 
+from .curves import transfers
 from .inversion import (
     MIN_MTF,
     MIN_SEPARATION_DEG,
@@ -18,7 +19,7 @@ from .inversion import (
     EllipticalProblem,
     drawn_models,
     fitted_model,
-    prepared,
+    stacked_inputs,
 )
 
 SEPARABLE, ELLIPTICAL, BRACKET = "separable", "elliptical", "bracket"
@@ -58,8 +59,7 @@ def prediction_tests(inputs, base, others, draws: int, seed: int) -> dict[str, f
         for a in ASSUMPTIONS:
             central = fitted_model(a, normals[pair], f, m[pair], sd[pair])
             predictions[a] = central.transfer(u, v)
-            drawn = np.array([again.transfer(u, v) for again in
-                              drawn_models(a, central, normals[pair], f, m[pair], sd[pair], shifts)]) \
+            drawn = transfers(drawn_models(a, central, normals[pair], f, m[pair], sd[pair], shifts), u, v) \
                 if sd.any() else None
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)       # all-NaN beyond the reach
@@ -113,21 +113,24 @@ def pair_decision(elliptical_p: float) -> tuple[str, str]:
     return BRACKET, f"two orientations cannot tell separable from elliptical (elliptical p={elliptical_p:.2g})"
 
 
-def overlay_test(inputs, model: EllipticalModel, seed: int, draws: int = 100) -> float:
-    """The p-value of the elliptical model's fit to the sections: how often
-    sections drawn from the fitted model (within their uncertainty and
-    ``SD_FLOOR``, as whole-curve shifts) lay onto one curve worse than the
-    measured ones do."""
+def overlay_tests(inputs, model: EllipticalModel, seed: int, draws: int = 100) -> np.ndarray:
+    """Each target's p-value of its elliptical model's fit to its sections:
+    how often sections drawn from the fitted model (within their
+    uncertainty and ``SD_FLOOR``, as whole-curve shifts) lay onto one
+    curve worse than the measured ones do.  ``inputs``: many targets'
+    (normals (T, n), frequencies (T, F), MTFs and standard deviations
+    (T, n, F)), ``model`` their models stacked: (T,)."""
     normals, f, m, sd = inputs
-    problem = EllipticalProblem(*prepared(normals, f, m, sd))
-    log_aspect = math.log(model.aspect)
-    observed = float(problem.costs(np.array([log_aspect]), problem.log_r)[0])
-    theta = np.radians(normals)
-    predicted = np.array([model.transfer(f * abs(math.cos(t)), f * abs(math.sin(t))) for t in theta])
+    problem = EllipticalProblem(*stacked_inputs(normals, f, m, sd))
+    log_aspect = np.array([math.log(a) for a in np.asarray(model.aspect).tolist()])
+    observed = problem.costs(log_aspect[:, None], problem.log_r)[:, 0]
+    theta = np.radians(normals)[..., None]
+    u, v = f[:, None] * np.abs(np.cos(theta)), f[:, None] * np.abs(np.sin(theta))
+    predicted = transfers(model, u.reshape(len(u), -1), v.reshape(len(v), -1)).reshape(m.shape)
     predicted = np.where(np.isfinite(predicted), predicted, m)
-    spread = np.hypot(sd, SD_FLOOR * f / 0.5)
-    shifts = np.random.default_rng(seed + 2).standard_normal((draws, normals.size))
-    null = EllipticalProblem(*prepared(normals, f, predicted, sd))
-    targets = null.remainders(predicted[None] + shifts[:, :, None] * spread[None])
-    costs = np.min(null.costs(log_aspect + np.linspace(-0.3, 0.3, 13), targets), axis=0)
-    return float(np.mean(costs >= observed))
+    spread = np.hypot(sd, SD_FLOOR * f[:, None] / 0.5)
+    shifts = np.random.default_rng(seed + 2).standard_normal((draws, normals.shape[1]))
+    null = EllipticalProblem(*stacked_inputs(normals, f, predicted, sd))
+    targets = null.remainders(predicted[:, None] + shifts[None, :, :, None] * spread[:, None])
+    costs = np.min(null.costs(log_aspect[:, None] + np.linspace(-0.3, 0.3, 13), targets), axis=1)
+    return np.mean(costs >= observed[:, None], axis=1)

@@ -86,11 +86,13 @@ def _interp_inside(x: np.ndarray, nodes: np.ndarray, values: np.ndarray) -> np.n
     return np.where(inside, interp_rows(x, nodes, values), np.nan)
 
 
-def transfers(models: Sequence[SeparableModel] | Sequence[EllipticalModel], u: np.ndarray,
-              v: np.ndarray) -> np.ndarray:
-    """Each model's 2-D MTF at the points (``u``, ``v``), cy/px: (models,
-    points), row i exactly ``models[i].transfer(u, v)``.  The models are
-    of one kind (the draws of one assumption).
+def transfers(models: SeparableModel | EllipticalModel | Sequence[SeparableModel] | Sequence[EllipticalModel],
+              u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Each model's 2-D MTF at the points (``u``, ``v``; (points,) shared,
+    or (models, points) each row its own), cy/px: (models, points), row i
+    exactly ``models[i].transfer(u, v)``.  The models are of one kind (the
+    draws of one assumption), a sequence or stacked (one model whose arrays
+    have a leading model axis, as :mod:`.inversion`'s problems give them).
 
     Examples
     --------
@@ -101,22 +103,28 @@ def transfers(models: Sequence[SeparableModel] | Sequence[EllipticalModel], u: n
     True
     """
     u, v = np.asarray(u, float), np.asarray(v, float)
+    stacked = _stacked(models)
+    if stacked is None:
+        return np.empty((0, u.shape[-1]))
+    if isinstance(stacked, SeparableModel):
+        return np.exp(_interp_inside(np.abs(u), stacked.nodes, stacked.log_x) +
+                      _interp_inside(np.abs(v), stacked.nodes, stacked.log_y))
+    w = np.hypot(u, v / np.asarray(stacked.aspect, float)[:, None])
+    return np.sinc(u) * np.sinc(v) * np.exp(_interp_inside(w, stacked.nodes, stacked.log_g))
+
+
+def _stacked(models) -> SeparableModel | EllipticalModel | None:
+    """``models`` as one stacked model (None: no models)."""
+    if isinstance(models, (SeparableModel, EllipticalModel)):
+        return models
     if not len(models):
-        return np.empty((0, u.size))
-    separable = [m for m in models if isinstance(m, SeparableModel)]
-    elliptical = [m for m in models if isinstance(m, EllipticalModel)]
-    rows = len(models)
-    if len(separable) == rows:
-        nodes = _shared_nodes(separable)
-        log_x = np.array([m.log_x for m in separable])
-        log_y = np.array([m.log_y for m in separable])
-        return np.exp(_interp_inside(np.abs(u), nodes, log_x) + _interp_inside(np.abs(v), nodes, log_y))
-    if len(elliptical) == rows:
-        aspects = np.array([m.aspect for m in elliptical])[:, None]
-        w = np.hypot(u, v / aspects)
-        nodes = np.array([m.nodes for m in elliptical])
-        log_g = np.array([m.log_g for m in elliptical])
-        return np.sinc(u) * np.sinc(v) * np.exp(_interp_inside(w, nodes, log_g))
+        return None
+    if all(isinstance(m, SeparableModel) for m in models):
+        return SeparableModel(_shared_nodes(models), np.array([m.log_x for m in models]),
+                              np.array([m.log_y for m in models]))
+    if all(isinstance(m, EllipticalModel) for m in models):
+        return EllipticalModel(np.array([m.nodes for m in models]), np.array([m.log_g for m in models]),
+                               np.array([m.aspect for m in models]))
     raise TypeError("transfers takes models of one kind, separable or elliptical")
 
 

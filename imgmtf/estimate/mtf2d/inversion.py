@@ -14,13 +14,19 @@ measures m(f) = M(f cos theta, f sin theta), f in cy/px along the normal.
   (:func:`elliptical_model`).
 
 Both are solved for many redrawn sections at once (:func:`drawn_models`):
-one design and its weights (the central sections'), many right-hand sides.
+one design and its weights (the central sections'), many right-hand sides;
+and for many targets at once: :class:`SeparableProblem` and
+:class:`EllipticalProblem` take their sections stacked along a leading
+target axis (:func:`stacked_inputs`), each target's used samples padded to
+one length with zero weights, and give their models stacked
+(:func:`model_row` takes one out).
 """
 from __future__ import annotations
 
 import functools
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -55,11 +61,12 @@ class SeparableModel:
 
 @dataclass(frozen=True)
 class EllipticalModel:
-    """log g on ``nodes`` (cy/px of the across-track axis) and the aspect."""
+    """log g on ``nodes`` (cy/px of the across-track axis) and the aspect
+    (stacked models, :func:`model_row`: an array, one per model)."""
 
     nodes: np.ndarray
     log_g: np.ndarray
-    aspect: float
+    aspect: float | np.ndarray
 
     def transfer(self, u: ArrayLike, v: ArrayLike) -> np.ndarray:
         u, v = np.asarray(u, float), np.asarray(v, float)
@@ -83,7 +90,8 @@ def separable_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: 
     >>> round(float(model.transfer(0.5, 0.0)), 3), round(float(truth(0.5, 0.0)), 3)
     (0.607, 0.607)
     """
-    return SeparableProblem(*prepared(normals_deg, frequencies_cy_px, mtfs, sd)).models()[0]
+    return cast(SeparableModel,
+                model_row(SeparableProblem(*_one(prepared(normals_deg, frequencies_cy_px, mtfs, sd))).models(), 0))
 
 
 def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs: ArrayLike,
@@ -102,148 +110,206 @@ def elliptical_model(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mtfs:
     >>> round(model.aspect, 2), round(float(model.transfer(0.0, 0.5)), 3), round(float(truth(0.0, 0.5)), 3)
     (0.7, 0.114, 0.114)
     """
-    problem = EllipticalProblem(*prepared(normals_deg, frequencies_cy_px, mtfs, sd))
-    log_aspect = problem.search() if aspect is None else math.log(aspect)
-    return problem.model(log_aspect, problem.log_r)
+    problem = EllipticalProblem(*_one(prepared(normals_deg, frequencies_cy_px, mtfs, sd)))
+    log_aspect = problem.search() if aspect is None else np.array([math.log(aspect)])
+    return cast(EllipticalModel, model_row(problem.model(log_aspect), 0))
+
+
+def model_row(models: SeparableModel | EllipticalModel, k: int) -> SeparableModel | EllipticalModel:
+    """Model ``k`` of stacked ones (each array with a leading model axis, as
+    the problems below give them)."""
+    if isinstance(models, SeparableModel):
+        nodes = models.nodes if models.nodes.ndim == 1 else models.nodes[k]
+        return SeparableModel(nodes, models.log_x[k], models.log_y[k])
+    return EllipticalModel(models.nodes[k], models.log_g[k], float(np.asarray(models.aspect)[k]))
+
+
+def _packed(use: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each target's used samples (``use``, targets x sections x
+    frequencies) in their order, padded to the most any target uses: their
+    flat indices into its sections (targets x samples) and which are real.
+    A padded sample weighs 0: it adds exact zeros to every sum."""
+    flat = use.reshape(use.shape[0], -1)
+    count = flat.sum(axis=1)
+    rows, columns = np.nonzero(flat)
+    position = np.arange(rows.size) - (np.cumsum(count) - count)[rows]
+    index = np.zeros((flat.shape[0], int(count.max(initial=0))), int)
+    valid = np.zeros(index.shape, bool)
+    index[rows, position] = columns
+    valid[rows, position] = True
+    return index, valid
+
+
+def _gathered(values: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """The used samples of ``values`` (targets x [draws x] sections x
+    frequencies, broadcast): targets x [draws x] samples."""
+    flat = values.reshape(*values.shape[:-2], -1)
+    return np.take_along_axis(flat, index.reshape(index.shape[0], *([1] * (flat.ndim - 2)), index.shape[1]), axis=-1)
 
 
 class SeparableProblem:
-    """The separable least squares of some sections: its design and
-    weights (fixed by the central sections), solved for any number of
-    redrawn ones at once."""
+    """The separable least squares of T targets' sections at once
+    (:func:`stacked_inputs`): each one's design and weights (fixed by its
+    central sections), solved for any number of redrawn ones."""
 
     def __init__(self, theta: np.ndarray, f: np.ndarray, m: np.ndarray, weight: np.ndarray):
         self.nodes = _nodes(REACH_CY_PX)
-        u, v = np.abs(np.cos(theta))[:, None] * f, np.abs(np.sin(theta))[:, None] * f
-        self.use = (m >= MIN_MTF) & (u <= self.nodes[-1]) & (v <= self.nodes[-1])
-        self.design = np.hstack([_hat(u[self.use], self.nodes), _hat(v[self.use], self.nodes)])
-        self.weight = weight[self.use]
+        u = np.abs(np.cos(theta))[..., None] * f[:, None, :]
+        v = np.abs(np.sin(theta))[..., None] * f[:, None, :]
+        self.index, self.valid = _packed((m >= MIN_MTF) & (u <= self.nodes[-1]) & (v <= self.nodes[-1]))
+        us, vs = (np.where(self.valid, _gathered(x, self.index), 0.0).ravel() for x in (u, v))
+        self.design = np.hstack([_hat(us, self.nodes), _hat(vs, self.nodes)]).reshape(*self.valid.shape, -1)
+        self.weight = np.where(self.valid, _gathered(weight, self.index), 0.0)
         self.m = m
 
-    def models(self, many: np.ndarray | None = None) -> list[SeparableModel]:
-        """The models of the sections ``many`` (draws x sections x
-        frequencies; default the central ones)."""
-        many = self.m[None] if many is None else many
-        targets = np.log(np.clip(many[:, self.use], MIN_MTF / 2, None)).T
+    def models(self, many: np.ndarray | None = None) -> SeparableModel:
+        """The models of the sections ``many`` (targets x draws x sections
+        x frequencies; default the central ones), stacked (targets x draws)."""
+        many = self.m[:, None] if many is None else many
+        logs = np.log(np.clip(_gathered(many, self.index), MIN_MTF / 2, None))
+        targets = np.swapaxes(np.where(self.valid[:, None], logs, 0.0), 1, 2)
         solution, reach = _solve(self.design, targets, self.weight, 2, self.nodes.size)
-        log_x = np.where(reach[0][:, None], solution[: self.nodes.size], np.nan).T
-        log_y = np.where(reach[1][:, None], solution[self.nodes.size:], np.nan).T
-        return [SeparableModel(self.nodes, log_x[k], log_y[k]) for k in range(many.shape[0])]
+        size = self.nodes.size
+        log_x = np.where(reach[:, 0, :, None], solution[:, :size], np.nan)
+        log_y = np.where(reach[:, 1, :, None], solution[:, size:], np.nan)
+        return SeparableModel(self.nodes, *(np.swapaxes(x, 1, 2).reshape(-1, size) for x in (log_x, log_y)))
 
 
 class EllipticalProblem:
-    """The elliptical least squares of some sections: the remainders'
-    logs, weights and used samples (fixed by the central sections), for
-    any aspect and any number of redrawn sections."""
+    """The elliptical least squares of T targets' sections at once
+    (:func:`stacked_inputs`): the remainders' logs, weights and used
+    samples (fixed by each target's central sections, padded to one
+    length with zero weights), for any aspects and redrawn sections."""
 
     def __init__(self, theta: np.ndarray, f: np.ndarray, m: np.ndarray, weight: np.ndarray):
-        self.c, self.s, self.f = np.abs(np.cos(theta))[:, None], np.abs(np.sin(theta))[:, None], f
-        pixel = np.sinc(f * self.c) * np.sinc(f * self.s)
-        self.use = (m >= MIN_MTF) & (np.maximum(f * self.c, f * self.s) <= REACH_CY_PX) & (pixel > 0.05)
-        self.log_pixel = np.log(pixel[self.use])
-        self.log_r = np.log(m[self.use]) - self.log_pixel
-        self.weight = weight[self.use]
+        c, s = np.abs(np.cos(theta))[..., None], np.abs(np.sin(theta))[..., None]
+        fc, fs = f[:, None, :] * c, f[:, None, :] * s
+        pixel = np.sinc(fc) * np.sinc(fs)
+        self.index, self.valid = _packed((m >= MIN_MTF) & (np.maximum(fc, fs) <= REACH_CY_PX) & (pixel > 0.05))
+        self.f, self.c, self.s = (np.where(self.valid, _gathered(np.broadcast_to(x, m.shape), self.index), 0.0)
+                                  for x in (f[:, None, :], c, s))
+        self.log_pixel = np.log(np.where(self.valid, _gathered(pixel, self.index), 1.0))
+        self.log_r = np.log(np.where(self.valid, _gathered(m, self.index), 1.0)) - self.log_pixel
+        self.weight = np.where(self.valid, _gathered(weight, self.index), 0.0)
 
     def remainders(self, many: np.ndarray) -> np.ndarray:
-        """The log remainders of sections ``many`` (draws x sections x
-        frequencies): samples x draws."""
-        return (np.log(np.clip(many[:, self.use], MIN_MTF / 2, None)) - self.log_pixel).T
+        """The log remainders of sections ``many`` (targets x draws x
+        sections x frequencies): targets x samples x draws."""
+        logs = np.log(np.clip(_gathered(many, self.index), MIN_MTF / 2, None)) - self.log_pixel[:, None]
+        return np.swapaxes(np.where(self.valid[:, None], logs, 0.0), 1, 2)
 
-    def _fit(self, log_aspect: float, targets: np.ndarray):
-        w = (self.f * np.sqrt(self.c ** 2 + self.s ** 2 * math.exp(-2 * log_aspect)))[self.use]
-        nodes = _nodes(max(float(w.max(initial=0.0)), NODE_STEP_CY_PX), count=33)
-        design = _hat(w, nodes)
-        solution, reach = _solve(design, targets, self.weight, 1, nodes.size)
-        misfit = self.weight.reshape(-1, *([1] * (targets.ndim - 1))) * (design @ solution[1:] - targets)
-        return np.sum(misfit ** 2, axis=0), solution, reach, nodes
-
-    def model(self, log_aspect: float, target: np.ndarray) -> EllipticalModel:
-        _, solution, reach, nodes = self._fit(log_aspect, target)
-        return EllipticalModel(nodes, np.where(reach[0], solution, np.nan), math.exp(log_aspect))
-
-    def search(self) -> float:
-        """The log aspect that best lays the central remainders onto one
-        curve: 25 trials across ``ASPECT_BOUNDS``, three finer rounds of 9
-        about the best, and a parabola (to 1e-4 in log)."""
-        trials = np.linspace(math.log(ASPECT_BOUNDS[0]), math.log(ASPECT_BOUNDS[1]), 25)
+    def search(self) -> np.ndarray:
+        """Each target's log aspect that best lays its central remainders
+        onto one curve: 25 trials across ``ASPECT_BOUNDS``, three finer
+        rounds of 9 about the best, and a parabola (to 1e-4 in log); every
+        target's round in one call."""
+        targets = np.arange(self.f.shape[0])
+        trials = np.tile(np.linspace(math.log(ASPECT_BOUNDS[0]), math.log(ASPECT_BOUNDS[1]), 25), (targets.size, 1))
         for _ in range(4):
             costs = self.costs(trials, self.log_r)
-            i = int(np.argmin(costs))
+            i = np.argmin(costs, axis=1)
             if _ < 3:
-                trials = np.linspace(trials[max(i - 1, 0)], trials[min(i + 1, trials.size - 1)], 9)
-        return _vertex(trials, costs)
+                trials = np.linspace(trials[targets, np.maximum(i - 1, 0)],
+                                     trials[targets, np.minimum(i + 1, trials.shape[1] - 1)], 9, axis=-1)
+        return _vertices(trials, costs[:, :, None])[:, 0]
 
-    def models(self, many: np.ndarray, near: float) -> list[EllipticalModel]:
-        """The models of sections ``many``, each with its own aspect (the
-        aspect is uncertain too): 13 trials within 0.3 of ``near`` (log)
-        for all of them at once, each refined by a parabola."""
+    def model(self, log_aspects: np.ndarray) -> EllipticalModel:
+        """Each target's model of its central sections at its log aspect
+        (targets,), stacked."""
+        return self.each_model(np.asarray(log_aspects, float)[:, None], self.log_r[:, :, None])
+
+    def models(self, many: np.ndarray, near: np.ndarray) -> EllipticalModel:
+        """The models of sections ``many`` (targets x draws x sections x
+        frequencies), each with its own aspect (the aspect is uncertain
+        too): 13 trials within 0.3 of its target's ``near`` (log) for all
+        of them at once, each refined by a parabola; stacked (targets x
+        draws)."""
         targets = self.remainders(many)
-        trials = near + np.linspace(-0.3, 0.3, 13)
+        trials = np.asarray(near, float)[:, None] + np.linspace(-0.3, 0.3, 13)
         return self.each_model(_vertices(trials, self.costs(trials, targets)), targets)
 
     def costs(self, log_aspects: np.ndarray, targets: np.ndarray) -> np.ndarray:
-        """The weighted misfit (:meth:`_fit`'s first value) of ``targets``
-        (samples, or samples x k) at each of ``log_aspects``, every
-        aspect's least squares solved in one call: (aspects,) or (aspects, k)."""
+        """The weighted misfit of each target's least squares at each of
+        its ``log_aspects`` (targets x aspects) to its ``targets``
+        (targets x samples, or targets x samples x k), every aspect's
+        solved in one call: targets x aspects [x k]."""
+        count, aspects = log_aspects.shape
         _, h = self._stacked(log_aspects)
-        if targets.ndim == 1:
-            solution = self._solved(h, np.broadcast_to(targets, h.low.shape))
-            return np.sum((self.weight * (hats.predicted(h, solution) - targets)) ** 2, axis=1)
+        weight = self._each(aspects)
+        if targets.ndim == 2:
+            each = np.broadcast_to(targets[:, None], (count, aspects, targets.shape[1])).reshape(weight.shape)
+            misfit = weight * (hats.predicted(h, self._solved(h, weight, each, aspects)) - each)
+            # summed in order (a padded sample adds an exact 0): the same sum whatever the targets batched with
+            return np.cumsum(misfit ** 2, axis=1)[:, -1].reshape(count, aspects)
         # many right-hand sides per aspect: one dense product each (BLAS), the normal matrices still sparse
-        weighted = hats.dense(h) * self.weight[None, :, None]
-        goal = targets * self.weight[:, None]
+        weighted = (hats.dense(h) * weight[:, :, None]).reshape(count, aspects, *h.low.shape[1:], -1)
+        goal = targets * self.weight[:, :, None]
         # the inverses (one small factorisation each) times the right-hand sides: a third of the time of
         # solving for them, and as exact here (the normal matrices' condition is a few thousand)
-        solution = np.linalg.inv(self._normal(h)) @ (np.transpose(weighted, (0, 2, 1)) @ goal)
+        inverse = np.linalg.inv(self._normal(h, weight)).reshape(count, aspects, h.size - 1, h.size - 1)
+        solution = inverse @ (np.swapaxes(weighted, 2, 3) @ goal[:, None])
         # the misfits an aspect at a time: all at once they were megabytes, fresh pages every call (twice the time)
-        out = np.empty((len(h.low), goal.shape[1]))
-        for a, (design, solved) in enumerate(zip(weighted, solution)):
-            misfit = design @ solved - goal
-            out[a] = np.einsum("sk,sk->k", misfit, misfit)
+        out = np.empty((count, aspects, goal.shape[2]))
+        for t in range(count):
+            for a in range(aspects):
+                misfit = weighted[t, a] @ solution[t, a] - goal[t]
+                out[t, a] = np.einsum("sk,sk->k", misfit, misfit)
         return out
 
-    def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> list[EllipticalModel]:
-        """:meth:`model` of each column of ``targets`` (samples x draws) at
-        its own log aspect, solved together: each draw's design (its
-        stretch, its nodes) kept sparse, the normal equations of all of
-        them solved in one call (a call per draw cost a dense chart's
-        scan, 484 targets of a hundred-odd draws each, a sixth of its
-        time; their dense designs another sixth)."""
+    def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> EllipticalModel:
+        """:meth:`model` of each column of ``targets`` (targets x samples
+        x draws) at its own log aspect (targets x draws), solved together
+        and stacked (targets x draws): each draw's design (its stretch, its
+        nodes) kept sparse, the normal equations of all of them solved in
+        one call (a call per draw cost a dense chart's scan, 484 targets
+        of a hundred-odd draws each, a sixth of its time; their dense
+        designs another sixth)."""
+        count, draws = log_aspects.shape
         nodes, h = self._stacked(log_aspects)
-        size = nodes.shape[1]
-        solution = np.concatenate([np.zeros((len(log_aspects), 1)), self._solved(h, targets.T)], axis=1)
+        size = nodes.shape[-1]
+        each = np.swapaxes(targets, 1, 2).reshape(count * draws, -1)
+        solution = np.concatenate([np.zeros((count * draws, 1)), self._solved(h, self._each(draws), each, draws)],
+                                  axis=1)
         touched = hats.touched(h)                                                    # draws x (nodes - 1)
         last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
         reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
-        log_g = np.where(reach, solution, np.nan)
-        return [EllipticalModel(nodes[k], log_g[k], math.exp(log_aspects[k])) for k in range(len(log_aspects))]
+        aspects = np.array([math.exp(a) for a in log_aspects.ravel().tolist()])
+        return EllipticalModel(nodes.reshape(-1, size), np.where(reach, solution, np.nan), aspects)
+
+    def _each(self, repeats: int) -> np.ndarray:
+        """Each target's weights for each of ``repeats`` systems: (targets x repeats) x samples."""
+        return np.repeat(self.weight, repeats, axis=0)
 
     def _stacked(self, log_aspects: np.ndarray) -> tuple[np.ndarray, hats.Hats]:
-        """:meth:`_fit`'s nodes and design at each of ``log_aspects``,
-        stacked: (aspects, 33) and the samples' interpolation weights
-        (aspects x samples) on them."""
-        stretch = np.sqrt(self.c ** 2 + self.s ** 2 * np.exp(-2 * np.asarray(log_aspects))[:, None, None])
-        w = (self.f * stretch)[:, self.use]                                         # aspects x samples
-        nodes = np.linspace(0.0, np.maximum(w.max(axis=1, initial=0.0), NODE_STEP_CY_PX), 33, axis=-1)
-        step = nodes[:, 1] - nodes[:, 0]
-        return nodes, hats.hats(w / step[:, None], nodes.shape[1])
+        """Each target's nodes and design at each of its ``log_aspects``
+        (targets x aspects), stacked: (targets, aspects, 33) and the
+        samples' interpolation weights ((targets x aspects) x samples) on
+        them."""
+        squeeze = np.exp(-2 * np.asarray(log_aspects))[:, :, None]
+        stretch = np.sqrt(self.c[:, None] ** 2 + self.s[:, None] ** 2 * squeeze)
+        w = self.f[:, None] * stretch                                     # targets x aspects x samples
+        nodes = np.linspace(0.0, np.maximum(w.max(axis=2, initial=0.0), NODE_STEP_CY_PX), 33, axis=-1)
+        step = nodes[..., 1] - nodes[..., 0]
+        return nodes, hats.hats((w / step[..., None]).reshape(-1, w.shape[2]), nodes.shape[-1])
 
-    def _normal(self, h: hats.Hats) -> np.ndarray:
+    def _normal(self, h: hats.Hats, weight: np.ndarray) -> np.ndarray:
         """:func:`_solve`'s normal matrices of stacked designs (sparse)."""
-        return hats.gram(h, self.weight) + _penalty(1, h.size) + 1e-10 * np.eye(h.size - 1)
+        return hats.gram(h, weight) + _penalty(1, h.size) + 1e-10 * np.eye(h.size - 1)
 
-    def _solved(self, h: hats.Hats, targets: np.ndarray) -> np.ndarray:
+    def _solved(self, h: hats.Hats, weight: np.ndarray, targets: np.ndarray, per_target: int) -> np.ndarray:
         """:func:`_solve`'s node values (but the first, 0) for stacked
-        designs and one target each (batch x samples): batch x (nodes - 1);
-        many at once by their normal matrices' bands (:mod:`.banded`)."""
-        rhs = hats.transposed(h, self.weight * (targets * self.weight))
-        if len(rhs) < BANDED_FROM:
-            return np.linalg.solve(self._normal(h), rhs[:, :, None])[:, :, 0]
-        return solve_pentadiagonal(*self._bands(h), rhs)
+        designs, weights and one target each (batch x samples): batch x
+        (nodes - 1).  A target's ``per_target`` systems are solved by their
+        bands (:mod:`.banded`) when they are many, else as dense matrices:
+        the same arithmetic however many targets share the call."""
+        rhs = hats.transposed(h, weight * (targets * weight))
+        if per_target < BANDED_FROM:
+            return np.linalg.solve(self._normal(h, weight), rhs[:, :, None])[:, :, 0]
+        return solve_pentadiagonal(*self._bands(h, weight), rhs)
 
-    def _bands(self, h: hats.Hats) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _bands(self, h: hats.Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`_normal`'s three bands (the matrix pentadiagonal)."""
-        diagonal, beside = hats.gram_bands(h, self.weight)
+        diagonal, beside = hats.gram_bands(h, weight)
         p0, p1, p2 = _penalty_bands(h.size)
         return diagonal + p0 + 1e-10, beside + p1, np.broadcast_to(p2, (diagonal.shape[0], p2.size))
 
@@ -251,38 +317,45 @@ class EllipticalProblem:
 def _vertex(trials: np.ndarray, costs: np.ndarray) -> float:
     """Where the parabola through the lowest cost and its neighbours has
     its minimum (at most a step from the lowest; the lowest at an end)."""
-    return float(_vertices(trials, costs[:, None])[0])
+    return float(_vertices(trials[None], costs[None, :, None])[0, 0])
 
 
 def _vertices(trials: np.ndarray, costs: np.ndarray) -> np.ndarray:
-    """:func:`_vertex` of each column of ``costs`` (trials x k), the same
-    arithmetic on arrays: (k,)."""
-    i = np.argmin(costs, axis=0)
-    inner = np.clip(i, 1, trials.size - 2)
-    columns = np.arange(costs.shape[1])
-    left, mid, right = costs[inner - 1, columns], costs[inner, columns], costs[inner + 1, columns]
-    step = trials[1] - trials[0]
+    """:func:`_vertex` of each target's trials (targets x trials) and each
+    column of its costs (targets x trials x k), the same arithmetic on
+    arrays: targets x k."""
+    i = np.argmin(costs, axis=1)
+    inner = np.clip(i, 1, trials.shape[1] - 2)
+
+    def at(index: np.ndarray) -> np.ndarray:
+        return np.take_along_axis(costs, index[:, None], axis=1)[:, 0]
+
+    left, mid, right = at(inner - 1), at(inner), at(inner + 1)
+    step = (trials[:, 1] - trials[:, 0])[:, None]
     curvature = left - 2 * mid + right
     with np.errstate(divide="ignore", invalid="ignore"):
         shift = np.where(curvature > 0, 0.5 * step * (left - right) / curvature, 0.0)
-    at_end = (i == 0) | (i == trials.size - 1)
-    return np.where(at_end, trials[i], trials[i] + np.clip(shift, -step, step))
+    at_end = (i == 0) | (i == trials.shape[1] - 1)
+    lowest = np.take_along_axis(trials, i, axis=1)
+    return np.where(at_end, lowest, lowest + np.clip(shift, -step, step))
 
 
 def fitted_model(assumption: str, normals, f, m, sd):
+    """One target's central model under ``assumption``."""
     if assumption == "separable":
         return separable_model(normals, f, m, sd)
     return elliptical_model(normals, f, m, sd)
 
 
-def drawn_models(assumption: str, model, normals, f, m, sd, shifts: np.ndarray) -> list:
-    """The models of the sections redrawn by ``shifts`` (draws x sections,
-    in standard deviations ``sd``), each inverted again."""
-    inputs = prepared(normals, f, m, sd)
-    many = m[None] + shifts[:, :, None] * sd[None]
+def drawn_models(assumption: str, model, normals, f, m, sd, shifts: np.ndarray):
+    """The models of one target's sections redrawn by ``shifts`` (draws x
+    sections, in standard deviations ``sd``), each inverted again:
+    stacked (:func:`.curves.transfers` evaluates them)."""
+    inputs = _one(prepared(normals, f, m, sd))
+    many = (m[None] + shifts[:, :, None] * sd[None])[None]
     if assumption == "separable":
         return SeparableProblem(*inputs).models(many)
-    return EllipticalProblem(*inputs).models(many, math.log(model.aspect))
+    return EllipticalProblem(*inputs).models(many, np.array([math.log(model.aspect)]))
 
 
 def prepared(normals_deg, frequencies_cy_px, mtfs, sd):
@@ -301,10 +374,40 @@ def prepared(normals_deg, frequencies_cy_px, mtfs, sd):
     if normals.size < 2 or apart.max() < MIN_SEPARATION_DEG:
         raise ParameterError(f"need sections along at least two normals {MIN_SEPARATION_DEG:g} deg apart, "
                              f"got {', '.join(f'{n:g}' for n in normals)} deg")
-    spread = 0.0 if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
+    return stacked_inputs(normals, f, m, 0.0 if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape))
+
+
+def stacked_inputs(normals_deg, f, m, sd):
+    """:func:`prepared`'s arithmetic, unchecked, on one target's or many
+    targets' sections (leading axes: normals_deg (T, n), f (T, F), m and
+    sd (T, n, F)): the problems above take them stacked."""
     m = np.where(np.isfinite(m), m, 0.0)
-    weight = np.clip(m, MIN_MTF, None) / np.hypot(np.nan_to_num(spread, nan=1.0), SD_FLOOR)
-    return np.radians(normals), f, m, weight
+    weight = np.clip(m, MIN_MTF, None) / np.hypot(np.nan_to_num(sd, nan=1.0), SD_FLOOR)
+    return np.radians(normals_deg), f, m, weight
+
+
+def _one(inputs):
+    """One target's :func:`prepared` inputs as a batch of one."""
+    return tuple(np.asarray(x)[None] for x in inputs)
+
+
+def _solve(design: np.ndarray, target: np.ndarray, weight: np.ndarray, curves: int, size: int):
+    """Weighted least squares for ``curves`` curves of ``size`` nodes each
+    (the first 0), smoothed by their second differences, for each
+    target's design (targets x samples x unknowns) and its many right-hand
+    sides (targets x samples x k); the nodes the data touch (``reach``,
+    targets x curves x size)."""
+    weighted = design * weight[..., None]
+    # the normal equations: a few dozen unknowns, solved for many draws at once
+    normal = np.swapaxes(weighted, 1, 2) @ weighted + _penalty(curves, size) + 1e-10 * np.eye(curves * (size - 1))
+    rhs = np.swapaxes(weighted, 1, 2) @ (target * weight[..., None])
+    solution = np.linalg.solve(normal, rhs)
+    touched = (np.abs(design).sum(axis=1) > 0).reshape(-1, curves, size - 1)
+    last = np.where(touched.any(axis=2), size - 2 - np.argmax(touched[:, :, ::-1], axis=2), -1)
+    reach = np.arange(size) < np.where(last >= 0, last + 2, 1)[..., None]
+    parts = np.split(solution, curves, axis=1)
+    zero = np.zeros((solution.shape[0], 1, solution.shape[2]))
+    return np.concatenate([np.concatenate([zero, part], axis=1) for part in parts], axis=1), reach
 
 
 def _nodes(reach: float, count: int | None = None) -> np.ndarray:
@@ -325,26 +428,6 @@ def _hat(x: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     out[rows, low] = 1.0 - frac
     out[rows, low + 1] = frac
     return out[:, 1:]
-
-
-def _solve(design: np.ndarray, target: np.ndarray, weight: np.ndarray, curves: int, size: int):
-    """Weighted least squares for ``curves`` curves of ``size`` nodes each
-    (the first 0), smoothed by their second differences, for one target
-    (samples) or many (samples x k); the nodes the data touch (``reach``,
-    per curve)."""
-    weighted = design * weight[:, None]
-    # the normal equations: a few dozen unknowns, solved for many draws at once
-    normal = weighted.T @ weighted + _penalty(curves, size) + 1e-10 * np.eye(curves * (size - 1))
-    rhs = weighted.T @ (target * weight.reshape(-1, *([1] * (target.ndim - 1))))
-    solution = np.linalg.solve(normal, rhs)
-    touched = np.abs(design).sum(axis=0).reshape(curves, size - 1) > 0
-    reach = np.zeros((curves, size), bool)
-    for c in range(curves):
-        last = np.flatnonzero(touched[c])
-        reach[c, : (last[-1] + 2 if last.size else 1)] = True
-    parts = np.split(solution, curves)
-    zero = np.zeros((1, *solution.shape[1:]))
-    return np.concatenate([np.concatenate([zero, part]) for part in parts]), reach
 
 
 @functools.lru_cache(maxsize=8)

@@ -19,6 +19,11 @@ then gives both and the ``bracket`` spanning them.  A third orientation is
 predicted from the two nearest the axes under each assumption and compared
 with its measurement; the assumption it does not reject is chosen.
 
+Many targets' sections are inverted together
+(:func:`mtf2d_from_sections_many`; one target's is a batch of one): every
+step takes a leading target axis, each target's numbers those it gives
+alone.
+
 Intervals: each section's uncertainty (one standard deviation per
 frequency) is drawn as a whole-curve shift (the noise of one edge's MTF is
 correlated across frequency), every draw inverted, and the percentiles
@@ -28,7 +33,9 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -42,19 +49,24 @@ from .assumptions import (
     SEPARABLE,
     base_pair,
     decision,
-    overlay_test,
+    overlay_tests,
     pair_decision,
     prediction_tests,
 )
 from .curves import mtf50_rows, transfers
 from .inversion import (
     REACH_CY_PX,
-    drawn_models,
-    fitted_model,
+    EllipticalModel,
+    EllipticalProblem,
+    SeparableProblem,
+    model_row,
     prepared,
+    stacked_inputs,
 )
 
 _GRID = np.round(np.arange(0.0, REACH_CY_PX + 1e-9, 0.01), 2)
+#: targets inverted together (a target's draws take some 2 MB through the inversion)
+BATCH_TARGETS = 16
 _FWHM_X = np.linspace(0.0, 4.0, 801)       # where the LSF is evaluated for its FWHM, px
 # the across (u, 0) then the along (0, v) section's points, cy/px
 _ACROSS_ALONG = (np.concatenate([_GRID, 0.0 * _GRID]), np.concatenate([0.0 * _GRID, _GRID]))
@@ -222,63 +234,153 @@ def mtf2d_from_sections(normals_deg: ArrayLike, frequencies_cy_px: ArrayLike, mt
     >>> result.assumption, round(result.across.mtf_nyquist, 3), round(float(truth(0.5, 0)), 3)
     ('bracket', 0.386, 0.386)
     """
+    result = mtf2d_from_sections_many([(normals_deg, frequencies_cy_px, mtfs, sd)], assumption=assumption,
+                                      draws=draws, confidence=confidence, seed=seed)[0]
+    if isinstance(result, ParameterError):
+        raise result
+    return result
+
+
+def mtf2d_from_sections_many(sections: Sequence[tuple], *, assumption: str = "auto", draws: int = 100,
+                             confidence: float = 0.95, seed: int = 0) -> list[MTF2D | ParameterError]:
+    """:func:`mtf2d_from_sections` of many targets' sections at once: each
+    result what the target alone gives, their arrays stacked along a
+    leading target axis through every step (one target's work is a few
+    hundred small array operations; a dense chart has hundreds of targets).
+
+    Parameters
+    ----------
+    sections : sequence of tuple
+        Each target's (normals_deg, frequencies_cy_px, mtfs[, sd]), as
+        :func:`mtf2d_from_sections` takes them.  Targets of different
+        shapes (normals, frequencies) or with and without ``sd`` are
+        inverted in groups of one shape.
+    assumption : str, optional
+        As :func:`mtf2d_from_sections`, for every target ("auto" default).
+    draws : int, optional
+        Draws of each target's sections for its intervals (default 100).
+    confidence : float, optional
+        Of the intervals (default 0.95).
+    seed : int, optional
+        Of the draws (each target's the same as alone).
+
+    Returns
+    -------
+    list of MTF2D or ParameterError
+        Per target, in order: its result, or the error that refuses its
+        sections (too few normals, shapes that do not agree).
+
+    Raises
+    ------
+    ParameterError
+        An unknown assumption.
+
+    Examples
+    --------
+    >>> f = np.linspace(0, 1, 101)
+    >>> gaussian = [np.sinc(f) * np.exp(-2 * f ** 2)] * 2
+    >>> results = mtf2d_from_sections_many([([0.0, 90.0], f, gaussian), ([16.8], f, gaussian[:1])])
+    >>> round(results[0].along.mtf_nyquist, 3), type(results[1]).__name__
+    (0.386, 'ParameterError')
+    """
     if assumption not in ("auto", BRACKET, *ASSUMPTIONS):
         raise ParameterError(f"assumption must be auto, separable, elliptical or bracket, got {assumption!r}")
+    out: list[MTF2D | ParameterError | None] = [None] * len(sections)
+    checked: dict[int, tuple] = {}
+    groups: dict[tuple, list[int]] = {}
+    for k, (normals_deg, frequencies_cy_px, mtfs, *rest) in enumerate(sections):
+        sd = rest[0] if rest else None
+        try:
+            theta, f, m, _ = prepared(normals_deg, frequencies_cy_px, mtfs, sd)
+        except ParameterError as exc:
+            out[k] = exc
+            continue
+        spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
+        checked[k] = (np.degrees(theta), f, m, spread)
+        groups.setdefault((m.shape, sd is not None), []).append(k)
     # small matrices: BLAS threads cost more than they save (on a busy machine, a third of the time)
     with one_blas_thread():
-        return _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption, draws, confidence, seed)
+        for (_, drawn), members in groups.items():
+            for start in range(0, len(members), BATCH_TARGETS):
+                part = members[start: start + BATCH_TARGETS]
+                inputs = tuple(np.stack([checked[k][i] for k in part]) for i in range(4))
+                for k, result in zip(part, _inverted(inputs, drawn, assumption, draws, confidence, seed)):
+                    out[k] = result
+    return out  # type: ignore[return-value]
 
 
-def _inverted(normals_deg, frequencies_cy_px, mtfs, sd, assumption: str, draws: int, confidence: float,
-              seed: int) -> MTF2D:
-    """:func:`mtf2d_from_sections`'s work, its arguments checked."""
-    theta, f, m, _ = prepared(normals_deg, frequencies_cy_px, mtfs, sd)
-    normals = np.degrees(theta)
-    spread = np.zeros_like(m) if sd is None else np.broadcast_to(np.asarray(sd, float), m.shape)
-    base = base_pair(normals)
-    inputs = (normals, f, m, spread)
-    models = {a: fitted_model(a, normals, f, m, spread) for a in ASSUMPTIONS}
-    tests: dict[str, float] = {}
-    if assumption == "auto":
-        others = [k for k in range(normals.size) if k not in base]
-        if others:
-            tests = prediction_tests(inputs, base, others, draws, seed)
-            assumption, because = decision(tests, normals[list(others)])
-        else:
-            tests = {ELLIPTICAL: overlay_test(inputs, models[ELLIPTICAL], seed)}
-            assumption, because = pair_decision(tests[ELLIPTICAL])
-    else:
-        because = "asked for"
-    rng = np.random.default_rng(seed)
-    shifts = rng.standard_normal((draws, normals.size)) if sd is not None and draws > 0 else None
-    alternatives = {a: _sections(a, models[a], inputs, shifts, confidence) for a in ASSUMPTIONS}
-    (sep_across, sep_along), (ell_across, ell_along) = alternatives[SEPARABLE], alternatives[ELLIPTICAL]
-    alternatives[BRACKET] = (_bracket(sep_across, ell_across), _bracket(sep_along, ell_along))
-    across, along = alternatives[assumption]
-    return MTF2D(assumption, because, across, along, alternatives, models, models[ELLIPTICAL].aspect,
-                 tuple(float(n) for n in normals), tests)
+def _inverted(inputs: tuple, drawn: bool, assumption: str, draws: int, confidence: float,
+              seed: int) -> list[MTF2D]:
+    """:func:`mtf2d_from_sections_many`'s work on targets of one shape, their
+    arguments checked and stacked (normals (T, n) deg, f (T, F), m and sd
+    (T, n, F))."""
+    normals, _, m, spread = inputs
+    separable, elliptical = SeparableProblem(*stacked_inputs(*inputs)), EllipticalProblem(*stacked_inputs(*inputs))
+    central: dict[str, Any] = {SEPARABLE: separable.models(), ELLIPTICAL: elliptical.model(elliptical.search())}
+    count, n = normals.shape
+    models = [{a: model_row(central[a], t) for a in ASSUMPTIONS} for t in range(count)]
+    aspects = [float(a) for a in np.asarray(central[ELLIPTICAL].aspect).tolist()]
+    chosen = _chosen(inputs, central[ELLIPTICAL], assumption, draws, seed)
+    shifts = np.random.default_rng(seed).standard_normal((draws, n)) if drawn and draws > 0 else None
+    again: dict[str, Any] = dict.fromkeys(ASSUMPTIONS)
+    if shifts is not None:
+        many = m[:, None] + shifts[None, :, :, None] * spread[:, None]
+        again[SEPARABLE] = separable.models(many)
+        again[ELLIPTICAL] = elliptical.models(many, np.array([math.log(a) for a in aspects]))
+    sections = {a: _sections(central[a], again[a], confidence) for a in ASSUMPTIONS}
+    out = []
+    for t in range(count):
+        alternatives = {a: sections[a][t] for a in ASSUMPTIONS}
+        (sep_across, sep_along), (ell_across, ell_along) = alternatives[SEPARABLE], alternatives[ELLIPTICAL]
+        alternatives[BRACKET] = (_bracket(sep_across, ell_across), _bracket(sep_along, ell_along))
+        name, because, tests = chosen[t]
+        across, along = alternatives[name]
+        out.append(MTF2D(name, because, across, along, alternatives, models[t], aspects[t],
+                         tuple(float(x) for x in normals[t]), tests))
+    return out
 
 
-def _sections(assumption: str, model, inputs, shifts, confidence: float) -> tuple[TrackSection, TrackSection]:
-    """The model's across and along sections, with intervals from the
-    sections redrawn by ``shifts`` (draws x sections) and inverted again."""
-    normals, f, m, sd = inputs
-    curves = np.stack([model.transfer(_GRID, 0.0 * _GRID), model.transfer(0.0 * _GRID, _GRID)])
-    if shifts is None:
-        return (_section("across-track", curves[0], None, confidence),
-                _section("along-track", curves[1], None, confidence))
-    # every draw's sections in one pass (a call per draw was a third of a dense chart's sections), across
-    # and along together (u then v): one interpolation, one quantile, one MTF50 search for both
-    again = drawn_models(assumption, model, normals, f, m, sd, shifts)
-    both = transfers(again, _ACROSS_ALONG[0], _ACROSS_ALONG[1])
+def _chosen(inputs: tuple, elliptical: EllipticalModel, assumption: str, draws: int,
+            seed: int) -> list[tuple[str, str, dict]]:
+    """Each target's assumption, why, and its tests' p-values: asked for,
+    else a third orientation's prediction tests, else (two orientations)
+    the elliptical model's overlay test, every target's at once."""
+    normals, f, m, spread = inputs
+    count, n = normals.shape
+    if assumption != "auto":
+        return [(assumption, "asked for", {})] * count
+    if n == 2:
+        return [(*pair_decision(p), {ELLIPTICAL: p}) for p in overlay_tests(inputs, elliptical, seed).tolist()]
+    out = []
+    for t in range(count):
+        base = base_pair(normals[t])
+        others = [k for k in range(n) if k not in base]
+        tests = prediction_tests((normals[t], f[t], m[t], spread[t]), base, others, draws, seed)
+        out.append((*decision(tests, normals[t][others]), tests))
+    return out
+
+
+def _sections(central, drawn, confidence: float) -> list[tuple[TrackSection, TrackSection]]:
+    """Each target's across and along sections of its ``central`` model
+    (stacked, one row per target), with intervals from its ``drawn``
+    redrawn models (stacked, targets x draws; None: no intervals)."""
+    curves = transfers(central, *_ACROSS_ALONG)
+    count, size = curves.shape[0], _GRID.size
+    directions = ("across-track", "along-track")
+    if drawn is None:
+        return [tuple(_section(d, curves[t, k * size: (k + 1) * size], None, confidence)  # type: ignore[misc]
+                      for k, d in enumerate(directions)) for t in range(count)]
+    # every target's draws in one pass (a call per draw was a third of a dense chart's sections), across
+    # and along together (u then v): one interpolation, one quantile, one MTF50 search for all
+    both = transfers(drawn, *_ACROSS_ALONG).reshape(count, -1, 2 * size)
     tail = (1 - confidence) / 2
-    low, high = np.quantile(both, [tail, 1 - tail], axis=0)
-    drawn = (both[:, : _GRID.size], both[:, _GRID.size:])
-    fifty = mtf50_rows(_GRID, np.concatenate(drawn))
-    return tuple(_section(direction, curves[k], drawn[k], confidence,   # type: ignore[return-value]
-                          (low[k * _GRID.size: (k + 1) * _GRID.size], high[k * _GRID.size: (k + 1) * _GRID.size],
-                           fifty[k * len(shifts): (k + 1) * len(shifts)]))
-                 for k, direction in enumerate(("across-track", "along-track")))
+    low, high = np.quantile(both, [tail, 1 - tail], axis=1)
+    fifty = mtf50_rows(_GRID, both.reshape(count, -1, 2, size).swapaxes(1, 2).reshape(-1, size))
+    fifty = fifty.reshape(count, 2, -1)
+    return [tuple(_section(d, curves[t, k * size: (k + 1) * size], both[t, :, k * size: (k + 1) * size],  # type: ignore[misc]
+                           confidence, (low[t, k * size: (k + 1) * size], high[t, k * size: (k + 1) * size],
+                                        fifty[t, k]))
+                  for k, d in enumerate(directions)) for t in range(count)]
 
 
 def _section(direction: str, curve: np.ndarray, drawn: np.ndarray | None, confidence: float,
