@@ -10,6 +10,7 @@ from scipy.special import erf
 import imgmtf as im
 from imgmtf.errors import ImgmtfError, MultipleTargetsError, TargetNotFoundError
 from imgmtf.estimate import gate
+from imgmtf.estimate.sides import side_checks
 
 from conftest import exact_edge_chip, exact_esf, gaussian_pixel_transfer
 
@@ -358,7 +359,7 @@ def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
     # 30 samples each side spread 1 per 0.2 px over 6 px: no 1-px band holds 10, no second feature looked for
     d = np.r_[-np.arange(3.0, 9.0, 0.2), np.arange(3.0, 9.0, 0.2)]
     values = np.where(d < 0, 200.0, 1200.0)
-    checks = gate.side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
+    checks = side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
     second = [c for c in checks if c.reason == "two-targets"]
     assert len(second) == 2 and all(c.outcome == "not-run" for c in second)
     assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")

@@ -58,6 +58,7 @@ from .resampling import Resampled, resample_profile
 from .saturation import saturation_checks
 from .settings import Settings
 from .sharpening import mtf_peak, sharpening_check
+from .sides import side_checks
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
@@ -486,7 +487,7 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     # each side's texture against its own pixel noise (linearisation scales it with the level)
     side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
-    checks += gate.side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
+    checks += side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
                                side_noise, kind.tail_power, (side_names[0], side_names[1]))
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
