@@ -5,8 +5,10 @@ arrays is made for all of them at once:
 
 - the chips' first stages and their edges' per-row Fermi fits, stacked
   into one Levenberg-Marquardt (:mod:`.prefit`);
-- the blur check's fits of each chip's halves and thirds, stacked alike
-  (:func:`.blur_along.group_widths_many`).
+- every stage the pipeline asks for (:mod:`.asks`: the resamplings, the
+  blur check's fits of each chip's halves and thirds...), the generators
+  advanced in lockstep and each round's asks of a name answered by one call
+  (:func:`.asks.drive`).
 
 Every result is the same, to the bit, as the chip's measured alone, and
 every refusal the same refusal (the same exception, returned in its place).
@@ -18,13 +20,13 @@ from typing import Any
 
 import numpy as np
 
-from .blur_along import group_widths_many
+from .asks import drive
 from .kind import TargetKind
-from .pipeline import Measurement, finish_steps, run_steps
+from .pipeline import Measurement, run_steps
 from .prefit import prefit_chips
 from .settings import Settings
 
-CHUNK = 256         # chips paused at their gate at once: the state of a few hundred small chips
+CHUNK = 256         # chips advanced in lockstep at once: the state of a few hundred small chips
 
 
 def run_many(kind: TargetKind, images: Sequence[np.ndarray], settings: Settings,
@@ -72,20 +74,5 @@ def run_many(kind: TargetKind, images: Sequence[np.ndarray], settings: Settings,
 def _run_chunk(kind: TargetKind, images: Sequence[np.ndarray], settings: Settings,
                options: Sequence[dict[str, Any]]) -> list[Measurement | Exception]:
     """:func:`run_many` of a few hundred chips at most."""
-    out: list[Measurement | Exception | None] = [None] * len(images)
-    paused = []
-    for k, (image, keywords, prefit) in enumerate(zip(images, options, prefit_chips(kind, images, settings,
-                                                                                     options))):
-        steps = run_steps(kind, image, settings, prefit=prefit, **keywords)
-        try:
-            evidence = next(steps)
-        except Exception as exc:       # its own run raises it: returned in its place
-            out[k] = exc
-        else:
-            paused.append((k, steps, evidence))
-    for (k, steps, _), widths in zip(paused, group_widths_many([evidence for _, _, evidence in paused])):
-        try:
-            out[k] = finish_steps(steps, widths)
-        except Exception as exc:
-            out[k] = exc
-    return out      # type: ignore[return-value]   # every place filled
+    return drive([run_steps(kind, image, settings, prefit=prefit, **keywords)
+                  for image, keywords, prefit in zip(images, options, prefit_chips(kind, images, settings, options))])

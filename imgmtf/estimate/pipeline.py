@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Generator
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -46,13 +46,14 @@ from numpy.typing import ArrayLike, DTypeLike
 from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
 from . import gate
+from .asks import Ask, Steps, alone
 from .chip import prepare_chip
-from .evidence import Evidence, evidence_of
+from .evidence import evidence_of
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
 from .intervals import Estimate, FigureIntervals, intervals
 from .kind import Shape, TargetKind, refuse_other_kind
 from .prefit import Prefit
-from .profile import read_profile, rebuild_staircase, widen_profile
+from .profile import read_profile_steps, rebuild_staircase, widen_profile_steps
 from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
 from .saturation import saturation_checks
@@ -216,31 +217,30 @@ def run(kind: TargetKind, image: ArrayLike, settings: Settings, *, roi: tuple[in
     >>> abs(m.estimate.spectrum.mtf_nyquist - float(chip.true_mtf(0.5))) < 0.002, m.located.rows_used
     (True, 60)
     """
-    steps = run_steps(kind, image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation, dtype=dtype,
-                      track_azimuth_deg=track_azimuth_deg, prefit=prefit)
-    next(steps)
-    return finish_steps(steps)
+    return alone(run_steps(kind, image, settings, roi=roi, mask=mask, gsd_m=gsd_m, saturation=saturation,
+                           dtype=dtype, track_azimuth_deg=track_azimuth_deg, prefit=prefit))
 
 
 def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit: Prefit | None = None,
-              **chip_options: Any) -> Generator[Evidence, list | None, Measurement]:
-    """:func:`run` as a generator that pauses before the quality gate: it
-    yields what the gate's profile checks read (:class:`.evidence.Evidence`)
-    and takes the blur check's widths (:attr:`.evidence.Evidence.blur_widths`,
-    fitted among other chips' by :func:`.blur_along.group_widths_many`; None:
-    the check fits them), then returns the measurement (:func:`finish_steps`).
+              **chip_options: Any) -> Steps[Measurement]:
+    """:func:`run` as a generator of asks (:mod:`.asks`): at each stage
+    whose work is alike across chips it yields an :class:`.asks.Ask` and
+    takes its answer (made among other chips' by :func:`.many.run_many`,
+    alone by :func:`run`), then returns the measurement.  It asks for the
+    profile's resamplings (``resample``) and, before the quality gate, the
+    blur check's widths (``blur-widths``, :attr:`.evidence.Evidence.blur_widths`).
     ``chip_options``: :func:`run`'s keywords of the chip (``roi``, ``mask``...)."""
     chip = prefit.chip if prefit is not None else prepare_chip(image, settings, **chip_options)
     try:
         located = locate_target(kind, chip, force=settings.force, prefit=prefit)
         samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
-        read, shape = read_profile(kind, samples, settings, located.checks)
+        read, shape = yield from read_profile_steps(kind, samples, settings, located.checks)
         noise = measure_noise(kind, samples, shape, chip.quantum_dn)
         window = choose_window(kind, samples, shape, noise, settings, chip.quantum_dn)
-        profile = widen_profile(read, samples, shape, window, settings, kind.name)
+        profile = yield from widen_profile_steps(read, samples, shape, window, settings, kind.name)
         lsf = blend_tails(kind, samples, profile, shape, window)
         spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
-        blur_widths = yield evidence_of(kind, chip, located, samples, shape, noise)
+        blur_widths = yield Ask("blur-widths", evidence_of(kind, chip, located, samples, shape, noise))
         checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings,
                                  blur_widths=blur_widths)
     except ImgmtfError as exc:
@@ -258,17 +258,6 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
               "dequantised": samples.dequantised, **chip.left_out_px}
     return Measurement(chip, located, shape, noise, estimate, found, tuple(checks), tuple(warnings), params,
                        settings.frequencies_cy_px)
-
-
-def finish_steps(steps: Generator[Evidence, list | None, Measurement], blur_widths: list | None = None
-                 ) -> Measurement:
-    """The measurement of :func:`run_steps` paused at its gate, given the
-    blur check's ``blur_widths`` (None: it fits them)."""
-    try:
-        steps.send(blur_widths)
-    except StopIteration as done:
-        return done.value
-    raise RuntimeError("the pipeline's steps paused twice")      # pragma: no cover - a bug, never data
 
 
 def _points_instead(exc: ImgmtfError, kind: TargetKind, chip: Chip, image: ArrayLike) -> ImgmtfError:

@@ -11,10 +11,11 @@ import numpy as np
 
 from ..errors import ImgmtfError, UnsuitableTargetError
 from . import gate
+from .asks import Ask, Steps, alone
 from .kind import Shape, TargetKind
 from .quantisation import dequantise
-from .resampling import resample_profile
 from .settings import Settings
+from .stacked_resampling import ResampleRequest
 from .state import Profile, Samples, Window
 
 INITIAL_SPAN_PX = 16.0            # the profile is first resampled this far from the line
@@ -98,9 +99,15 @@ def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
     >>> shape.centre == m.shape.centre, round(shape.scale_px, 2)
     (True, 1.32)
     """
+    return alone(read_profile_steps(kind, samples, settings, known))
+
+
+def read_profile_steps(kind: TargetKind, samples: Samples, settings: Settings,
+                       known: Sequence[gate.Check] = ()) -> Steps[tuple[Profile, Shape]]:
+    """:func:`read_profile` as a generator of its asks (:mod:`.asks`)."""
     reach = samples.reach_px
     try:
-        profile = resample_samples(samples, settings, min(reach, INITIAL_SPAN_PX), kind.name)
+        profile = yield from resample_samples_steps(samples, settings, min(reach, INITIAL_SPAN_PX), kind.name)
         seen = gate.classify_profile(profile.values)
         if seen != kind.profile:
             outer = np.abs(samples.distance_px) > 0.6 * samples.half_range_px      # as a bar's shape reads its noise
@@ -114,7 +121,7 @@ def read_profile(kind: TargetKind, samples: Samples, settings: Settings,
             if profile.grid[-1] >= reach - settings.step_px:
                 raise
             # a profile still rising at the span's end (a drifting level): all of it
-            profile = resample_samples(samples, settings, reach, kind.name)
+            profile = yield from resample_samples_steps(samples, settings, reach, kind.name)
             shape = kind.shape(profile.grid, profile.values, samples.distance_px, samples.values_dn,
                                samples.half_range_px)
     except ImgmtfError:
@@ -162,8 +169,14 @@ def resample_samples(samples: Samples, settings: Settings, span_px: float, name:
     >>> float(profile.grid[0]), float(profile.grid[-1])
     (-4.0, 4.0)
     """
-    resampled = resample_profile(samples.distance_px, samples.values_dn, method=settings.method,
-                                 step=settings.step_px, half_range=span_px, **settings.method_options)
+    return alone(resample_samples_steps(samples, settings, span_px, name))
+
+
+def resample_samples_steps(samples: Samples, settings: Settings, span_px: float, name: str) -> Steps[Profile]:
+    """:func:`resample_samples` as a generator of its ask (``resample``, :mod:`.asks`)."""
+    resampled = yield Ask("resample", ResampleRequest(samples.distance_px, samples.values_dn, span_px,
+                                                      settings.method, settings.step_px,
+                                                      settings.method_options))
     return Profile(resampled, _central_run(resampled.values, name))
 
 
@@ -203,10 +216,16 @@ def widen_profile(profile: Profile, samples: Samples, shape: Shape, window: Wind
     >>> widen_profile(m.profile, m.estimate.samples, m.shape, m.estimate.window, make_settings(), "edge") is m.profile
     True
     """
+    return alone(widen_profile_steps(profile, samples, shape, window, settings, name))
+
+
+def widen_profile_steps(profile: Profile, samples: Samples, shape: Shape, window: Window, settings: Settings,
+                        name: str) -> Steps[Profile]:
+    """:func:`widen_profile` as a generator of its asks (:mod:`.asks`)."""
     grid, reach = profile.grid, samples.reach_px
     window_end = abs(shape.centre) + window.core_px + window.taper_px + 3.0 * settings.step_px
     if window_end > min(-grid[0], grid[-1]) and grid[-1] < reach - settings.step_px:
-        return resample_samples(samples, settings, min(reach, window_end + 1.0), name)
+        return (yield from resample_samples_steps(samples, settings, min(reach, window_end + 1.0), name))
     return profile
 
 
