@@ -127,6 +127,7 @@ def mixed_evidence():
     """What the gate reads (:class:`imgmtf.estimate.evidence.Evidence`) of a
     few unlike chips: noise-free and noisy edges, a shaded side, a bar, an
     8-bit edge; for checks made for many chips at once against each alone."""
+    from imgmtf.estimate.asks import answer
     from imgmtf.estimate.edge import EdgeKind
     from imgmtf.estimate.pipeline import run_steps
     from imgmtf.estimate.pulse import PulseKind
@@ -142,6 +143,9 @@ def mixed_evidence():
              (PulseKind(), bar), (EdgeKind(), np.clip(edge(7.0, 1.0) / 6.0, 0, 255))]
     evidence = []
     for kind, image in chips:
-        settings = make_settings(force=True)
-        evidence.append(next(run_steps(kind, image, settings)))
+        steps = run_steps(kind, image, make_settings(force=True))
+        ask = next(steps)
+        while ask.name != "settled-sides":          # its asks answered alone up to the gate's
+            ask = steps.send(answer(ask.name, [ask.payload])[0])
+        evidence.append(ask.payload)
     return evidence
