@@ -386,3 +386,10 @@ def test_every_message_of_a_noise_free_chip_stands_under_rounding(monkeypatch):
     plain = messages()
     monkeypatch.setattr(geometry, "_straight_line", lambda y, x: tuple(float(v) for v in np.polyfit(y, x, 1)))
     assert messages() == plain
+
+
+def test_many_targets_lines_are_checked_as_each_alone(mixed_evidence):
+    calls = [(ev.geometry, 0.05, ev.name) for ev in mixed_evidence]
+    together = gate.line_checks_many(calls)
+    assert together == [gate.line_checks(*call) for call in calls]
+    assert len({str(checks) for checks in together}) == len(together)

@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import MultipleTargetsError, UnsuitableTargetError
 from ._order import median
 from .bar_pair import PAIR_REASON, pair_in_profile
-from .phase import without_phase_bias
+from .phase import phase_bias_many
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
 MIN_SNR = 8.0                   # below this an edge's MTF at Nyquist is mostly noise (about +-0.1)
@@ -287,11 +287,38 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
     """Does the target run straight through the rows?  The kept fraction of
     rows, their robust scatter about the line beyond what their sub-pixel
     phase explains (against what the pixel noise explains), and the bow of
-    a quadratic through them."""
+    a quadratic through them.  A batch of one of :func:`line_checks_many`."""
+    return line_checks_many([(geometry, expected_scatter_px, name)])[0]
+
+
+def line_checks_many(calls) -> list[list[Check]]:
+    """:func:`line_checks` of many targets, their rows' biases with the
+    sub-pixel phase fitted together (:func:`.phase.phase_bias_many`): each
+    target's checks the same, to the bit, as alone.
+
+    Parameters
+    ----------
+    calls : sequence of tuple
+        Each target's arguments of :func:`line_checks` (its geometry, the
+        scatter its noise explains, px, and its name).
+
+    Returns
+    -------
+    list of list of Check
+        Each target's checks, in order.
+    """
+    lines = [geometry.slope * geometry.rows[geometry.kept] + geometry.intercept for geometry, _, _ in calls]
+    away = [geometry.locations[geometry.kept] - line for (geometry, _, _), line in zip(calls, lines)]
+    biases = phase_bias_many([(resid, line, None) for resid, line in zip(away, lines)])
+    return [_line_checks(geometry, expected, name, resid - bias)
+            for (geometry, expected, name), resid, bias in zip(calls, away, biases)]
+
+
+def _line_checks(geometry, expected_scatter_px: float, name: str, resid: np.ndarray) -> list[Check]:
+    """:func:`line_checks` given the kept rows' residuals about the line
+    less their bias with the sub-pixel phase (px)."""
     rows, loc, kept = geometry.rows, geometry.locations, geometry.kept
     fraction = kept.sum() / max(rows.size, 1)
-    line = geometry.slope * rows[kept] + geometry.intercept
-    resid = without_phase_bias(loc[kept] - line, line)
     scatter = float(1.4826 * median(np.abs(resid))) if resid.size else math.inf
     limit = max(MAX_LINE_SCATTER_PX, 3.0 * expected_scatter_px)
     checks = [
