@@ -21,6 +21,15 @@ blur-widths   the blur check's widths of a chip's halves and thirds
 resample      a profile's samples resampled onto a grid
               (:func:`.stacked_resampling.resample_many`; payload: a
               :class:`.stacked_resampling.ResampleRequest`).
+line-checks   the checks of a target's line through its rows
+              (:func:`.gate.line_checks_many`; payload: the chip's
+              arguments of :func:`.gate.line_checks`).
+settled-sides the settling check of a chip's sides
+              (:func:`.settling.settled_sides_many`; payload: the chip's
+              :class:`.evidence.Evidence`).
+side-checks   the uniformity checks of a chip's sides
+              (:func:`.sides.side_checks_many`; payload: the chip's
+              arguments of :func:`.sides.side_checks`).
 """
 from __future__ import annotations
 
@@ -29,6 +38,9 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from .blur_along import group_widths_many
+from .gate import line_checks_many
+from .settling import settled_sides_many
+from .sides import side_checks_many
 from .stacked_resampling import resample_many
 
 T = TypeVar("T")
@@ -54,6 +66,9 @@ class Ask:
 ANSWERS: dict[str, Callable[[list], list]] = {
     "blur-widths": group_widths_many,
     "resample": resample_many,
+    "line-checks": line_checks_many,
+    "settled-sides": settled_sides_many,
+    "side-checks": side_checks_many,
 }
 
 Steps = Generator[Ask, Any, T]
