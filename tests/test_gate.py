@@ -393,3 +393,10 @@ def test_many_targets_lines_are_checked_as_each_alone(mixed_evidence):
     together = gate.line_checks_many(calls)
     assert together == [gate.line_checks(*call) for call in calls]
     assert len({str(checks) for checks in together}) == len(together)
+
+
+def test_many_chips_block_jumps_are_judged_as_each_alone(mixed_evidence):
+    from imgmtf.estimate.blocks import block_boundaries, block_boundaries_many
+    together = block_boundaries_many(mixed_evidence)
+    assert together == [block_boundaries(ev) for ev in mixed_evidence]
+    assert len({str(outcome) for outcome in together}) == len(together)

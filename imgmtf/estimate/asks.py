@@ -21,6 +21,9 @@ blur-widths   the blur check's widths of a chip's halves and thirds
 resample      a profile's samples resampled onto a grid
               (:func:`.stacked_resampling.resample_many`; payload: a
               :class:`.stacked_resampling.ResampleRequest`).
+block-boundaries  the block compression check of a chip's row locations
+              (:func:`.blocks.block_boundaries_many`; payload: the chip's
+              :class:`.evidence.Evidence`).
 line-checks   the checks of a target's line through its rows
               (:func:`.gate.line_checks_many`; payload: the chip's
               arguments of :func:`.gate.line_checks`).
@@ -37,6 +40,7 @@ from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+from .blocks import block_boundaries_many
 from .blur_along import group_widths_many
 from .gate import line_checks_many
 from .settling import settled_sides_many
@@ -65,6 +69,7 @@ class Ask:
 #: ask name -> function of a list of payloads returning one answer (or exception) per payload, in order
 ANSWERS: dict[str, Callable[[list], list]] = {
     "blur-widths": group_widths_many,
+    "block-boundaries": block_boundaries_many,
     "resample": resample_many,
     "line-checks": line_checks_many,
     "settled-sides": settled_sides_many,

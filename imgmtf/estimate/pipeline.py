@@ -47,6 +47,7 @@ from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
 from . import gate
 from .asks import Ask, Steps, alone
+from .blocks import block_boundaries
 from .chip import prepare_chip
 from .evidence import evidence_of
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
@@ -477,8 +478,8 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
                 window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
                 ) -> Steps[tuple[list[gate.Check], list[str]]]:
     """:func:`judge` as a generator of asks (:mod:`.asks`): the sides'
-    uniformity (``side-checks``) and settling (``settled-sides``) are
-    fitted among other chips'."""
+    uniformity (``side-checks``), settling (``settled-sides``) and block
+    jumps (``block-boundaries``) are fitted among other chips'."""
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
     contrast, quantum_dn = noise.contrast_dn, chip.quantum_dn
@@ -500,6 +501,7 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
     checks += snr_failures
     evidence = evidence_of(kind, chip, located, samples, shape, noise, blur_widths)
     settled = yield Ask("settled-sides", evidence)
+    blocks = yield Ask("block-boundaries", evidence)
     # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
     excess, sharpening_notes, _, _ = sharpening_check(
         gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)
@@ -508,7 +510,8 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
     figures = _figures_check(spectrum, first_hidden, nyquist_hidden)
     checks.append(figures)
     # the registered checks come last: a failure above (a sharpened halo) names the cause better
-    profile_checks, profile_warnings = run_profile_checks(evidence, made={settled_sides: settled})
+    profile_checks, profile_warnings = run_profile_checks(evidence, made={block_boundaries: blocks,
+                                                                                settled_sides: settled})
     checks += profile_checks
     warnings = (list(gate.enforce(checks, settings.force)) + snr_warnings + sharpening_notes + profile_warnings
                 + list(chip.warnings))
