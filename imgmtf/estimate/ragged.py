@@ -98,13 +98,22 @@ class Groups:
     def median(self, values: np.ndarray) -> np.ndarray:
         """Each group's median (the mean of the two middle values for an
         even count, as :func:`numpy.median`); NaN for an empty group."""
-        order = np.lexsort((values, self.ids))
-        ranked = values[order]
-        low = self.starts + (self.sizes - 1) // 2
-        high = self.starts + self.sizes // 2
         out = np.full(self.count, np.nan)
         full = self.sizes > 0
-        out[full] = (ranked[low[full]] + ranked[high[full]]) / 2
+        if not full.any():
+            return out
+        width = int(self.sizes.max())
+        if self.count * width <= 4 * values.size + 1024:
+            # each group sorted in a row of its own, padded past its end (a direct sort: faster than lexsort)
+            rows = np.full((self.count, width), np.inf)
+            rows[self.ids, np.arange(values.size) - self.starts[self.ids]] = values
+            rows.sort(axis=1)
+            at = np.flatnonzero(full)
+            out[full] = (rows[at, (self.sizes[full] - 1) // 2] + rows[at, self.sizes[full] // 2]) / 2
+            return out
+        ranked = values[np.lexsort((values, self.ids))]
+        low, high = (self.starts + (self.sizes - 1) // 2)[full], (self.starts + self.sizes // 2)[full]
+        out[full] = (ranked[low] + ranked[high]) / 2
         return out
 
 
