@@ -27,6 +27,9 @@ block-boundaries  the block compression check of a chip's row locations
 line-checks   the checks of a target's line through its rows
               (:func:`.gate.line_checks_many`; payload: the chip's
               arguments of :func:`.gate.line_checks`).
+saturation    the saturation checks of a chip's sides and peak
+              (:func:`.saturation.saturation_checks_many`; payload: the
+              chip's keywords of :func:`.saturation.saturation_checks`).
 settled-sides the settling check of a chip's sides
               (:func:`.settling.settled_sides_many`; payload: the chip's
               :class:`.evidence.Evidence`).
@@ -43,6 +46,7 @@ from typing import Any, TypeVar
 from .blocks import block_boundaries_many
 from .blur_along import group_widths_many
 from .gate import line_checks_many
+from .saturation import saturation_checks_many
 from .settling import settled_sides_many
 from .sides import side_checks_many
 from .stacked_resampling import resample_many
@@ -72,6 +76,7 @@ ANSWERS: dict[str, Callable[[list], list]] = {
     "block-boundaries": block_boundaries_many,
     "resample": resample_many,
     "line-checks": line_checks_many,
+    "saturation": saturation_checks_many,
     "settled-sides": settled_sides_many,
     "side-checks": side_checks_many,
 }

@@ -57,7 +57,6 @@ from .prefit import Prefit
 from .profile import read_profile_steps, rebuild_staircase, widen_profile_steps
 from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
-from .saturation import saturation_checks
 from .settings import Settings
 from .settling import settled_sides
 from .sharpening import mtf_peak, sharpening_check
@@ -478,7 +477,7 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
                 window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
                 ) -> Steps[tuple[list[gate.Check], list[str]]]:
     """:func:`judge` as a generator of asks (:mod:`.asks`): the sides'
-    uniformity (``side-checks``), settling (``settled-sides``) and block
+    saturation (``saturation``), uniformity (``side-checks``), settling (``settled-sides``) and block
     jumps (``block-boundaries``) are fitted among other chips'."""
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
@@ -487,10 +486,11 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
                   for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
     sides = kind.saturation_sides(side_masks)
     checks = list(located.checks)
-    checks += saturation_checks(distance, raw, centre, shape.scale_px, sides, chip.limits, quantum_dn,
-                                noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
-                                bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone,
-                                contrast=contrast, bar_edge_px=kind.known_half_width_px(shape))
+    checks += yield Ask("saturation", dict(
+        distance=distance, values=raw, centre=centre, rise_px=shape.scale_px, sides=sides, limits=chip.limits,
+        quantum=quantum_dn, noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
+        bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone, contrast=contrast,
+        bar_edge_px=kind.known_half_width_px(shape)))
     # each side's texture against its own pixel noise (linearisation scales it with the level)
     side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
