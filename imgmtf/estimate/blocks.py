@@ -62,14 +62,15 @@ def block_boundaries_many(evidences: Sequence[Evidence]) -> list[tuple[list[Chec
             residuals.append(None)
             continue
         line = geometry.slope * geometry.rows + geometry.intercept
-        residuals.append(geometry.locations - line)
+        residual = geometry.locations - line
+        residuals.append(residual)
         # less the locator's bias with the sub-pixel phase, which jumps where the phase wraps (every
         # 1 / tan(angle) rows: a sharpened edge's up to 0.3 px), not with an 8-row grid
         if _phase_apart_from_blocks(geometry.slope, geometry.rows.size):
-            lines.append((len(residuals) - 1, line, geometry.kept))
-    biases = phase_bias_many([(residuals[k], line, kept) for k, line, kept in lines])
-    for (k, _, _), bias in zip(lines, biases):
-        residuals[k] = residuals[k] - bias
+            lines.append((len(residuals) - 1, residual, line, geometry.kept))
+    biases = phase_bias_many([(residual, line, kept) for _, residual, line, kept in lines])
+    for (k, residual, _, _), bias in zip(lines, biases):
+        residuals[k] = residual - bias
     return [_block_jumps(ev, residual) for ev, residual in zip(evidences, residuals)]
 
 

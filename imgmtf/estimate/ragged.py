@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 class Groups:
@@ -43,7 +44,7 @@ class Groups:
     [3.0, 0.0, 12.0]
     """
 
-    def __init__(self, sizes: Sequence[int] | np.ndarray):
+    def __init__(self, sizes: ArrayLike):
         self.sizes = np.asarray(sizes, dtype=np.intp).reshape(-1)
         self.count = int(self.sizes.size)
         self.starts = np.zeros(self.count, np.intp)
@@ -63,13 +64,13 @@ class Groups:
         """``values`` to each group's power ``exponents`` (one a group), each
         exponent a scalar as a group alone raises it (NumPy's ``x ** -2.0``
         is not its ``x ** array`` to the bit, nor as fast)."""
-        exponents = np.asarray(exponents, float)
-        distinct = np.unique(exponents)
+        each = np.asarray(exponents, float)
+        distinct = np.unique(each)
         if distinct.size == 1:
             return values ** float(distinct[0])
         out = np.empty_like(values)
         for exponent in distinct:
-            take = self.spread(exponents == exponent)
+            take = self.spread(each == exponent)
             out[take] = values[take] ** float(exponent)
         return out
 
