@@ -559,13 +559,15 @@ def _image_kind(path: str) -> str | None:
 
 
 def _band(src, index: int, window: Window, out_shape=None) -> np.ndarray:
-    """Band ``index`` as float64 with nodata (mask) set to NaN."""
+    """Band ``index`` as float64, nodata (mask) NaN; no mask read where GDAL says all is valid."""
+    masked = rasterio.enums.MaskFlags.all_valid not in src.mask_flag_enums[index - 1]
     try:
-        values = src.read(index, window=window, masked=True, out_shape=out_shape)
+        values = src.read(index, window=window, masked=masked, out_shape=out_shape)
     except GDAL_ERRORS as exc:
         raise ImageReadError(f"{src.name}: the file is damaged or truncated ({_reason(exc)})") from None
-    data = values.data.astype(np.float64)
-    data[np.ma.getmaskarray(values)] = np.nan
+    data = (values.data if masked else values).astype(np.float64)
+    if masked:
+        data[np.ma.getmaskarray(values)] = np.nan
     return data
 
 

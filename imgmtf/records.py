@@ -472,8 +472,9 @@ class JsonRows:
         if run:
             pieces.append(ENCODER.encode(run)[1:-1])
         text = "{" + ", ".join(pieces) + "}"
-        # a NaN, infinity or -0.0 among the other values: the whole row the safe way
-        return dumps_safe(row) if has_unsafe_value(text) else text
+        # a NaN, infinity or -0.0 among the other values: the whole row the safe way (made safe first:
+        # dumps_safe(row) would encode the row again only to find what this text already shows)
+        return dumps_safe(json_safe(row)) if has_unsafe_value(text) else text
 
     def _text(self, key: str, value) -> str | None:
         """``"key": value`` as JSON when ``value`` is a list of floats,
