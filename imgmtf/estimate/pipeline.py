@@ -333,18 +333,8 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: 
 def locate_target_steps(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: Prefit | None = None
                         ) -> Steps[Located]:
     """:func:`locate_target` as a generator of asks (:mod:`.asks`): the
-    line's checks (``line-checks``) are made among other chips'.
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.chip import prepare_chip
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> steps = locate_target_steps(EdgeKind(), prepare_chip(chip.image, make_settings()))
-    >>> next(steps).name
-    'line-checks'
+    line's checks (``line-checks``) are made among other chips' (its
+    Examples: :func:`locate_target`, a batch of one).
     """
     checks = list(chip.checks)
     try:
@@ -490,23 +480,8 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
                 ) -> Steps[tuple[list[gate.Check], list[str]]]:
     """:func:`judge` as a generator of asks (:mod:`.asks`): the sides'
     saturation (``saturation``), uniformity (``side-checks``), settling (``settled-sides``) and block
-    jumps (``block-boundaries``) are fitted among other chips'.
-
-    Examples
-    --------
-    >>> import imgmtf
-    >>> from imgmtf.estimate.edge import EdgeKind
-    >>> from imgmtf.estimate.settings import make_settings
-    >>> chip = imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", 6.0), 60, noise_std_dn=2.0, seed=1)
-    >>> m = run(EdgeKind(), chip.image, make_settings())
-    >>> e = m.estimate
-    >>> steps = judge_steps(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window, e.spectrum,
-    ...                     make_settings())
-    >>> next(steps).name
-    'saturation'
-    >>> alone(judge_steps(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window, e.spectrum,
-    ...                   make_settings()))[0] == list(m.checks)
-    True
+    jumps (``block-boundaries``) are fitted among other chips' (its
+    Examples: :func:`judge`, a batch of one).
     """
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
