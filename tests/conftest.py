@@ -120,3 +120,32 @@ def olpf_transfer(split_px, angle_deg):
 
 def product(*transfers):
     return lambda f: np.prod([t(f) for t in transfers], axis=0)
+
+
+@pytest.fixture(scope="session")
+def mixed_evidence():
+    """What the gate reads (:class:`imgmtf.estimate.evidence.Evidence`) of a
+    few unlike chips: noise-free and noisy edges, a shaded side, a bar, an
+    8-bit edge; for checks made for many chips at once against each alone."""
+    from imgmtf.estimate.asks import answer
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.pipeline import run_steps
+    from imgmtf.estimate.pulse import PulseKind
+    from imgmtf.estimate.settings import make_settings
+
+    def edge(angle, noise, seed=1, bits=16, shade=0.0):
+        image = im.render(im.Sensor(), im.Target("edge", angle), 60, noise_std_dn=noise, seed=seed,
+                          bits=bits).image.astype(float)
+        return image + shade * np.arange(image.shape[1])[None, :]
+
+    bar = im.render(im.Sensor(), im.Target("pulse", 4.0, width_px=3.0), 60, noise_std_dn=2.0, seed=2).image
+    chips = [(EdgeKind(), edge(5.0, 0.0)), (EdgeKind(), edge(8.0, 2.0)), (EdgeKind(), edge(3.0, 4.0, shade=2.0)),
+             (PulseKind(), bar), (EdgeKind(), np.clip(edge(7.0, 1.0) / 6.0, 0, 255))]
+    evidence = []
+    for kind, image in chips:
+        steps = run_steps(kind, image, make_settings(force=True))
+        ask = next(steps)
+        while ask.name != "settled-sides":          # its asks answered alone up to the gate's
+            ask = steps.send(answer(ask.name, [ask.payload])[0])
+        evidence.append(ask.payload)
+    return evidence

@@ -10,6 +10,7 @@ from scipy.special import erf
 import imgmtf as im
 from imgmtf.errors import ImgmtfError, MultipleTargetsError, TargetNotFoundError
 from imgmtf.estimate import gate
+from imgmtf.estimate.sides import side_checks
 
 from conftest import exact_edge_chip, exact_esf, gaussian_pixel_transfer
 
@@ -358,7 +359,7 @@ def test_checks_with_nothing_to_judge_are_not_run_rather_than_passed():
     # 30 samples each side spread 1 per 0.2 px over 6 px: no 1-px band holds 10, no second feature looked for
     d = np.r_[-np.arange(3.0, 9.0, 0.2), np.arange(3.0, 9.0, 0.2)]
     values = np.where(d < 0, 200.0, 1200.0)
-    checks = gate.side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
+    checks = side_checks(d, values, np.arange(d.size, dtype=float), 0.0, 2.0, 1000.0, 1.0, 1)
     second = [c for c in checks if c.reason == "two-targets"]
     assert len(second) == 2 and all(c.outcome == "not-run" for c in second)
     assert all(c.outcome == "passed" for c in checks if c.reason == "non-uniform")
@@ -385,3 +386,17 @@ def test_every_message_of_a_noise_free_chip_stands_under_rounding(monkeypatch):
     plain = messages()
     monkeypatch.setattr(geometry, "_straight_line", lambda y, x: tuple(float(v) for v in np.polyfit(y, x, 1)))
     assert messages() == plain
+
+
+def test_many_targets_lines_are_checked_as_each_alone(mixed_evidence):
+    calls = [(ev.geometry, 0.05, ev.name) for ev in mixed_evidence]
+    together = gate.line_checks_many(calls)
+    assert together == [gate.line_checks(*call) for call in calls]
+    assert len({str(checks) for checks in together}) == len(together)
+
+
+def test_many_chips_block_jumps_are_judged_as_each_alone(mixed_evidence):
+    from imgmtf.estimate.blocks import block_boundaries, block_boundaries_many
+    together = block_boundaries_many(mixed_evidence)
+    assert together == [block_boundaries(ev) for ev in mixed_evidence]
+    assert len({str(outcome) for outcome in together}) == len(together)

@@ -2,7 +2,7 @@
 repeats with the phase, noise and a bend left as they are."""
 import numpy as np
 
-from imgmtf.estimate.phase import phase_bias, without_phase_bias
+from imgmtf.estimate.phase import phase_bias, phase_bias_many, without_phase_bias
 
 
 def test_a_bias_that_repeats_with_the_phase_is_removed_and_noise_is_not():
@@ -20,3 +20,15 @@ def test_a_bias_that_repeats_with_the_phase_is_removed_and_noise_is_not():
     wild[10] += 5.0
     assert abs(phase_bias(wild, line)[20] - bias[20]) < 0.02
     assert not phase_bias(bias[:10], line[:10]).any()
+
+
+def test_many_targets_biases_are_each_alone():
+    rng = np.random.default_rng(2)
+    calls = []
+    for slope, rows in ((0.105, 100), (0.2, 60), (0.03, 15), (0.07, 80)):
+        line = slope * np.arange(float(rows))
+        fit = rng.uniform(size=rows) > 0.1
+        calls.append((0.2 * np.sin(2 * np.pi * line) + rng.normal(0, 0.1, rows), line, fit))
+    together = phase_bias_many(calls)
+    assert all(np.array_equal(a, phase_bias(*call)) for a, call in zip(together, calls))
+    assert not together[2].any() and all(a.any() for k, a in enumerate(together) if k != 2)

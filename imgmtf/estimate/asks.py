@@ -29,6 +29,21 @@ blur-widths   the blur check's widths of a chip's halves and thirds
 resample      a profile's samples resampled onto a grid
               (:func:`.stacked_resampling.resample_many`; payload: a
               :class:`.stacked_resampling.ResampleRequest`).
+block-boundaries  the block compression check of a chip's row locations
+              (:func:`.blocks.block_boundaries_many`; payload: the chip's
+              :class:`.evidence.Evidence`).
+line-checks   the checks of a target's line through its rows
+              (:func:`.gate.line_checks_many`; payload: the chip's
+              arguments of :func:`.gate.line_checks`).
+saturation    the saturation checks of a chip's sides and peak
+              (:func:`.saturation.saturation_checks_many`; payload: the
+              chip's keywords of :func:`.saturation.saturation_checks`).
+settled-sides the settling check of a chip's sides
+              (:func:`.settling.settled_sides_many`; payload: the chip's
+              :class:`.evidence.Evidence`).
+side-checks   the uniformity checks of a chip's sides
+              (:func:`.sides.side_checks_many`; payload: the chip's
+              arguments of :func:`.sides.side_checks`).
 """
 from __future__ import annotations
 
@@ -36,7 +51,12 @@ from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+from .blocks import block_boundaries_many
 from .blur_along import group_widths_many
+from .gate import line_checks_many
+from .saturation import saturation_checks_many
+from .settling import settled_sides_many
+from .sides import side_checks_many
 from .stacked_resampling import resample_many
 
 T = TypeVar("T")
@@ -61,7 +81,12 @@ class Ask:
 #: ask name -> function of a list of payloads returning one answer (or exception) per payload, in order
 ANSWERS: dict[str, Callable[[list], list]] = {
     "blur-widths": group_widths_many,
+    "block-boundaries": block_boundaries_many,
     "resample": resample_many,
+    "line-checks": line_checks_many,
+    "saturation": saturation_checks_many,
+    "settled-sides": settled_sides_many,
+    "side-checks": side_checks_many,
 }
 
 Steps = Generator[Ask, Any, T]

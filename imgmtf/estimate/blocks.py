@@ -13,12 +13,13 @@ rows.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from .evidence import Evidence
 from .gate import Check, not_run
-from .phase import PHASE_HARMONICS, phase_bias
+from .phase import PHASE_HARMONICS, phase_bias_many
 
 BLOCK_PX = 8
 MIN_BOUNDARIES = 6             # boundary jumps needed to judge
@@ -33,17 +34,52 @@ def block_boundaries(ev: Evidence) -> tuple[list[Check], list[str]]:
     """The row-to-row jumps of the target's location, by the rows' phase
     in an 8-row block grid: where one phase's mean jump stands out above
     the others', the codec's blocks shape the target.  Returns the
-    ``compression`` check and a warning for visible but smaller blocks."""
-    geometry = ev.geometry
-    if geometry is None:
-        return [not_run("compression", f"the {ev.name}'s row locations are not known")], []
-    rows, kept = geometry.rows, geometry.kept
-    line = geometry.slope * rows + geometry.intercept
-    residual = geometry.locations - line
-    if _phase_apart_from_blocks(geometry.slope, rows.size):
+    ``compression`` check and a warning for visible but smaller blocks.
+    A batch of one of :func:`block_boundaries_many`."""
+    return block_boundaries_many([ev])[0]
+
+
+def block_boundaries_many(evidences: Sequence[Evidence]) -> list[tuple[list[Check], list[str]]]:
+    """:func:`block_boundaries` of many chips, their rows' biases with the
+    sub-pixel phase fitted together (:func:`.phase.phase_bias_many`): each
+    chip's outcome the same, to the bit, as alone.
+
+    Parameters
+    ----------
+    evidences : sequence of Evidence
+        The chips' samples, shapes and geometries.
+
+    Returns
+    -------
+    list of (list of Check, list of str)
+        Each chip's check and warnings, in order.
+    """
+    residuals: list[np.ndarray | None] = []
+    lines = []
+    for ev in evidences:
+        geometry = ev.geometry
+        if geometry is None:
+            residuals.append(None)
+            continue
+        line = geometry.slope * geometry.rows + geometry.intercept
+        residual = geometry.locations - line
+        residuals.append(residual)
         # less the locator's bias with the sub-pixel phase, which jumps where the phase wraps (every
         # 1 / tan(angle) rows: a sharpened edge's up to 0.3 px), not with an 8-row grid
-        residual = residual - phase_bias(residual, line, kept)
+        if _phase_apart_from_blocks(geometry.slope, geometry.rows.size):
+            lines.append((len(residuals) - 1, residual, line, geometry.kept))
+    biases = phase_bias_many([(residual, line, kept) for _, residual, line, kept in lines])
+    for (k, residual, _, _), bias in zip(lines, biases):
+        residuals[k] = residual - bias
+    return [_block_jumps(ev, residual) for ev, residual in zip(evidences, residuals)]
+
+
+def _block_jumps(ev: Evidence, residual: np.ndarray | None) -> tuple[list[Check], list[str]]:
+    """:func:`block_boundaries` given the rows' ``residual`` about the line
+    (px; less their phase bias where it is told from the blocks)."""
+    if residual is None or ev.geometry is None:
+        return [not_run("compression", f"the {ev.name}'s row locations are not known")], []
+    rows, kept = ev.geometry.rows, ev.geometry.kept
     adjacent = kept[:-1] & kept[1:] & (np.diff(rows) == 1)
     jumps = np.abs(np.diff(residual))[adjacent]
     phase = (rows[:-1] % BLOCK_PX)[adjacent]

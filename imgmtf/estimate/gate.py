@@ -16,7 +16,7 @@ warnings.  Reasons:
 ``not-straight``          the per-row locations do not lie on one line (no
                           edge at all, a curved edge, texture)
 ``two-targets``           a second edge or bar beside the target
-``non-uniform``           a side with a level trend or texture, a level
+``non-uniform``           a side with a level trend or texture (:mod:`.sides`), a level
                           that curves or never settles
                           (:mod:`.settling`)
 ``varying-blur``          the blur changes along the target
@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import MultipleTargetsError, UnsuitableTargetError
 from ._order import median
 from .bar_pair import PAIR_REASON, pair_in_profile
-from .phase import without_phase_bias
+from .phase import phase_bias_many
 
 MIN_ROWS = 20                   # fewer rows: the row-location line and the profile are unstable
 MIN_SNR = 8.0                   # below this an edge's MTF at Nyquist is mostly noise (about +-0.1)
@@ -287,11 +287,38 @@ def line_checks(geometry, expected_scatter_px: float, name: str) -> list[Check]:
     """Does the target run straight through the rows?  The kept fraction of
     rows, their robust scatter about the line beyond what their sub-pixel
     phase explains (against what the pixel noise explains), and the bow of
-    a quadratic through them."""
+    a quadratic through them.  A batch of one of :func:`line_checks_many`."""
+    return line_checks_many([(geometry, expected_scatter_px, name)])[0]
+
+
+def line_checks_many(calls) -> list[list[Check]]:
+    """:func:`line_checks` of many targets, their rows' biases with the
+    sub-pixel phase fitted together (:func:`.phase.phase_bias_many`): each
+    target's checks the same, to the bit, as alone.
+
+    Parameters
+    ----------
+    calls : sequence of tuple
+        Each target's arguments of :func:`line_checks` (its geometry, the
+        scatter its noise explains, px, and its name).
+
+    Returns
+    -------
+    list of list of Check
+        Each target's checks, in order.
+    """
+    lines = [geometry.slope * geometry.rows[geometry.kept] + geometry.intercept for geometry, _, _ in calls]
+    away = [geometry.locations[geometry.kept] - line for (geometry, _, _), line in zip(calls, lines)]
+    biases = phase_bias_many([(resid, line, None) for resid, line in zip(away, lines)])
+    return [_line_checks(geometry, expected, name, resid - bias)
+            for (geometry, expected, name), resid, bias in zip(calls, away, biases)]
+
+
+def _line_checks(geometry, expected_scatter_px: float, name: str, resid: np.ndarray) -> list[Check]:
+    """:func:`line_checks` given the kept rows' residuals about the line
+    less their bias with the sub-pixel phase (px)."""
     rows, loc, kept = geometry.rows, geometry.locations, geometry.kept
     fraction = kept.sum() / max(rows.size, 1)
-    line = geometry.slope * rows[kept] + geometry.intercept
-    resid = without_phase_bias(loc[kept] - line, line)
     scatter = float(1.4826 * median(np.abs(resid))) if resid.size else math.inf
     limit = max(MAX_LINE_SCATTER_PX, 3.0 * expected_scatter_px)
     checks = [
@@ -394,62 +421,6 @@ def beyond_rounding(share: float) -> float:
     (0.0, 0.0, 0.02)
     """
     return float(share) if abs(share) > ROUNDING_SHARE else 0.0
-
-
-def side_checks(distance, values, along, centre, start_px, contrast, pixel_noise, tail_power,
-                names: tuple[str, str] = ("left", "right")) -> list[Check]:
-    """Uniform sides: each side's samples beyond ``start_px`` from the
-    centre fitted with its level, its tail (a / |s|^p), a trend across and
-    a trend along the target; a trend over the side larger than
-    ``MAX_SIDE_TREND`` of the contrast, texture beyond the pixel noise, or
-    a 1-px band far off the model (another edge or bar) fail.
-    ``pixel_noise`` (DN): one for both sides, or (left, right) where it
-    differs (linearised values: the stored noise scaled at each level);
-    ``names`` what the left and right sides are called ("dark", "bright")."""
-    checks = []
-    s = distance - centre
-    noises = tuple(pixel_noise) if np.ndim(pixel_noise) else (pixel_noise, pixel_noise)
-    for (name, mask), pixel_noise in zip(((names[0], s <= -start_px), (names[1], s >= start_px)), noises):
-        if mask.sum() < 20:
-            # the sides' settling check (:mod:`.settling`) refuses a side without a plateau
-            checks.append(not_run("non-uniform", f"the {name} side holds {int(mask.sum())} samples beyond "
-                                  f"{start_px:.1f} px (20 needed): its trend and texture not measured"))
-            continue
-        ss, v, t = np.abs(s[mask]), values[mask], along[mask]
-        design = np.column_stack([np.ones_like(ss), ss ** -tail_power, ss - ss.mean(), t - t.mean()])
-        coef, *_ = np.linalg.lstsq(design, v, rcond=None)
-        resid = v - design @ coef
-        across, along_target = (beyond_rounding(abs(coef[2]) * np.ptp(ss) / contrast),
-                                beyond_rounding(abs(coef[3]) * np.ptp(t) / contrast))
-        trend, way = max((across, "across"), (along_target, "along"))
-        scatter = np.var(resid)
-        texture = math.sqrt(max(scatter - pixel_noise ** 2, 0.0)) / contrast
-        bands = np.floor(ss).astype(int)
-        counts = np.bincount(bands)
-        sums = np.bincount(bands, weights=resid)
-        full = counts >= 10
-        band_means = np.abs(sums[full] / counts[full])
-        band_means[band_means <= ROUNDING_SHARE * abs(contrast)] = 0.0     # a flat side's: rounding, no feature
-        band_noise = np.sqrt(scatter / counts[full])
-        checks += [
-            Check("non-uniform", trend <= MAX_SIDE_TREND,
-                  f"the {name} side's level drifts by {100 * trend:.0f} % of the contrast {way} the target (at "
-                  f"most {100 * MAX_SIDE_TREND:g} %): not a uniform field", trend, MAX_SIDE_TREND),
-            Check("non-uniform", texture <= MAX_SIDE_TEXTURE,
-                  f"the {name} side carries texture of {100 * texture:.0f} % of the contrast beyond the "
-                  f"pixel noise (at most {100 * MAX_SIDE_TEXTURE:g} %): not a uniform field",
-                  texture, MAX_SIDE_TEXTURE),
-        ]
-        if not full.any():
-            checks.append(not_run("two-targets", f"no 1-px band of the {name} side holds 10 samples: a second "
-                                  "feature there not looked for"))
-            continue
-        worst = int(np.argmax(band_means - 5 * band_noise))
-        second = float(band_means[worst]) / contrast if band_means[worst] > 5 * band_noise[worst] else 0.0
-        checks.append(Check("two-targets", second <= MAX_SECOND_FEATURE,
-                            f"another feature lies on the {name} side, {np.nonzero(full)[0][worst]} px from the "
-                            f"target ({100 * second:.0f} % of the contrast)", second, MAX_SECOND_FEATURE))
-    return checks
 
 
 def snr_checks(snr: float, threshold: float, rows: int, name: str) -> tuple[list[Check], list[str]]:

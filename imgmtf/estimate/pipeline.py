@@ -47,6 +47,7 @@ from ..errors import ImgmtfError, TargetNotFoundError, UnsuitableTargetError
 from ..metrics import fwhm
 from . import gate
 from .asks import Ask, Steps, alone
+from .blocks import block_boundaries
 from .chip import prepare_chip
 from .evidence import evidence_of
 from .geometry import TargetGeometry, check_angle, direction_label, profile_samples, vertical_frame
@@ -56,8 +57,8 @@ from .prefit import Prefit
 from .profile import read_profile_steps, rebuild_staircase, widen_profile_steps
 from .profile_checks import run_profile_checks
 from .resampling import Resampled, resample_profile
-from .saturation import saturation_checks
 from .settings import Settings
+from .settling import settled_sides
 from .sharpening import mtf_peak, sharpening_check
 from .spectrum import (
     MIN_TRANSFER,
@@ -231,7 +232,7 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
     ``chip_options``: :func:`run`'s keywords of the chip (``roi``, ``mask``...)."""
     chip = prefit.chip if prefit is not None else prepare_chip(image, settings, **chip_options)
     try:
-        located = locate_target(kind, chip, force=settings.force, prefit=prefit)
+        located = yield from locate_target_steps(kind, chip, force=settings.force, prefit=prefit)
         samples = rebuild_staircase(kind, located.samples, chip.quantum_dn)
         read, shape = yield from read_profile_steps(kind, samples, settings, located.checks)
         noise = measure_noise(kind, samples, shape, chip.quantum_dn)
@@ -240,8 +241,8 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
         lsf = blend_tails(kind, samples, profile, shape, window)
         spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
         blur_widths = yield Ask("blur-widths", evidence_of(kind, chip, located, samples, shape, noise))
-        checks, warnings = judge(kind, chip, located, samples, shape, noise, window, spectrum, settings,
-                                 blur_widths=blur_widths)
+        checks, warnings = yield from judge_steps(kind, chip, located, samples, shape, noise, window, spectrum,
+                                                  settings, blur_widths=blur_widths)
     except ImgmtfError as exc:
         raise _points_instead(exc, kind, chip, image) from None
     estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
@@ -326,6 +327,15 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: 
     >>> located.rows_used, located.geometry.slope == m.located.geometry.slope
     (60, True)
     """
+    return alone(locate_target_steps(kind, chip, force=force, prefit=prefit))
+
+
+def locate_target_steps(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: Prefit | None = None
+                        ) -> Steps[Located]:
+    """:func:`locate_target` as a generator of asks (:mod:`.asks`): the
+    line's checks (``line-checks``) are made among other chips' (its
+    Examples: :func:`locate_target`, a batch of one).
+    """
     checks = list(chip.checks)
     try:
         line, seed_checks = kind.seed(chip.pixels, chip.noise_dn) if prefit is None else prefit.seeded()
@@ -343,7 +353,7 @@ def locate_target(kind: TargetKind, chip: Chip, *, force: bool = False, prefit: 
         if not force:
             gate.enforce(checks, force=False)
         raise
-    checks += gate.line_checks(geometry, geometry.location_sd_px, kind.name)
+    checks += yield Ask("line-checks", (geometry, geometry.location_sd_px, kind.name))
     checks.append(gate.rows_check(int(geometry.kept.sum()), kind.name))
     return Located(geometry, transposed, int(frame.shape[0]), Samples(distance, values, values, rows, half_range),
                    tuple(checks))
@@ -461,6 +471,18 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     >>> all(check.passed for check in checks), warnings
     (True, [])
     """
+    return alone(judge_steps(kind, chip, located, samples, shape, noise, window, spectrum, settings,
+                             blur_widths=blur_widths))
+
+
+def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
+                window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
+                ) -> Steps[tuple[list[gate.Check], list[str]]]:
+    """:func:`judge` as a generator of asks (:mod:`.asks`): the sides'
+    saturation (``saturation``), uniformity (``side-checks``), settling (``settled-sides``) and block
+    jumps (``block-boundaries``) are fitted among other chips' (its
+    Examples: :func:`judge`, a batch of one).
+    """
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
     contrast, quantum_dn = noise.contrast_dn, chip.quantum_dn
@@ -468,19 +490,22 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
                   for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
     sides = kind.saturation_sides(side_masks)
     checks = list(located.checks)
-    checks += saturation_checks(distance, raw, centre, shape.scale_px, sides, chip.limits, quantum_dn,
-                                noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
-                                bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone,
-                                contrast=contrast, bar_edge_px=kind.known_half_width_px(shape))
+    checks += yield Ask("saturation", dict(
+        distance=distance, values=raw, centre=centre, rise_px=shape.scale_px, sides=sides, limits=chip.limits,
+        quantum=quantum_dn, noise_free=noise.noise_dn <= max(1.5 * quantum_dn / math.sqrt(12.0), 1e-9 * contrast),
+        bright_core=kind.peak_mask(offsets, shape), monotone=kind.monotone, contrast=contrast,
+        bar_edge_px=kind.known_half_width_px(shape)))
     # each side's texture against its own pixel noise (linearisation scales it with the level)
     side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
-    checks += gate.side_checks(distance, raw, samples.rows.astype(float), centre, shape.plateau_px, contrast,
-                               side_noise, kind.tail_power, (side_names[0], side_names[1]))
+    checks += yield Ask("side-checks", (distance, raw, samples.rows.astype(float), centre, shape.plateau_px,
+                                        contrast, side_noise, kind.tail_power, (side_names[0], side_names[1])))
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
     evidence = evidence_of(kind, chip, located, samples, shape, noise, blur_widths)
+    settled = yield Ask("settled-sides", evidence)
+    blocks = yield Ask("block-boundaries", evidence)
     # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
     excess, sharpening_notes, _, _ = sharpening_check(
         gate.mtf_excess_check(spectrum.mtf, spectrum.noise_sd, spectrum.noise_limit_cy_px), spectrum, evidence)
@@ -489,7 +514,8 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     figures = _figures_check(spectrum, first_hidden, nyquist_hidden)
     checks.append(figures)
     # the registered checks come last: a failure above (a sharpened halo) names the cause better
-    profile_checks, profile_warnings = run_profile_checks(evidence)
+    profile_checks, profile_warnings = run_profile_checks(evidence, made={block_boundaries: blocks,
+                                                                                settled_sides: settled})
     checks += profile_checks
     warnings = (list(gate.enforce(checks, settings.force)) + snr_warnings + sharpening_notes + profile_warnings
                 + list(chip.warnings))

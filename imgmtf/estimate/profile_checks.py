@@ -17,12 +17,15 @@ ProfileCheck = Callable[[Evidence], tuple[list[Check], list[str]]]
 PROFILE_CHECKS: tuple[ProfileCheck, ...] = (block_boundaries, settled_sides, uniform_blur)
 
 
-def run_profile_checks(evidence: Evidence) -> tuple[list[Check], list[str]]:
-    """Every registered check's outcome on ``evidence``: (checks, warnings)."""
+def run_profile_checks(evidence: Evidence, made: dict[ProfileCheck, tuple[list[Check], list[str]]] | None = None
+                       ) -> tuple[list[Check], list[str]]:
+    """Every registered check's outcome on ``evidence``: (checks, warnings).
+    ``made``: the outcomes of checks already made on it (among other
+    chips', :mod:`.asks`), by check."""
     checks: list[Check] = []
     warnings: list[str] = []
     for check in PROFILE_CHECKS:
-        more_checks, more_warnings = check(evidence)
+        more_checks, more_warnings = made[check] if made and check in made else check(evidence)
         checks += more_checks
         warnings += more_warnings
     return checks, warnings

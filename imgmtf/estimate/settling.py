@@ -19,11 +19,13 @@ absorb either as blur (the MTF reads low, in the issue's case 0.04 for
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from .evidence import Evidence
 from .gate import ROUNDING_SHARE, Check, beyond_rounding, not_run
+from .ragged import Groups
 
 MIN_SIDE_SAMPLES = 40
 MIN_SIDE_EXTENT_PX = 4.0       # a side spanning less beyond the plateau's start is too short to see curve...
@@ -46,9 +48,47 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
 
     Returns the checks (reason ``non-uniform``) and the warnings for
     departures too small to refuse but larger than the estimate ignores.
+    The chip's sides are fitted as a batch of one
+    (:func:`settled_sides_many`).
     """
-    s = ev.distance_px - ev.centre_px
-    fits = [_side_fit(ev, s, mask) for mask in (s <= -ev.plateau_px, s >= ev.plateau_px)]
+    return settled_sides_many([ev])[0]
+
+
+def settled_sides_many(evidences: Sequence[Evidence]) -> list[tuple[list[Check], list[str]]]:
+    """:func:`settled_sides` of many chips, their sides fitted together
+    (:mod:`.ragged`): each chip's outcome the same, to the bit, as alone.
+
+    Parameters
+    ----------
+    evidences : sequence of Evidence
+        The chips' samples and shapes.
+
+    Returns
+    -------
+    list of (list of Check, list of str)
+        Each chip's checks and warnings, in order.
+
+    Examples
+    --------
+    >>> import imgmtf
+    >>> from imgmtf.estimate.edge import EdgeKind
+    >>> from imgmtf.estimate.evidence import evidence_of
+    >>> from imgmtf.estimate.pipeline import run
+    >>> from imgmtf.estimate.settings import make_settings
+    >>> chips = [imgmtf.render(imgmtf.Sensor(), imgmtf.Target("edge", a), 60, noise_std_dn=2.0, seed=1).image
+    ...          for a in (5.0, 8.0)]
+    >>> ms = [run(EdgeKind(), c, make_settings()) for c in chips]
+    >>> evs = [evidence_of(EdgeKind(), m.chip, m.located, m.estimate.samples, m.shape, m.noise) for m in ms]
+    >>> settled_sides_many(evs) == [settled_sides(ev) for ev in evs]
+    True
+    """
+    fits = _side_fits(evidences)
+    return [_verdicts(ev, fits[2 * k: 2 * k + 2]) for k, ev in enumerate(evidences)]
+
+
+def _verdicts(ev: Evidence, fits: list[dict | Check]) -> tuple[list[Check], list[str]]:
+    """A chip's settling checks and warnings from its two sides' fits
+    (:func:`_side_fits`)."""
     checks: list[Check] = []
     warnings: list[str] = []
     for name, fit in zip(ev.side_names, fits):
@@ -97,8 +137,9 @@ def settled_sides(ev: Evidence) -> tuple[list[Check], list[str]]:
     return checks, warnings
 
 
-def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
-    """One side's level + A / |s|^p fit: its smooth departure (DN, its
+def _side_fits(evidences: Sequence[Evidence]) -> list[dict | Check]:
+    """Every chip's two sides' level + A / |s|^p fits (left, right, chip
+    after chip), made together: each side's smooth departure (DN, its
     standard deviation, where, px; None where the side holds too few bands
     to see a curve) and its unsettled share at the side's start (fraction
     of the contrast towards the other level, and its sd).  Where no fit
@@ -107,66 +148,121 @@ def _side_fit(ev: Evidence, s: np.ndarray, mask: np.ndarray) -> dict | Check:
     the chip (too few samples, too short a span beyond ``plateau_px``:
     a level still changing there reads as blur, and nothing would
     show it), not run where the fit is ill-conditioned."""
-    side = s[mask]
-    count = side.size
+    side_s, side_v, owner = [], [], []
+    for ev in evidences:
+        s = ev.distance_px - ev.centre_px
+        for mask in (s <= -ev.plateau_px, s >= ev.plateau_px):
+            side_s.append(s[mask])
+            side_v.append(ev.values[mask])
+            owner.append(ev)
+    sides = Groups([side.size for side in side_s])
+    side = np.concatenate(side_s) if side_s else np.empty(0)
     reach = np.abs(side)
-    extent = float(reach.max() - reach.min()) if count else 0.0
-    if count < MIN_SIDE_SAMPLES or extent < MIN_PLATEAU_PX:
-        return Check("non-uniform", False,
-                     f"the {{name}} side holds no plateau within the chip: {count} samples over {extent:.1f} px lie "
-                     f"beyond {ev.plateau_px:.1f} px from the {ev.name} (at least {MIN_SIDE_SAMPLES} over "
-                     f"{MIN_PLATEAU_PX:g} px needed to see it settle): its level may still be changing "
-                     "(illumination, a slope) and would read as blur; crop wider or choose a flatter side")
-    v = ev.values[mask]
-    u = reach ** -float(ev.tail_power)
+    counts = sides.sizes
+    far, nearest = sides.extreme(reach, True), sides.extreme(reach, False)
+    extent = np.where(counts > 0, far - nearest, 0.0)
+    out: list[dict | Check | None] = [None] * sides.count
+    for g in np.flatnonzero((counts < MIN_SIDE_SAMPLES) | (extent < MIN_PLATEAU_PX)):
+        ev = owner[g]
+        out[g] = Check("non-uniform", False,
+                       f"the {{name}} side holds no plateau within the chip: {counts[g]} samples over "
+                       f"{extent[g]:.1f} px lie beyond {ev.plateau_px:.1f} px from the {ev.name} (at least "
+                       f"{MIN_SIDE_SAMPLES} over {MIN_PLATEAU_PX:g} px needed to see it settle): its level may "
+                       "still be changing (illumination, a slope) and would read as blur; crop wider or choose "
+                       "a flatter side")
+    fitted = np.array([o is None for o in out], bool)
+    if not fitted.any():
+        return out      # type: ignore[return-value]   # every place filled
+    keep = sides.spread(fitted)
+    fits = Groups(counts[fitted])
+    owners = [owner[g] for g in np.flatnonzero(fitted)]
+    side, reach, v = side[keep], reach[keep], np.concatenate(side_v)[keep]
+    u = fits.power(reach, [-float(ev.tail_power) for ev in owners])
+    n = fits.sizes.astype(float)
     # the straight line in u in closed form about its mean: the normal
     # matrix [[n, sum u], [sum u, sum u^2]] has determinant n * spread
-    mean_u = float(u.sum()) / count
-    centred = u - mean_u
-    spread = float(centred @ centred)
-    n = u.size
+    mean_u = fits.sum(u) / n
+    centred = u - fits.spread(mean_u)
+    spread = fits.sum(centred * centred)
     trace = n + spread + n * mean_u ** 2
-    largest = 0.5 * (trace + math.hypot(n - spread - n * mean_u ** 2, 2.0 * n * mean_u))
-    if not spread > 0 or largest ** 2 > 1e12 * n * spread:      # its condition number, largest^2 / det
-        return not_run("non-uniform", "the {name} side's level and tail cannot be told apart (its samples span "
-                       "too little of the tail): its settling not judged")
-    coef = np.empty(2)
-    coef[1] = float(centred @ v) / spread
-    coef[0] = float(v.sum()) / count - coef[1] * mean_u
-    resid = v - (coef[0] + coef[1] * u)
-    sigma2 = max(float(resid @ resid) / max(resid.size - 2, 1), ev.quantum ** 2 / 12.0)
-    # the model's own noise: its tail at the side's start, towards the target's other level
-    start_u = ev.plateau_px ** -float(ev.tail_power)
-    towards = _towards_target(ev, left=bool(side[0] < 0))
-    tail_cov = sigma2 / spread                      # the slope's variance, (M^-1)[1, 1] sigma^2
-    unsettled = (beyond_rounding(towards * coef[1] * start_u / ev.contrast),
-                 math.sqrt(tail_cov) * start_u / ev.contrast)
+    largest = 0.5 * (trace + np.hypot(n - spread - n * mean_u ** 2, 2.0 * n * mean_u))
+    conditioned = (spread > 0) & ~(largest ** 2 > 1e12 * n * spread)      # its condition number, largest^2 / det
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = fits.sum(centred * v) / spread
+    level = fits.sum(v) / n - slope * mean_u
+    resid = v - (fits.spread(level) + fits.spread(slope) * u)
+    quantum = np.array([ev.quantum for ev in owners])
+    sigma2 = np.maximum(fits.sum(resid * resid) / np.maximum(n - 2, 1), quantum ** 2 / 12.0)
+    departures = _departures(fits, reach, resid, fits.extreme(reach, False), sigma2,
+                             np.array([ev.rounding_floor for ev in owners]),
+                             np.array([abs(ev.contrast) for ev in owners]), extent[fitted])
+    firsts = side[fits.starts]
+    for j, g in enumerate(np.flatnonzero(fitted)):
+        ev = owners[j]
+        if not conditioned[j]:
+            out[g] = not_run("non-uniform", "the {name} side's level and tail cannot be told apart (its samples "
+                             "span too little of the tail): its settling not judged")
+            continue
+        # the model's own noise: its tail at the side's start, towards the target's other level
+        start_u = ev.plateau_px ** -float(ev.tail_power)
+        towards = _towards_target(ev, left=bool(firsts[j] < 0))
+        tail_cov = float(sigma2[j] / spread[j])          # the slope's variance, (M^-1)[1, 1] sigma^2
+        unsettled = (beyond_rounding(towards * float(slope[j]) * start_u / ev.contrast),
+                     math.sqrt(tail_cov) * start_u / ev.contrast)
+        out[g] = {"departure": departures[j], "unsettled": unsettled}
+    return out      # type: ignore[return-value]   # every place filled
 
-    nearest = float(reach.min())
-    band = ((reach - nearest) / BAND_PX).astype(int)       # (non-negative: truncation is the floor)
-    counts = np.bincount(band)
-    sums = np.bincount(band, weights=resid)
+
+def _departures(sides: Groups, reach: np.ndarray, resid: np.ndarray, nearest: np.ndarray, sigma2: np.ndarray,
+                floor: np.ndarray, contrast: np.ndarray, extent: np.ndarray) -> list[tuple | None]:
+    """Each side's smooth departure from its model: a Legendre cubic fitted
+    to its 1-px band means of the residuals ``resid``, weighted by their
+    errors; (its largest size (DN), that size's sd, where (px)), or None
+    where the side holds too few full bands or too short an extent."""
+    band = ((reach - sides.spread(nearest)) / BAND_PX).astype(int)       # (non-negative: truncation is the floor)
+    # each side's bands in a run of slots of its own
+    slots = Groups(np.where(sides.sizes > 0, np.nan_to_num(sides.extreme(band.astype(float), True)) + 1, 0))
+    slot = slots.starts[sides.ids] + band
+    counts = np.bincount(slot, minlength=slots.ids.size)
+    sums = np.bincount(slot, weights=resid, minlength=slots.ids.size)
     full = counts >= MIN_BAND_SAMPLES
-    if full.sum() <= SMOOTH_DEGREE + 1 or extent < MIN_SIDE_EXTENT_PX:
-        return {"departure": None, "unsettled": unsettled}
-    centres = nearest + (np.nonzero(full)[0] + 0.5) * BAND_PX
-    counted = counts[full]
-    means = sums[full] / counted
-    error2 = sigma2 / counted + ev.rounding_floor ** 2
-    t = 2.0 * (centres - centres[0]) / max(centres[-1] - centres[0], 1e-9) - 1.0
+    used = slots.sum(full.astype(float))
+    curved = (used > SMOOTH_DEGREE + 1) & (extent >= MIN_SIDE_EXTENT_PX)
+    out: list[tuple | None] = [None] * sides.count
+    if not curved.any():
+        return out
+    take = full & slots.spread(curved)
+    bands = Groups(slots.sum(take.astype(float)).astype(np.intp)[curved])
+    groups = np.flatnonzero(curved)
+    centres = nearest[slots.ids[take]] + (np.flatnonzero(take) - slots.starts[slots.ids[take]] + 0.5) * BAND_PX
+    counted = counts[take]
+    means = sums[take] / counted
+    error2 = bands.spread(sigma2[groups]) / counted + bands.spread(floor[groups] ** 2)
+    first = centres[bands.starts]
+    last = centres[bands.starts + bands.sizes - 1]
+    t = 2.0 * (centres - bands.spread(first)) / bands.spread(np.maximum(last - first, 1e-9)) - 1.0
     basis = np.polynomial.legendre.legvander(t, SMOOTH_DEGREE)
     weights = 1.0 / np.maximum(error2, 1e-300)
-    normal_b = (basis * weights[:, None]).T @ basis
+    size = SMOOTH_DEGREE + 1
+    normal_b = np.empty((bands.count, size, size))
+    for i in range(size):
+        for j in range(i, size):
+            normal_b[:, i, j] = normal_b[:, j, i] = bands.sum(weights * basis[:, i] * basis[:, j])
     cov = np.linalg.pinv(normal_b)
-    smooth_coef = cov @ (basis * weights[:, None]).T @ means
-    curve = basis @ smooth_coef
-    if np.max(np.abs(curve)) <= ROUNDING_SHARE * abs(ev.contrast):
-        # a flat side (noise-free): the curve is the arithmetic's rounding, and where it peaks would
-        # move with any change of the arithmetic before it; no departure, said at the side's start
-        curve = np.zeros_like(curve)
-    worst = int(np.argmax(np.abs(curve)))
-    sd = math.sqrt(max(float(basis[worst] @ cov @ basis[worst]), 0.0))
-    return {"departure": (float(abs(curve[worst])), sd, float(centres[worst])), "unsettled": unsettled}
+    rhs = [bands.sum(weights * basis[:, i] * means) for i in range(size)]
+    smooth_coef = [sum(cov[:, i, j] * rhs[j] for j in range(size)) for i in range(size)]
+    curve = sum(basis[:, i] * bands.spread(smooth_coef[i]) for i in range(size))
+    flat = bands.extreme(np.abs(curve), True) <= ROUNDING_SHARE * contrast[groups]
+    # a flat side (noise-free): the curve is the arithmetic's rounding, and where it peaks would
+    # move with any change of the arithmetic before it; no departure, said at the side's start
+    curve = np.where(bands.spread(flat), 0.0, curve)
+    worst = bands.starts + bands.argmax(np.abs(curve))
+    row = basis[worst]
+    variance = sum(row[:, i] * sum(cov[:, i, j] * row[:, j] for j in range(size)) for i in range(size))
+    sd = np.sqrt(np.maximum(variance, 0.0))
+    for k, g in enumerate(groups):
+        out[g] = (float(abs(curve[worst[k]])), float(sd[k]), float(centres[worst[k]]))
+    return out
 
 
 def _towards_target(ev: Evidence, left: bool) -> float:

@@ -1,0 +1,170 @@
+"""Many groups' samples laid end to end (one group a chip's side, or a
+chip's rows) and reduced group by group in one call each, so that the
+gate's small fits of a few hundred chips cost a handful of NumPy calls,
+not a handful per chip.
+
+Every reduction adds a group's values one after another in their order
+(:func:`numpy.bincount`), whatever the other groups hold: a group's result
+is the same to the bit alone or among others, which is what lets a chip's
+own check be a batch of one.  Least squares go by modified Gram-Schmidt
+on the groups' columns (:func:`least_squares`), as accurate as a QR and
+built of the same sums.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+
+class Groups:
+    """Samples laid end to end in groups (each group's in one run).
+
+    Parameters
+    ----------
+    sizes : sequence of int
+        Each group's number of samples (0 allowed).
+
+    Attributes
+    ----------
+    count : int
+        The number of groups.
+    sizes : numpy.ndarray
+        Each group's number of samples.
+    starts : numpy.ndarray
+        Where each group's run begins.
+    ids : numpy.ndarray
+        Each sample's group.
+
+    Examples
+    --------
+    >>> g = Groups([2, 0, 3])
+    >>> g.sum(np.array([1.0, 2.0, 3.0, 4.0, 5.0])).tolist()
+    [3.0, 0.0, 12.0]
+    """
+
+    def __init__(self, sizes: ArrayLike):
+        self.sizes = np.asarray(sizes, dtype=np.intp).reshape(-1)
+        self.count = int(self.sizes.size)
+        self.starts = np.zeros(self.count, np.intp)
+        np.cumsum(self.sizes[:-1], out=self.starts[1:])
+        self.ids = np.repeat(np.arange(self.count), self.sizes)
+
+    def sum(self, values: np.ndarray) -> np.ndarray:
+        """Each group's sum of ``values`` (one a sample), added in order;
+        0 for an empty group."""
+        return np.bincount(self.ids, weights=values, minlength=self.count)
+
+    def spread(self, per_group: np.ndarray) -> np.ndarray:
+        """``per_group`` (one a group) repeated for each of its samples."""
+        return per_group[self.ids]
+
+    def power(self, values: np.ndarray, exponents: Sequence[float]) -> np.ndarray:
+        """``values`` to each group's power ``exponents`` (one a group), each
+        exponent a scalar as a group alone raises it (NumPy's ``x ** -2.0``
+        is not its ``x ** array`` to the bit, nor as fast)."""
+        each = np.asarray(exponents, float)
+        distinct = np.unique(each)
+        if distinct.size == 1:
+            return values ** float(distinct[0])
+        out = np.empty_like(values)
+        for exponent in distinct:
+            take = self.spread(each == exponent)
+            out[take] = values[take] ** float(exponent)
+        return out
+
+    def extreme(self, values: np.ndarray, largest: bool) -> np.ndarray:
+        """Each group's largest (or smallest) value; NaN for an empty group."""
+        out = np.full(self.count, np.nan)
+        full = self.sizes > 0
+        if full.any():
+            out[full] = (np.maximum if largest else np.minimum).reduceat(values, self.starts[full])
+        return out
+
+    def first_at(self, hit: np.ndarray) -> np.ndarray:
+        """Each group's first sample where ``hit`` is True, as its index
+        within the group; 0 where none is (as :func:`numpy.argmax`)."""
+        where = np.flatnonzero(hit)
+        first = np.zeros(self.count, np.intp)
+        groups, at = np.unique(self.ids[where], return_index=True)
+        first[groups] = where[at] - self.starts[groups]
+        return first
+
+    def argmax(self, values: np.ndarray) -> np.ndarray:
+        """Each group's :func:`numpy.argmax` (index within the group, the
+        first of equal largest values); 0 for an empty group."""
+        return self.first_at(values == self.spread(self.extreme(values, True)))
+
+    def median(self, values: np.ndarray) -> np.ndarray:
+        """Each group's median (the mean of the two middle values for an
+        even count, as :func:`numpy.median`); NaN for an empty group."""
+        out = np.full(self.count, np.nan)
+        full = self.sizes > 0
+        if not full.any():
+            return out
+        width = int(self.sizes.max())
+        if self.count * width <= 4 * values.size + 1024:
+            # each group sorted in a row of its own, padded past its end (a direct sort: faster than lexsort)
+            rows = np.full((self.count, width), np.inf)
+            rows[self.ids, np.arange(values.size) - self.starts[self.ids]] = values
+            rows.sort(axis=1)
+            at = np.flatnonzero(full)
+            out[full] = (rows[at, (self.sizes[full] - 1) // 2] + rows[at, self.sizes[full] // 2]) / 2
+            return out
+        ranked = values[np.lexsort((values, self.ids))]
+        low, high = (self.starts + (self.sizes - 1) // 2)[full], (self.starts + self.sizes // 2)[full]
+        out[full] = (ranked[low] + ranked[high]) / 2
+        return out
+
+
+def least_squares(groups: Groups, columns: Sequence[np.ndarray], target: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Each group's least-squares coefficients of ``columns`` (each an array
+    over all samples) for ``target``, by modified Gram-Schmidt: a column that
+    nothing independent is left of in a group (within 1e-13 of its own
+    norm) is given coefficient 0 there, the minimum-norm solution's.
+
+    Returns
+    -------
+    coef : numpy.ndarray
+        (groups, columns).
+    residual : numpy.ndarray
+        ``target`` less each group's fit, over all samples.
+
+    Examples
+    --------
+    >>> g = Groups([4, 3])
+    >>> x = np.array([0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0])
+    >>> coef, resid = least_squares(g, [np.ones(7), x], 1.0 + 2.0 * x)
+    >>> np.round(coef, 12).tolist(), bool(np.abs(resid).max() < 1e-12)
+    ([[1.0, 2.0], [1.0, 2.0]], True)
+    """
+    m = len(columns)
+    basis: list[np.ndarray] = []
+    # r[i][j]: the triangular factor, one value a group
+    r = [[np.zeros(groups.count) for _ in range(m)] for _ in range(m)]
+    rhs = []
+    residual = np.array(target, float)
+    for j, column in enumerate(columns):
+        q = np.array(column, float)
+        original = np.sqrt(groups.sum(q * q))
+        for i, earlier in enumerate(basis):
+            r[i][j] = groups.sum(earlier * q)
+            q = q - earlier * groups.spread(r[i][j])
+        norm = np.sqrt(groups.sum(q * q))
+        independent = norm > 1e-13 * original
+        r[j][j] = np.where(independent, norm, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            q = q * groups.spread(np.where(independent, 1.0 / norm, 0.0))
+        basis.append(q)
+        rhs.append(groups.sum(q * residual))
+        residual = residual - q * groups.spread(rhs[j])
+    coef = np.zeros((groups.count, m))
+    for j in range(m - 1, -1, -1):
+        value = rhs[j]
+        for k in range(j + 1, m):
+            value = value - r[j][k] * coef[:, k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            coef[:, j] = np.where(r[j][j] > 0, value / np.where(r[j][j] > 0, r[j][j], 1.0), 0.0)
+    return coef, residual
