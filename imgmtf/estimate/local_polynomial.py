@@ -254,25 +254,11 @@ def _fit_side_by_side(members: list[tuple[_Windows, bool]], order: int, step: fl
 def _inverse_first_rows(moments: np.ndarray, n: int) -> np.ndarray:
     """e0' M^-1 of every window's normal matrix M (M[i, j] = moments[i + j],
     symmetric positive definite; ``moments`` (2 n - 1, windows)): each
-    window's (n,) row of coefficients, (n, windows), by eliminating the
-    unknowns from the last up (symmetric pivots, stable for such matrices;
-    the lower triangle only), with the identity's columns as right-hand
-    sides, every matrix entry one array of the windows (as
-    :func:`.weight_stacks.first_levels`; a LAPACK solve per window costs a
-    microsecond each, and its floats differ in their last bits)."""
-    a = {(i, j): moments[i + j].copy() for i in range(n) for j in range(i + 1)}
-    b = np.zeros((n, n, moments.shape[-1]))
-    for i in range(n):
-        b[i, i] = 1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for k in range(n - 1, 0, -1):
-            inverse = 1.0 / a[k, k]
-            for i in range(k):
-                factor = a[k, i] * inverse
-                for j in range(i + 1):
-                    a[i, j] -= factor * a[k, j]
-                b[i] -= factor * b[k]
-        return b[0] / a[0, 0]
+    window's (n,) row of coefficients, (n, windows), the identity's columns
+    the right-hand sides of :func:`.weight_stacks.first_unknown`."""
+    identity = np.zeros((n, n, moments.shape[-1]))
+    identity[np.arange(n), np.arange(n)] = 1.0
+    return weight_stacks.first_unknown(moments, list(identity))
 
 
 def _adjoint(h, *, win: _Windows, valid: np.ndarray, coef: np.ndarray, u0: np.ndarray, trim: int,

@@ -16,6 +16,8 @@ differ from a LAPACK solve's in their last bits.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 #: samples fall into at most this many groups per tap of the window for their sums to be taken per group:
@@ -163,10 +165,41 @@ def first_levels(moments: np.ndarray, rhs: np.ndarray, valid: np.ndarray) -> np.
     >>> first_levels(m, np.array([[[4.0, 2.0]]]), np.array([[True]]))    # values 1 and 3: level 2
     array([2.])
     """
-    n = rhs.shape[-1]
     by_entry = np.moveaxis(moments, 0, -1)                   # (moment, grid, replicate)
-    a = {(i, j): by_entry[i + j].copy() for i in range(n) for j in range(i + 1)}
-    b = [rhs[..., i].T.copy() for i in range(n)]
+    return first_unknown(by_entry, [rhs[..., i].T for i in range(rhs.shape[-1])]).T[valid]
+
+
+def first_unknown(moments: Sequence[np.ndarray], rhs: Sequence[np.ndarray]) -> np.ndarray:
+    """The first unknown x_0 of many symmetric positive definite Hankel
+    systems sum_j moments[i + j] x_j = rhs[i] (i, j < n = len(rhs)), by
+    eliminating the unknowns from the last up (symmetric pivots, stable for
+    such matrices; the lower triangle only), every matrix entry one array
+    of all the systems: a LAPACK solve per system costs a microsecond of
+    call each, and its floats differ in their last bits with what else is
+    solved.
+
+    Parameters
+    ----------
+    moments : sequence of numpy.ndarray
+        The 2 n - 1 moment arrays, each of the systems' shape.
+    rhs : sequence of numpy.ndarray
+        The n right-hand sides, each broadcasting against a moment array
+        (a leading axis of its own solves several right-hand sides at once).
+
+    Returns
+    -------
+    numpy.ndarray
+        x_0 of every system (a singular one gives inf or nan).
+
+    Examples
+    --------
+    >>> m = [np.array([2.0]), np.array([0.0]), np.array([2.0])]     # two samples at u = -1, 1
+    >>> first_unknown(m, [np.array([4.0]), np.array([2.0])])          # values 1 and 3: level 2
+    array([2.])
+    """
+    n = len(rhs)
+    a = {(i, j): np.array(moments[i + j], float) for i in range(n) for j in range(i + 1)}
+    b = [np.array(r, float) for r in rhs]
     with np.errstate(divide="ignore", invalid="ignore"):
         for k in range(n - 1, 0, -1):
             inverse = 1.0 / a[k, k]
@@ -175,4 +208,4 @@ def first_levels(moments: np.ndarray, rhs: np.ndarray, valid: np.ndarray) -> np.
                 for j in range(i + 1):
                     a[i, j] -= factor * a[k, j]
                 b[i] -= factor * b[k]
-        return (b[0] / a[0, 0]).T[valid]
+        return b[0] / a[0, 0]
