@@ -169,7 +169,7 @@ def first_levels(moments: np.ndarray, rhs: np.ndarray, valid: np.ndarray) -> np.
     return first_unknown(by_entry, [rhs[..., i].T for i in range(rhs.shape[-1])]).T[valid]
 
 
-def first_unknown(moments: Sequence[np.ndarray], rhs: Sequence[np.ndarray]) -> np.ndarray:
+def first_unknown(moments: np.ndarray, rhs: Sequence[np.ndarray]) -> np.ndarray:
     """The first unknown x_0 of many symmetric positive definite Hankel
     systems sum_j moments[i + j] x_j = rhs[i] (i, j < n = len(rhs)), by
     eliminating the unknowns from the last up (symmetric pivots, stable for
@@ -180,8 +180,9 @@ def first_unknown(moments: Sequence[np.ndarray], rhs: Sequence[np.ndarray]) -> n
 
     Parameters
     ----------
-    moments : sequence of numpy.ndarray
-        The 2 n - 1 moment arrays, each of the systems' shape.
+    moments : numpy.ndarray
+        The 2 n - 1 moment arrays along its first axis, each of the
+        systems' shape.
     rhs : sequence of numpy.ndarray
         The n right-hand sides, each broadcasting against a moment array
         (a leading axis of its own solves several right-hand sides at once).
@@ -193,7 +194,7 @@ def first_unknown(moments: Sequence[np.ndarray], rhs: Sequence[np.ndarray]) -> n
 
     Examples
     --------
-    >>> m = [np.array([2.0]), np.array([0.0]), np.array([2.0])]     # two samples at u = -1, 1
+    >>> m = np.array([[2.0], [0.0], [2.0]])                         # two samples at u = -1, 1
     >>> first_unknown(m, [np.array([4.0]), np.array([2.0])])          # values 1 and 3: level 2
     array([2.])
     """
