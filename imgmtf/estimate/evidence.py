@@ -90,8 +90,8 @@ class Evidence:
         return self.quantum / np.sqrt(12.0) if self.pixel_noise < 0.5 * self.quantum else 0.0
 
 
-def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-                blur_widths: list | None = None) -> Evidence:
+def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise
+                ) -> Evidence:
     """What the gate's profile checks read of a measured chip: its samples,
     the shape read off them, its noise and its sides' names."""
     offsets = samples.distance_px - shape.centre
@@ -100,4 +100,4 @@ def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples
     side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
     return Evidence(samples.distance_px, samples.raw_dn, samples.rows, shape.centre, shape.scale_px, shape.plateau_px,
                     shape.low, shape.high, noise.noise_dn, chip.quantum_dn, kind.tail_power, kind.name, kind.profile,
-                    (side_names[0], side_names[1]), located.geometry, blur_widths)
+                    (side_names[0], side_names[1]), located.geometry)

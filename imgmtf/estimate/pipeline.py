@@ -37,7 +37,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -227,8 +227,8 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
     whose work is alike across chips it yields an :class:`.asks.Ask` and
     takes its answer (made among other chips' by :func:`.many.run_many`,
     alone by :func:`run`), then returns the measurement.  It asks for the
-    profile's resamplings (``resample``) and, before the quality gate, the
-    blur check's widths (``blur-widths``, :attr:`.evidence.Evidence.blur_widths`).
+    profile's resamplings (``resample``) and the quality gate's fits
+    (:func:`judge_steps`).
     ``chip_options``: :func:`run`'s keywords of the chip (``roi``, ``mask``...)."""
     chip = prefit.chip if prefit is not None else prepare_chip(image, settings, **chip_options)
     try:
@@ -240,9 +240,8 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
         profile = yield from widen_profile_steps(read, samples, shape, window, settings, kind.name)
         lsf = blend_tails(kind, samples, profile, shape, window)
         spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
-        blur_widths = yield Ask("blur-widths", evidence_of(kind, chip, located, samples, shape, noise))
         checks, warnings = yield from judge_steps(kind, chip, located, samples, shape, noise, window, spectrum,
-                                                  settings, blur_widths=blur_widths)
+                                                  settings)
     except ImgmtfError as exc:
         raise _points_instead(exc, kind, chip, image) from None
     estimate = Estimate(samples, profile, read, shape.centre, window, lsf, spectrum, kind.tail_power,
@@ -417,8 +416,7 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
 
 
 def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-          window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
-          ) -> tuple[list[gate.Check], list[str]]:
+          window: Window, spectrum: Spectrum, settings: Settings) -> tuple[list[gate.Check], list[str]]:
     """The quality gate: every check (saturation, the sides, SNR, MTF above
     its noise, the figures, then the registered profile checks) added to
     those run so far, enforced (failures raise unless ``settings.force``),
@@ -444,9 +442,6 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
         The MTF and its figures.
     settings : Settings
         The SNR threshold and ``force``.
-    blur_widths : list, optional
-        The blur check's widths fitted among other chips'
-        (:func:`.blur_along.group_widths_many`); None: the check fits them.
 
     Returns
     -------
@@ -471,17 +466,16 @@ def judge(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shap
     >>> all(check.passed for check in checks), warnings
     (True, [])
     """
-    return alone(judge_steps(kind, chip, located, samples, shape, noise, window, spectrum, settings,
-                             blur_widths=blur_widths))
+    return alone(judge_steps(kind, chip, located, samples, shape, noise, window, spectrum, settings))
 
 
 def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples, shape: Shape, noise: Noise,
-                window: Window, spectrum: Spectrum, settings: Settings, *, blur_widths: list | None = None
-                ) -> Steps[tuple[list[gate.Check], list[str]]]:
+                window: Window, spectrum: Spectrum, settings: Settings) -> Steps[tuple[list[gate.Check], list[str]]]:
     """:func:`judge` as a generator of asks (:mod:`.asks`): the sides'
-    saturation (``saturation``), uniformity (``side-checks``), settling (``settled-sides``) and block
-    jumps (``block-boundaries``) are fitted among other chips' (its
-    Examples: :func:`judge`, a batch of one).
+    saturation (``saturation``), uniformity (``side-checks``), settling (``settled-sides``), block
+    jumps (``block-boundaries``) and the blur check's widths of its halves and thirds (``blur-widths``,
+    :attr:`.evidence.Evidence.blur_widths`) are fitted among other chips' (its Examples: :func:`judge`,
+    a batch of one).
     """
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
@@ -503,7 +497,8 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
     snr_failures, snr_warnings = gate.snr_checks(noise.snr, threshold, located.rows_used, kind.name)
     checks += snr_failures
-    evidence = evidence_of(kind, chip, located, samples, shape, noise, blur_widths)
+    evidence = evidence_of(kind, chip, located, samples, shape, noise)
+    evidence = replace(evidence, blur_widths=(yield Ask("blur-widths", evidence)))
     settled = yield Ask("settled-sides", evidence)
     blocks = yield Ask("block-boundaries", evidence)
     # an MTF above 1: a sharpening kernel's (measured, and said) or trouble (refused)
