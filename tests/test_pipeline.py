@@ -198,8 +198,8 @@ def test_the_transform_divides_out_the_central_difference_and_nothing_else_uncor
     from dataclasses import replace
 
     from imgmtf.estimate.edge import EdgeKind
-    from imgmtf.estimate.pipeline import transform
     from imgmtf.estimate.spectrum import edge_divisor
+    from imgmtf.estimate.transform import transform
     m = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0))
     e, sigma = m.estimate, 0.6
     lsf = replace(e.lsf, combined=np.exp(-e.lsf.x_px ** 2 / (2 * sigma ** 2)))
@@ -213,7 +213,7 @@ def test_the_transform_divides_out_the_central_difference_and_nothing_else_uncor
 
 def test_the_gate_stage_passes_a_clean_chip_and_warns_of_a_noisy_one():
     from imgmtf.estimate.edge import EdgeKind
-    from imgmtf.estimate.pipeline import judge
+    from imgmtf.estimate.judge import judge
     m = _stages_of(exact_edge_chip(gaussian_pixel_transfer(0.5, 6.0), 6.0, noise_std=3.0, seed=1))
     e = m.estimate
     checks, warnings = judge(EdgeKind(), m.chip, m.located, e.samples, m.shape, m.noise, e.window, e.spectrum,
