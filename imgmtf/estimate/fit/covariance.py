@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .arrowhead import normal_blocks, split_columns
+
 
 def parameter_covariance(jacobian, reduced_chi_square: float, n_free: int | None = None,
                          counts: list[int] | None = None) -> np.ndarray:
@@ -73,20 +75,11 @@ def arrowhead_columns(jacobian, n_free: int, counts: list[int]) -> np.ndarray:
     block is S^+ with S = P - sum Q_e D_e^+ Q_e', and edge e's rows of
     those columns are -D_e^+ Q_e' S^+ (the inverse of the blocks, equal to
     the whole's pseudo-inverse when the normal matrix is regular)."""
-    coo = jacobian.tocoo()
-    rows = jacobian.shape[0]
-    stage = np.zeros((rows, n_free))
-    nuisance = np.zeros((rows, 3))
-    row, column, value = coo.row, coo.col, coo.data
-    is_stage = column < n_free
-    np.add.at(stage, (row[is_stage], column[is_stage]), value[is_stage])
-    np.add.at(nuisance, (row[~is_stage], (column[~is_stage] - n_free) % 3), value[~is_stage])
-    starts = np.cumsum([0, *counts[:-1]])
-    d = np.add.reduceat(nuisance[:, :, None] * nuisance[:, None, :], starts, axis=0)        # (edges, 3, 3)
-    q = np.add.reduceat(stage[:, :, None] * nuisance[:, None, :], starts, axis=0)          # (edges, n, 3)
+    blocks = normal_blocks(*split_columns(jacobian, n_free, counts), counts)
+    q, d = blocks.q, blocks.d
     d_inverse = np.linalg.pinv(d)
     qd = q @ d_inverse                                                                     # Q_e D_e^+
-    schur = stage.T @ stage - np.einsum("eij,ekj->ik", qd, q)
+    schur = blocks.p - np.einsum("eij,ekj->ik", qd, q)
     s_inverse = np.linalg.pinv(schur)
     below = -np.einsum("eij,ik->ejk", qd, s_inverse).reshape(-1, n_free)                  # -D_e^+ Q_e' S^+
     return np.vstack([s_inverse, below])

@@ -33,6 +33,7 @@ from ...sensor.lines import HermitePlacement, LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
+from .arrowhead import NoConvergence, solve_arrowhead
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
 from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
@@ -486,14 +487,18 @@ class Model:
         ImgmtfError
             No convergence within ``max_iterations`` Jacobians.
         """
-        from scipy.optimize import least_squares
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        if max_iterations > 0:
-            solver = {"tr_solver": "lsmr", "tr_options": {"atol": 1e-12, "btol": 1e-12}} if self.sparse else {}
+        if max_iterations > 0 and self.sparse:
+            try:
+                return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
+                                       max_iterations)
+            except NoConvergence:
+                pass
+        elif max_iterations > 0:
+            from scipy.optimize import least_squares
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
-                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations,
-                                   **solver)
+                                   x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
             if result.status > 0:
                 return result.x, result.jac
         raise ImgmtfError(f"the fit of {', '.join(s.name for s in self.stages)} did not converge in "
