@@ -189,7 +189,7 @@ class NoConvergence(Exception):
 
 def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Callable[[np.ndarray], object],
                     z: np.ndarray, n_free: int, counts: list[int], lower: np.ndarray, upper: np.ndarray,
-                    max_evaluations: int = 200, tolerance: float = 1e-10):
+                    max_evaluations: int = 200, tolerance: float = 1e-12):
     """Bounded nonlinear least squares over an arrowhead Jacobian by
     Levenberg-Marquardt steps solved exactly (:func:`damped_step`), the
     damping scaled by the columns' largest squared norms so far
@@ -197,7 +197,7 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     leaving the bounds (the shared parameters' only) is cut back to them,
     and a parameter at a bound that the gradient pushes out of it stays
     there.  It stops where the full Gauss-Newton step would lower half
-    the sum of squares by less than ``tolerance`` times it: a tenth of
+    the sum of squares by less than ``tolerance`` times it: a thousandth of
     SciPy's ``ftol=1e-9`` on the last step's reduction, and on the
     prediction at the last point rather than the reduction of the step
     that led there.
