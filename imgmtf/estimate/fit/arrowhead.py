@@ -51,16 +51,21 @@ class NormalBlocks:
         return np.concatenate([np.diag(self.p), np.diagonal(self.d, axis1=1, axis2=2).ravel()])
 
 
-def split_columns(jacobian, n_free: int, counts: list[int]) -> tuple[np.ndarray, np.ndarray]:
+def split_columns(jacobian, n_free: int, counts: list[int],
+                  layout: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The shared columns A (rows, n_free) and each row's own edge's three
     columns B (rows, 3) of an arrowhead Jacobian, dense or sparse.  A
     compressed-row Jacobian laid out as :meth:`.model.Model.jacobian`
     writes it (each row's shared columns, then its edge's three) is read
-    in place."""
+    in place: without checking its column indices when they are
+    ``layout``'s own memory (the model's, :meth:`.model.Model._jacobian_layout`)."""
     rows = jacobian.shape[0]
     width = n_free + 3
     if hasattr(jacobian, "indices") and getattr(jacobian, "format", "") == "csr" and jacobian.nnz == rows * width:
         indices = np.asarray(jacobian.indices).reshape(rows, width)
+        if layout is not None and layout.size == indices.size and np.may_share_memory(layout, indices):
+            values = np.asarray(jacobian.data).reshape(rows, width)
+            return values[:, :n_free], values[:, n_free:]
         edge = np.repeat(np.arange(len(counts)), counts)
         if (np.array_equal(indices[:, :n_free], np.broadcast_to(np.arange(n_free), (rows, n_free)))
                 and np.array_equal(indices[:, n_free:], (n_free + 3 * edge)[:, None] + np.arange(3))):
@@ -189,7 +194,7 @@ class NoConvergence(Exception):
 
 def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Callable[[np.ndarray], object],
                     z: np.ndarray, n_free: int, counts: list[int], lower: np.ndarray, upper: np.ndarray,
-                    max_evaluations: int = 200, tolerance: float = 1e-12):
+                    max_evaluations: int = 200, tolerance: float = 1e-12, layout: np.ndarray | None = None):
     """Bounded nonlinear least squares over an arrowhead Jacobian by
     Levenberg-Marquardt steps solved exactly (:func:`damped_step`), the
     damping scaled by the columns' largest squared norms so far
@@ -201,6 +206,9 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     SciPy's ``ftol=1e-9`` on the last step's reduction, and on the
     prediction at the last point rather than the reduction of the step
     that led there.
+
+    ``layout`` is the compressed-row Jacobian's column indices, when known
+    (:func:`split_columns`).
 
     Returns
     -------
@@ -220,7 +228,7 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     scale = np.zeros(z.size)
     damping, growth = 1e-3, 2.0
     while True:
-        a, b = split_columns(jac, n_free, counts)
+        a, b = split_columns(jac, n_free, counts, layout)
         blocks = normal_blocks(a, b, counts, r)
         scale = np.maximum(scale, blocks.diagonal)
         u, g_u = z[:n_free], blocks.g[:n_free]

@@ -471,16 +471,20 @@ class Model:
 
     @property
     def sparse(self) -> bool:
-        """Whether the Jacobian is sparse (solved by LSMR): with many edges.
-        A few edges' dense Jacobian is smaller than LSMR's iterations cost
-        (least squares then solves it exactly, by its SVD)."""
+        """Whether the Jacobian is sparse (its arrowhead normal matrix
+        solved by blocks, :mod:`.arrowhead`): with many edges.  A few
+        edges' dense Jacobian costs about the same (least squares then
+        solves it exactly, by its SVD)."""
         return len(self.data) > DENSE_EDGES
 
     def solve(self, z: np.ndarray, max_iterations: int = 200):
-        """Bounded least squares from ``z`` (SciPy's trust-region
-        reflective ``least_squares``, with :meth:`jacobian`, the columns
-        scaled by their norms, the steps exact or, for a sparse Jacobian, by
-        LSMR).  Returns the solution and its Jacobian.
+        """Bounded least squares from ``z`` with :meth:`jacobian`: a few
+        edges' by SciPy's trust-region reflective ``least_squares`` (the
+        columns scaled by their norms, the steps exact by its SVD), many
+        edges' (a sparse Jacobian) by Levenberg-Marquardt steps solved
+        exactly over the arrowhead normal matrix
+        (:func:`.arrowhead.solve_arrowhead`).  Returns the solution and
+        its Jacobian.
 
         Raises
         ------
@@ -492,7 +496,7 @@ class Model:
         if max_iterations > 0 and self.sparse:
             try:
                 return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
-                                       max_iterations)
+                                       max_iterations, layout=self._jacobian_layout()[0])
             except NoConvergence:
                 pass
         elif max_iterations > 0:
