@@ -14,6 +14,7 @@ from ..geometry import direction_label
 from .bands import band_sensors, model_mtf50_band, model_mtf_band, sensor_transfers
 from .choice import other_stages
 from .model import Model
+from .responses import StackedResponses
 from .results import EdgeFit, FittedParameter, SensorFit
 
 #: residual bins along the normal (px) for the misfit test
@@ -65,6 +66,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
                     correlations.append((model.free[i], model.free[j], float(corr[i, j])))
 
     edges, start_row = [], 0
+    reaches = misfit_reaches(model, responses)
     stepped = band_sensors(model, u)
     nyquist_bands, model_mtf50s = edge_model_mtfs(model, u, covariance, stepped, confidence)
     for e, (d, r) in enumerate(zip(model.data, responses)):
@@ -74,7 +76,7 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
         start_row += bins.x.size
         chi = float(sample_chi_squares[e] / max(d.x.size - 3 - n / len(model.data), 1))
         # on the samples: the fit's bins, formed before x0 was known, straddle the misfit test's
-        p, fraction = misfit_test(d.x - x0, sample_residuals[e], d.noise, abs(hi - lo), r)
+        p, fraction = misfit_test(d.x - x0, sample_residuals[e], d.noise, abs(hi - lo), r, float(reaches[e]))
         value, low, high = nyquist_bands[:, e]
         measured = d.measurement
         edge = EdgeFit(d.source, d.normal_angle_deg, direction_label(d.normal_angle_deg, 0.0),
@@ -254,7 +256,39 @@ def residual_means(x: np.ndarray, residuals: np.ndarray, counts: np.ndarray, rea
     return (np.flatnonzero(used) + first + 0.5) * width_px, total[used] / count[used], count[used]
 
 
-def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response):
+#: where the misfit test looks for an edge's transition: distances from the edge, px
+MISFIT_GRID_PX = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
+
+
+def transition_reach(esf: np.ndarray) -> np.ndarray:
+    """How far from the edge (px, at least 3) the misfit test takes
+    residuals: the farthest point of :data:`MISFIT_GRID_PX` where the
+    model's edge response is between 0.1 % and 99.9 %, from ``esf`` (its
+    values there; one row per edge).
+
+    Examples
+    --------
+    >>> from scipy.special import ndtr
+    >>> transition_reach(ndtr(MISFIT_GRID_PX / 2.0)).round(4).tolist()
+    6.125
+    """
+    inside = (esf > 1e-3) & (esf < 1 - 1e-3)
+    far = np.where(inside, np.abs(MISFIT_GRID_PX), 0.0).max(axis=-1, initial=0.0)
+    return np.maximum(far, 3.0)
+
+
+def misfit_reaches(model: Model, responses: list) -> np.ndarray:
+    """Each edge's :func:`transition_reach`, its responses' ESFs on the
+    grid evaluated side by side in one pass (:meth:`.model.Model.stacked`)."""
+    count = len(responses)
+    if count == 1:
+        return np.array([transition_reach(responses[0].esf(MISFIT_GRID_PX))])
+    stacked = StackedResponses(responses, [MISFIT_GRID_PX.size] * count, *model._laid_out(responses))
+    return transition_reach(stacked.esf(np.tile(MISFIT_GRID_PX, count)).reshape(count, -1))
+
+
+def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float, response,
+                reach: float | None = None):
     """P-value and size (RMS fraction of the step, noise removed) of the
     structure of an edge's samples' residuals (``residuals``, data - model,
     DN, at distances ``x`` px from the fitted edge; of one sample's noise
@@ -264,11 +298,10 @@ def misfit_test(x: np.ndarray, residuals: np.ndarray, noise: float, step: float,
     samples, not the fit's bins: those are formed on the distances before
     the fitted offset, so at an offset they straddle these bins' edges.
     (NaN, NaN) where no bin holds 3 samples: the test cannot run, which is
-    no pass."""
-    grid = np.arange(-50.0, 50.0, MISFIT_BIN_PX / 4)
-    esf = response.esf(grid)
-    inside = grid[(esf > 1e-3) & (esf < 1 - 1e-3)]
-    reach = max(3.0, float(np.abs(inside).max()) if inside.size else 3.0)
+    no pass.  ``reach`` is :func:`transition_reach` when known (default
+    from ``response``)."""
+    if reach is None:
+        reach = float(transition_reach(response.esf(MISFIT_GRID_PX)))
     _, means, count = residual_means(x, residuals, np.ones(x.size), reach)
     if not count.size:
         return math.nan, math.nan
