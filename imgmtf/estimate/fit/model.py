@@ -460,7 +460,7 @@ class Model:
         its edge's levels' and offset's (which act on its own bins only),
         and where each row starts among them: its compressed rows, written
         directly (its size grows with the edges, not with their square);
-        made once for the free parameters; 32-bit where they fit (LSMR's products read a quarter less)."""
+        made once for the free parameters; 32-bit where they fit (a quarter less to read)."""
         if self._layout[0] != self.n_free:
             nuisance = np.repeat(self.n_free + 3 * np.arange(len(self.counts)), self.counts)[:, None] + np.arange(3)
             indices = np.hstack([np.broadcast_to(np.arange(self.n_free), (nuisance.shape[0], self.n_free)), nuisance])
