@@ -29,14 +29,13 @@ from .tables import print_scan
 DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it for --help
 # what a scan's workers load, NumPy's lazily loaded parts included: imported once by the workers'
 # fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
-# of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
-# Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
+# of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s)
 SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
                     "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial",
                     *CLI_MODULES)
 FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
-# with several scenes each worker runs whole scans, the segment graph's SciPy included: loaded once by
-# the fork server rather than by every worker as its first scene starts
+# with several scenes each worker runs whole scans, the segment graph included: loaded once by the fork
+# server rather than by every worker as its first scene starts
 WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 
 

@@ -38,6 +38,7 @@ from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments, tile_windows
 from .features import crossing, placed_windows
 from .fill import fill_screen
+from .neighbours import components
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
 from .settings import ScanSettings
@@ -148,7 +149,6 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                  else workers)
     if scheduler is None and detecting > 1:
         prestart_workers(detecting, WORKER_MODULES)
-    # the segment graph's SciPy (0.3-0.5 s to import) loads while the workers' fork server loads theirs
     from .segments import (
         BAR_MAX_SEPARATION_PX,
         SampledSegments,
@@ -158,7 +158,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         split_at_junctions,
     )
     segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
-    sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
+    sampled = SampledSegments.of(segments)          # one sampling for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
     halves = split_at_junctions(sampled, junctions, events, fill_fraction)
     track = track_azimuth(info, settings)
@@ -376,8 +376,6 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     were accepted) joined through the junctions they share; each target
     with an accepted half-edge gets a ``target_id`` (1, 2... in the order
     of its best rank is assigned after ranking, see :func:`_ranked`)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
     reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
     owners: dict[int, list[int]] = {}
     for i in reached:
@@ -387,8 +385,7 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     n = len(records)
     a = [m[0] for m in owners.values() for _ in m[1:]]
     b = [x for m in owners.values() for x in m[1:]]
-    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
+    _, label = components(n, np.array(a, np.intp), np.array(b, np.intp))
     groups_with_accepted = {label[i] for i, r in enumerate(records) if r.ok}
     return [r.with_(site={"group": int(label[i])}) if i in reached and label[i] in groups_with_accepted else r
             for i, r in enumerate(records)]
