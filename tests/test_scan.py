@@ -237,7 +237,7 @@ def test_a_scan_without_fits_loads_no_scipy():
     import subprocess
     import sys
 
-    from imgmtf.cli.scan import SCANNING_MODULES, WHOLE_SCAN_MODULES
+    from imgmtf.preloads import SCANNING_MODULES, WHOLE_SCAN_MODULES
     graph = ("from imgmtf.scene.segments import SampledSegments, find_junctions, merge_segments; "
              "s = SampledSegments.of([[0, 50, 100, 50], [50, 0, 50, 100], [101, 50, 160, 50]]); "
              "j, _ = find_junctions(s); assert len(j) == 1, j; assert len(merge_segments(s.segments)) == 2; "

@@ -10,10 +10,6 @@ from ..kinds import kinds_with_width
 
 MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
 MIN_REPLICATES, MAX_REPLICATES = 20, 5000     # as imgmtf.estimate.intervals checks them
-# what a worker started by the fork server imports before its first task: it runs the ``imgmtf`` script
-# again as ``__mp_main__`` (CPython does not hand the script to the fork server, which would run it once),
-# and the script imports the command line: 30-40 ms a worker, once in the fork server when preloaded
-CLI_MODULES = ("imgmtf.cli",)
 
 
 class FiniteFloat(click.FloatRange):

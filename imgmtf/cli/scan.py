@@ -9,9 +9,9 @@ import click
 
 from ..errors import ParameterError
 from ..kinds import get_kind, kind_names
+from ..preloads import FITTING_MODULES, SCANNING_MODULES, WHOLE_SCAN_MODULES
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
-    CLI_MODULES,
     FiniteFloat,
     MethodName,
     auto_parallel_options,
@@ -27,16 +27,6 @@ from .options import (
 from .tables import print_scan
 
 DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it for --help
-# what a scan's workers load, NumPy's lazily loaded parts included: imported once by the workers'
-# fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
-# of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s)
-SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
-                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial",
-                    *CLI_MODULES)
-FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
-# with several scenes each worker runs whole scans, the segment graph included: loaded once by the fork
-# server rather than by every worker as its first scene starts
-WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 
 
 @click.command(short_help="Find, measure and combine every edge, bar or point array in a scene.")

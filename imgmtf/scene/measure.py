@@ -33,6 +33,7 @@ from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
 from ..kinds import get_kind
 from ..parallel import auto_workers, prestart_workers, run_tasks
+from ..preloads import SCAN_TASK_MODULES
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments, tile_windows
@@ -51,11 +52,6 @@ if TYPE_CHECKING:
 AUTO_PLANS_PER_WORKER = 100
 AUTO_TILES_PER_WORKER = 4       # ... and detection its tiles from this many a worker (0.2-0.3 s a tile)
 TASKS_PER_WORKER = 4            # a pool's candidates are split into this many tasks a worker: a late tile waits less
-# what the scan's own tasks (the tiles' detection, the candidates' measurement) import: loaded once, as the
-# scan starts, by the workers' fork server (parallel.prestart_workers), not by every worker of each of its
-# two pools as its first task arrives (0.5-0.6 s each time, while the scan waits)
-WORKER_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.estimate.edge", "imgmtf.estimate.pulse",
-                  "numpy.fft", "numpy.ma", "numpy.polynomial")
 
 
 def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
@@ -148,7 +144,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
                  else workers)
     if scheduler is None and detecting > 1:
-        prestart_workers(detecting, WORKER_MODULES)
+        prestart_workers(detecting, SCAN_TASK_MODULES)    # once, not by each of the two pools' workers
     from .segments import (
         BAR_MAX_SEPARATION_PX,
         SampledSegments,
