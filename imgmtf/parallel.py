@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 LOCAL_CLUSTER = "local"
 SCHEDULER_TIMEOUT_S = 10        # how long to keep trying a remote Dask scheduler
 _prestarted: list = []      # at most one pool started ahead by prestart_workers
+_preloaded: set[str] = set()    # what this process's fork server was asked to import
 MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
@@ -249,6 +250,33 @@ def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     _prestarted.append((workers, pool))
 
 
+def can_preload() -> bool:
+    """Whether this system starts workers from a fork server (Linux, and
+    Unix but macOS), whose preloaded imports every worker forked from it
+    shares: a pool's workers then start in milliseconds.
+
+    Examples
+    --------
+    >>> isinstance(can_preload(), bool)
+    True
+    """
+    import multiprocessing
+    return "forkserver" in multiprocessing.get_all_start_methods()
+
+
+def preloaded(modules: Iterable[str]) -> bool:
+    """Whether this process's fork server runs (:func:`prestart_workers`)
+    with every one of ``modules`` imported: a pool forked from it has them
+    loaded, or soon will, in its workers from their start.
+
+    Examples
+    --------
+    >>> preloaded(["a.module.never.preloaded"])
+    False
+    """
+    return set(modules) <= _preloaded and _fork_server_running()
+
+
 def _fork_server_running() -> bool:
     from multiprocessing import forkserver
     server = getattr(forkserver, "_forkserver", None)
@@ -261,6 +289,7 @@ def _start_fork_server(modules: Iterable[str]) -> None:
     library; the call does not wait for the imports."""
     from multiprocessing import forkserver
     forkserver.set_forkserver_preload([*modules, *WORKER_MODULES])
+    _preloaded.update([*modules, *WORKER_MODULES])
     saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
     os.environ.update(dict.fromkeys(THREAD_VARIABLES, "1"))
     try:

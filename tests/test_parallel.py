@@ -80,8 +80,9 @@ def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread
     """prestart_workers starts the fork server importing the modules once
     (before the workers' fork), with one numerical-library thread (what the
     probe saw when the server imported it); the caller's environment is left
-    as it was.  A fork server already running is left alone: prestarted
-    workers then import the modules themselves.  (In processes of their
+    as it was, and ``preloaded`` says the server has them.  A fork server
+    already running is left alone: prestarted workers then import the
+    modules themselves, and none is preloaded.  (In processes of their
     own: a process has one fork server.)"""
     import subprocess
     import sys
@@ -96,16 +97,17 @@ def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread
            "OPENBLAS_NUM_THREADS": "7"}
 
     def run(before=""):
-        code = ("import os, math; from imgmtf.parallel import prestart_workers, run_tasks; " + before +
+        code = ("import os, math; from imgmtf.parallel import preloaded, prestart_workers, run_tasks; " + before +
                 "prestart_workers(2, ['probe', 'colorsys']); import probe; "
                 "print(list(run_tasks(probe.state, ['colorsys', 'wave'], workers=2)), "
-                "os.environ.get('OPENBLAS_NUM_THREADS'))")
+                "os.environ.get('OPENBLAS_NUM_THREADS'), preloaded(['probe']), preloaded(['probe', 'wave']))")
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
         assert out.returncode == 0, out.stderr
         return out.stdout.strip()
-    assert run() == "[(True, True, '1'), (False, True, '1')] 7"
+    assert run() == "[(True, True, '1'), (False, True, '1')] 7 True False"
     # a fork server started before (by another pool): the workers import
-    assert run("list(run_tasks(math.sqrt, [1, 4], workers=2)); ") == "[(True, False, '1'), (False, False, '1')] 7"
+    assert run("list(run_tasks(math.sqrt, [1, 4], workers=2)); ") == \
+        "[(True, False, '1'), (False, False, '1')] 7 False False"
 
 
 def test_a_signal_inside_a_deferred_block_is_handled_after_it():
@@ -125,6 +127,7 @@ def test_the_fork_server_preloads_what_every_worker_set_up_imports(monkeypatch):
 
     from imgmtf import parallel
     preloaded = []
+    monkeypatch.setattr(parallel, "_preloaded", set())
     monkeypatch.setattr(forkserver, "set_forkserver_preload", preloaded.extend)
     monkeypatch.setattr(forkserver, "ensure_running", lambda: None)
     parallel._start_fork_server(("imgmtf.batch",))

@@ -341,3 +341,34 @@ def test_a_scene_whose_one_candidate_is_rejected_says_so_in_the_singular(tmp_pat
     result = CliRunner().invoke(main, ["scan", str(chip), "--min-length", "100"])
     assert result.exit_code == 1
     assert f"{chip}: no usable edge found (1 candidate, rejected)" in result.stderr     # not "1 candidates, all"
+
+
+def test_one_scene_with_fits_has_the_fork_server_load_the_optimizer_for_its_workers(monkeypatch):
+    """One scene, workers chosen automatically: the fork server starts as the scan does, the fits' modules
+    (SciPy's optimizer) among its imports, loaded on another core while this process detects and measures,
+    and the scene's few fits go to its workers; not without fits, nor with --workers 1, nor with no
+    fork server, when they run here."""
+    from types import SimpleNamespace
+
+    import imgmtf.parallel as parallel
+    from imgmtf.errors import ParameterError
+    from imgmtf.preloads import FITTING_MODULES
+    from imgmtf.scene.series import _fit_workers
+    started = []
+
+    def prestart(workers, modules):
+        started.append((workers, set(FITTING_MODULES) <= set(modules)))
+        raise ParameterError("stopped here")
+    monkeypatch.setattr(parallel, "prestart_workers", prestart)
+    monkeypatch.setattr(parallel, "available_cores", lambda: 2)
+    monkeypatch.setattr(parallel, "can_preload", lambda: True)
+    for options in ([], ["--fit-stages", "none"], ["--workers", "1"]):
+        CliRunner().invoke(main, ["scan", "chart.tif", *options])
+    monkeypatch.setattr(parallel, "can_preload", lambda: False)
+    CliRunner().invoke(main, ["scan", "chart.tif"])
+    assert started == [(2, True), (1, False), (1, True), (1, True)]
+    records = [SimpleNamespace(ok=True)] * 16 + [SimpleNamespace(ok=False)] * 3
+    monkeypatch.setattr(parallel, "preloaded", lambda modules: False)
+    assert _fit_workers(records, None) == 1 and _fit_workers(records, 3) == 3
+    monkeypatch.setattr(parallel, "preloaded", lambda modules: set(modules) == set(FITTING_MODULES))
+    assert _fit_workers(records, None) == 2 and _fit_workers(records[:1], None) == 1 and _fit_workers(records, 1) == 1

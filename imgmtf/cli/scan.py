@@ -134,7 +134,7 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
     interrupted, outcomes = None, []
     with reported_errors():
         from ..batch import expand_inputs
-        from ..parallel import prestart_workers
+        from ..parallel import available_cores, can_preload, prestart_workers
         from ..scene.series import outputs_folder, scan_scenes, scenes_workers
         from ..scene.settings import ScanSettings
         rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
@@ -157,9 +157,13 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                                    "scan them one at a time, or let their metadata or product names say when")
         if scheduler is None:
             fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            # workers chosen automatically for one scene wait for its candidates to be counted
-            prestart_workers(scenes_workers(len(paths)) if workers is None else workers,
-                             SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+            # workers chosen automatically for one scene wait for its candidates to be counted; but its
+            # fits go to workers forked from a server that imports SciPy's optimizer (0.35-0.6 s) on
+            # another core while this process detects and measures (series._fit_workers)
+            count = scenes_workers(len(paths)) if workers is None else workers
+            if workers is None and fitted and len(paths) == 1 and can_preload():
+                count = available_cores()
+            prestart_workers(count, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
                              + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:
