@@ -46,8 +46,8 @@ WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
-# as it starts (5-10 ms each)
-WORKER_MODULES = ("threadpoolctl",)
+# as it starts (5-10 ms each); and the server's own quick exit
+WORKER_MODULES = ("threadpoolctl", "imgmtf._server_exit")
 # what numerical libraries read, at load time, for their thread count
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",

@@ -132,3 +132,26 @@ def test_the_fork_server_preloads_what_every_worker_set_up_imports(monkeypatch):
     monkeypatch.setattr(forkserver, "ensure_running", lambda: None)
     parallel._start_fork_server(("imgmtf.batch",))
     assert preloaded == ["imgmtf.batch", *parallel.WORKER_MODULES] and "threadpoolctl" in preloaded
+
+
+def test_only_the_fork_server_skips_its_teardown(tmp_path):
+    """The fork server, once its command has ended, exits without the interpreter's teardown (0.3 s with
+    SciPy loaded, its inherited output pipes open meanwhile: a slow exit handler stands for it here); a
+    process that merely imports the module keeps its exit status and exit handlers."""
+    import subprocess
+    import sys
+    import time
+    if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
+        pytest.skip("no fork server on this platform")
+    (tmp_path / "slow_exit.py").write_text("import atexit, time\natexit.register(time.sleep, 5)\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    code = ("from imgmtf.parallel import prestart_workers, run_tasks; prestart_workers(2, ['slow_exit']); "
+            "print(list(run_tasks(abs, [-1, -2], workers=2)))")
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "[1, 2]", out.stderr
+    assert time.perf_counter() - t < 4
+    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit as quick; "
+            "print(quick._in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 3 and out.stdout.split() == ["False", "handled"], out.stderr
