@@ -9,6 +9,7 @@ from __future__ import annotations
 import atexit
 import os
 import sys
+from types import FrameType
 
 
 def _in_fork_server() -> bool:
@@ -16,7 +17,7 @@ def _in_fork_server() -> bool:
     server = sys.modules.get("multiprocessing.forkserver")
     if server is None:
         return False
-    frame = sys._getframe()
+    frame: FrameType | None = sys._getframe()
     while frame is not None:
         if frame.f_code is server.main.__code__:
             return True
