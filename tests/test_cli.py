@@ -249,10 +249,24 @@ def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
     assert run("measure", "--intervals", "bootstrap", "--bootstrap", "50", chip).exit_code == 0
 
 
-def test_workers_bound_is_the_pools():
+def test_workers_bound_is_the_pools_and_the_default_method_a_registered_one():
     from imgmtf import parallel
     from imgmtf.cli import options
-    assert options.MAX_WORKERS == parallel.MAX_WORKERS
+    from imgmtf.estimate.resampling import METHODS
+    assert options.MAX_WORKERS == parallel.MAX_WORKERS and options.DEFAULT_METHOD in METHODS
+
+
+def test_a_batch_starts_its_workers_fork_server_before_it_loads_numpy():
+    # the server's imports (0.3-0.4 s) are the workers' start: they begin as the command does, beside
+    # the parent's own, not after its options are parsed with NumPy loaded (the method registry's)
+    import subprocess
+    import sys
+    code = ("import sys, imgmtf.parallel as parallel; "
+            "parallel.prestart_workers = lambda *a: (print(sorted(m for m in ('numpy', 'scipy', 'cv2', 'rasterio') "
+            "if m in sys.modules)), sys.exit(0)); "
+            "from imgmtf.cli import main; main(['measure', '--workers', '2', 'chip.tif', 'other.tif'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):

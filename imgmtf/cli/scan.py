@@ -12,6 +12,7 @@ from ..kinds import get_kind, kind_names
 from ..preloads import FITTING_MODULES, SCANNING_MODULES, WHOLE_SCAN_MODULES
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
+    DEFAULT_METHOD,
     FiniteFloat,
     MethodName,
     auto_parallel_options,
@@ -41,7 +42,7 @@ DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it fo
               help="ROI extent either side of the target, px")
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width (0.2 to 10 px; px or m) for every bar; estimated per bar when omitted")
-@click.option("--method", type=MethodName(), default="msg", show_default=True)
+@click.option("--method", type=MethodName(), default=DEFAULT_METHOD, show_default=True)
 @click.option("--band", type=click.IntRange(min=1),
               help="1-based band (default: the only band, or the luminance of RGB)")
 @click.option("--saturation", callback=parse_pair, metavar="LO,HI",
