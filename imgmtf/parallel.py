@@ -359,10 +359,13 @@ def _with_progress(completed, total: int, description: str):
 
 
 def _completed(function, items, workers, scheduler, on_error, help_start=False):
-    """(index, result) pairs as tasks complete."""
+    """(index, result) pairs as tasks complete.  A lone task runs here (a
+    pool's start would cost more than it saves), unless a fork server this
+    process prestarted has its modules loaded already: its worker starts in
+    milliseconds, and this process need not import them."""
     if scheduler is not None:
         yield from _dask_completed(function, items, workers, scheduler, on_error)
-    elif workers == 1 or len(items) <= 1:
+    elif workers == 1 or not items or (len(items) == 1 and not (_preloaded and _fork_server_running())):
         _take_prestarted(0)
         for index, item in enumerate(items):
             yield index, _call(function, item, on_error)

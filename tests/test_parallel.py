@@ -159,7 +159,8 @@ def test_only_the_fork_server_skips_its_teardown(tmp_path):
 
 def test_the_caller_runs_the_last_tasks_while_its_workers_start(tmp_path):
     """help_start: while the fork server imports (here a module that takes 0.3 s), the caller runs tasks
-    from the end of the list, each task once, the results in order as ever; without it, it waits."""
+    from the end of the list, each task once, the results in order as ever; without it, it waits.  A lone
+    task goes to a worker of the server this process prestarted (its modules loaded there, not here)."""
     import subprocess
     import sys
     if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
@@ -174,9 +175,10 @@ def test_the_caller_runs_the_last_tasks_while_its_workers_start(tmp_path):
             "prestart_workers(2, ['slow_start']); import slow_start; "
             "out = list(run_tasks(slow_start.where, range(12), workers=2, help_start=sys.argv[1] == 'help')); "
             "here = [x for x, pid in out if pid == os.getpid()]; "
-            "print([x for x, _ in out] == list(range(12)), here == list(range(12 - len(here), 12)), len(here))")
+            "lone = list(run_tasks(slow_start.where, [7], workers=2))[0][1] != os.getpid(); "
+            "print([x for x, _ in out] == list(range(12)), here == list(range(12 - len(here), 12)), lone, len(here))")
     for asked in ("help", "wait"):
         out = subprocess.run([sys.executable, "-c", code, asked], capture_output=True, text=True, env=env, timeout=60)
         assert out.returncode == 0, out.stderr
-        same, last, here = out.stdout.split()
-        assert same == last == "True" and (int(here) >= 3 if asked == "help" else here == "0")
+        same, last, lone, here = out.stdout.split()
+        assert same == last == lone == "True" and (int(here) >= 3 if asked == "help" else here == "0")
