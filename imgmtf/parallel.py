@@ -364,7 +364,9 @@ def _completed(function, items, workers, scheduler, on_error, help_start=False):
     process prestarted has its modules loaded already: its worker starts in
     milliseconds, and this process need not import them."""
     if scheduler is not None:
-        yield from _dask_completed(function, items, workers, scheduler, on_error)
+        from .dask_tasks import dask_completed
+        yield from dask_completed(function, items, workers, scheduler, on_error,
+                                  local=scheduler == LOCAL_CLUSTER, timeout_s=SCHEDULER_TIMEOUT_S)
     elif workers == 1 or not items or (len(items) == 1 and not (_preloaded and _fork_server_running())):
         _take_prestarted(0)
         for index, item in enumerate(items):
@@ -564,45 +566,6 @@ def _alive(pid: int) -> bool:
     except PermissionError:
         return True
     return True
-
-
-def _dask_completed(function, items, workers, scheduler, on_error):
-    try:
-        from distributed import Client, LocalCluster
-        from distributed import as_completed as dask_as_completed
-    except ImportError:
-        raise ParameterError("a Dask scheduler needs Dask: pip install 'imgmtf[dask]'") from None
-    cluster = None
-    try:
-        if scheduler == LOCAL_CLUSTER:
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-            client = Client(cluster)
-        else:
-            client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        if cluster is not None:
-            cluster.close()
-        raise ParameterError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    futures = []
-    try:
-        futures = client.map(function, items, pure=False)
-        index = {future.key: i for i, future in enumerate(futures)}
-        for future in dask_as_completed(futures):
-            i = index[future.key]
-            try:
-                result = future.result()
-            except Exception as exc:
-                if on_error is None:
-                    raise
-                result = on_error(items[i], exc)
-            yield i, result
-    finally:
-        if futures:
-            client.cancel(futures)
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def _stderr_is_terminal() -> bool:
