@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 
 from .atomic import ensure_folder
-from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
+from .errors import FileWriteError, ImgmtfError, ParameterError
 from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
+from .file_lists import IMAGE_SUFFIXES, expand_inputs, once_each  # noqa: F401  (where callers found them)
 from .file_notes import file_notes as raster_notes
 from .io import Raster, many_files, open_raster, read_raster
 from .measure_settings import MeasureSettings
@@ -33,54 +34,6 @@ GROUP_BYTES = 4 * 2 ** 20  # and their bytes on disk at most: a larger file is a
 GROUP_SHARE = 3            # with several workers a group takes 1/(GROUP_SHARE x workers) of the files left,
 MIN_GROUP_FILES = 3        # ... at least this many: the last groups small, so that the workers end together
 POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
-IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
-                            ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
-
-
-def expand_inputs(paths, recursive: bool = False) -> list[str]:
-    """Files named, plus the image files (by suffix) in folders named,
-    sorted; with ``recursive`` also in their sub-folders.  Paths that do not
-    exist are kept, to be reported as errors."""
-    out = []
-    for raw in map(str, paths):
-        path = Path(raw)
-        if raw and path.is_dir():          # Path("") is the current folder: "" is no file
-            try:
-                found = list(path.rglob("*") if recursive else path.iterdir())
-            except OSError as exc:
-                raise ImageReadError(f"{raw}: cannot list the folder: {exc.strerror or exc}") from None
-            # not only regular files: a FIFO named x.tif is reported, not skipped
-            out.extend(sorted(str(p) for p in found
-                              if p.suffix.lower() in IMAGE_SUFFIXES and not p.is_dir()))
-        else:
-            out.append(raw)
-    return out
-
-
-def once_each(files: list[str]) -> tuple[list[str], dict[str, int]]:
-    """The files in their order with each file once (the same file named
-    twice, or by two paths, as ``a.tif ./a.tif``, or inside a folder also
-    named), and how many times each repeated one was named (by its first
-    name): a batch measures a file once and says so.
-
-    Examples
-    --------
-    >>> once_each(["a.tif", "b.tif", "./a.tif", "a.tif"])
-    (['a.tif', 'b.tif'], {'a.tif': 3})
-    """
-    first: dict[str, str] = {}
-    counts: dict[str, int] = {}
-    kept = []
-    for name in files:
-        key = os.path.normcase(os.path.realpath(name)) if name else name
-        if key in first:
-            counts[first[key]] = counts.get(first[key], 1) + 1
-            continue
-        first[key] = name
-        kept.append(name)
-    return kept, counts
-
-
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
                  *, run_utc: str | None = None, **options: Any) -> list[Record]:
     """Measure one image file as ``imgmtf measure FILE`` does: every
