@@ -256,17 +256,19 @@ def test_workers_bound_is_the_pools_and_the_default_method_a_registered_one():
     assert options.MAX_WORKERS == parallel.MAX_WORKERS and options.DEFAULT_METHOD in METHODS
 
 
-def test_a_batch_starts_its_workers_fork_server_before_it_loads_numpy():
-    # the server's imports (0.3-0.4 s) are the workers' start: they begin as the command does, beside
-    # the parent's own, not after its options are parsed with NumPy loaded (the method registry's)
+def test_a_batch_and_a_scan_start_their_workers_fork_server_before_they_load_numpy():
+    # the server's imports (0.3-0.8 s) are the workers' start: they begin as the command does, beside
+    # the parent's own, not after its options are parsed with NumPy loaded (the method registry's, a
+    # batch's readers, a scan's modules)
     import subprocess
     import sys
-    code = ("import sys, imgmtf.parallel as parallel; "
-            "parallel.prestart_workers = lambda *a: (print(sorted(m for m in ('numpy', 'scipy', 'cv2', 'rasterio') "
-            "if m in sys.modules)), sys.exit(0)); "
-            "from imgmtf.cli import main; main(['measure', '--workers', '2', 'chip.tif', 'other.tif'])")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr
+    for command in (["measure", "--workers", "2", "chip.tif", "other.tif"], ["scan", "chart.tif"]):
+        code = ("import sys, imgmtf.parallel as parallel; "
+                "parallel.prestart_workers = lambda *a: (print(sorted(m for m in ('numpy', 'scipy', 'cv2', "
+                "'rasterio') if m in sys.modules)), sys.exit(0)); "
+                f"from imgmtf.cli import main; main({command!r})")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0 and out.stdout.strip() == "[]", (command, out.stdout, out.stderr)
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):

@@ -134,9 +134,10 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         raise click.UsageError(f"{flag} describes the acquisitions of a campaign store: give --campaign STORE.gpkg")
     interrupted, outcomes = None, []
     with reported_errors():
-        from ..batch import expand_inputs
-        from ..parallel import available_cores, can_preload, prestart_workers
-        from ..scene.series import outputs_folder, scan_scenes, scenes_workers
+        from ..file_lists import expand_inputs
+        if scheduler is None:
+            _prestart(scenes, recursive, kind, fit_stages, workers)
+        from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
         rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
         with option_errors():           # a malformed option: exit 2, before any work
@@ -156,16 +157,6 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         if acquired is not None and len(paths) > 1:
             raise click.UsageError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
                                    "scan them one at a time, or let their metadata or product names say when")
-        if scheduler is None:
-            fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            # workers chosen automatically for one scene wait for its candidates to be counted; but its
-            # fits go to workers forked from a server that imports SciPy's optimizer (0.35-0.6 s) on
-            # another core while this process detects and measures (series._fit_workers)
-            count = scenes_workers(len(paths)) if workers is None else workers
-            if workers is None and fitted and len(paths) == 1 and can_preload():
-                count = available_cores()
-            prestart_workers(count, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
-                             + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
@@ -203,6 +194,35 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                    + (f"; written to {out_dir}" if out_dir else ""), err=True)
         sys.exit(interrupt_code(interrupted))
     sys.exit(0 if all(o.ok for o in outcomes) else 1)
+
+
+def _prestart(scenes, recursive: bool, kind: str, fit_stages: str, workers: int | None) -> None:
+    """Start the workers' fork server (parallel.prestart_workers) as the scan starts, before this process
+    loads anything numerical, so that its imports overlap this process's own: for the workers asked for,
+    or chosen for several scenes; for one scene's fits, workers chosen automatically, one per core: they
+    go to workers forked from a server that imports SciPy's optimizer (0.35-0.6 s) on another core while
+    this process detects and measures (scene.series._fit_workers).  Workers chosen automatically for one
+    scene's tiles and candidates wait for them to be counted.  The scenes are listed again where their
+    errors are reported, after the options' (the list is not checked here)."""
+    from ..errors import ImgmtfError
+    from ..file_lists import expand_inputs
+    from ..parallel import available_cores, can_preload, prestart_workers
+    try:
+        paths = expand_inputs(scenes, recursive)
+    except ImgmtfError:
+        return
+    if not paths:
+        return
+    fitted = fit_stages.strip() != "none" and get_kind(kind).fits_sensor      # as scan_one decides
+    if workers is not None:
+        count = workers
+    elif len(paths) > 1:
+        from ..scene.series import scenes_workers
+        count = scenes_workers(len(paths))
+    else:
+        count = available_cores() if fitted and can_preload() else 1
+    prestart_workers(count, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+                     + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
 
 
 def _stages(text: str) -> str | None:
