@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 
 from .atomic import ensure_folder
-from .errors import FileWriteError, ImageReadError, ImgmtfError, ParameterError
+from .errors import FileWriteError, ImgmtfError, ParameterError
 from .estimate.field import field_position, resolve_centre
 from .figures import with_figure
+from .file_lists import IMAGE_SUFFIXES, expand_inputs, once_each  # noqa: F401  (where callers found them)
 from .file_notes import file_notes as raster_notes
 from .io import Raster, many_files, open_raster, read_raster
 from .measure_settings import MeasureSettings
@@ -30,56 +31,9 @@ from .vectors import Unplaced, VectorROIs
 
 GROUP_FILES = 32           # files measured in one task at most: their small rasters estimated together
 GROUP_BYTES = 4 * 2 ** 20  # and their bytes on disk at most: a larger file is a task of its own
-GROUPS_PER_WORKER = 6      # tasks per worker at least, where there are files enough: workers end together
+GROUP_SHARE = 3            # with several workers a group takes 1/(GROUP_SHARE x workers) of the files left,
+MIN_GROUP_FILES = 3        # ... at least this many: the last groups small, so that the workers end together
 POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
-IMAGE_SUFFIXES = frozenset({".tif", ".tiff", ".png", ".jpg", ".jpeg", ".jp2", ".j2k", ".ntf", ".nitf",
-                            ".img", ".bmp", ".gif", ".vrt", ".hdr", ".webp"})
-
-
-def expand_inputs(paths, recursive: bool = False) -> list[str]:
-    """Files named, plus the image files (by suffix) in folders named,
-    sorted; with ``recursive`` also in their sub-folders.  Paths that do not
-    exist are kept, to be reported as errors."""
-    out = []
-    for raw in map(str, paths):
-        path = Path(raw)
-        if raw and path.is_dir():          # Path("") is the current folder: "" is no file
-            try:
-                found = list(path.rglob("*") if recursive else path.iterdir())
-            except OSError as exc:
-                raise ImageReadError(f"{raw}: cannot list the folder: {exc.strerror or exc}") from None
-            # not only regular files: a FIFO named x.tif is reported, not skipped
-            out.extend(sorted(str(p) for p in found
-                              if p.suffix.lower() in IMAGE_SUFFIXES and not p.is_dir()))
-        else:
-            out.append(raw)
-    return out
-
-
-def once_each(files: list[str]) -> tuple[list[str], dict[str, int]]:
-    """The files in their order with each file once (the same file named
-    twice, or by two paths, as ``a.tif ./a.tif``, or inside a folder also
-    named), and how many times each repeated one was named (by its first
-    name): a batch measures a file once and says so.
-
-    Examples
-    --------
-    >>> once_each(["a.tif", "b.tif", "./a.tif", "a.tif"])
-    (['a.tif', 'b.tif'], {'a.tif': 3})
-    """
-    first: dict[str, str] = {}
-    counts: dict[str, int] = {}
-    kept = []
-    for name in files:
-        key = os.path.normcase(os.path.realpath(name)) if name else name
-        if key in first:
-            counts[first[key]] = counts.get(first[key], 1) + 1
-            continue
-        first[key] = name
-        kept.append(name)
-    return kept, counts
-
-
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
                  *, run_utc: str | None = None, **options: Any) -> list[Record]:
     """Measure one image file as ``imgmtf measure FILE`` does: every
@@ -284,8 +238,9 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
 
     def lost(task, exc):
         return [[settings.failed(path, settings.band, exc, run_utc)] for path in task[0]]
+    # while the workers start (their fork server's imports), this process measures the last, smallest groups
     groups = run_tasks(_measure_group, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                       description="measuring", on_error=lost, ordered=ordered)
+                       description="measuring", on_error=lost, ordered=ordered, help_start=True)
     if ordered:
         for group in groups:
             yield from group
@@ -297,34 +252,50 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
 def group_sizes(file_bytes: Sequence[int], workers: int = 1) -> list[int]:
     """How many files each task of a batch measures, in order, given the
     files' sizes on disk (bytes): at most :data:`GROUP_FILES` and
-    :data:`GROUP_BYTES` a group (a file larger alone), and with several
-    workers at least :data:`GROUPS_PER_WORKER` groups per worker where
-    there are files enough, so that the workers finish together.  Small
-    chips gain from being estimated together; large files would only keep
-    their rows (and, on an interrupt, what was measured) waiting.
+    :data:`GROUP_BYTES` a group (a file larger alone); with one worker
+    groups of even size, with several shrinking ones (each
+    1/(:data:`GROUP_SHARE` x workers) of the files left, at least
+    :data:`MIN_GROUP_FILES`), so that the workers finish together and the
+    last tasks, which the caller may run while its workers start
+    (:func:`imgmtf.parallel.run_tasks`), are short.  Small chips gain from
+    being estimated together (three or four as much as more); large files
+    would only keep their rows (and, on an interrupt, what was measured)
+    waiting.
 
     Examples
     --------
     >>> group_sizes([20_000] * 100), group_sizes([20_000] * 100, workers=2)
-    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8])
+    ([25, 25, 25, 25], [17, 14, 12, 10, 8, 7, 6, 5, 4, 3, 3, 3, 3, 5])
     >>> group_sizes([20_000] * 3 + [50_000_000] + [20_000] * 2), group_sizes([])
     ([3, 1, 2], [])
     """
     files = len(file_bytes)
     if files == 0:
         return []
-    count = -(-files // GROUP_FILES)
-    if workers > 1:
-        count = max(count, min(files, GROUPS_PER_WORKER * workers))
-    size, extra = divmod(files, count)
     sizes: list[int] = []
-    for target in [size + 1] * extra + [size] * (count - extra):
+    for target in _shrinking(files, workers) if workers > 1 else _even(files):
         start = sum(sizes)
         group = file_bytes[start: start + target]
         # cut where the bytes would pass the budget: a group holds one file at least
         taken = next((n for n in range(1, len(group)) if sum(group[:n + 1]) > GROUP_BYTES), len(group))
         sizes.append(taken)
         sizes += group_sizes(group[taken:], 1) if taken < len(group) else []
+    return sizes
+
+
+def _even(files: int) -> list[int]:
+    count = -(-files // GROUP_FILES)
+    size, extra = divmod(files, count)
+    return [size + 1] * extra + [size] * (count - extra)
+
+
+def _shrinking(files: int, workers: int) -> list[int]:
+    sizes: list[int] = []
+    while files:
+        size = min(GROUP_FILES, max(MIN_GROUP_FILES, -(-files // (GROUP_SHARE * workers))))
+        size = files if files - size < MIN_GROUP_FILES else size
+        sizes.append(size)
+        files -= size
     return sizes
 
 

@@ -140,7 +140,7 @@ class MeasureSettings:
 
     def estimator(self) -> Callable[..., MTFResult]:
         # the estimators load SciPy and OpenCV: imported by the processes
-        # that measure (imgmtf.cli.measure.MEASURING_MODULES), not by a batch's parent
+        # that measure (imgmtf.preloads.MEASURING_MODULES), not by a batch's parent
         return get_kind(self.target).make_estimator(self.method, intervals=self.intervals, force=self.force,
                                                     transfer=self.transfer)
 

@@ -40,13 +40,15 @@ if TYPE_CHECKING:
 LOCAL_CLUSTER = "local"
 SCHEDULER_TIMEOUT_S = 10        # how long to keep trying a remote Dask scheduler
 _prestarted: list = []      # at most one pool started ahead by prestart_workers
+_preloaded: set[str] = set()    # what this process's fork server was asked to import
 MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
+HELP_GRACE_S = 0.03           # workers started within this are started: the caller waits rather than helps
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
-# as it starts (5-10 ms each)
-WORKER_MODULES = ("threadpoolctl",)
+# as it starts (5-10 ms each); and the server's own quick exit
+WORKER_MODULES = ("threadpoolctl", "imgmtf._server_exit")
 # what numerical libraries read, at load time, for their thread count
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
@@ -111,7 +113,7 @@ def signals_deferred():
 
 def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, scheduler: str | None = None,
               progress: bool | None = None, description: str = "measuring",
-              on_error: Callable | None = None, ordered: bool = True) -> Iterator:
+              on_error: Callable | None = None, ordered: bool = True, help_start: bool = False) -> Iterator:
     """``function(item)`` for every item, yielded in input order.
 
     Parameters
@@ -139,6 +141,11 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     ordered : bool, optional
         False yields ``(index, result)`` pairs as tasks complete (default
         True: results in input order).
+    help_start : bool, optional
+        With local workers whose start is not instant (a fork server still
+        importing, 0.3-0.5 s), run tasks here meanwhile, from the end of
+        the list (default False: this process waits).  For tasks whose
+        imports this process can afford, where the last are the smallest.
 
     Yields
     ------
@@ -154,7 +161,7 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     check_workers(workers)
     if progress is None:
         progress = len(items) > 1 and _stderr_is_terminal()
-    completed = _completed(function, items, workers, scheduler, on_error)
+    completed = _completed(function, items, workers, scheduler, on_error, help_start)
     if progress:
         completed = _with_progress(completed, len(items), description)
     try:
@@ -249,6 +256,33 @@ def prestart_workers(workers: int, modules: Iterable[str] = ()) -> None:
     _prestarted.append((workers, pool))
 
 
+def can_preload() -> bool:
+    """Whether this system starts workers from a fork server (Linux, and
+    Unix but macOS), whose preloaded imports every worker forked from it
+    shares: a pool's workers then start in milliseconds.
+
+    Examples
+    --------
+    >>> isinstance(can_preload(), bool)
+    True
+    """
+    import multiprocessing
+    return "forkserver" in multiprocessing.get_all_start_methods()
+
+
+def preloaded(modules: Iterable[str]) -> bool:
+    """Whether this process's fork server runs (:func:`prestart_workers`)
+    with every one of ``modules`` imported: a pool forked from it has them
+    loaded, or soon will, in its workers from their start.
+
+    Examples
+    --------
+    >>> preloaded(["a.module.never.preloaded"])
+    False
+    """
+    return set(modules) <= _preloaded and _fork_server_running()
+
+
 def _fork_server_running() -> bool:
     from multiprocessing import forkserver
     server = getattr(forkserver, "_forkserver", None)
@@ -261,6 +295,7 @@ def _start_fork_server(modules: Iterable[str]) -> None:
     library; the call does not wait for the imports."""
     from multiprocessing import forkserver
     forkserver.set_forkserver_preload([*modules, *WORKER_MODULES])
+    _preloaded.update([*modules, *WORKER_MODULES])
     saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
     os.environ.update(dict.fromkeys(THREAD_VARIABLES, "1"))
     try:
@@ -323,16 +358,21 @@ def _with_progress(completed, total: int, description: str):
             completed.close()
 
 
-def _completed(function, items, workers, scheduler, on_error):
-    """(index, result) pairs as tasks complete."""
+def _completed(function, items, workers, scheduler, on_error, help_start=False):
+    """(index, result) pairs as tasks complete.  A lone task runs here (a
+    pool's start would cost more than it saves), unless a fork server this
+    process prestarted has its modules loaded already: its worker starts in
+    milliseconds, and this process need not import them."""
     if scheduler is not None:
-        yield from _dask_completed(function, items, workers, scheduler, on_error)
-    elif workers == 1 or len(items) <= 1:
+        from .dask_tasks import dask_completed
+        yield from dask_completed(function, items, workers, scheduler, on_error,
+                                  local=scheduler == LOCAL_CLUSTER, timeout_s=SCHEDULER_TIMEOUT_S)
+    elif workers == 1 or not items or (len(items) == 1 and not (_preloaded and _fork_server_running())):
         _take_prestarted(0)
         for index, item in enumerate(items):
             yield index, _call(function, item, on_error)
     else:
-        yield from _pool_completed(function, items, workers, on_error)
+        yield from _pool_completed(function, items, workers, on_error, help_start)
 
 
 def _call(function, item, on_error):
@@ -344,17 +384,24 @@ def _call(function, item, on_error):
         return on_error(item, exc)
 
 
-def _pool_completed(function, items, workers, on_error):
+def _pool_completed(function, items, workers, on_error, help_start=False):
     """(index, result) pairs from a pool of ``workers`` processes.  Only
     ``IN_FLIGHT_PER_WORKER`` tasks per worker are submitted at a time, so
     that each wait (and a stop's cancelling) looks at a few futures however
-    long the batch."""
+    long the batch.  With ``help_start``, the first are submitted from a
+    thread (a submission starts a worker, which waits for the fork server's
+    imports) while this process runs tasks from the end of the list."""
     from concurrent.futures.process import BrokenProcessPool
     pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
-    queue = iter(enumerate(items))
+    pending = list(enumerate(items))
+    queue = iter(pending)
     in_flight: dict = {}
     finished = False
     try:
+        if help_start:
+            first = list(itertools.islice(queue, IN_FLIGHT_PER_WORKER * workers))
+            helped = yield from _helping_start(pool, function, first, pending, on_error, in_flight)
+            queue = iter(pending[len(first):len(pending) - helped])
         while True:
             failed = []         # tasks the pool refused: it broke (a worker died)
             with signals_deferred():
@@ -385,6 +432,42 @@ def _pool_completed(function, items, workers, on_error):
             pool.shutdown()
         else:
             _stop(pool, in_flight)
+
+
+def _helping_start(pool, function, first, pending, on_error, submitted: dict):
+    """Submit ``first`` (index, item) pairs to ``pool`` from a thread (into
+    ``submitted``, future: index; a submission the pool refused has the
+    error as its future's) and, until it is done, yield ``(index, result)``
+    of the tasks at the end of ``pending`` run here, one at a time; returns
+    how many ran here.  However this ends (an interrupt, a task's error),
+    the thread has ended: every submitted future is in ``submitted``."""
+    from concurrent.futures import Future
+
+    def submit():
+        for index, item in first:
+            try:
+                submitted[pool.submit(function, item)] = index
+            except Exception as exc:        # a broken pool: the task's result is its error
+                refused: Future = Future()
+                refused.set_exception(exc)
+                submitted[refused] = index
+    thread = threading.Thread(target=submit, name="imgmtf-pool-start", daemon=True)
+    thread.start()
+    helped = 0
+    try:
+        # a server already serving forks in milliseconds: nothing is run here
+        while not _joined(thread, HELP_GRACE_S) and len(first) + helped < len(pending):
+            helped += 1
+            index, item = pending[-helped]
+            yield index, _call(function, item, on_error)
+    finally:
+        thread.join()
+    return helped
+
+
+def _joined(thread: threading.Thread, timeout: float) -> bool:
+    thread.join(timeout)
+    return not thread.is_alive()
 
 
 def _died(item, exc: BrokenProcessPool, on_error):
@@ -483,45 +566,6 @@ def _alive(pid: int) -> bool:
     except PermissionError:
         return True
     return True
-
-
-def _dask_completed(function, items, workers, scheduler, on_error):
-    try:
-        from distributed import Client, LocalCluster
-        from distributed import as_completed as dask_as_completed
-    except ImportError:
-        raise ParameterError("a Dask scheduler needs Dask: pip install 'imgmtf[dask]'") from None
-    cluster = None
-    try:
-        if scheduler == LOCAL_CLUSTER:
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-            client = Client(cluster)
-        else:
-            client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        if cluster is not None:
-            cluster.close()
-        raise ParameterError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    futures = []
-    try:
-        futures = client.map(function, items, pure=False)
-        index = {future.key: i for i, future in enumerate(futures)}
-        for future in dask_as_completed(futures):
-            i = index[future.key]
-            try:
-                result = future.result()
-            except Exception as exc:
-                if on_error is None:
-                    raise
-                result = on_error(items[i], exc)
-            yield i, result
-    finally:
-        if futures:
-            client.cancel(futures)
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def _stderr_is_terminal() -> bool:

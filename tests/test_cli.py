@@ -249,10 +249,26 @@ def test_bootstrap_replicates_are_bounded_and_intervals_selectable(run, chip):
     assert run("measure", "--intervals", "bootstrap", "--bootstrap", "50", chip).exit_code == 0
 
 
-def test_workers_bound_is_the_pools():
+def test_workers_bound_is_the_pools_and_the_default_method_a_registered_one():
     from imgmtf import parallel
     from imgmtf.cli import options
-    assert options.MAX_WORKERS == parallel.MAX_WORKERS
+    from imgmtf.estimate.resampling import METHODS
+    assert options.MAX_WORKERS == parallel.MAX_WORKERS and options.DEFAULT_METHOD in METHODS
+
+
+def test_a_batch_and_a_scan_start_their_workers_fork_server_before_they_load_numpy():
+    # the server's imports (0.3-0.8 s) are the workers' start: they begin as the command does, beside
+    # the parent's own, not after its options are parsed with NumPy loaded (the method registry's, a
+    # batch's readers, a scan's modules)
+    import subprocess
+    import sys
+    for command in (["measure", "--workers", "2", "chip.tif", "other.tif"], ["scan", "chart.tif"]):
+        code = ("import sys, imgmtf.parallel as parallel; "
+                "parallel.prestart_workers = lambda *a: (print(sorted(m for m in ('numpy', 'scipy', 'cv2', "
+                "'rasterio') if m in sys.modules)), sys.exit(0)); "
+                f"from imgmtf.cli import main; main({command!r})")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0 and out.stdout.strip() == "[]", (command, out.stdout, out.stderr)
 
 
 def test_binary_sensor_file_is_one_line(run, tmp_path):

@@ -80,8 +80,9 @@ def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread
     """prestart_workers starts the fork server importing the modules once
     (before the workers' fork), with one numerical-library thread (what the
     probe saw when the server imported it); the caller's environment is left
-    as it was.  A fork server already running is left alone: prestarted
-    workers then import the modules themselves.  (In processes of their
+    as it was, and ``preloaded`` says the server has them.  A fork server
+    already running is left alone: prestarted workers then import the
+    modules themselves, and none is preloaded.  (In processes of their
     own: a process has one fork server.)"""
     import subprocess
     import sys
@@ -96,16 +97,17 @@ def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread
            "OPENBLAS_NUM_THREADS": "7"}
 
     def run(before=""):
-        code = ("import os, math; from imgmtf.parallel import prestart_workers, run_tasks; " + before +
+        code = ("import os, math; from imgmtf.parallel import preloaded, prestart_workers, run_tasks; " + before +
                 "prestart_workers(2, ['probe', 'colorsys']); import probe; "
                 "print(list(run_tasks(probe.state, ['colorsys', 'wave'], workers=2)), "
-                "os.environ.get('OPENBLAS_NUM_THREADS'))")
+                "os.environ.get('OPENBLAS_NUM_THREADS'), preloaded(['probe']), preloaded(['probe', 'wave']))")
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
         assert out.returncode == 0, out.stderr
         return out.stdout.strip()
-    assert run() == "[(True, True, '1'), (False, True, '1')] 7"
+    assert run() == "[(True, True, '1'), (False, True, '1')] 7 True False"
     # a fork server started before (by another pool): the workers import
-    assert run("list(run_tasks(math.sqrt, [1, 4], workers=2)); ") == "[(True, False, '1'), (False, False, '1')] 7"
+    assert run("list(run_tasks(math.sqrt, [1, 4], workers=2)); ") == \
+        "[(True, False, '1'), (False, False, '1')] 7 False False"
 
 
 def test_a_signal_inside_a_deferred_block_is_handled_after_it():
@@ -125,7 +127,58 @@ def test_the_fork_server_preloads_what_every_worker_set_up_imports(monkeypatch):
 
     from imgmtf import parallel
     preloaded = []
+    monkeypatch.setattr(parallel, "_preloaded", set())
     monkeypatch.setattr(forkserver, "set_forkserver_preload", preloaded.extend)
     monkeypatch.setattr(forkserver, "ensure_running", lambda: None)
     parallel._start_fork_server(("imgmtf.batch",))
     assert preloaded == ["imgmtf.batch", *parallel.WORKER_MODULES] and "threadpoolctl" in preloaded
+
+
+def test_only_the_fork_server_skips_its_teardown(tmp_path):
+    """The fork server, once its command has ended, exits without the interpreter's teardown (0.3 s with
+    SciPy loaded, its inherited output pipes open meanwhile: a slow exit handler stands for it here); a
+    process that merely imports the module keeps its exit status and exit handlers."""
+    import subprocess
+    import sys
+    import time
+    if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
+        pytest.skip("no fork server on this platform")
+    (tmp_path / "slow_exit.py").write_text("import atexit, time\natexit.register(time.sleep, 5)\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    code = ("from imgmtf.parallel import prestart_workers, run_tasks; prestart_workers(2, ['slow_exit']); "
+            "print(list(run_tasks(abs, [-1, -2], workers=2)))")
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "[1, 2]", out.stderr
+    assert time.perf_counter() - t < 4
+    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit as quick; "
+            "print(quick._in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 3 and out.stdout.split() == ["False", "handled"], out.stderr
+
+
+def test_the_caller_runs_the_last_tasks_while_its_workers_start(tmp_path):
+    """help_start: while the fork server imports (here a module that takes 0.3 s), the caller runs tasks
+    from the end of the list, each task once, the results in order as ever; without it, it waits.  A lone
+    task goes to a worker of the server this process prestarted (its modules loaded there, not here)."""
+    import subprocess
+    import sys
+    if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
+        pytest.skip("no fork server on this platform")
+    (tmp_path / "slow_start.py").write_text("import os, time\n"
+                                            "if os.environ['CALLER'] != str(os.getpid()):  # the server's\n"
+                                            "    time.sleep(0.3)\n"
+                                            "def where(x):\n    time.sleep(0.02)\n    return x, os.getpid()\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    code = ("import os, sys; os.environ['CALLER'] = str(os.getpid()); "
+            "from imgmtf.parallel import prestart_workers, run_tasks; "
+            "prestart_workers(2, ['slow_start']); import slow_start; "
+            "out = list(run_tasks(slow_start.where, range(12), workers=2, help_start=sys.argv[1] == 'help')); "
+            "here = [x for x, pid in out if pid == os.getpid()]; "
+            "lone = list(run_tasks(slow_start.where, [7], workers=2))[0][1] != os.getpid(); "
+            "print([x for x, _ in out] == list(range(12)), here == list(range(12 - len(here), 12)), lone, len(here))")
+    for asked in ("help", "wait"):
+        out = subprocess.run([sys.executable, "-c", code, asked], capture_output=True, text=True, env=env, timeout=60)
+        assert out.returncode == 0, out.stderr
+        same, last, lone, here = out.stdout.split()
+        assert same == last == lone == "True" and (int(here) >= 3 if asked == "help" else here == "0")

@@ -227,16 +227,23 @@ def test_cli_scan_for_pulses_prints_its_table_and_json_rows(tmp_path):
     assert header[:3] == ["id", "rank", "path"] and "bar_width_px" in header and "run_utc" in header
 
 
-def test_the_scans_workers_load_no_scipy():
-    """What the workers run (tile search, a batch of candidates, a target's
-    fit) and what their fork server preloads (imgmtf.cli.scan's lists,
-    without the fits') load no SciPy: only the segment graph, in the
-    calling process, needs it."""
+def test_a_scan_without_fits_loads_no_scipy():
+    """What the workers run (tile search, a batch of candidates) and what
+    their fork server preloads (imgmtf.cli.scan's lists, without the
+    fits'), and the scan's own steps in the calling process (the segment
+    graph: merging, junctions, the targets' grouping), load no SciPy:
+    its sparse and spatial packages cost 0.2-0.3 s of a chart's start-up.
+    Only a sensor fit does (its optimizer)."""
     import subprocess
     import sys
 
-    from imgmtf.cli.scan import SCANNING_MODULES
-    code = f"import sys; import {', '.join(SCANNING_MODULES)}; print(sorted(m for m in sys.modules if m == 'scipy'))"
+    from imgmtf.preloads import SCANNING_MODULES, WHOLE_SCAN_MODULES
+    graph = ("from imgmtf.scene.segments import SampledSegments, find_junctions, merge_segments; "
+             "s = SampledSegments.of([[0, 50, 100, 50], [50, 0, 50, 100], [101, 50, 160, 50]]); "
+             "j, _ = find_junctions(s); assert len(j) == 1, j; assert len(merge_segments(s.segments)) == 2; "
+             "from imgmtf.scene.neighbours import components; assert components(3, [0], [2])[0] == 2; ")
+    code = (f"import sys; import {', '.join(SCANNING_MODULES + WHOLE_SCAN_MODULES)}; {graph}"
+            "print(sorted(m for m in sys.modules if m == 'scipy'))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
@@ -334,3 +341,34 @@ def test_a_scene_whose_one_candidate_is_rejected_says_so_in_the_singular(tmp_pat
     result = CliRunner().invoke(main, ["scan", str(chip), "--min-length", "100"])
     assert result.exit_code == 1
     assert f"{chip}: no usable edge found (1 candidate, rejected)" in result.stderr     # not "1 candidates, all"
+
+
+def test_one_scene_with_fits_has_the_fork_server_load_the_optimizer_for_its_workers(monkeypatch):
+    """One scene, workers chosen automatically: the fork server starts as the scan does, the fits' modules
+    (SciPy's optimizer) among its imports, loaded on another core while this process detects and measures,
+    and the scene's few fits go to its workers; not without fits, nor with --workers 1, nor with no
+    fork server, when they run here."""
+    from types import SimpleNamespace
+
+    import imgmtf.parallel as parallel
+    from imgmtf.errors import ParameterError
+    from imgmtf.preloads import FITTING_MODULES
+    from imgmtf.scene.series import _fit_workers
+    started = []
+
+    def prestart(workers, modules):
+        started.append((workers, set(FITTING_MODULES) <= set(modules)))
+        raise ParameterError("stopped here")
+    monkeypatch.setattr(parallel, "prestart_workers", prestart)
+    monkeypatch.setattr(parallel, "available_cores", lambda: 2)
+    monkeypatch.setattr(parallel, "can_preload", lambda: True)
+    for options in ([], ["--fit-stages", "none"], ["--workers", "1"]):
+        CliRunner().invoke(main, ["scan", "chart.tif", *options])
+    monkeypatch.setattr(parallel, "can_preload", lambda: False)
+    CliRunner().invoke(main, ["scan", "chart.tif"])
+    assert started == [(2, True), (1, False), (1, True), (1, True)]
+    records = [SimpleNamespace(ok=True)] * 16 + [SimpleNamespace(ok=False)] * 3
+    monkeypatch.setattr(parallel, "preloaded", lambda modules: False)
+    assert _fit_workers(records, None) == 1 and _fit_workers(records, 3) == 3
+    monkeypatch.setattr(parallel, "preloaded", lambda modules: set(modules) == set(FITTING_MODULES))
+    assert _fit_workers(records, None) == 2 and _fit_workers(records[:1], None) == 1 and _fit_workers(records, 1) == 1

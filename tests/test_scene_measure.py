@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import imgmtf as im
+from imgmtf.preloads import SCAN_TASK_MODULES
 from imgmtf.scene.combine import combine, normal_families, summarise_scan
 from imgmtf.scene.measure import scan_scene
 from imgmtf.scene.settings import ScanSettings
@@ -218,8 +219,8 @@ def test_a_scan_detecting_on_workers_has_their_fork_server_load_its_tasks_module
     settings = ScanSettings(tile_px=256)            # 15 tiles: two workers
     assert scan_scene(str(path), settings, workers=1) == [] and started == []
     assert scan_scene(str(path), settings, workers=None) == []
-    assert started == [(2, measure.WORKER_MODULES)]
-    assert all(importlib.util.find_spec(name) is not None for name in measure.WORKER_MODULES)
+    assert started == [(2, SCAN_TASK_MODULES)]
+    assert all(importlib.util.find_spec(name) is not None for name in SCAN_TASK_MODULES)
 
 
 def test_the_scan_module_loads_without_scipy_so_the_workers_fork_server_starts_first():

@@ -87,8 +87,8 @@ def fit(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, band, roi
         return
     if pulse_width or gap:
         raise click.UsageError("--pulse-width and --gap describe bars: give --target pulse or double-bar")
-    from ..batch import expand_inputs
     from ..estimate.fit import check_names
+    from ..file_lists import expand_inputs
     from ..sensor.model import Sensor
     from ..sensor_fit import edge_sources, fit_sensor
     with reported_errors():
@@ -166,8 +166,8 @@ def _fit_bars(paths, kind, pulse_width, gap, stages, sensor_path, hold, gsd, ban
     if len(roi) > 1:
         raise click.UsageError("--target pulse or double-bar takes one --roi for every file")
     from ..bar_fit import fit_bar_files
-    from ..batch import expand_inputs
     from ..estimate.fit import check_names
+    from ..file_lists import expand_inputs
     from ..sensor.model import Sensor
     with reported_errors():
         start = Sensor.from_toml(sensor_path) if sensor_path else None

@@ -9,11 +9,11 @@ import click
 
 from ..errors import ParameterError
 from ..kinds import get_kind, kind_names
+from ..preloads import MEASURING_MODULES
 from .campaign import CampaignWriter, campaign_options
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .files import check_figure_file, check_output_file
 from .options import (
-    CLI_MODULES,
     FiniteFloat,
     MethodOption,
     interval_options,
@@ -29,14 +29,6 @@ from .options import (
     width_refusal,
 )
 from .tables import TextRows
-
-# what a process measuring files loads, NumPy's lazily loaded parts included:
-# imported once by the workers' fork server rather than by each worker's first
-# file (batch imports the estimators only where it measures, so that a batch's
-# parent, which collects records, stays light)
-MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", "numpy.fft", "numpy.ma",
-                     "numpy.polynomial", *CLI_MODULES)
-
 
 
 @click.command(short_help="Measure the MTF of the edge or bar in image files or folders.")

@@ -10,10 +10,7 @@ from ..kinds import kinds_with_width
 
 MAX_WORKERS = 64                    # as imgmtf.parallel.MAX_WORKERS, without importing it for --help
 MIN_REPLICATES, MAX_REPLICATES = 20, 5000     # as imgmtf.estimate.intervals checks them
-# what a worker started by the fork server imports before its first task: it runs the ``imgmtf`` script
-# again as ``__mp_main__`` (CPython does not hand the script to the fork server, which would run it once),
-# and the script imports the command line: 30-40 ms a worker, once in the fork server when preloaded
-CLI_MODULES = ("imgmtf.cli",)
+DEFAULT_METHOD = "msg"              # a registered resampling method (tests/test_cli.py checks)
 
 
 class FiniteFloat(click.FloatRange):
@@ -72,8 +69,9 @@ class Replicates(click.IntRange):
 
 class MethodName(click.ParamType):
     """A resampling method name, checked against the method registry when
-    the option is used (the registry imports SciPy: ``imgmtf --help`` does
-    not pay for it)."""
+    the option is given (the registry imports NumPy: ``imgmtf --help`` does
+    not pay for it, nor a command run with the default method before it
+    starts its workers)."""
 
     name = "method"
 
@@ -86,7 +84,7 @@ class MethodName(click.ParamType):
         return "[" + "|".join(self.names()) + "]"
 
     def convert(self, value, param, ctx):
-        if value in self.names():
+        if value == DEFAULT_METHOD or value in self.names():
             return value
         self.fail(f"{value!r} is not one of {', '.join(map(repr, self.names()))}", param, ctx)
 
@@ -101,7 +99,7 @@ class MethodOption(click.Option):
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("type", MethodName())
-        kwargs.setdefault("default", "msg")
+        kwargs.setdefault("default", DEFAULT_METHOD)
         kwargs.setdefault("show_default", True)
         super().__init__(*args, **kwargs)
 

@@ -82,7 +82,7 @@ def restore(paths, sensor_path, measured_path, target_nyquist, max_noise_gain, a
         raise click.UsageError("give the system to compensate: --sensor FILE (a fitted sensor) or --measured FILE "
                                "(imgmtf scan --format json's rows), one of them")
     with reported_errors():
-        from ..batch import expand_inputs
+        from ..file_lists import expand_inputs
         files = expand_inputs(paths, recursive)
         if not files:
             raise ParameterError(f"no image files in {', '.join(paths)}")

@@ -9,9 +9,10 @@ import click
 
 from ..errors import ParameterError
 from ..kinds import get_kind, kind_names
+from ..preloads import FITTING_MODULES, SCANNING_MODULES, WHOLE_SCAN_MODULES
 from .errors import closing, interrupt_code, option_errors, reported_errors, signal_name
 from .options import (
-    CLI_MODULES,
+    DEFAULT_METHOD,
     FiniteFloat,
     MethodName,
     auto_parallel_options,
@@ -27,17 +28,6 @@ from .options import (
 from .tables import print_scan
 
 DEFAULT_STAGES = "auto"   # as imgmtf.scene.targetfit's, without importing it for --help
-# what a scan's workers load, NumPy's lazily loaded parts included: imported once by the workers'
-# fork server rather than by each worker of each run of tasks (detection, measurement, fits); those
-# of the fits only when targets are fitted, edges and not bars (SciPy's optimizer alone is 0.35 s).
-# Not the segment graph's SciPy (0.2 s), which only this process needs: the workers start sooner
-SCANNING_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.scene.targetfit",
-                    "imgmtf.scene.sections", "imgmtf.estimate.mtf2d", "numpy.fft", "numpy.ma", "numpy.polynomial",
-                    *CLI_MODULES)
-FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
-# with several scenes each worker runs whole scans, the segment graph's SciPy included: loaded once by
-# the fork server rather than by every worker as its first scene starts
-WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 
 
 @click.command(short_help="Find, measure and combine every edge, bar or point array in a scene.")
@@ -52,7 +42,7 @@ WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.sce
               help="ROI extent either side of the target, px")
 @click.option("--pulse-width", callback=length_option("px"),
               help="bar width (0.2 to 10 px; px or m) for every bar; estimated per bar when omitted")
-@click.option("--method", type=MethodName(), default="msg", show_default=True)
+@click.option("--method", type=MethodName(), default=DEFAULT_METHOD, show_default=True)
 @click.option("--band", type=click.IntRange(min=1),
               help="1-based band (default: the only band, or the luminance of RGB)")
 @click.option("--saturation", callback=parse_pair, metavar="LO,HI",
@@ -144,9 +134,10 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         raise click.UsageError(f"{flag} describes the acquisitions of a campaign store: give --campaign STORE.gpkg")
     interrupted, outcomes = None, []
     with reported_errors():
-        from ..batch import expand_inputs
-        from ..parallel import prestart_workers
-        from ..scene.series import outputs_folder, scan_scenes, scenes_workers
+        from ..file_lists import expand_inputs
+        if scheduler is None:
+            _prestart(scenes, recursive, kind, fit_stages, workers)
+        from ..scene.series import outputs_folder, scan_scenes
         from ..scene.settings import ScanSettings
         rois = read_roi_file(roi_file)      # once, before any scene: its errors are an input's (exit 1)
         with option_errors():           # a malformed option: exit 2, before any work
@@ -166,12 +157,6 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
         if acquired is not None and len(paths) > 1:
             raise click.UsageError(f"--acquired gives one time, for one scene; {len(paths)} scenes were given: "
                                    "scan them one at a time, or let their metadata or product names say when")
-        if scheduler is None:
-            fitted = bool(stages) and get_kind(kind).fits_sensor      # as scan_one decides
-            # workers chosen automatically for one scene wait for its candidates to be counted
-            prestart_workers(scenes_workers(len(paths)) if workers is None else workers,
-                             SCANNING_MODULES + (FITTING_MODULES if fitted else ())
-                             + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
         folders: dict[str, str] = {}
         if out_dir:
             from ..atomic import ensure_folder
@@ -209,6 +194,35 @@ def scan(scenes, kind, min_length, max_length, margin, pulse_width, method, band
                    + (f"; written to {out_dir}" if out_dir else ""), err=True)
         sys.exit(interrupt_code(interrupted))
     sys.exit(0 if all(o.ok for o in outcomes) else 1)
+
+
+def _prestart(scenes, recursive: bool, kind: str, fit_stages: str, workers: int | None) -> None:
+    """Start the workers' fork server (parallel.prestart_workers) as the scan starts, before this process
+    loads anything numerical, so that its imports overlap this process's own: for the workers asked for,
+    or chosen for several scenes; for one scene's fits, workers chosen automatically, one per core: they
+    go to workers forked from a server that imports SciPy's optimizer (0.35-0.6 s) on another core while
+    this process detects and measures (scene.series._fit_workers).  Workers chosen automatically for one
+    scene's tiles and candidates wait for them to be counted.  The scenes are listed again where their
+    errors are reported, after the options' (the list is not checked here)."""
+    from ..errors import ImgmtfError
+    from ..file_lists import expand_inputs
+    from ..parallel import available_cores, can_preload, prestart_workers
+    try:
+        paths = expand_inputs(scenes, recursive)
+    except ImgmtfError:
+        return
+    if not paths:
+        return
+    fitted = fit_stages.strip() != "none" and get_kind(kind).fits_sensor      # as scan_one decides
+    if workers is not None:
+        count = workers
+    elif len(paths) > 1:
+        from ..scene.series import scenes_workers
+        count = scenes_workers(len(paths))
+    else:
+        count = available_cores() if fitted and can_preload() else 1
+    prestart_workers(count, SCANNING_MODULES + (FITTING_MODULES if fitted else ())
+                     + (WHOLE_SCAN_MODULES if len(paths) > 1 else ()))
 
 
 def _stages(text: str) -> str | None:

@@ -33,11 +33,13 @@ from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
 from ..kinds import get_kind
 from ..parallel import auto_workers, prestart_workers, run_tasks
+from ..preloads import SCAN_TASK_MODULES
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
 from .detect import detect_segments, tile_windows
 from .features import crossing, placed_windows
 from .fill import fill_screen
+from .neighbours import components
 from .roi import JUNCTION_CLEARANCE_PX, MIN_HALF_WIDTH_PX, plan_roi, roi_margin_px
 from .screen import geometry_screen
 from .settings import ScanSettings
@@ -50,11 +52,6 @@ if TYPE_CHECKING:
 AUTO_PLANS_PER_WORKER = 100
 AUTO_TILES_PER_WORKER = 4       # ... and detection its tiles from this many a worker (0.2-0.3 s a tile)
 TASKS_PER_WORKER = 4            # a pool's candidates are split into this many tasks a worker: a late tile waits less
-# what the scan's own tasks (the tiles' detection, the candidates' measurement) import: loaded once, as the
-# scan starts, by the workers' fork server (parallel.prestart_workers), not by every worker of each of its
-# two pools as its first task arrives (0.5-0.6 s each time, while the scan waits)
-WORKER_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.estimate.edge", "imgmtf.estimate.pulse",
-                  "numpy.fft", "numpy.ma", "numpy.polynomial")
 
 
 def track_azimuth(info: RasterInfo, settings: ScanSettings) -> float | None:
@@ -147,8 +144,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
     detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
                  else workers)
     if scheduler is None and detecting > 1:
-        prestart_workers(detecting, WORKER_MODULES)
-    # the segment graph's SciPy (0.3-0.5 s to import) loads while the workers' fork server loads theirs
+        prestart_workers(detecting, SCAN_TASK_MODULES)    # once, not by each of the two pools' workers
     from .segments import (
         BAR_MAX_SEPARATION_PX,
         SampledSegments,
@@ -158,7 +154,7 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
         split_at_junctions,
     )
     segments, fill_fraction = detect_segments(path, settings, workers=detecting, scheduler=scheduler, progress=progress)
-    sampled = SampledSegments.of(segments)          # one tree for the junctions, the lines and the neighbours
+    sampled = SampledSegments.of(segments)          # one sampling for the junctions, the lines and the neighbours
     junctions, events = find_junctions(sampled)
     halves = split_at_junctions(sampled, junctions, events, fill_fraction)
     track = track_azimuth(info, settings)
@@ -376,8 +372,6 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     were accepted) joined through the junctions they share; each target
     with an accepted half-edge gets a ``target_id`` (1, 2... in the order
     of its best rank is assigned after ranking, see :func:`_ranked`)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
     reached = [i for i, r in enumerate(records) if r.site.get("verdict_by") == "gate"]
     owners: dict[int, list[int]] = {}
     for i in reached:
@@ -387,8 +381,7 @@ def _grouped(records: list[Record], halves: list[HalfEdge]) -> list[Record]:
     n = len(records)
     a = [m[0] for m in owners.values() for _ in m[1:]]
     b = [x for m in owners.values() for x in m[1:]]
-    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
+    _, label = components(n, np.array(a, np.intp), np.array(b, np.intp))
     groups_with_accepted = {label[i] for i, r in enumerate(records) if r.ok}
     return [r.with_(site={"group": int(label[i])}) if i in reached and label[i] in groups_with_accepted else r
             for i, r in enumerate(records)]

@@ -10,9 +10,10 @@
 3. bars (:func:`pair_bars`): two parallel segments a few pixels apart are
    the two sides of one bar.
 
-Contacts between segments are found with a k-d tree over points sampled
-along them (:func:`contacts`), so merging, junctions and pairing cost
-about the number of segments times their neighbours, never their square.
+Contacts between segments are found with a grid of cells over points
+sampled along them (:func:`contacts`, :mod:`.neighbours`), so merging,
+junctions and pairing cost about the number of segments times their
+neighbours, never their square.
 """
 from __future__ import annotations
 
@@ -22,13 +23,8 @@ from itertools import pairwise
 
 import numpy as np
 
-# SciPy's graphs and trees (0.2-0.25 s to import) at the module's import: a scan imports this
-# while its workers start, not after their tiles when every other step waits for the graph
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
-
 from .geometry import SAMPLE_STEP_PX, sample_points, segment_lengths, unit_vectors
+from .neighbours import close_pairs, components, pairs_within
 
 MERGE_ANGLE_DEG = 2.0        # pieces of one line differ by less than this in direction
 MERGE_OFFSET_PX = 1.5        # ... lie within this of each other's line
@@ -39,9 +35,6 @@ JUNCTION_ANGLE_DEG = 20.0    # segments closer in direction do not make a juncti
 JUNCTION_MERGE_PX = 4.0      # meeting points closer than this are one junction
 SPLIT_MARGIN_PX = 8.0        # a junction this far inside a segment splits it
 MIN_SEGMENT_PX = 8.0         # shorter LSD output is noise, never a partner at a junction
-# k-d trees split at the midpoint, their nodes not shrunk to their points: built in half the time,
-# queried a little slower; what a query finds is the same (in another order, which every caller sorts)
-_TREE = {"balanced_tree": False, "compact_nodes": False}
 
 
 @dataclass(frozen=True)
@@ -124,14 +117,13 @@ def segment_rows(segments: list[Segment] | tuple[Segment, ...]) -> np.ndarray:
 class SampledSegments:
     """Segments (rows x0, y0, x1, y1) with points sampled every ``step``
     px or closer along each (:func:`sample_points`: ``points``, and
-    ``owner``, the segment of each) and a k-d tree over those points: built
-    once, for every search of contacts with the same segments (the scan's
-    junctions, straight lines and neighbours alike)."""
+    ``owner``, the segment of each): sampled once, for every search of
+    contacts with the same segments (the scan's junctions, straight lines
+    and neighbours alike)."""
 
     segments: np.ndarray
     points: np.ndarray
     owner: np.ndarray
-    tree: cKDTree
     step: float
     found: dict = field(default_factory=dict, init=False, repr=False)     # end_contacts, by radius
 
@@ -139,7 +131,7 @@ class SampledSegments:
     def of(cls, segments: np.ndarray, step: float = SAMPLE_STEP_PX) -> SampledSegments:
         segments = np.asarray(segments, float).reshape(-1, 4)
         points, owner = sample_points(segments, step)
-        return cls(segments, points, owner, cKDTree(points, **_TREE), step)
+        return cls(segments, points, owner, step)
 
     def end_contacts(self, radius: float) -> tuple[np.ndarray, np.ndarray]:
         """Which segments pass within about ``radius`` px of an end of
@@ -165,7 +157,7 @@ def contacts(queries: np.ndarray, s: np.ndarray | SampledSegments, radius: float
     """Which segments pass within about ``radius`` px of which query
     points: (query index, segment index) pairs, each pair once; with
     ``by`` (one index per query: the segment it was sampled from), (that
-    index, segment index) pairs, each once.  A k-d tree over points
+    index, segment index) pairs, each once.  A grid over points
     sampled along the segments (every ``step`` px, or as sampled already
     when ``s`` is a :class:`SampledSegments`): the cost grows with the
     number of contacts, not with the square of the number of segments."""
@@ -173,10 +165,9 @@ def contacts(queries: np.ndarray, s: np.ndarray | SampledSegments, radius: float
     if len(queries) == 0 or n == 0:
         return np.zeros(0, int), np.zeros(0, int)
     sampled = s if isinstance(s, SampledSegments) else SampledSegments.of(s, step)
-    near = cKDTree(queries, **_TREE).sparse_distance_matrix(sampled.tree, radius + sampled.step / 2,
-                                                           output_type="ndarray")
-    first = near["i"] if by is None else np.asarray(by)[near["i"]]
-    key = np.unique(first.astype(np.int64) * n + sampled.owner[near["j"]])
+    i, j = pairs_within(queries, sampled.points, radius + sampled.step / 2)
+    first = i if by is None else np.asarray(by)[i]
+    key = np.unique(first.astype(np.int64) * n + sampled.owner[j])
     return key // n, key % n
 
 
@@ -240,7 +231,7 @@ def line_lengths(segments: np.ndarray | SampledSegments) -> np.ndarray:
     whatever the polarity: collinear segments that meet end to end (the
     two halves of a checkerboard's inner line, whose polarity flips at its
     centre) count as one line.  ``segments``: rows (x0, y0, x1, y1), or
-    :class:`SampledSegments` of them (whose tree this reuses)."""
+    :class:`SampledSegments` of them (whose samples this reuses)."""
     sampled = segments if isinstance(segments, SampledSegments) else None
     segments = rows_of(segments)
     if len(segments) < 2:
@@ -270,9 +261,7 @@ def _merge_labels(pieces: np.ndarray, sampled: SampledSegments | None = None) ->
     offset = np.maximum(np.abs(d0), np.abs(d1))
     gap = np.maximum(np.minimum(t0, t1) - lengths[long_], -np.maximum(t0, t1))
     join = (offset <= MERGE_OFFSET_PX) & (gap <= MERGE_GAP_PX)
-    n = len(pieces)
-    graph = coo_matrix((np.ones(join.sum()), (a[join], b[join])), shape=(n, n))
-    return connected_components(graph, directed=False)[1]
+    return components(len(pieces), a[join], b[join])[1]
 
 
 def _joined(pieces: np.ndarray, label: np.ndarray) -> np.ndarray:
@@ -314,7 +303,7 @@ def find_junctions(segments: np.ndarray | SampledSegments) -> tuple[list[Junctio
     are one junction.
 
     ``segments``: rows (x0, y0, x1, y1), or :class:`SampledSegments` of
-    them (whose tree this reuses).
+    them (whose samples this reuses).
 
     Returns the junctions and the events (rows: segment, partner, junction
     id, t of the junction along the segment in px from its start), one per
@@ -330,7 +319,7 @@ def find_junctions(segments: np.ndarray | SampledSegments) -> tuple[list[Junctio
     lengths, units = segment_lengths(segments), unit_vectors(segments)
     a, b = sampled.end_contacts(JUNCTION_REACH_PX)
     owner = sampled.owner
-    near = sampled.tree.query_pairs(SAMPLE_STEP_PX, output_type="ndarray")
+    near = close_pairs(sampled.points, SAMPLE_STEP_PX)
     a, b = _unique_pairs(np.concatenate([a, owner[near[:, 0]]]), np.concatenate([b, owner[near[:, 1]]]),
                          len(segments), ordered=False)
     a, b = a[a != b], b[a != b]
@@ -344,9 +333,8 @@ def find_junctions(segments: np.ndarray | SampledSegments) -> tuple[list[Junctio
     a, b, x, ta, tb = a[on_both], b[on_both], x[on_both], ta[on_both], tb[on_both]
     if len(a) == 0:
         return [], empty
-    close = cKDTree(x).query_pairs(JUNCTION_MERGE_PX, output_type="ndarray")
-    graph = coo_matrix((np.ones(len(close)), (close[:, 0], close[:, 1])), shape=(len(x), len(x)))
-    count, label = connected_components(graph, directed=False)
+    close = close_pairs(x, JUNCTION_MERGE_PX)
+    count, label = components(len(x), close[:, 0], close[:, 1])
     members_n = np.bincount(label, None, count)[:, None]
     centre = np.column_stack([np.bincount(label, x[:, k], count) for k in (0, 1)]) / members_n
     events = np.vstack([np.column_stack([a, b, label, ta]), np.column_stack([b, a, label, tb])])
@@ -367,7 +355,7 @@ def split_at_junctions(segments: np.ndarray | SampledSegments, junctions: list[J
     segments met there (its partners), the other halves of its own line
     included; ``fill_fraction`` (per segment, from :func:`detect_segments`)
     passes on to its halves.  ``segments``: rows (x0, y0, x1, y1), or
-    :class:`SampledSegments` of them (whose tree this reuses)."""
+    :class:`SampledSegments` of them (whose samples this reuses)."""
     lines = line_lengths(segments).tolist()
     segments = rows_of(segments)
     lengths = segment_lengths(segments).tolist()
@@ -440,7 +428,7 @@ def parallel_clearance(candidates: list[Segment], segments: np.ndarray | Sampled
     ``JUNCTION_ANGLE_DEG``, alongside it over part of its length, and
     farther than its own half-width (a bar's own sides do not count);
     ``inf`` when none lies within ``reach_px``.  ``segments``: rows (x0,
-    y0, x1, y1), or :class:`SampledSegments` of them (whose tree this
+    y0, x1, y1), or :class:`SampledSegments` of them (whose samples this
     reuses)."""
     c = segment_rows(candidates)
     out = np.full(len(c), np.inf)

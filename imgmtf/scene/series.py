@@ -261,12 +261,19 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
 
 def _fit_workers(records: Sequence[Record], workers: int | None) -> int:
     """The workers of a scene's fits: as given, or chosen (None) as its
-    candidates' were, by its accepted half-edges."""
+    candidates' were, by its accepted half-edges; but where the workers'
+    fork server has the fits' modules loaded already (a command started it
+    with them, :func:`imgmtf.parallel.prestart_workers`), even a few fits
+    go to its workers, rather than SciPy's optimizer (0.35-0.6 s) being
+    imported here after the scene's measurement."""
     if workers is not None:
         return workers
-    from ..parallel import auto_workers
+    from ..parallel import auto_workers, preloaded
+    from ..preloads import FITTING_MODULES
     from .measure import AUTO_PLANS_PER_WORKER
-    return auto_workers(sum(r.ok for r in records), AUTO_PLANS_PER_WORKER)
+    accepted = sum(r.ok for r in records)
+    chosen = auto_workers(accepted, AUTO_PLANS_PER_WORKER)
+    return auto_workers(accepted, 1) if chosen == 1 and preloaded(FITTING_MODULES) else chosen
 
 
 def _image_axes(records) -> list[Record]:

@@ -1,0 +1,27 @@
+"""What each kind of worker process imports before its first task: the
+lists a command hands :func:`imgmtf.parallel.prestart_workers`, so that
+the workers' fork server imports them once, as the command starts, rather
+than every worker of every pool as its first task arrives (NumPy's lazily
+loaded parts included).  One place for them, free of imports itself: the
+command line reads them before it loads anything numerical.
+"""
+from __future__ import annotations
+
+# NumPy's parts loaded on first use, which every estimate uses
+NUMPY_LAZY = ("numpy.fft", "numpy.ma", "numpy.polynomial")
+# a worker started by the fork server runs the ``imgmtf`` script again as ``__mp_main__`` (CPython does
+# not hand the script to the fork server, which would run it once), and the script imports the command
+# line: 30-40 ms a worker, once in the fork server when preloaded
+CLI_MODULES = ("imgmtf.cli",)
+# a scan's own tasks: the tiles' detection, the candidates' measurement
+SCAN_TASK_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.estimate.edge",
+                     "imgmtf.estimate.pulse", *NUMPY_LAZY)
+# what a scan's workers run besides, the targets' sections and the 2-D MTF (fits below: SciPy's optimizer,
+# 0.35 s alone, only when targets are fitted)
+SCANNING_MODULES = (*SCAN_TASK_MODULES, "imgmtf.scene.targetfit", "imgmtf.scene.sections", "imgmtf.estimate.mtf2d",
+                    *CLI_MODULES)
+FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
+# with several scenes each worker runs whole scans, the segment graph included
+WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
+# a batch of files measured (imgmtf measure): the estimators and the files' reading and records
+MEASURING_MODULES = ("imgmtf.batch", "imgmtf.estimate.edge", "imgmtf.estimate.pulse", *NUMPY_LAZY, *CLI_MODULES)
