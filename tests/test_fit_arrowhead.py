@@ -6,7 +6,14 @@ from scipy import sparse
 from scipy.optimize import least_squares
 from scipy.special import erf
 
-from imgmtf.estimate.fit.arrowhead import damped_step, normal_blocks, product, solve_arrowhead, split_columns
+from imgmtf.estimate.fit.arrowhead import (
+    NoConvergence,
+    damped_step,
+    normal_blocks,
+    product,
+    solve_arrowhead,
+    split_columns,
+)
 
 
 def arrowhead(rng, n, counts):
@@ -111,3 +118,15 @@ def test_the_arrowhead_solve_reaches_scipys_optimum(width_upper):
     np.testing.assert_allclose(z, reference.x, rtol=1e-6, atol=1e-6)
     if np.isfinite(width_upper):
         assert z[1] == width_upper and z[0] < width_upper
+
+
+def test_residuals_not_finite_at_the_start_end_the_solve_at_once():
+    residuals, jacobian, z0, counts, lower, upper = edges_problem()
+    calls = []
+
+    def broken(z):
+        calls.append(1)
+        return np.full(residuals(z).size, np.nan)
+    with pytest.raises(NoConvergence, match="not finite"):
+        solve_arrowhead(broken, jacobian, z0, 2, counts, lower, upper)
+    assert len(calls) == 1

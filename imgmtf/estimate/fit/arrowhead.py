@@ -22,6 +22,8 @@ import numpy as np
 
 #: values (8 bytes each) of one zero-padded stack of edges' columns in :func:`normal_blocks`
 STACK_VALUES = 1 << 22
+#: the damping (relative to the columns' squared norms) at which a solve that finds no lower cost gives up
+MAX_DAMPING = 1e20
 
 @dataclass(frozen=True)
 class NormalBlocks:
@@ -218,12 +220,15 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     Raises
     ------
     NoConvergence
-        Not converged within ``max_evaluations`` residual evaluations.
+        Not converged within ``max_evaluations`` residual evaluations, no
+        step lowering the cost, or residuals not finite at the start.
     """
     z = np.clip(np.asarray(z, float), lower, upper)
     r = residuals(z)
     evaluations = 1
     cost = 0.5 * float(r @ r)
+    if not np.isfinite(cost):
+        raise NoConvergence("the residuals are not finite at the start")
     jac = jacobian(z)
     scale = np.zeros(z.size)
     damping, growth = 1e-3, 2.0
@@ -258,5 +263,7 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
                 return z, jac                 # no step can lower the cost within rounding
             damping *= growth
             growth *= 2.0
+            if damping > MAX_DAMPING:                     # no step lowers the cost: nowhere to go
+                raise NoConvergence("no step lowers the cost")
         z, r, cost = trial, r_trial, cost_trial
         jac = jacobian(z)
