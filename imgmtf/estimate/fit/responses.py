@@ -123,8 +123,8 @@ class EdgeResponses:
         """
         return self._base(sensor, given)[2]
 
-    def changes(self, sensor: Sensor, shifted: Sequence[Sensor],
-                given: Given | None = None) -> tuple[LineResponse, np.ndarray, np.ndarray]:
+    def changes(self, sensor: Sensor, shifted: Sequence[Sensor], given: Given | None = None,
+                out: np.ndarray | None = None) -> tuple[LineResponse, np.ndarray, np.ndarray]:
         """The line response of ``sensor`` and the remainders of the
         ``shifted`` sensors' minus its own on its grid.
 
@@ -136,6 +136,9 @@ class EdgeResponses:
             Its shifted copies (same GSD, same chain).
         given : dict, optional
             As for :meth:`response` (the shifted stages' transfers).
+        out : numpy.ndarray, shape (2, len(shifted), grid size), optional
+            Where to write the LSF and ESF changes (:meth:`LineGrid.remainders`):
+            a view of several edges' changes side by side, say.
 
         Returns
         -------
@@ -149,7 +152,7 @@ class EdgeResponses:
         spectra = np.empty((len(shifted), base.size), base.dtype)       # complex for a one-sided stage
         for row, other in zip(spectra, shifted):
             np.subtract(self._transfer(other, keep=False, given=given)[1:], base, out=row)
-        esf, lsf = grid.remainders(spectra)
+        esf, lsf = grid.remainders(spectra, out)
         return response, esf, lsf
 
     def _base(self, sensor: Sensor, given: Given | None = None) -> tuple[LineGrid, np.ndarray, LineResponse]:
