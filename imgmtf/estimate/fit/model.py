@@ -35,7 +35,7 @@ from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
-from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
+from .responses import EdgeResponses, StackedResponses, edges_responses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -300,8 +300,9 @@ class Model:
                 for i, response in zip(members, group.responses(sensor)):
                     out[i] = response
             own = [self.edges[i] for i in self.own]
-            for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
-                out[i] = edge.response(sensor, g)
+            for i, response in zip(self.own, edges_responses(own, sensor, shared_transfers(own, sensor.stages,
+                                                                                           sensor.gsd_m))):
+                out[i] = response
             self._last_responses = (key, out, grid_layout(self.groups, self.own, sensor, out) if self.groups else None)
         return self._last_responses[1]
 
