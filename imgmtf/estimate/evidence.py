@@ -94,10 +94,17 @@ def evidence_of(kind: TargetKind, chip: Chip, located: Located, samples: Samples
                 ) -> Evidence:
     """What the gate's profile checks read of a measured chip: its samples,
     the shape read off them, its noise and its sides' names."""
-    offsets = samples.distance_px - shape.centre
-    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
-                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
-    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks(shape, samples.distance_px
+                                                                                - shape.centre)))
     return Evidence(samples.distance_px, samples.raw_dn, samples.rows, shape.centre, shape.scale_px, shape.plateau_px,
                     shape.low, shape.high, noise.noise_dn, chip.quantum_dn, kind.tail_power, kind.name, kind.profile,
                     (side_names[0], side_names[1]), located.geometry)
+
+
+def side_masks(shape: Shape, offsets: np.ndarray) -> list[tuple[str, np.ndarray, None]]:
+    """The left and the right side of a profile as (name, mask, None): the
+    samples at ``offsets`` (px from the centre) beyond the plateau's start,
+    named "dark" or "bright" by the levels, as
+    :meth:`.kind.TargetKind.saturation_sides` takes them (a kind renames them)."""
+    return [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
+            for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]

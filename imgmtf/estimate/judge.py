@@ -10,7 +10,7 @@ import numpy as np
 from . import gate
 from .asks import Ask, Steps, alone
 from .blocks import block_boundaries
-from .evidence import evidence_of
+from .evidence import evidence_of, side_masks
 from .kind import Shape, TargetKind
 from .profile_checks import run_profile_checks
 from .settings import Settings
@@ -88,9 +88,7 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
     distance, raw, centre = samples.distance_px, samples.raw_dn, shape.centre
     offsets = distance - centre
     contrast, quantum_dn = noise.contrast_dn, chip.quantum_dn
-    side_masks = [("dark" if (shape.low <= shape.high) == (i == 0) else "bright", mask, None)
-                  for i, mask in enumerate((offsets <= -shape.plateau_px, offsets >= shape.plateau_px))]
-    sides = kind.saturation_sides(side_masks)
+    sides = kind.saturation_sides(side_masks(shape, offsets))
     checks = list(located.checks)
     checks += yield Ask("saturation", dict(
         distance=distance, values=raw, centre=centre, rise_px=shape.scale_px, sides=sides, limits=chip.limits,
@@ -99,7 +97,7 @@ def judge_steps(kind: TargetKind, chip: Chip, located: Located, samples: Samples
         bar_edge_px=kind.known_half_width_px(shape)))
     # each side's texture against its own pixel noise (linearisation scales it with the level)
     side_noise = (chip.noise_at(shape.low), chip.noise_at(shape.low if kind.profile == "bar" else shape.high))
-    side_names = tuple(name for name, _, _ in kind.saturation_sides(side_masks))
+    side_names = tuple(name for name, _, _ in sides)
     checks += yield Ask("side-checks", (distance, raw, samples.rows.astype(float), centre, shape.plateau_px,
                                         contrast, side_noise, kind.tail_power, (side_names[0], side_names[1])))
     threshold = settings.snr_threshold or kind.confident_snr(located.rows_used)
