@@ -167,6 +167,7 @@ class EdgeResponses:
         made = self._grid_and_transfer(sensor, given)
         if made is not None:
             self._keep(sensor, *made, made[0].response(made[1]))
+        assert self._last is not None               # (kept just now, or the last sensor's)
         return self._last[1:]
 
     def _grid_and_transfer(self, sensor: Sensor, given: Given | None = None) -> tuple[LineGrid, np.ndarray] | None:
@@ -277,7 +278,7 @@ def edges_responses(edges: Sequence[EdgeResponses], sensor: Sensor, given: Seque
             esf, lsf = rows[0][1].remainders(spectra)
             for (edge, own, transfer), e, s in zip(rows, esf, lsf):
                 edge._keep(sensor, own, transfer, LineResponse(own.start_px, own.step_px, e, s, own.reference))
-    return [edge._last[3] for edge in edges]
+    return [edge._base(sensor)[2] for edge in edges]            # each now the last one's, kept
 
 
 def shared_transfers(edges: Sequence[EdgeResponses], stages: Iterable[Stage], gsd_m: float) -> list[Given]:

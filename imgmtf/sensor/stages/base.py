@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from functools import cache
 from typing import Any, ClassVar
 
 import numpy as np
@@ -202,16 +201,25 @@ def _checked(stage: Stage, f, value) -> float:
     return number
 
 
-@cache
+#: per stage class, its fit specs and its fields by name (:func:`_fit_specs`, :func:`_fields_by_name`)
+_SPECS: dict[type, dict[str, FitSpec]] = {}
+_FIELDS: dict[type, dict[str, Any]] = {}
+
+
 def _fit_specs(cls: type[Stage]) -> dict[str, FitSpec]:
     """:meth:`Stage.fit_specs`, made once per class (a fit asks for it at every evaluation)."""
-    return {f.name: f.metadata["fit"] for f in fields(cls) if f.metadata.get("fit")}
+    specs = _SPECS.get(cls)
+    if specs is None:
+        specs = _SPECS[cls] = {f.name: f.metadata["fit"] for f in fields(cls) if f.metadata.get("fit")}
+    return specs
 
 
-@cache
-def _fields_by_name(cls: type[Stage]) -> dict:
+def _fields_by_name(cls: type[Stage]) -> dict[str, Any]:
     """The dataclass fields of ``cls`` by name, made once per class."""
-    return {f.name: f for f in fields(cls)}
+    by_name = _FIELDS.get(cls)
+    if by_name is None:
+        by_name = _FIELDS[cls] = {f.name: f for f in fields(cls)}
+    return by_name
 
 
 def stage_from_dict(values: dict) -> Stage:
