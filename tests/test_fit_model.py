@@ -76,3 +76,31 @@ def test_edges_grouped_by_angle_fit_as_each_edge_alone(edges, monkeypatch):
     np.testing.assert_allclose(grouped.residuals(z), own.residuals(z), rtol=0, atol=1e-7)
     np.testing.assert_allclose(grouped.jacobian(z).toarray(), own.jacobian(z).toarray(), rtol=1e-7, atol=1e-7)
     np.testing.assert_allclose(grouped.solve(z)[0], own.solve(z)[0], rtol=1e-7, atol=1e-7)
+
+
+def test_changes_written_in_place_are_each_edges_and_groups_own(edges, monkeypatch):
+    """The Jacobian's changes, each edge's inverse FFT written into its
+    place among the grids side by side and the groups' combined there, are
+    what an edge's own changes and its group's combination give, bit for
+    bit (a group of two and an edge of its own)."""
+    from imgmtf.estimate.fit import angles
+    monkeypatch.setattr(angles, "MIN_EDGES", 2)
+    data = [edge_data(e, k, None) for k, e in enumerate(edges[:3])]
+    model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    assert [members for members, _ in model.groups] == [[2, 0]] and model.own == [1]
+    u = model.initial_vector()[: model.n_free]
+    sensor = model.sensor(u)
+    shifted = [model.sensor(u + np.eye(model.n_free)[k] * 1e-3) for k in range(model.n_free)]
+    model.responses(u)
+    esf, lsf = model._changes(sensor, shifted)
+    layout = model._last_responses[2]
+    _, own_esf, own_lsf = model.edges[1].changes(sensor, shifted)
+    start, size = layout.offsets[1], own_esf.shape[-1]
+    assert np.array_equal(esf[:, start: start + size], own_esf) and np.array_equal(lsf[:, start: start + size], own_lsf)
+    (_, group), = model.groups
+    node_esf, node_lsf = group.node_changes(sensor, shifted)
+    for k in range(len(shifted)):
+        for j, i in enumerate([2, 0]):
+            at = slice(layout.offsets[i], layout.offsets[i] + node_esf.shape[-1])
+            assert np.array_equal(esf[k, at], group.combine(node_esf[:, k])[j])
+            assert np.array_equal(lsf[k, at], group.combine(node_lsf[:, k])[j])

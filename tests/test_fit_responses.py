@@ -140,3 +140,20 @@ def test_stacked_esf_is_each_responses_own_bit_for_bit():
     stacked = StackedResponses(responses, [3, 2])
     d = np.array([-0.5, 0.25, 40.0, 0.5, -3.0])
     np.testing.assert_array_equal(stacked.esf(d), [*responses[0].esf(d[:3]), *responses[1].esf(d[3:])])
+
+
+def test_edges_responses_together_are_each_edges_alone():
+    """Edges' responses made with one inverse FFT per kind of grid (reaches
+    that make grids of two sizes; a Cauchy tail too) are each edge's own
+    response, bit for bit, and kept as the next evaluation's start."""
+    from imgmtf.estimate.fit.responses import edges_responses
+    for sensor in (im.Sensor(), im.Sensor(1.0, [st.Diffraction(), st.Detector(1.0, 1.0)])):
+        edges = [EdgeResponses(angle, 1.0, reach) for angle, reach in ((5.0, 10.0), (80.0, 60.0), (-7.0, 12.0))]
+        together = edges_responses(edges, sensor)
+        assert len({r.esf_remainder.size for r in together}) == 2 or sensor.tail_length_m() == 0
+        for edge, response in zip(edges, together):
+            alone = EdgeResponses(edge.angle_deg, 1.0, edge.reach_px).response(sensor)
+            assert response.reference == alone.reference and response.start_px == alone.start_px
+            assert np.array_equal(response.esf_remainder, alone.esf_remainder)
+            assert np.array_equal(response.lsf_remainder, alone.lsf_remainder)
+            assert edge.response(sensor) is response

@@ -108,3 +108,45 @@ def test_numpy_scalars_are_plain_floats():
 def test_bad_parameters_are_named(make, message):
     with pytest.raises(ParameterError, match=message):
         make()
+
+
+@pytest.mark.parametrize("name", [n for n, cls in st.STAGES.items() if cls.fit_specs()])
+def test_with_fit_coordinates_is_the_constructors_stage(name):
+    # the copy checks only the parameters it sets: it must equal (and hash as) the stage built afresh,
+    # with the fields' types the constructor gives, and refuse what the constructor refuses
+    stage = st.STAGES[name]()
+    moved = {k: 1.01 * v + 1e-3 for k, v in stage.fit_coordinates(1.0).items()}
+    copy = stage.with_fit_coordinates(moved, 1.0)
+    fresh = type(stage)(**copy.to_dict(include_name=False))
+    assert copy == fresh and hash(copy) == hash(fresh) and repr(copy) == repr(fresh)
+    assert all(type(getattr(copy, k)) is float for k in moved)
+    assert stage.to_dict() == type(stage)().to_dict()             # the original untouched
+    specs = stage.fit_specs()
+    extreme = {k: 1e-60 if specs[k].kind == "frequency" else 1e40 for k in moved}
+    with pytest.raises(ParameterError) as refused:
+        stage.with_fit_coordinates(extreme, 1.0)
+    with pytest.raises(ParameterError) as built:
+        _rebuilt(stage, extreme)
+    assert str(refused.value) == str(built.value)
+
+
+def _rebuilt(stage, coordinates):
+    """The constructor's refusal of what ``coordinates`` make (the values as with_fit_coordinates makes them)."""
+    values = {}
+    for name, u in coordinates.items():
+        spec = stage.fit_specs()[name]
+        if spec.kind == "fraction":
+            values[name] = max(u, 0.0)
+        elif spec.kind == "f-number":
+            values[name] = max(u, 1e-6) * stage.pixel_pitch_m / stage.wavelength_m
+        else:
+            length = max(u, 0.0) ** (1.0 / spec.power)
+            values[name] = length if spec.kind == "length" else 1.0 / length
+    return type(stage)(**{**stage.to_dict(include_name=False), **values})
+
+
+def test_optics_transfer_underflows_to_exact_zero():
+    optics = st.GaussianOptics(0.4, 0.5)
+    f = np.linspace(0.0, 40.0, 4001)
+    assert np.array_equal(optics.transfer(f, f / 3, 1.0),
+                          np.exp(-2.0 * np.pi**2 * (0.4**2 * f**2 + 0.5**2 * (f / 3) ** 2)))

@@ -250,7 +250,7 @@ class LineGrid:
         np.multiply(spectra, to_lsf, out=lsf)
         return np.fft.irfft(lsf, self.size)
 
-    def remainders(self, spectra: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def remainders(self, spectra: np.ndarray, out: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The ESF and LSF (1/px) on the grid of the spectra ``spectra``
         (each row's zero-frequency value 0), all in one inverse FFT; each
         ESF starts from 0 at the grid's first sample.
@@ -259,11 +259,24 @@ class LineGrid:
         ----------
         spectra : numpy.ndarray, shape (..., size // 2 + 1)
             Transfers (or their differences) at :attr:`frequencies_cy_px`.
+        out : numpy.ndarray, shape (2, ..., size), optional
+            Where to write the LSF (``out[0]``) and ESF (``out[1]``), a view
+            into a larger array included (the same numbers; default new).
 
         Returns
         -------
         esf, lsf : numpy.ndarray, shape (..., size)
-            Their edge and line spread functions on the grid.
+            Their edge and line spread functions on the grid (views of
+            ``out`` when given).
+
+        Examples
+        --------
+        >>> grid = LineGrid(0.25, 8, ("gaussian", 1.0))
+        >>> spectra = np.exp(-grid.frequencies_cy_px) - 1.0
+        >>> side_by_side = np.zeros((2, 20))
+        >>> esf, lsf = grid.remainders(spectra, out=side_by_side[:, 4:12])
+        >>> bool(np.array_equal(esf, grid.remainders(spectra)[0])), bool(side_by_side[1, 4:12].any())
+        (True, True)
         """
         _, to_lsf, to_esf = _inverse_factors(self.step_px, self.size)
         spectra = np.asarray(spectra)
@@ -272,7 +285,7 @@ class LineGrid:
         both = np.empty((2, *spectra.shape), complex)
         np.multiply(spectra, to_lsf, out=both[0])
         np.multiply(spectra, to_esf, out=both[1])
-        lsf, esf = np.fft.irfft(both, self.size)
+        lsf, esf = np.fft.irfft(both, self.size, out=out)
         esf -= esf[..., :1]             # in place: the transform's own array, no copy
         return esf, lsf
 

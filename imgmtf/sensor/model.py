@@ -223,7 +223,12 @@ class Sensor:
         float
             b, m.
         """
-        return sum(stage.tail_length_m(self.gsd_m) for stage in self.stages)
+        # kept: a fit's every edge asks for it at every evaluation (the fields are frozen)
+        length = self.__dict__.get("_tail_length_m")
+        if length is None:
+            length = sum(stage.tail_length_m(self.gsd_m) for stage in self.stages)
+            object.__setattr__(self, "_tail_length_m", length)
+        return length
 
     def support_radius_m(self) -> float:
         """A radius (m) outside which the sampled PSF is negligible: the sum
@@ -234,7 +239,11 @@ class Sensor:
         float
             The radius, m.
         """
-        return max(sum(stage.support_radius_m(self.gsd_m) for stage in self.stages), self.gsd_m)
+        radius = self.__dict__.get("_support_radius_m")
+        if radius is None:
+            radius = max(sum(stage.support_radius_m(self.gsd_m) for stage in self.stages), self.gsd_m)
+            object.__setattr__(self, "_support_radius_m", radius)
+        return radius
 
     def line_response(self, angle_deg: float, gsd_m: float | None = None, *, reach_px: float = 0.0,
                       step_px: float = 1.0 / 64.0) -> LineResponse:

@@ -266,24 +266,18 @@ def grid_layout(groups: list[tuple[list[int], AngleGroup]], own: list[int], sens
     return GridLayout(offsets, start, (np.concatenate(esf), np.concatenate(lsf)))
 
 
-def laid_out_changes(groups: list[tuple[list[int], AngleGroup]], own: list[int],
-                     own_changes: list[tuple[np.ndarray, np.ndarray]], layout: GridLayout, sensor: Sensor,
-                     shifted: Sequence[Sensor]) -> tuple[np.ndarray, np.ndarray]:
-    """The changes of every edge's ESF and LSF for each of the ``shifted``
-    sensors (a row each), on the grids as ``layout`` lays them: the
-    groups' combined in place from their nodes', the edges ``own``'s
-    (``own_changes``, each edge's ESF and LSF changes) copied in."""
-    out = np.empty((2, len(shifted), layout.size))
+def laid_out_changes(groups: list[tuple[list[int], AngleGroup]], sensor: Sensor, shifted: Sequence[Sensor],
+                     out: np.ndarray) -> None:
+    """The changes of the groups' edges' LSF and ESF for each of the
+    ``shifted`` sensors (a row each), combined from their nodes' in place
+    into ``out`` (shape (2, len(shifted), samples): LSF, ESF), the groups'
+    grids first, in turn, as :func:`grid_layout` lays them."""
     start = 0
     for _, group in groups:
         size = 0
-        for both, nodes in zip(out, group.node_changes(sensor, shifted)):
+        esf, lsf = group.node_changes(sensor, shifted)
+        for both, nodes in zip(out, (lsf, esf)):
             size = nodes.shape[-1] * group.weights.shape[0]
             for row, node_rows in zip(both, nodes.transpose(1, 0, 2)):
                 group.combine(node_rows, row[start: start + size])
         start += size
-    for i, (esf, lsf) in zip(own, own_changes):
-        size = esf.shape[-1]
-        out[0, :, layout.offsets[i]: layout.offsets[i] + size] = esf
-        out[1, :, layout.offsets[i]: layout.offsets[i] + size] = lsf
-    return out[0], out[1]

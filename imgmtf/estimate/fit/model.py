@@ -36,7 +36,7 @@ from .angles import grid_layout, grouped_edges, laid_out_changes
 from .arrowhead import NoConvergence, solve_arrowhead
 from .choice import AUTO, AUTO_CANDIDATES
 from .data import EdgeData, ProfileBins
-from .responses import EdgeResponses, StackedResponses, esf_changes, shared_transfers
+from .responses import EdgeResponses, StackedResponses, edges_responses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
 #: wider than this fraction of the length ...
@@ -301,8 +301,9 @@ class Model:
                 for i, response in zip(members, group.responses(sensor)):
                     out[i] = response
             own = [self.edges[i] for i in self.own]
-            for i, edge, g in zip(self.own, own, shared_transfers(own, sensor.stages, sensor.gsd_m)):
-                out[i] = edge.response(sensor, g)
+            for i, response in zip(self.own, edges_responses(own, sensor, shared_transfers(own, sensor.stages,
+                                                                                           sensor.gsd_m))):
+                out[i] = response
             self._last_responses = (key, out, grid_layout(self.groups, self.own, sensor, out) if self.groups else None)
         return self._last_responses[1]
 
@@ -429,31 +430,43 @@ class Model:
         self._solution = (self._last_responses, ((tuple(self.free), z.tobytes()), esf, placement))
         changes = esf_changes(stacked, esf_change, lsf_change, d, placement)
         spans = z[self.n_free + 1::3] - z[self.n_free::3]
-        stage_columns = changes.T * self.weight[:, None] * self.per_bin(-spans[:, None] / steps)
         lsf = self.side_by_side([r.lsf(d[start: start + count])
                                  for r, start, count in zip(base, self.starts, self.counts)])
-        blocks = np.column_stack([(esf - 1) * self.weight, -esf * self.weight, (hi - lo) * self.weight * lsf])
-        columns = self.n_free + 3 * len(self.counts)
+        # each row's stage columns, then its edge's levels' and offset's, written in place (a sparse
+        # Jacobian's values as they are laid out, :meth:`_jacobian_layout`)
+        n = self.n_free
+        values = np.empty((self.rows, n + 3))
+        np.multiply(changes.T * self.weight[:, None], self.per_bin(-spans[:, None] / steps), out=values[:, :n])
+        np.multiply(esf - 1, self.weight, out=values[:, n])
+        np.multiply(-esf, self.weight, out=values[:, n + 1])
+        np.multiply((hi - lo) * self.weight, lsf, out=values[:, n + 2])
+        columns = n + 3 * len(self.counts)
         if not self.sparse:
             jacobian = np.zeros((self.rows, columns))
-            jacobian[:, : self.n_free] = stage_columns
+            jacobian[:, :n] = values[:, :n]
             for e, (start, count) in enumerate(zip(self.starts, self.counts)):
-                rows, first = slice(start, start + count), self.n_free + 3 * e
-                jacobian[rows, first: first + 3] = blocks[rows]
+                rows, first = slice(start, start + count), n + 3 * e
+                jacobian[rows, first: first + 3] = values[rows, n:]
             return jacobian
         from scipy import sparse
         indices, starts = self._jacobian_layout()
-        values = np.hstack([stage_columns, blocks])
         return sparse.csr_array((values.ravel(), indices.ravel(), starts), shape=(self.rows, columns))
 
     def _changes(self, sensor: Sensor, shifted: list[Sensor]) -> tuple[np.ndarray, np.ndarray]:
-        """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids side by side (:meth:`stacked`)."""
+        """Every edge's ESF and LSF changes for each ``shifted`` sensor, grids
+        side by side (:meth:`stacked`): each edge's inverse FFT written in
+        its place (the responses at ``sensor`` made before)."""
+        responses, layout = self._last_responses[1:]
+        sizes = [r.esf_remainder.size for r in responses]
+        offsets = layout.offsets if layout is not None else np.cumsum([0, *sizes[:-1]]).tolist()
+        out = np.empty((2, len(shifted), layout.size if layout is not None else sum(sizes)))
         own = [self.edges[i] for i in self.own]
         given = shared_transfers(own, [stage for other in shifted for stage in other.stages], sensor.gsd_m)
-        rows = [edge.changes(sensor, shifted, g)[1:] for edge, g in zip(own, given)]
-        if not self.groups:
-            return self.side_by_side([r[0] for r in rows]), self.side_by_side([r[1] for r in rows])
-        return laid_out_changes(self.groups, self.own, rows, self._last_responses[2], sensor, shifted)
+        for i, edge, g in zip(self.own, own, given):
+            edge.changes(sensor, shifted, g, out[:, :, offsets[i]: offsets[i] + sizes[i]])
+        if self.groups:
+            laid_out_changes(self.groups, sensor, shifted, out)
+        return out[1], out[0]
 
     def _jacobian_layout(self) -> tuple[np.ndarray, np.ndarray]:
         """Each row's columns in a sparse Jacobian, the stage columns then

@@ -77,14 +77,7 @@ class Stage:
 
     def __post_init__(self):
         for f in fields(self):
-            value = check_number(f"{self.name} {f.name}", getattr(self, f.name),
-                                 positive=f.metadata.get("positive", False),
-                                 allow_inf=f.metadata.get("allow_inf", False),
-                                 signed=f.metadata.get("signed", False), high=f.metadata.get("high"))
-            if math.isfinite(value) and value > MAX_PARAMETER:
-                raise ParameterError(f"{self.name} {f.name} must be at most {MAX_PARAMETER:g} "
-                                     f"{f.metadata['unit']}, got {value:g}".rstrip())
-            object.__setattr__(self, f.name, value)
+            object.__setattr__(self, f.name, _checked(self, f, getattr(self, f.name)))
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
         """The stage's transfer function, 1 at zero frequency: real for a
@@ -132,7 +125,7 @@ class Stage:
     @classmethod
     def fit_specs(cls) -> dict[str, FitSpec]:
         """The parameters the fit can free, with how it treats them."""
-        return {f.name: f.metadata["fit"] for f in fields(cls) if f.metadata.get("fit")}
+        return dict(_fit_specs(cls))
 
     def fit_coordinates(self, gsd_m: float) -> dict[str, float]:
         """Each fittable parameter in the fit's coordinate (see :class:`FitSpec`)."""
@@ -148,9 +141,10 @@ class Stage:
 
     def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> Stage:
         """A copy with the given parameters set from fit coordinates."""
+        specs = _fit_specs(type(self))
         values = {}
         for name, u in coordinates.items():
-            spec = self.fit_specs()[name]
+            spec = specs[name]
             if spec.kind == "fraction":
                 values[name] = max(u, 0.0)
                 continue
@@ -160,7 +154,23 @@ class Stage:
             length = max(u, 0.0) ** (1.0 / spec.power)
             values[name] = length * gsd_m if spec.kind == "length" else (
                 1.0 / (length * gsd_m) if length > 0 else math.inf)
-        return type(self)(**{**self.to_dict(include_name=False), **values})
+        return self._replaced(values)
+
+    def _replaced(self, values: dict[str, float]) -> Stage:
+        """A copy with ``values`` for some of its parameters, each checked as
+        the constructor checks it (the same errors), the others taken as
+        they are, already checked: what a fit's every evaluation makes,
+        without the constructor's checks of every field.  A stage with its
+        own ``__post_init__`` is made by its constructor."""
+        cls = type(self)
+        if cls.__post_init__ is not Stage.__post_init__:
+            return cls(**{**self.to_dict(include_name=False), **values})
+        other = object.__new__(cls)
+        state = dict(self.__dict__)
+        for name, value in values.items():
+            state[name] = _checked(self, _fields_by_name(cls)[name], value)
+        object.__setattr__(other, "__dict__", state)
+        return other
 
     def to_dict(self, include_name: bool = True) -> dict:
         """``{"stage": name, parameter: value, ...}`` (JSON and TOML ready)."""
@@ -178,6 +188,38 @@ class Stage:
             raise ParameterError(f"unknown {cls.name} parameter(s) {', '.join(unknown)}; "
                                  f"known: {', '.join(known)}")
         return cls(**values)
+
+
+def _checked(stage: Stage, f, value) -> float:
+    """A parameter's ``value`` checked (a ParameterError naming it) and as a float."""
+    number = check_number(f"{stage.name} {f.name}", value, positive=f.metadata.get("positive", False),
+                          allow_inf=f.metadata.get("allow_inf", False), signed=f.metadata.get("signed", False),
+                          high=f.metadata.get("high"))
+    if math.isfinite(number) and number > MAX_PARAMETER:
+        raise ParameterError(f"{stage.name} {f.name} must be at most {MAX_PARAMETER:g} "
+                             f"{f.metadata['unit']}, got {number:g}".rstrip())
+    return number
+
+
+#: per stage class, its fit specs and its fields by name (:func:`_fit_specs`, :func:`_fields_by_name`)
+_SPECS: dict[type, dict[str, FitSpec]] = {}
+_FIELDS: dict[type, dict[str, Any]] = {}
+
+
+def _fit_specs(cls: type[Stage]) -> dict[str, FitSpec]:
+    """:meth:`Stage.fit_specs`, made once per class (a fit asks for it at every evaluation)."""
+    specs = _SPECS.get(cls)
+    if specs is None:
+        specs = _SPECS[cls] = {f.name: f.metadata["fit"] for f in fields(cls) if f.metadata.get("fit")}
+    return specs
+
+
+def _fields_by_name(cls: type[Stage]) -> dict[str, Any]:
+    """The dataclass fields of ``cls`` by name, made once per class."""
+    by_name = _FIELDS.get(cls)
+    if by_name is None:
+        by_name = _FIELDS[cls] = {f.name: f for f in fields(cls)}
+    return by_name
 
 
 def stage_from_dict(values: dict) -> Stage:

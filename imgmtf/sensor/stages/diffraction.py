@@ -74,4 +74,4 @@ class Diffraction(Stage):
 
     def with_fit_coordinates(self, coordinates: dict[str, float], gsd_m: float) -> Stage:
         u = max(coordinates["f_number"], 1e-6)
-        return type(self)(u * self.pixel_pitch_m / self.wavelength_m, self.wavelength_m, self.pixel_pitch_m)
+        return self._replaced({"f_number": u * self.pixel_pitch_m / self.wavelength_m})
