@@ -219,8 +219,8 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
     from ..io import raster_info
     from .combine import summarise_scan
     from .measure import in_image_axes, scan_scene
-    from .sections import recommend, section_rows
-    from .targetfit import fit_targets
+    from .afterscan import sections_and_fits
+    from .sections import recommend
     try:
         acquisition = None
         if facts is not None:
@@ -245,11 +245,10 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                 raise
             return SceneOutcome(path, _reported(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
-        summaries += section_rows(summaries, workers=workers, scheduler=scheduler, progress=progress)
-        if get_kind(settings.target).fits_sensor and stages:
-            summaries += fit_targets(records, stages=stages, workers=_fit_workers(records, workers),
-                                     scheduler=scheduler, progress=progress)
-        summaries = recommend(summaries)
+        # the sections and the fits on one pool: neither waits for the other's last task
+        sections, fits = sections_and_fits(records, summaries, stages if get_kind(settings.target).fits_sensor
+                                           else None, workers=workers, scheduler=scheduler, progress=progress)
+        summaries = recommend(summaries + sections + fits)
         if in_image_axes(raster_info(path), settings):
             records, summaries = _image_axes(records), _image_axes(summaries)
     except ImgmtfError as exc:
@@ -257,16 +256,6 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
                             reason=exc.reason)
     return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
-
-
-def _fit_workers(records: Sequence[Record], workers: int | None) -> int:
-    """The workers of a scene's fits: as given, or chosen (None) as its
-    candidates' were, by its accepted half-edges."""
-    if workers is not None:
-        return workers
-    from ..parallel import auto_workers
-    from .measure import AUTO_PLANS_PER_WORKER
-    return auto_workers(sum(r.ok for r in records), AUTO_PLANS_PER_WORKER)
 
 
 def _image_axes(records) -> list[Record]:
