@@ -117,7 +117,8 @@ def section_groups(summaries: Sequence[Record]) -> list[list[Record]]:
     groups: dict[tuple, list[Record]] = {}
     for r in combined:
         groups.setdefault((r.site.get("scope"), r.site.get("target_id")), []).append(r)
-    return [group for _, group in sorted(groups.items(), key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
+    return [group for _, group in sorted(groups.items(),
+                                         key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
 
 
 def section_tasks(groups: list[list[Record]]) -> list[list[list[Record]]]:

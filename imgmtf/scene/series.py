@@ -217,9 +217,9 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
     with the error when the scene cannot be scanned, ``interrupted`` with
     the records so far on Ctrl-C."""
     from ..io import raster_info
+    from .afterscan import sections_and_fits
     from .combine import summarise_scan
     from .measure import in_image_axes, scan_scene
-    from .afterscan import sections_and_fits
     from .sections import recommend
     try:
         acquisition = None
