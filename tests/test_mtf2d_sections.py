@@ -180,6 +180,25 @@ def test_the_draws_elliptical_models_solved_together_are_each_ones_own():
     for k in range(5):
         assert np.allclose(many[:, :, k], problem.costs(log_aspects[:, :13], targets[:, :, k]), rtol=1e-10, atol=0)
 
+
+def test_the_misfits_of_sections_a_model_fits_almost_exactly_keep_their_digits(monkeypatch):
+    """Many right-hand sides' misfits come from the normal equations
+    (g.g - 2 b.x + x.Gx); noise-free elliptical sections at their own
+    aspect leave a misfit of 3e-6 of g.g, and one below ``CANCELLATION``
+    is summed sample by sample: both the one right-hand side's misfit."""
+    import imgmtf.estimate.mtf2d.inversion as inversion
+    f = np.linspace(0, 1, 101)
+    normals = [16.8, -73.2, 40.0]
+    c, s = np.cos(np.radians(normals))[:, None], np.sin(np.radians(normals))[:, None]
+    m = np.sinc(f * c) * np.sinc(f * s) / (1 + 9 * f ** 2 * (c ** 2 + (s / 0.7) ** 2))
+    problem = inversion.EllipticalProblem(*inversion._one(inversion.prepared(normals, f, m, np.full_like(m, 0.01))))
+    log_aspects = np.log(0.7) + np.linspace(-0.3, 0.3, 13)[None]
+    one = problem.costs(log_aspects, problem.log_r)
+    twice = problem.log_r[:, :, None].repeat(2, axis=2)
+    assert np.allclose(problem.costs(log_aspects, twice)[:, :, 1], one, rtol=1e-9, atol=0)
+    monkeypatch.setattr(inversion, "CANCELLATION", 1.0)         # every misfit summed sample by sample
+    assert np.allclose(problem.costs(log_aspects, twice)[:, :, 1], one, rtol=1e-12, atol=0)
+
 def test_many_targets_inverted_together_are_each_alone():
     """Targets of mixed shapes (two and three orientations, other
     frequencies, no intervals, one refused) inverted in one call: each
@@ -213,3 +232,25 @@ def test_many_targets_inverted_together_are_each_alone():
                     assert np.array_equal(getattr(one, field), getattr(other, field), equal_nan=True)
                 figures = [[*s.mtf_nyquist_ci, s.mtf50_cy_px, *s.mtf50_ci_cy_px, s.fwhm_px] for s in (one, other)]
                 assert np.array_equal(*figures, equal_nan=True)
+
+
+def test_the_intervals_of_many_rows_are_numpys_quantiles_of_each():
+    """Each row's interval from its finite draws, widened to its centre:
+    numpy.quantile's numbers to the bit (NaN and inf draws left out; no
+    finite draw or no finite centre: NaN)."""
+    from imgmtf.estimate.mtf2d.sections import _interval_rows
+    rng = np.random.default_rng(5)
+    values = rng.normal(0.3, 0.02, (6, 100))
+    values[1, ::3] = np.nan
+    values[2, :5] = np.inf
+    values[3] = np.nan
+    values[4, 1:] = np.nan                                     # a single finite draw
+    central = np.array([0.3, 0.25, 0.4, 0.3, 0.3, np.nan])
+    rows = _interval_rows(values, 0.025, central)
+    for k in range(6):
+        finite = values[k][np.isfinite(values[k])]
+        if not finite.size or not np.isfinite(central[k]):
+            assert np.isnan(rows[k]).all()
+            continue
+        low, high = np.quantile(finite, [0.025, 0.975])
+        assert rows[k].tolist() == [min(low, central[k]), max(high, central[k])]

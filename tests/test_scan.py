@@ -353,7 +353,7 @@ def test_one_scene_with_fits_has_the_fork_server_load_the_optimizer_for_its_work
     import imgmtf.parallel as parallel
     from imgmtf.errors import ParameterError
     from imgmtf.preloads import FITTING_MODULES
-    from imgmtf.scene.series import _fit_workers
+    from imgmtf.scene.afterscan import fit_workers
     started = []
 
     def prestart(workers, modules):
@@ -369,6 +369,6 @@ def test_one_scene_with_fits_has_the_fork_server_load_the_optimizer_for_its_work
     assert started == [(2, True), (1, False), (1, True), (1, True)]
     records = [SimpleNamespace(ok=True)] * 16 + [SimpleNamespace(ok=False)] * 3
     monkeypatch.setattr(parallel, "preloaded", lambda modules: False)
-    assert _fit_workers(records, None) == 1 and _fit_workers(records, 3) == 3
+    assert fit_workers(records, None) == 1 and fit_workers(records, 3) == 3
     monkeypatch.setattr(parallel, "preloaded", lambda modules: set(modules) == set(FITTING_MODULES))
-    assert _fit_workers(records, None) == 2 and _fit_workers(records[:1], None) == 1 and _fit_workers(records, 1) == 1
+    assert fit_workers(records, None) == 2 and fit_workers(records[:1], None) == 1 and fit_workers(records, 1) == 1

@@ -92,6 +92,24 @@ def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, schedu
     >>> [(r.figures["assumption"], r.figures["mtf_nyquist"]) for r in rows][:2]  # doctest: +SKIP
     [('separable', 0.1811), ('separable', 0.1615)]
     """
+    ordered = section_groups(summaries)
+    chosen = sections_workers(len(ordered), workers)
+    if chosen == 1:
+        return _task_rows(ordered)
+    from ..parallel import run_tasks
+    return [row for rows in run_tasks(_task_rows, section_tasks(ordered), workers=chosen, scheduler=scheduler,
+                                      progress=progress, description="2-D sections") for row in rows]
+
+
+def section_groups(summaries: Sequence[Record]) -> list[list[Record]]:
+    """The combined rows of each target, then of the scene, that
+    :func:`section_rows` inverts (those with an MTF and a track azimuth).
+
+    Raises
+    ------
+    ParameterError
+        ``summaries`` is not a list of Records.
+    """
     if any(not isinstance(r, Record) for r in summaries):
         raise ParameterError("summaries must be a scan's summary Records (imgmtf.summarise_scan)")
     combined = [r for r in summaries if r.ok and r.figures.get("summary") == "combined" and r.figures.get("mtf")
@@ -99,15 +117,15 @@ def section_rows(summaries: Sequence[Record], *, workers: int | None = 1, schedu
     groups: dict[tuple, list[Record]] = {}
     for r in combined:
         groups.setdefault((r.site.get("scope"), r.site.get("target_id")), []).append(r)
-    ordered = [group for _, group in sorted(groups.items(),
-                                            key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
-    chosen = sections_workers(len(ordered), workers)
-    if chosen == 1:
-        return _task_rows(ordered)
-    from ..parallel import run_tasks
-    tasks = [ordered[k: k + TARGETS_PER_TASK] for k in range(0, len(ordered), TARGETS_PER_TASK)]
-    return [row for rows in run_tasks(_task_rows, tasks, workers=chosen, scheduler=scheduler, progress=progress,
-                                      description="2-D sections") for row in rows]
+    return [group for _, group in sorted(groups.items(),
+                                         key=lambda item: (item[0][0] != TARGET_SCOPE, item[0][1] or 0))]
+
+
+def section_tasks(groups: list[list[Record]]) -> list[list[list[Record]]]:
+    """:func:`section_groups`' groups as workers' tasks for
+    :func:`_task_rows`, ``TARGETS_PER_TASK`` each: their rows, joined in
+    order, are :func:`section_rows`' (a target's the same in any task)."""
+    return [groups[k: k + TARGETS_PER_TASK] for k in range(0, len(groups), TARGETS_PER_TASK)]
 
 
 def sections_workers(targets: int, workers: int | None) -> int:

@@ -217,10 +217,10 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
     with the error when the scene cannot be scanned, ``interrupted`` with
     the records so far on Ctrl-C."""
     from ..io import raster_info
+    from .afterscan import sections_and_fits
     from .combine import summarise_scan
     from .measure import in_image_axes, scan_scene
-    from .sections import recommend, section_rows
-    from .targetfit import fit_targets
+    from .sections import recommend
     try:
         acquisition = None
         if facts is not None:
@@ -245,11 +245,10 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
                 raise
             return SceneOutcome(path, _reported(partial), tuple(summarise_scan(partial)), interrupt=exc)
         summaries = summarise_scan(records)
-        summaries += section_rows(summaries, workers=workers, scheduler=scheduler, progress=progress)
-        if get_kind(settings.target).fits_sensor and stages:
-            summaries += fit_targets(records, stages=stages, workers=_fit_workers(records, workers),
-                                     scheduler=scheduler, progress=progress)
-        summaries = recommend(summaries)
+        # the sections and the fits on one pool: neither waits for the other's last task
+        sections, fits = sections_and_fits(records, summaries, stages if get_kind(settings.target).fits_sensor
+                                           else None, workers=workers, scheduler=scheduler, progress=progress)
+        summaries = recommend(summaries + sections + fits)
         if in_image_axes(raster_info(path), settings):
             records, summaries = _image_axes(records), _image_axes(summaries)
     except ImgmtfError as exc:
@@ -257,23 +256,6 @@ def scan_one(path: str, settings: ScanSettings, stages: str | None = DEFAULT_STA
         return SceneOutcome(path, error=message if message.startswith(path) else f"{path}: {message}",
                             reason=exc.reason)
     return SceneOutcome(path, _reported(records), tuple(summaries), acquisition, figures_dir=figures_dir)
-
-
-def _fit_workers(records: Sequence[Record], workers: int | None) -> int:
-    """The workers of a scene's fits: as given, or chosen (None) as its
-    candidates' were, by its accepted half-edges; but where the workers'
-    fork server has the fits' modules loaded already (a command started it
-    with them, :func:`imgmtf.parallel.prestart_workers`), even a few fits
-    go to its workers, rather than SciPy's optimizer (0.35-0.6 s) being
-    imported here after the scene's measurement."""
-    if workers is not None:
-        return workers
-    from ..parallel import auto_workers, preloaded
-    from ..preloads import FITTING_MODULES
-    from .measure import AUTO_PLANS_PER_WORKER
-    accepted = sum(r.ok for r in records)
-    chosen = auto_workers(accepted, AUTO_PLANS_PER_WORKER)
-    return auto_workers(accepted, 1) if chosen == 1 and preloaded(FITTING_MODULES) else chosen
 
 
 def _image_axes(records) -> list[Record]:

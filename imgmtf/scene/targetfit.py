@@ -107,32 +107,54 @@ def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_
         raise ParameterError(f"records must be a list of a scan's Records, got {records!r}") from None
     if any(not isinstance(r, Record) for r in records):
         raise ParameterError("records must be a scan's Records (imgmtf.scan_scene)")
+    tasks, scenes = fit_tasks(records, stages, workers=workers, scheduler=scheduler)
+    if not tasks:
+        return []
+    from ..parallel import run_tasks
+    return fitted_rows(list(run_tasks(_fit_task, tasks, workers=workers, scheduler=scheduler, progress=progress,
+                                      description="fitting targets")), scenes)
+
+
+def fit_tasks(records: list[Record], stages: str | list[str], *, workers: int = 1,
+              scheduler: str | None = None) -> tuple[list[tuple], int]:
+    """:func:`fit_targets`'s tasks for :func:`_fit_task`, the scene's first
+    (the longest), then each target's, and how many are the scene's (0 or
+    1): none for a scene with nothing to fit.  ``records`` are checked.
+    Run here (``workers`` 1, no ``scheduler``), a half-edge without its
+    measurement is measured once now for its target's fit and the
+    scene's; else each task measures its own on its worker."""
     accepted = [r for r in records if r.ok and get_kind(r.target).fits_sensor and r.site.get("scope") == CANDIDATE_SCOPE
                 and r.site.get("target_id") is not None and r.site.get("roi_polygon_px")]
     if not accepted or track_of(accepted[0]) is None:
-        return []
-    from ..parallel import run_tasks
+        return [], 0
     targets = sorted({int(r.site["target_id"]) for r in accepted})
     groups = [[r for r in accepted if r.site["target_id"] == target] for target in targets]
     # a half-edge without its measurement is measured again: by its task on workers, else here, once, for
     # its target's fit and the scene's
-    known = {id(r): _from_scan(r) for r in accepted}
-    if workers == 1 and scheduler is None:
+    here = workers == 1 and scheduler is None
+    known = {id(r): _from_scan(r, shipped=not here) for r in accepted}
+    if here:
         missing = [r for r in accepted if r.measurement is None]
         known.update(zip(map(id, missing), _measured(missing)))
+    # tasks sent to workers carry each measurement once, beside its record (which then travels without
+    # its own: a dense chart's 1936 half-edges were 0.2 GB twice, for its scene's task and its targets')
+    shipped = {id(r): r if here or r.measurement is None else r.with_(measurement=None) for r in accepted}
 
     def task(members: list[Record], site: dict) -> tuple:
-        return members, site, stages, [known[id(r)] for r in members]
+        return [shipped[id(r)] for r in members], site, stages, [known[id(r)] for r in members]
 
     # the scene's fit, the longest, goes first and beside its targets' (on workers, at once): started
     # from its targets' ends it reached the same optimum no sooner (0.39 s against 0.37 on the 4096 px
     # bench scene, 0.16 against 0.17 on the chart), so it need not wait for them
     scene = [task(accepted, {"scope": SCENE_SCOPE})] if len(targets) > 1 else []
-    fitted = list(run_tasks(_fit_task, scene + [task(members, {"scope": TARGET_SCOPE, "target_id": target})
-                                                for members, target in zip(groups, targets)],
-                            workers=workers, scheduler=scheduler, progress=progress, description="fitting targets"))
-    rows = [row for target_rows in fitted[len(scene):] + fitted[:len(scene)] for row in target_rows]
-    return rows
+    return scene + [task(members, {"scope": TARGET_SCOPE, "target_id": target})
+                    for members, target in zip(groups, targets)], len(scene)
+
+
+def fitted_rows(fitted: list[list[Record]], scenes: int) -> list[Record]:
+    """The rows of :func:`fit_tasks`' tasks (each task's, in their order):
+    the targets' first, then the scene's."""
+    return [row for task_rows in fitted[scenes:] + fitted[:scenes] for row in task_rows]
 
 
 def track_of(record: Record) -> float | None:
@@ -163,13 +185,16 @@ def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon: ArrayLike
     return inside
 
 
-def _from_scan(record: Record) -> Any:
+def _from_scan(record: Record, shipped: bool = False) -> Any:
     """The scan's own measurement of a half-edge, its normal turned into
-    the sensor's frame; None when the record has none."""
+    the sensor's frame; None when the record has none.  ``shipped`` (to a
+    worker): without its MTF function, which the fit does not use (more
+    than half of a pickled measurement: the transform it interpolates)."""
     if record.measurement is None:
         return None
     result = record.measurement
-    return replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0))
+    dropped = {"mtf_function": None} if shipped else {}
+    return replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0), **dropped)
 
 
 def _measured(records: list[Record]) -> list[Any]:

@@ -42,6 +42,9 @@ SD_FLOOR = 0.005            # what a measured MTF cannot be trusted to better (e
 MIN_SEPARATION_DEG = 30.0   # two normals closer than this hardly tell the axes apart
 SMOOTHING = 3.0             # weight of the curves' second differences (per node, log units)
 ASPECT_BOUNDS = (0.25, 4.0)  # the elliptical remainder's along/across width ratio searched
+# a least-squares misfit below this fraction of its data's sum of squares is summed sample by sample (the
+# normal equations' difference would lose its digits)
+CANCELLATION = 1e-6
 # from this many systems on, solved by their bands: fewer are solved faster as dense matrices (the banded
 # loop's steps cost the same for one system as for a hundred; a hundred dense ones are megabytes)
 BANDED_FROM = 48
@@ -244,16 +247,23 @@ class EllipticalProblem:
         # many right-hand sides per aspect: one dense product each (BLAS), the normal matrices still sparse
         weighted = (hats.dense(h) * weight[:, :, None]).reshape(count, aspects, *h.low.shape[1:], -1)
         goal = targets * self.weight[:, :, None]
+        unknowns = h.size - 1
+        gram = hats.gram(h, weight)
         # the inverses (one small factorisation each) times the right-hand sides: a third of the time of
         # solving for them, and as exact here (the normal matrices' condition is a few thousand)
-        inverse = np.linalg.inv(self._normal(h, weight)).reshape(count, aspects, h.size - 1, h.size - 1)
-        solution = inverse @ (np.swapaxes(weighted, 2, 3) @ goal[:, None])
-        # the misfits an aspect at a time: all at once they were megabytes, fresh pages every call (twice the time)
-        out = np.empty((count, aspects, goal.shape[2]))
-        for t in range(count):
-            for a in range(aspects):
-                misfit = weighted[t, a] @ solution[t, a] - goal[t]
-                out[t, a] = np.einsum("sk,sk->k", misfit, misfit)
+        inverse = np.linalg.inv(gram + _penalty(1, h.size) + 1e-10 * np.eye(unknowns))
+        projected = np.swapaxes(weighted, 2, 3) @ goal[:, None]                     # b = (W D)^T g
+        solution = inverse.reshape(count, aspects, unknowns, unknowns) @ projected
+        # |W D x - g|^2 = g.g - 2 b.x + x.(D^T W^2 D) x: products of the unknowns, not of the samples (those
+        # were half of the work)
+        squares = np.einsum("tsk,tsk->tk", goal, goal)[:, None]
+        out = squares - 2 * np.einsum("tank,tank->tak", projected, solution) + \
+            np.einsum("tank,tank->tak", solution, gram.reshape(count, aspects, unknowns, unknowns) @ solution)
+        # where the misfit is a sliver of g.g (data a model fits almost exactly) that difference loses its
+        # digits: the misfit itself, sample by sample
+        for t, a in zip(*np.nonzero(np.any(out < CANCELLATION * squares, axis=2))):
+            misfit = weighted[t, a] @ solution[t, a] - goal[t]
+            out[t, a] = np.einsum("sk,sk->k", misfit, misfit)
         return out
 
     def each_model(self, log_aspects: np.ndarray, targets: np.ndarray) -> EllipticalModel:

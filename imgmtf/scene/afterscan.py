@@ -1,0 +1,117 @@
+"""What follows a scene's scan and its combined summaries, run on one
+pool: the targets' across/along sections (:mod:`.sections`) and the
+sensor model's fits (:mod:`.targetfit`).
+
+Neither needs the other: both follow the scan's records and their
+summaries.  Run one after the other, each stage waited for its last task
+(a barrier), and the scene's fit is one task as long as all its targets'
+(11 s of a dense chart's 21 s on two workers): while it ran alone the
+other worker waited.  Here the scene's fit goes first, then the
+sections' tasks and the targets' fits, on the same workers, and each
+task's rows are put back in their place: the rows are those the two
+stages give apart, in the same order.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ..records import Record
+
+SECTIONS, FIT = "sections", "fit"
+
+
+def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], stages: str | list[str] | None, *,
+                      workers: int | None = 1, scheduler: str | None = None,
+                      progress: bool | None = False) -> tuple[list[Record], list[Record]]:
+    """A scan's section rows and fit rows, their tasks on one pool.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        The scene's scan records (:func:`imgmtf.scene.measure.scan_scene`).
+    summaries : sequence of Record
+        Their summaries (:func:`imgmtf.scene.combine.summarise_scan`).
+    stages : str or list of str or None
+        The stages fitted (:func:`imgmtf.scene.targetfit.fit_targets`);
+        None: no fit, the sections only.
+    workers : int or None, optional
+        Local worker processes (default 1: none, the work runs here);
+        None chooses as each stage would (the more of the two).
+    scheduler : str, optional
+        A Dask distributed scheduler's address, or ``"local"``
+        (:func:`imgmtf.parallel.run_tasks`).
+    progress : bool, optional
+        Show one progress bar on stderr for both (default False; None:
+        when stderr is a terminal).
+
+    Returns
+    -------
+    (list of Record, list of Record)
+        :func:`imgmtf.scene.sections.section_rows`' rows and
+        :func:`imgmtf.scene.targetfit.fit_targets`' rows, each what the
+        stage alone gives, whatever the workers.
+
+    Raises
+    ------
+    ParameterError
+        ``summaries`` or ``records`` are not Records, ``workers`` out of
+        range, or ``stages`` names no stage.
+
+    Examples
+    --------
+    >>> records = scan_scene("chart.tif")                                  # doctest: +SKIP
+    >>> sections, fits = sections_and_fits(records, summarise_scan(records), "auto", workers=2)  # doctest: +SKIP
+    """
+    from ..errors import ParameterError
+    from ..parallel import check_workers, run_tasks
+    from .sections import section_groups, section_tasks, sections_workers
+    from .targetfit import fit_tasks, fitted_rows
+    groups = section_groups(summaries)
+    if workers is not None:
+        check_workers(workers)
+    records = list(records)
+    if any(not isinstance(r, Record) for r in records):
+        raise ParameterError("records must be a scan's Records (imgmtf.scan_scene)")
+    fitting = fit_workers(records, workers) if stages else 1
+    chosen = max(sections_workers(len(groups), workers), fitting)
+    fits, scenes = fit_tasks(records, stages, workers=chosen, scheduler=scheduler) if stages else ([], 0)
+    here = chosen == 1 and scheduler is None
+    # the scene's fit first (the longest), then the sections (short tasks; here, all at once), then the
+    # targets' fits
+    tasks = [(FIT, t) for t in fits[:scenes]] + \
+        [(SECTIONS, t) for t in ([groups] if here else section_tasks(groups)) if t] + [(FIT, t) for t in fits[scenes:]]
+    if here:
+        results = [_stage_task(task) for task in tasks]
+    else:
+        results = list(run_tasks(_stage_task, tasks, workers=chosen, scheduler=scheduler, progress=progress,
+                                 description="sections and fits"))
+    sections = [row for (kind, _), rows in zip(tasks, results) if kind == SECTIONS for row in rows]
+    fitted = [rows for (kind, _), rows in zip(tasks, results) if kind == FIT]
+    return sections, fitted_rows(fitted, scenes)
+
+
+def fit_workers(records: Sequence[Record], workers: int | None) -> int:
+    """The workers of a scene's fits: as given, or chosen (None) as its
+    candidates' were, by its accepted half-edges; but where the workers'
+    fork server has the fits' modules loaded already (a command started it
+    with them, :func:`imgmtf.parallel.prestart_workers`), even a few fits
+    go to its workers, rather than SciPy's optimizer (0.35-0.6 s) being
+    imported here after the scene's measurement."""
+    if workers is not None:
+        return workers
+    from ..parallel import auto_workers, preloaded
+    from ..preloads import FITTING_MODULES
+    from .measure import AUTO_PLANS_PER_WORKER
+    accepted = sum(r.ok for r in records)
+    chosen = auto_workers(accepted, AUTO_PLANS_PER_WORKER)
+    return auto_workers(accepted, 1) if chosen == 1 and preloaded(FITTING_MODULES) else chosen
+
+
+def _stage_task(task: tuple) -> list[Record]:
+    """One task's rows: a few targets' sections, or one fit."""
+    kind, item = task
+    if kind == SECTIONS:
+        from .sections import _task_rows
+        return _task_rows(item)
+    from .targetfit import _fit_task
+    return _fit_task(item)

@@ -1,0 +1,53 @@
+"""A scan's sections and fits on one pool: the rows each stage gives
+alone, in their order, the scene's fit the first task."""
+
+import pytest
+
+import imgmtf as im
+import imgmtf.parallel
+from imgmtf.errors import ParameterError
+from imgmtf.scene.afterscan import sections_and_fits
+from imgmtf.scene.combine import summarise_scan
+from imgmtf.scene.measure import scan_scene
+from imgmtf.scene.sections import section_rows
+from imgmtf.scene.targetfit import fit_targets
+from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants
+from imgmtf.sensor.stages import Detector, GaussianOptics
+
+
+@pytest.fixture(scope="module")
+def two_targets(tmp_path_factory):
+    """A tilted four-square target scanned, and its half-edges again as a
+    second target: a scene of two targets (and so a scene's fit)."""
+    sensor = im.Sensor(1.0, [GaussianOptics(0.32, 0.42), Detector(1.0, 1.0)])
+    target = QuadrantTarget((60.4, 60.3), 16.8, (9000.0, 2500.0, 9000.0, 4500.0), 48.0)
+    path = tmp_path_factory.mktemp("afterscan") / "target.tif"
+    im.write_geotiff(path, render_quadrants(sensor, (121, 121), target, fill=True, noise_std_dn=25.0, seed=3).image)
+    records = scan_scene(str(path))
+    twin = [r.with_(site={"target_id": 2}) for r in records if r.site.get("target_id") == 1]
+    records = [*records, *twin]
+    return records, summarise_scan(records)
+
+
+def rows(records):
+    return [(r.status, r.site, r.figures) for r in records]
+
+
+def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_targets, monkeypatch):
+    records, summaries = two_targets
+    sections, fits = section_rows(summaries), fit_targets(records)
+    assert [r.site.get("target_id") for r in fits[::2]] == [1, 2, None]
+    assert rows(sections_and_fits(records, summaries, "auto")[0]) == rows(sections)
+    kinds = []
+
+    def in_turn(function, items, workers, **options):     # the pool's tasks, run here in turn
+        kinds.extend((workers, kind) for kind, _ in items)
+        return map(function, items)
+    monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
+    # on workers: the measurements travel without their MTF function, the fits the same
+    there = sections_and_fits(records, summaries, "auto", workers=2)
+    assert kinds == [(2, "fit"), (2, "sections"), (2, "fit"), (2, "fit")]
+    assert (rows(there[0]), rows(there[1])) == (rows(sections), rows(fits))
+    assert sections_and_fits(records, summaries, None, workers=2)[1] == []
+    with pytest.raises(ParameterError, match="workers"):
+        sections_and_fits(records, summaries, "auto", workers=0)
