@@ -31,8 +31,7 @@ from .vectors import Unplaced, VectorROIs
 
 GROUP_FILES = 32           # files measured in one task at most: their small rasters estimated together
 GROUP_BYTES = 4 * 2 ** 20  # and their bytes on disk at most: a larger file is a task of its own
-GROUP_SHARE = 3            # with several workers a group takes 1/(GROUP_SHARE x workers) of the files left,
-MIN_GROUP_FILES = 3        # ... at least this many: the last groups small, so that the workers end together
+GROUPS_PER_WORKER = 6      # tasks per worker at least, where there are files enough: workers end together
 POOLED_MAX_PX = 512 * 512  # a raster larger than this is estimated on its own (memory), as it is read
 def measure_file(path: str | os.PathLike, settings: MeasureSettings | None = None, plot_path: str | None = None,
                  *, run_utc: str | None = None, **options: Any) -> list[Record]:
@@ -238,9 +237,8 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
 
     def lost(task, exc):
         return [[settings.failed(path, settings.band, exc, run_utc)] for path in task[0]]
-    # while the workers start (their fork server's imports), this process measures the last, smallest groups
     groups = run_tasks(_measure_group, tasks, workers=workers, scheduler=scheduler, progress=progress,
-                       description="measuring", on_error=lost, ordered=ordered, help_start=True)
+                       description="measuring", on_error=lost, ordered=ordered)
     if ordered:
         for group in groups:
             yield from group
@@ -252,50 +250,34 @@ def measure_files(paths, settings: MeasureSettings, *, workers: int = 1, schedul
 def group_sizes(file_bytes: Sequence[int], workers: int = 1) -> list[int]:
     """How many files each task of a batch measures, in order, given the
     files' sizes on disk (bytes): at most :data:`GROUP_FILES` and
-    :data:`GROUP_BYTES` a group (a file larger alone); with one worker
-    groups of even size, with several shrinking ones (each
-    1/(:data:`GROUP_SHARE` x workers) of the files left, at least
-    :data:`MIN_GROUP_FILES`), so that the workers finish together and the
-    last tasks, which the caller may run while its workers start
-    (:func:`imgmtf.parallel.run_tasks`), are short.  Small chips gain from
-    being estimated together (three or four as much as more); large files
-    would only keep their rows (and, on an interrupt, what was measured)
-    waiting.
+    :data:`GROUP_BYTES` a group (a file larger alone), and with several
+    workers at least :data:`GROUPS_PER_WORKER` groups per worker where
+    there are files enough, so that the workers finish together.  Small
+    chips gain from being estimated together; large files would only keep
+    their rows (and, on an interrupt, what was measured) waiting.
 
     Examples
     --------
     >>> group_sizes([20_000] * 100), group_sizes([20_000] * 100, workers=2)
-    ([25, 25, 25, 25], [17, 14, 12, 10, 8, 7, 6, 5, 4, 3, 3, 3, 3, 5])
+    ([25, 25, 25, 25], [9, 9, 9, 9, 8, 8, 8, 8, 8, 8, 8, 8])
     >>> group_sizes([20_000] * 3 + [50_000_000] + [20_000] * 2), group_sizes([])
     ([3, 1, 2], [])
     """
     files = len(file_bytes)
     if files == 0:
         return []
+    count = -(-files // GROUP_FILES)
+    if workers > 1:
+        count = max(count, min(files, GROUPS_PER_WORKER * workers))
+    size, extra = divmod(files, count)
     sizes: list[int] = []
-    for target in _shrinking(files, workers) if workers > 1 else _even(files):
+    for target in [size + 1] * extra + [size] * (count - extra):
         start = sum(sizes)
         group = file_bytes[start: start + target]
         # cut where the bytes would pass the budget: a group holds one file at least
         taken = next((n for n in range(1, len(group)) if sum(group[:n + 1]) > GROUP_BYTES), len(group))
         sizes.append(taken)
         sizes += group_sizes(group[taken:], 1) if taken < len(group) else []
-    return sizes
-
-
-def _even(files: int) -> list[int]:
-    count = -(-files // GROUP_FILES)
-    size, extra = divmod(files, count)
-    return [size + 1] * extra + [size] * (count - extra)
-
-
-def _shrinking(files: int, workers: int) -> list[int]:
-    sizes: list[int] = []
-    while files:
-        size = min(GROUP_FILES, max(MIN_GROUP_FILES, -(-files // (GROUP_SHARE * workers))))
-        size = files if files - size < MIN_GROUP_FILES else size
-        sizes.append(size)
-        files -= size
     return sizes
 
 

@@ -45,7 +45,6 @@ MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
-HELP_GRACE_S = 0.03           # workers started within this are started: the caller waits rather than helps
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
 # as it starts (5-10 ms each); and the server's own quick exit
 WORKER_MODULES = ("threadpoolctl", "imgmtf._server_exit")
@@ -113,7 +112,7 @@ def signals_deferred():
 
 def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, scheduler: str | None = None,
               progress: bool | None = None, description: str = "measuring",
-              on_error: Callable | None = None, ordered: bool = True, help_start: bool = False) -> Iterator:
+              on_error: Callable | None = None, ordered: bool = True) -> Iterator:
     """``function(item)`` for every item, yielded in input order.
 
     Parameters
@@ -141,11 +140,6 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     ordered : bool, optional
         False yields ``(index, result)`` pairs as tasks complete (default
         True: results in input order).
-    help_start : bool, optional
-        With local workers whose start is not instant (a fork server still
-        importing, 0.3-0.5 s), run tasks here meanwhile, from the end of
-        the list (default False: this process waits).  For tasks whose
-        imports this process can afford, where the last are the smallest.
 
     Yields
     ------
@@ -161,7 +155,7 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     check_workers(workers)
     if progress is None:
         progress = len(items) > 1 and _stderr_is_terminal()
-    completed = _completed(function, items, workers, scheduler, on_error, help_start)
+    completed = _completed(function, items, workers, scheduler, on_error)
     if progress:
         completed = _with_progress(completed, len(items), description)
     try:
@@ -358,7 +352,7 @@ def _with_progress(completed, total: int, description: str):
             completed.close()
 
 
-def _completed(function, items, workers, scheduler, on_error, help_start=False):
+def _completed(function, items, workers, scheduler, on_error):
     """(index, result) pairs as tasks complete.  A lone task runs here (a
     pool's start would cost more than it saves), unless a fork server this
     process prestarted has its modules loaded already: its worker starts in
@@ -372,7 +366,7 @@ def _completed(function, items, workers, scheduler, on_error, help_start=False):
         for index, item in enumerate(items):
             yield index, _call(function, item, on_error)
     else:
-        yield from _pool_completed(function, items, workers, on_error, help_start)
+        yield from _pool_completed(function, items, workers, on_error)
 
 
 def _call(function, item, on_error):
@@ -384,24 +378,17 @@ def _call(function, item, on_error):
         return on_error(item, exc)
 
 
-def _pool_completed(function, items, workers, on_error, help_start=False):
+def _pool_completed(function, items, workers, on_error):
     """(index, result) pairs from a pool of ``workers`` processes.  Only
     ``IN_FLIGHT_PER_WORKER`` tasks per worker are submitted at a time, so
     that each wait (and a stop's cancelling) looks at a few futures however
-    long the batch.  With ``help_start``, the first are submitted from a
-    thread (a submission starts a worker, which waits for the fork server's
-    imports) while this process runs tasks from the end of the list."""
+    long the batch."""
     from concurrent.futures.process import BrokenProcessPool
     pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
-    pending = list(enumerate(items))
-    queue = iter(pending)
+    queue = iter(enumerate(items))
     in_flight: dict = {}
     finished = False
     try:
-        if help_start:
-            first = list(itertools.islice(queue, IN_FLIGHT_PER_WORKER * workers))
-            helped = yield from _helping_start(pool, function, first, pending, on_error, in_flight)
-            queue = iter(pending[len(first):len(pending) - helped])
         while True:
             failed = []         # tasks the pool refused: it broke (a worker died)
             with signals_deferred():
@@ -432,42 +419,6 @@ def _pool_completed(function, items, workers, on_error, help_start=False):
             pool.shutdown()
         else:
             _stop(pool, in_flight)
-
-
-def _helping_start(pool, function, first, pending, on_error, submitted: dict):
-    """Submit ``first`` (index, item) pairs to ``pool`` from a thread (into
-    ``submitted``, future: index; a submission the pool refused has the
-    error as its future's) and, until it is done, yield ``(index, result)``
-    of the tasks at the end of ``pending`` run here, one at a time; returns
-    how many ran here.  However this ends (an interrupt, a task's error),
-    the thread has ended: every submitted future is in ``submitted``."""
-    from concurrent.futures import Future
-
-    def submit():
-        for index, item in first:
-            try:
-                submitted[pool.submit(function, item)] = index
-            except Exception as exc:        # a broken pool: the task's result is its error
-                refused: Future = Future()
-                refused.set_exception(exc)
-                submitted[refused] = index
-    thread = threading.Thread(target=submit, name="imgmtf-pool-start", daemon=True)
-    thread.start()
-    helped = 0
-    try:
-        # a server already serving forks in milliseconds: nothing is run here
-        while not _joined(thread, HELP_GRACE_S) and len(first) + helped < len(pending):
-            helped += 1
-            index, item = pending[-helped]
-            yield index, _call(function, item, on_error)
-    finally:
-        thread.join()
-    return helped
-
-
-def _joined(thread: threading.Thread, timeout: float) -> bool:
-    thread.join(timeout)
-    return not thread.is_alive()
 
 
 def _died(item, exc: BrokenProcessPool, on_error):

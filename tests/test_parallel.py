@@ -157,28 +157,19 @@ def test_only_the_fork_server_skips_its_teardown(tmp_path):
     assert out.returncode == 3 and out.stdout.split() == ["False", "handled"], out.stderr
 
 
-def test_the_caller_runs_the_last_tasks_while_its_workers_start(tmp_path):
-    """help_start: while the fork server imports (here a module that takes 0.3 s), the caller runs tasks
-    from the end of the list, each task once, the results in order as ever; without it, it waits.  A lone
-    task goes to a worker of the server this process prestarted (its modules loaded there, not here)."""
+def test_a_lone_task_goes_to_the_prestarted_fork_server(tmp_path):
+    """A lone task goes to a worker of the server this process prestarted (its modules loaded there, not
+    here); without a prestarted server it runs here."""
     import subprocess
     import sys
     if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
         pytest.skip("no fork server on this platform")
-    (tmp_path / "slow_start.py").write_text("import os, time\n"
-                                            "if os.environ['CALLER'] != str(os.getpid()):  # the server's\n"
-                                            "    time.sleep(0.3)\n"
-                                            "def where(x):\n    time.sleep(0.02)\n    return x, os.getpid()\n")
+    (tmp_path / "lone_task.py").write_text("import os\ndef where(x):\n    return x, os.getpid()\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
-    code = ("import os, sys; os.environ['CALLER'] = str(os.getpid()); "
-            "from imgmtf.parallel import prestart_workers, run_tasks; "
-            "prestart_workers(2, ['slow_start']); import slow_start; "
-            "out = list(run_tasks(slow_start.where, range(12), workers=2, help_start=sys.argv[1] == 'help')); "
-            "here = [x for x, pid in out if pid == os.getpid()]; "
-            "lone = list(run_tasks(slow_start.where, [7], workers=2))[0][1] != os.getpid(); "
-            "print([x for x, _ in out] == list(range(12)), here == list(range(12 - len(here), 12)), lone, len(here))")
-    for asked in ("help", "wait"):
+    code = ("import os, sys; from imgmtf.parallel import prestart_workers, run_tasks; "
+            "started = sys.argv[1] == 'prestart'; started and prestart_workers(2, ['lone_task']); "
+            "import lone_task; "
+            "print(list(run_tasks(lone_task.where, [7], workers=2))[0][1] != os.getpid())")
+    for asked, away in (("prestart", "True"), ("none", "False")):
         out = subprocess.run([sys.executable, "-c", code, asked], capture_output=True, text=True, env=env, timeout=60)
-        assert out.returncode == 0, out.stderr
-        same, last, lone, here = out.stdout.split()
-        assert same == last == lone == "True" and (int(here) >= 3 if asked == "help" else here == "0")
+        assert out.returncode == 0 and out.stdout.split() == [away], out.stderr
