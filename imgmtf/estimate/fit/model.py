@@ -506,13 +506,15 @@ class Model:
         """
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        if max_iterations > 0 and self.sparse:
+        if max_iterations > 0:
             try:
                 return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
-                                       max_iterations, layout=self._jacobian_layout()[0])
+                                       max_iterations, layout=self._jacobian_layout()[0] if self.sparse else None,
+                                       ftol=None if self.sparse else 1e-9)
             except NoConvergence:
                 pass
-        elif max_iterations > 0:
+        if max_iterations > 0 and not self.sparse:
+            # a few edges' fit that our solver could not finish: SciPy's, which refuses as before
             from scipy.optimize import least_squares
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
                                    x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
