@@ -211,7 +211,11 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     that led there.
 
     ``layout`` is the compressed-row Jacobian's column indices, when known
-    (:func:`split_columns`).
+    (:func:`split_columns`).  With ``ftol`` it also stops, as SciPy's
+    ``least_squares`` does, after an accepted step that lowered half the
+    sum of squares by less than ``ftol`` times it (the Jacobian then
+    evaluated at the new point): a few edges' fits, whose last steps at
+    the 1e-12 criterion were mostly rejected at rounding level.
 
     Returns
     -------
