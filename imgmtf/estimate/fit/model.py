@@ -48,6 +48,10 @@ DETERMINED_PX = 0.2
 #: (bench's scan chart) cost the same either way at 8 edges (0.169 s dense,
 #: 0.163 s sparse), dense 10 % less at 4-6, sparse 15-35 % less at 12-16
 DENSE_EDGES = 8
+#: stage parameters up to which a few edges' fit is solved by our Levenberg-Marquardt (a target's optics and
+#: detector): with more (the extra stages' candidates) a badly fitting target has several optima, and which one
+#: a solver reaches depends on its path (Baotou's target 1 changed its chosen stages with ours)
+OWN_SOLVER_FREE = 4
 
 
 def stage_names(names, start: Sensor | None) -> list[str]:
@@ -494,10 +498,12 @@ class Model:
         """Bounded least squares from ``z`` with :meth:`jacobian`, by
         Levenberg-Marquardt steps solved exactly over the arrowhead normal
         matrix (:func:`.arrowhead.solve_arrowhead`): many edges' (a sparse
-        Jacobian) to its own tight end, a few edges' (a target's) stopped
-        where an accepted step lowers the cost by less than 1e-9 of it, as
-        SciPy's trust region did (its overhead was a quarter of a target's
-        solve).  A few edges' fit it cannot finish goes to SciPy's
+        Jacobian) to its own tight end, a few edges' of at most
+        :data:`OWN_SOLVER_FREE` stage parameters (a target's optics and
+        detector) stopped where an accepted step lowers the cost by less
+        than 1e-9 of it, as SciPy's trust region did (its overhead was a
+        quarter of a target's solve).  Other few edges' fits, and those
+        it cannot finish, go to SciPy's
         trust-region reflective ``least_squares`` (the columns scaled by
         their norms), which refuses as before.  Returns the solution and
         its Jacobian.
@@ -509,7 +515,7 @@ class Model:
         """
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        if max_iterations > 0:
+        if max_iterations > 0 and (self.sparse or self.n_free <= OWN_SOLVER_FREE):
             try:
                 return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
                                        max_iterations, layout=self._jacobian_layout()[0] if self.sparse else None,
@@ -517,7 +523,8 @@ class Model:
             except NoConvergence:
                 pass
         if max_iterations > 0 and not self.sparse:
-            # a few edges' fit that our solver could not finish: SciPy's, which refuses as before
+            # a few edges' fit of many parameters, or one our solver could not finish: SciPy's, which
+            # refuses as before
             from scipy.optimize import least_squares
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
                                    x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
