@@ -52,6 +52,9 @@ DENSE_EDGES = 8
 #: detector): with more (the extra stages' candidates) a badly fitting target has several optima, and which one
 #: a solver reaches depends on its path (Baotou's target 1 changed its chosen stages with ours)
 OWN_SOLVER_FREE = 4
+#: edges from which a few edges' fit is solved by ours (a target's four half-edges, both axes seen): with fewer an
+#: axis's parameters are flat, and ours and SciPy's reached different optima of one chip (bench/fit_accuracy.py)
+OWN_SOLVER_EDGES = 4
 
 
 def stage_names(names, start: Sensor | None) -> list[str]:
@@ -499,8 +502,9 @@ class Model:
         Levenberg-Marquardt steps solved exactly over the arrowhead normal
         matrix (:func:`.arrowhead.solve_arrowhead`): many edges' (a sparse
         Jacobian) to its own tight end, a few edges' of at most
-        :data:`OWN_SOLVER_FREE` stage parameters (a target's optics and
-        detector) stopped where an accepted step lowers the cost by less
+        :data:`OWN_SOLVER_FREE` stage parameters and at least
+        :data:`OWN_SOLVER_EDGES` edges (a target's optics and detector)
+        stopped where an accepted step lowers the cost by less
         than 1e-9 of it, as SciPy's trust region did (its overhead was a
         quarter of a target's solve).  Other few edges' fits, and those
         it cannot finish, go to SciPy's
@@ -515,7 +519,8 @@ class Model:
         """
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        if max_iterations > 0 and (self.sparse or self.n_free <= OWN_SOLVER_FREE):
+        ours = self.sparse or (self.n_free <= OWN_SOLVER_FREE and len(self.data) >= OWN_SOLVER_EDGES)
+        if max_iterations > 0 and ours:
             try:
                 return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
                                        max_iterations, layout=self._jacobian_layout()[0] if self.sparse else None,
