@@ -110,3 +110,17 @@ def test_noise_limited_frequency_closed_form():
     # masked frequencies (NaN) are skipped, not taken for noise
     masked = noise_limited_frequency(lambda f: np.where((f > 0.5) & (f < 0.7), np.nan, mtf(f)), edge_noise)
     assert masked == got
+
+
+def test_many_spectra_are_each_the_same_to_the_bit_as_alone():
+    """Profiles of one step and length share an FFT (in blocks of
+    SPECTRUM_ROWS rows); each row is the profile's transform alone."""
+    from imgmtf.estimate.spectrum import SPECTRUM_ROWS, spectrum, spectrum_many
+    rng = np.random.default_rng(6)
+    requests = [(rng.normal(size=rng.integers(50, 400)), 0.05) for _ in range(SPECTRUM_ROWS + 3)]
+    requests += [(rng.normal(size=300), 0.1), (rng.normal(size=600), 2.0)]     # a coarser step; longer than padded
+    together = spectrum_many(requests)
+    for (profile, step), (f, modulus) in zip(requests, together):
+        alone_f, alone_modulus = spectrum(profile, step)
+        np.testing.assert_array_equal(f, alone_f)
+        np.testing.assert_array_equal(modulus, alone_modulus)

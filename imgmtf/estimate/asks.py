@@ -41,6 +41,9 @@ saturation    the saturation checks of a chip's sides and peak
 settled-sides the settling check of a chip's sides
               (:func:`.settling.settled_sides_many`; payload: the chip's
               :class:`.evidence.Evidence`).
+spectrum      the windowed profile's zero-padded transform
+              (:func:`.spectrum.spectrum_many`; payload: the profile's
+              support and its step, px).
 side-checks   the uniformity checks of a chip's sides
               (:func:`.sides.side_checks_many`; payload: the chip's
               arguments of :func:`.sides.side_checks`).
@@ -57,6 +60,7 @@ from .gate import line_checks_many
 from .saturation import saturation_checks_many
 from .settling import settled_sides_many
 from .sides import side_checks_many
+from .spectrum import spectrum_many
 from .stacked_resampling import resample_many
 
 T = TypeVar("T")
@@ -87,6 +91,7 @@ ANSWERS: dict[str, Callable[[list], list]] = {
     "saturation": saturation_checks_many,
     "settled-sides": settled_sides_many,
     "side-checks": side_checks_many,
+    "spectrum": spectrum_many,
 }
 
 Steps = Generator[Ask, Any, T]
