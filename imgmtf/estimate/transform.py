@@ -16,9 +16,9 @@ from .settings import Settings
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
+    RestoreRequest,
     mtf50,
     noise_limited_frequency,
-    restore_lsf,
     supported,
     tabulated_mtf,
     white_noise_mtf_sd,
@@ -78,8 +78,9 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
 def transform_steps(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape, noise: Noise,
                     window: Window, lsf: TailedLSF, settings: Settings) -> Steps[Spectrum]:
     """:func:`transform` as a generator of asks (:mod:`.asks`): the
-    profile's zero-padded FFT (``spectrum``) is made among other chips'
-    (:func:`.spectrum.spectrum_many`)."""
+    profile's zero-padded FFT (``spectrum``) and the LSF's restoration
+    (``restore-lsf``) are made among other chips' (:func:`.spectrum.spectrum_many`,
+    :func:`.spectrum.restore_lsf_many`)."""
     divisor = kind.divisor(lsf.step_px, profile.resampled.transfer if settings.correct else None, shape)
     mtf = tabulated_mtf(*(yield Ask("spectrum", (supported(lsf.combined), lsf.step_px))), divisor)
     density = samples.distance_px.size / (2.0 * samples.half_range_px)
@@ -87,7 +88,8 @@ def transform_steps(kind: TargetKind, samples: Samples, profile: Profile, shape:
                                kind.noise_gain(shape, noise.contrast_dn))
     noise_sd = functools.partial(_corrected_noise_sd, white=white, divisor=divisor)
     noise_limit = noise_limited_frequency(mtf, noise_sd)
-    lsf_x, restored = restore_lsf(lsf.combined, lsf.x_px, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
+    lsf_x, restored = yield Ask("restore-lsf", RestoreRequest(lsf.combined, lsf.x_px, divisor, noise_limit,
+                                                             min_divisor=kind.restore_min_divisor))
     return Spectrum(divisor, mtf, noise_sd, noise_limit, lsf_x, restored, float(mtf(np.array([NYQUIST]))[0]),
                     mtf50(mtf), fwhm(lsf_x, restored))
 
