@@ -27,7 +27,7 @@ import functools
 import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -210,7 +210,7 @@ def _restore_steps(profile: np.ndarray, x: np.ndarray, divisor: Callable, noise_
     return (np.arange(n * k) - n * k // 2) * out_step_px, out / (out.sum() * out_step_px)
 
 
-def _fft_rows(steps: list[Generator]) -> list:
+def _fft_rows(steps: list[Generator[Any, Any, Any]]) -> list:
     """Run generators of transforms (each yields ``(np.fft.rfft or
     np.fft.irfft, values, length)`` and takes the transform of ``values``
     to ``length`` points) in lockstep, the transforms of one function and

@@ -82,7 +82,8 @@ def transform_steps(kind: TargetKind, samples: Samples, profile: Profile, shape:
     (``restore-lsf``) are made among other chips' (:func:`.spectrum.spectrum_many`,
     :func:`.spectrum.restore_lsf_many`)."""
     divisor = kind.divisor(lsf.step_px, profile.resampled.transfer if settings.correct else None, shape)
-    mtf = tabulated_mtf(*(yield Ask("spectrum", (supported(lsf.combined), lsf.step_px))), divisor)
+    freqs, modulus = yield Ask("spectrum", (supported(lsf.combined), lsf.step_px))
+    mtf = tabulated_mtf(freqs, modulus, divisor)
     density = samples.distance_px.size / (2.0 * samples.half_range_px)
     white = white_noise_mtf_sd(noise.snr, 2.0 * window.core_px + window.taper_px, density,
                                kind.noise_gain(shape, noise.contrast_dn))
