@@ -18,6 +18,7 @@ feature or texture, keeps its free fit).
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -191,15 +192,16 @@ def _levenberg_marquardt(x, y, w, p, iterations, free=None):
     """Every row's parameters from ``p`` on; ``free`` (4 bools) holds the
     others at their start."""
     held = None if free is None else np.asarray(free, float)
+    scratch = _Scratch()
     p = np.array(p, float)
     lam = np.full(y.shape[0], 1e-2)
-    cost, terms = _cost(x, y, w, p)
-    jtj, jtr = _normal_equations(x, y, w, p, terms, held)
+    cost, terms = _cost(x, y, w, p, scratch)
+    jtj, jtr = (a.copy() for a in _normal_equations(x, y, w, p, terms, scratch, held))
     for _ in range(iterations):
         step = _solve_rows(_damped(jtj, lam), jtr)
         trial = p + step
-        trial_cost, terms = _cost(x, y, w, trial)
-        _accept(x, y, w, (p, cost, jtj, jtr, lam), (trial, trial_cost, terms), held)
+        trial_cost, terms = _cost(x, y, w, trial, scratch)
+        _accept(x, y, w, (p, cost, jtj, jtr, lam), (trial, trial_cost, terms), scratch, held)
         # converged: no row proposes to move its edge by more than 1e-5 px
         if np.all((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5)):
             break
@@ -211,18 +213,19 @@ def _levenberg_marquardt_stacked(x, y, w, p, iterations, edges):
     each row's edge, ascending): every row computed as in its edge's own
     fit, and an edge's rows set aside once its own rows converged, as its
     own fit would stop there."""
+    scratch = _Scratch()
     out = np.array(p, float)
     p = out.copy()
     live = np.arange(y.shape[0])            # the rows of the edges still iterating, and their state
     lam = np.full(live.size, 1e-2)
-    cost, terms = _cost(x, y, w, p)
-    jtj, jtr = _normal_equations(x, y, w, p, terms)
+    cost, terms = _cost(x, y, w, p, scratch)
+    jtj, jtr = (a.copy() for a in _normal_equations(x, y, w, p, terms, scratch))
     ids = edges
     for _ in range(iterations):
         step = _solve_by_edge(_damped(jtj, lam), jtr, ids)
         trial = p + step
-        trial_cost, terms = _cost(x, y, w, trial)
-        _accept(x, y, w, (p, cost, jtj, jtr, lam), (trial, trial_cost, terms))
+        trial_cost, terms = _cost(x, y, w, trial, scratch)
+        _accept(x, y, w, (p, cost, jtj, jtr, lam), (trial, trial_cost, terms), scratch)
         # an edge has converged when none of its rows proposes to move its edge by more than 1e-5 px
         moving = ~((lam > 1e8) | (np.abs(step[:, 1]) < 1e-5))
         going = np.bincount(ids, weights=moving, minlength=int(edges[-1]) + 1)[ids] > 0
@@ -236,33 +239,51 @@ def _levenberg_marquardt_stacked(x, y, w, p, iterations, edges):
     return out
 
 
-def _cost(x, y, w, p):
+class _Scratch:
+    """Arrays reused from one iteration to the next, each a view of the
+    start of a buffer kept by name.  A stack's arrays are larger than
+    what the allocator keeps at hand: made afresh, each is mapped from
+    the system anew and its pages faulted in, which cost as much as the
+    arithmetic done in them."""
+
+    def __init__(self) -> None:
+        self._buffers: dict[str, np.ndarray] = {}
+
+    def __call__(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
+        size = math.prod(shape)
+        buffer = self._buffers.get(name)
+        if buffer is None or buffer.size < size:
+            buffer = self._buffers[name] = np.empty(size)
+        return buffer[:size].reshape(shape)
+
+
+def _cost(x, y, w, p, scratch):
     """Each row's cost (weighted sum of squared residuals) at ``p``, as
     :func:`fermi` evaluates the model, and the terms its Jacobian reuses:
-    (x - b) / c clipped, and 1 + its exponential."""
+    (x - b) / c clipped, and 1 + its exponential (in ``scratch``)."""
     a, b, c, d = (p[:, k, None] for k in range(4))
-    u = np.subtract(x, b)
+    u = np.subtract(x, b, out=scratch("u", y.shape))
     u /= c
     np.clip(u, -50.0, 50.0, out=u)
-    one_plus_e = np.exp(u)
+    one_plus_e = np.exp(u, out=scratch("one_plus_e", y.shape))
     one_plus_e += 1.0
-    r = np.divide(a, one_plus_e)
+    r = np.divide(a, one_plus_e, out=scratch("r", y.shape))
     r += d
     np.subtract(y, r, out=r)
     r *= w
     return np.einsum("rk,rk->r", r, r), (u, one_plus_e)
 
 
-def _normal_equations(x, y, w, p, terms, held=None):
-    """Every row's J'WJ and J'Wr at ``p`` (``terms`` from :func:`_cost`),
-    the Jacobian in (a, b, c, d) from the model's logistic; ``held`` (4
-    floats) zeroes the columns of parameters held."""
+def _normal_equations(x, y, w, p, terms, scratch, held=None):
+    """Every row's J'WJ and J'Wr at ``p`` (``terms`` from :func:`_cost`; in
+    ``scratch``), the Jacobian in (a, b, c, d) from the model's logistic;
+    ``held`` (4 floats) zeroes the columns of parameters held."""
     u, one_plus_e = terms
     a, c, d = (p[:, k, None] for k in (0, 2, 3))
-    s = np.divide(1.0, one_plus_e)
-    ds = np.subtract(1.0, s)
+    s = np.divide(1.0, one_plus_e, out=scratch("s", y.shape))
+    ds = np.subtract(1.0, s, out=scratch("ds", y.shape))
     ds *= s
-    jac = np.empty(s.shape + (4,))
+    jac = scratch("jac", y.shape + (4,))
     jac[..., 0] = s
     a_ds = np.multiply(a, ds, out=ds)
     np.divide(a_ds, c, out=jac[..., 1])
@@ -275,8 +296,11 @@ def _normal_equations(x, y, w, p, terms, held=None):
     s += d
     resid = np.subtract(y, s, out=s)
     resid *= w
-    weighted = np.swapaxes(jac * w[..., None], 1, 2)
-    return weighted @ jac, (weighted @ resid[..., None])[..., 0]
+    weighted = np.swapaxes(np.multiply(jac, w[..., None], out=scratch("weighted", jac.shape)), 1, 2)
+    jtj = np.matmul(weighted, jac, out=scratch("jtj", (y.shape[0], 4, 4)))
+    jtr = scratch("jtr", (y.shape[0], 4))
+    np.matmul(weighted, resid[..., None], out=jtr[..., None])
+    return jtj, jtr
 
 
 def _damped(jtj, lam):
@@ -288,27 +312,34 @@ def _damped(jtj, lam):
     return damped
 
 
-def _accept(x, y, w, state, trial, held=None):
+def _accept(x, y, w, state, trial, scratch, held=None):
     """Each row's state (parameters, cost, normal equations, damping;
     updated in place) after a trial step: the trial's where it lowered the
-    cost (damping / 3), the row's own before where not (damping x 4)."""
+    cost (damping / 3), the row's own before where not (damping x 4).  The
+    normal equations are made for every row when most improved (a row's
+    are the same made among any rows), else for those rows alone."""
     p, cost, jtj, jtr, lam = state
     trial_p, trial_cost, terms = trial
     better = np.isfinite(trial_cost) & (trial_cost < cost)
-    if better.all():
+    improved = int(np.count_nonzero(better))
+    if improved == better.size:
         p[:] = trial_p
         cost[:] = trial_cost
-        jtj[:], jtr[:] = _normal_equations(x, y, w, trial_p, terms, held)
+        jtj[:], jtr[:] = _normal_equations(x, y, w, trial_p, terms, scratch, held)
         lam /= 3.0
         return
     lam[:] = np.where(better, lam / 3.0, lam * 4.0)
-    if not better.any():
+    if not improved:
         return
-    rows = np.flatnonzero(better)
-    p[rows] = trial_p[rows]
-    cost[rows] = trial_cost[rows]
-    jtj[rows], jtr[rows] = _normal_equations(x[rows] if x.ndim == 2 else x, y[rows], w[rows], trial_p[rows],
-                                             tuple(t[rows] for t in terms), held)
+    p[better] = trial_p[better]
+    cost[better] = trial_cost[better]
+    if 2 * improved > better.size:
+        new_jtj, new_jtr = _normal_equations(x, y, w, trial_p, terms, scratch, held)
+        jtj[better], jtr[better] = new_jtj[better], new_jtr[better]
+    else:
+        rows = np.flatnonzero(better)
+        jtj[rows], jtr[rows] = _normal_equations(x[rows] if x.ndim == 2 else x, y[rows], w[rows], trial_p[rows],
+                                                 tuple(t[rows] for t in terms), scratch, held)
 
 
 def _solve_rows(damped: np.ndarray, jtr: np.ndarray) -> np.ndarray:
