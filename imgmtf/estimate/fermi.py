@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,13 +38,15 @@ class FermiFit:
     ``params`` is (n_rows, 4) holding a, b, c, d; ``rms`` the RMS residual
     (DN); ``ok`` is False where the fit diverged or left the data;
     ``pinned`` is True where the width collapsed and was held at
-    ``MIN_WIDTH_PX``.
+    ``MIN_WIDTH_PX``; ``rows`` which of the image's rows they are, where
+    the rows fitted said so (:attr:`FermiRows.rows`).
     """
 
     params: np.ndarray
     rms: np.ndarray
     ok: np.ndarray
     pinned: np.ndarray | None = None
+    rows: np.ndarray | None = None
 
     @property
     def location(self) -> np.ndarray:
@@ -60,12 +62,14 @@ class FermiRows:
     """One edge's rows to fit (:func:`fit_fermi`'s arguments): sample
     positions ``x`` (px), values ``y`` (DN) and weights (1 a sample, 0
     padding), each n_rows x n_samples, and each row's starting location
-    ``b0`` (px)."""
+    ``b0`` (px); ``rows``, where given, marks which of the image's rows
+    they are (their fit carries it on)."""
 
     x: np.ndarray
     y: np.ndarray
     weight: np.ndarray
     b0: np.ndarray
+    rows: np.ndarray | None = None
 
 
 def fermi(x: np.ndarray, params: np.ndarray) -> np.ndarray:
@@ -120,15 +124,16 @@ def fit_fermi_many(edges: Sequence[FermiRows], c0: float = 0.7, iterations: int 
     [9.5, 10.25]
     """
     if len({np.shape(e.y)[1:] for e in edges}) > 1 or any(np.ndim(e.x) != 2 for e in edges):
-        return [fit_fermi(e.x, e.y, e.weight, e.b0, c0, iterations) for e in edges]
-    out: list[FermiFit] = []
-    group: list[FermiRows] = []
-    for edge in edges:      # stacks of about STACK_ROWS rows: arrays that stay in the cache
-        group.append(edge)
-        if sum(np.shape(e.y)[0] for e in group) >= STACK_ROWS:
-            out += _fit_stacked(group, c0, iterations)
-            group = []
-    return out + _fit_stacked(group, c0, iterations) if group else out
+        out = [fit_fermi(e.x, e.y, e.weight, e.b0, c0, iterations) for e in edges]
+    else:
+        out, group = [], []
+        for edge in edges:      # stacks of about STACK_ROWS rows: arrays that stay in the cache
+            group.append(edge)
+            if sum(np.shape(e.y)[0] for e in group) >= STACK_ROWS:
+                out += _fit_stacked(group, c0, iterations)
+                group = []
+        out += _fit_stacked(group, c0, iterations) if group else []
+    return [fit if e.rows is None else replace(fit, rows=e.rows) for fit, e in zip(out, edges)]
 
 
 def _fit_stacked(edges: list[FermiRows], c0: float, iterations: int) -> list[FermiFit]:
