@@ -123,3 +123,11 @@ def test_a_rejected_array_tells_the_scans_peaks_from_the_features_measured(capsy
     print_point_scan("s.tif", SimpleNamespace(width=64, height=64), [record], [], [], "text")
     line = capsys.readouterr().out.splitlines()[-1]
     assert "grouped from 4 peaks the scan found" in line and "4 points found" not in line
+
+
+def test_a_run_of_several_scenes_counts_those_with_a_point_array(tmp_path):
+    array = render_points(SENSOR, ARRAY, 60, bits=None).image + 100.0
+    paths = [write(tmp_path / f"array{i}.tif", np.random.default_rng(i).normal(array, 2.0)) for i in (1, 2)]
+    result = CliRunner().invoke(main, ["scan", "--target", "points", *paths, "--format", "json", "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    assert "2 of 2 scenes scanned: 2 with a usable point array, 0 without or failed" in result.stderr

@@ -306,7 +306,8 @@ def _closing_notes(outcomes, paths, store, kind, fmt) -> None:
     if len(paths) > 1:
         usable = sum(o.ok for o in outcomes)
         stored = f"; {written} stored in {store}" if store else ""
-        click.echo(f"{len(outcomes)} of {len(paths)} scenes scanned: {usable} with a usable {kind}, "
+        target = get_kind(kind).noun + (" array" if get_kind(kind).scanner is not None else "")
+        click.echo(f"{len(outcomes)} of {len(paths)} scenes scanned: {usable} with a usable {target}, "
                    f"{len(outcomes) - usable} without or failed{stored}", err=True)
     elif store and outcomes and not outcomes[0].interrupted:      # as measure --campaign says it
         click.echo(f"{written} acquisition(s) written to {store}", err=True)
