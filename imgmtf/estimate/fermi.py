@@ -288,7 +288,7 @@ def _normal_equations(x, y, w, p, terms, scratch, held=None):
     s = np.divide(1.0, one_plus_e, out=scratch("s", y.shape))
     ds = np.subtract(1.0, s, out=scratch("ds", y.shape))
     ds *= s
-    jac = scratch("jac", y.shape + (4,))
+    jac = scratch("jac", (*y.shape, 4))
     jac[..., 0] = s
     a_ds = np.multiply(a, ds, out=ds)
     np.divide(a_ds, c, out=jac[..., 1])
