@@ -3,8 +3,9 @@ import numpy as np
 
 
 def test_detection_on_workers_finds_the_segments_one_process_finds(tmp_path):
-    """Tiles searched on two workers give the same segments, in the same
-    order, as in this process: the tiles' pieces are joined in tile order."""
+    """Tiles searched on two workers (the first of them here while the
+    workers start) give the same segments, in the same order, as in this
+    process: the tiles' pieces are joined in tile order."""
     import imgmtf as im
     from imgmtf.io import raster_info
     from imgmtf.scene.detect import detect_segments, tile_windows
