@@ -76,7 +76,7 @@ def _searched_while_workers_start(tiles: list, workers: int) -> list[tuple[np.nd
     import threading
     starting = threading.Thread(target=_start_workers, args=(workers,), daemon=True, name="imgmtf-workers-start")
     starting.start()
-    found = []
+    found: list[tuple[np.ndarray, np.ndarray]] = []
     while starting.is_alive() and len(found) < len(tiles) - 1:
         found.append(tile_segments(tiles[len(found)]))
     starting.join()
