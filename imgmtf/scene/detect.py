@@ -54,7 +54,7 @@ def detect_segments(path: str, settings: ScanSettings | None = None, *, workers:
     check_scene_size(info)
     lo, hi = display_levels(path, settings.band, info)
     tiles = [(path, settings.band, window, lo, hi, info.dtype) for window in tile_windows(info, settings.tile_px)]
-    found = _searched_while_workers_start(tiles, workers) if workers > 1 and scheduler is None else []
+    found = _searched_while_workers_start(tiles, workers) if _workers_start_apart(workers, scheduler) else []
     found += run_tasks(tile_segments, tiles[len(found):], workers=workers, scheduler=scheduler, progress=progress,
                        description="detecting segments")
     found = [f for f in found if len(f[0])]
@@ -83,14 +83,21 @@ def _searched_while_workers_start(tiles: list, workers: int) -> list[tuple[np.nd
     return found
 
 
+def _workers_start_apart(workers: int, scheduler: str | None) -> bool:
+    """Whether a thread may start the local pool while this process
+    searches tiles: a fork server runs already with the tiles' modules (a
+    scan's, or the command's, started it), so the thread only forks the
+    workers from it; or the system has none, and the thread starts them."""
+    from ..parallel import can_preload, preloaded
+    from ..preloads import SCAN_TASK_MODULES
+    return workers > 1 and scheduler is None and (preloaded(SCAN_TASK_MODULES) or not can_preload())
+
+
 def _start_workers(workers: int) -> None:
-    """A pool of ``workers`` started (:func:`imgmtf.parallel.prestart_workers`);
-    where no fork server runs yet, the first call starts one (and returns
-    at once), the second forks the pool's workers from it."""
+    """A pool of ``workers`` started (:func:`imgmtf.parallel.prestart_workers`)."""
     from ..parallel import prestart_workers
     from ..preloads import SCAN_TASK_MODULES
-    for _ in range(2):
-        prestart_workers(workers, SCAN_TASK_MODULES)
+    prestart_workers(workers, SCAN_TASK_MODULES)
 
 
 def tile_windows(info: RasterInfo, tile_px: int) -> list[tuple[int, int, int, int]]:
