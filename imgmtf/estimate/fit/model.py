@@ -48,13 +48,9 @@ DETERMINED_PX = 0.2
 #: (bench's scan chart) cost the same either way at 8 edges (0.169 s dense,
 #: 0.163 s sparse), dense 10 % less at 4-6, sparse 15-35 % less at 12-16
 DENSE_EDGES = 8
-#: stage parameters up to which a few edges' fit is solved by our Levenberg-Marquardt (a target's optics and
-#: detector): with more (the extra stages' candidates) a badly fitting target has several optima, and which one
-#: a solver reaches depends on its path (Baotou's target 1 changed its chosen stages with ours)
-OWN_SOLVER_FREE = 4
-#: edges from which a few edges' fit is solved by ours (a target's four half-edges, both axes seen): with fewer an
-#: axis's parameters are flat, and ours and SciPy's reached different optima of one chip (bench/fit_accuracy.py)
-OWN_SOLVER_EDGES = 4
+#: a few edges' fits solved by ours: a target's (4+ half-edges, <= 4 stage parameters); with more parameters
+#: (Baotou's target 1) or fewer edges (one chip) the optimum reached followed the solver's path
+OWN_SOLVER_FREE, OWN_SOLVER_EDGES = 4, 4
 
 
 def stage_names(names, start: Sensor | None) -> list[str]:
@@ -528,8 +524,7 @@ class Model:
             except NoConvergence:
                 pass
         if max_iterations > 0 and not self.sparse:
-            # a few edges' fit of many parameters, or one our solver could not finish: SciPy's, which
-            # refuses as before
+            # a few edges' fit not ours, or one ours could not finish: SciPy's, which refuses as before
             from scipy.optimize import least_squares
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
                                    x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
