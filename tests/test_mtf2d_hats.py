@@ -1,10 +1,9 @@
 """Sparse linear-interpolation designs (imgmtf.estimate.mtf2d.hats): the
-dense design's algebra, and the draws' vertices and the curves' node
-search, batched, each exactly what one at a time gives."""
+dense design's algebra, and the draws' vertices, batched, each exactly
+what one at a time gives."""
 import numpy as np
 
 from imgmtf.estimate.mtf2d import hats
-from imgmtf.estimate.mtf2d.curves import _search_rows
 from imgmtf.estimate.mtf2d.inversion import _hat, _vertex, _vertices
 
 
@@ -42,17 +41,3 @@ def test_the_draws_vertices_are_each_draws_own():
     together = _vertices(trials[None], costs[None])[0]
     assert np.array_equal(together, [_vertex(trials, costs[:, k]) for k in range(costs.shape[1])])
 
-
-def test_the_node_search_is_numpys():
-    """Uniform rows (a model's linspace, the guess then exact), uneven
-    rows (several steps), points on nodes, outside and NaN: the index of
-    the last node at or below each point, as comparing with every node."""
-    rng = np.random.default_rng(6)
-    uniform = np.linspace(0.0, rng.uniform(0.5, 1.2, 4), 33, axis=-1)
-    uneven = np.sort(rng.uniform(0, 1, (4, 33)), axis=1)
-    for nodes in (uniform, uneven):
-        x = np.concatenate([rng.uniform(-0.2, 1.3, (4, 50)), nodes, np.full((4, 1), np.nan)], axis=1)
-        expected = np.sum(x[:, :, None] >= nodes[:, None, :], axis=2) - 1
-        found = _search_rows(x, nodes, np.arange(4)[:, None])
-        finite = np.isfinite(x)
-        assert np.array_equal(found[finite], expected[finite])
