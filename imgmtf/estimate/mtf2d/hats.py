@@ -60,21 +60,28 @@ def hats(position: np.ndarray, size: int) -> Hats:
     return Hats(low, position - low, size, (low + size * np.arange(low.shape[0])[:, None]).ravel())
 
 
-def dense(h: Hats) -> np.ndarray:
+def dense(h: Hats, weight: np.ndarray | None = None) -> np.ndarray:
     """The design (batch, samples, size - 1), the first node dropped: for
-    products with many right-hand sides at once (BLAS does those best).
+    products with many right-hand sides at once (BLAS does those best);
+    with ``weight`` (batch, samples), each sample's row times its weight
+    (W D, the same numbers as the product, without a pass over the zeros).
 
     Examples
     --------
     >>> dense(hats(np.array([[0.25, 1.5]]), 3)).tolist()
     [[[0.25, 0.0], [0.5, 0.5]]]
+    >>> dense(hats(np.array([[0.25, 1.5]]), 3), np.array([[2.0, 4.0]])).tolist()
+    [[[0.5, 0.0], [2.0, 2.0]]]
     """
     batch, samples = h.low.shape
     out = np.zeros((batch, samples, h.size))
+    lower, upper = 1.0 - h.frac, h.frac
+    if weight is not None:
+        lower, upper = lower * weight, upper * weight
     # by flat indices into the rows of nodes: a third of the time of indexing by (batch, sample, node)
     flat, at = out.reshape(-1, h.size), np.arange(batch * samples)
-    flat[at, h.low.ravel()] = (1.0 - h.frac).ravel()
-    flat[at, h.low.ravel() + 1] = h.frac.ravel()
+    flat[at, h.low.ravel()] = lower.ravel()
+    flat[at, h.low.ravel() + 1] = upper.ravel()
     return out[:, :, 1:]
 
 

@@ -245,7 +245,7 @@ class EllipticalProblem:
             # summed in order (a padded sample adds an exact 0): the same sum whatever the targets batched with
             return np.cumsum(misfit ** 2, axis=1)[:, -1].reshape(count, aspects)
         # many right-hand sides per aspect: one dense product each (BLAS), the normal matrices still sparse
-        weighted = (hats.dense(h) * weight[:, :, None]).reshape(count, aspects, *h.low.shape[1:], -1)
+        weighted = hats.dense(h, weight).reshape(count, aspects, *h.low.shape[1:], -1)
         goal = targets * self.weight[:, :, None]
         unknowns = h.size - 1
         gram = hats.gram(h, weight)
