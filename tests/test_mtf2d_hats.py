@@ -26,8 +26,9 @@ def test_the_sparse_designs_algebra_is_the_dense_designs():
     assert np.allclose(hats.transposed(h, values), np.einsum("bsn,bs->bn", design, values), rtol=1e-13, atol=1e-13)
     assert np.allclose(hats.predicted(h, solution), np.einsum("bsn,bn->bs", design, solution), rtol=1e-13,
                        atol=1e-13)
-    assert np.array_equal(hats.touched(h), np.abs(design).sum(axis=1) > 0)
-    assert not hats.touched(h)[:, -3:].any()                  # nothing reaches past 0.5 cy/px
+    touched = np.abs(design).sum(axis=1) > 0                   # the unknowns (the nodes after the first)
+    assert np.array_equal(hats.last_touched(h), [np.flatnonzero(row).max(initial=-1) + 1 for row in touched])
+    assert hats.last_touched(h).max() < nodes.size - 3          # nothing reaches past 0.5 cy/px
 
 
 def test_the_draws_vertices_are_each_draws_own():

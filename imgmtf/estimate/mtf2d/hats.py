@@ -96,14 +96,26 @@ def gram(h: Hats, weight: np.ndarray) -> np.ndarray:
     >>> bool(np.allclose(gram(h, np.ones(2))[0], dense(h)[0].T @ dense(h)[0]))
     True
     """
-    diagonal, beside = _gram_bands(h, weight)
+    return tridiagonal(*gram_bands(h, weight))
+
+
+def tridiagonal(diagonal: np.ndarray, beside: np.ndarray) -> np.ndarray:
+    """The symmetric matrices (batch, n, n) of bands ``diagonal`` (batch,
+    n) and ``beside`` (batch, n - 1): :func:`gram` of its
+    :func:`gram_bands`, when those are wanted too.
+
+    Examples
+    --------
+    >>> tridiagonal(np.array([[2.0, 3.0]]), np.array([[1.0]])).tolist()
+    [[[2.0, 1.0], [1.0, 3.0]]]
+    """
     batch, nodes = diagonal.shape
     out = np.zeros((batch, nodes, nodes))
     k = np.arange(nodes)
     out[:, k, k] = diagonal
     out[:, k[:-1], k[1:]] = beside
     out[:, k[1:], k[:-1]] = beside
-    return out[:, 1:, 1:]
+    return out
 
 
 def gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -155,17 +167,18 @@ def predicted(h: Hats, solution: np.ndarray) -> np.ndarray:
                                                                                                   axis=1)
 
 
-def touched(h: Hats) -> np.ndarray:
-    """Whether any sample weighs on each unknown node (batch, size - 1),
-    as a dense design's non-zero columns say.
+def last_touched(h: Hats) -> np.ndarray:
+    """The last node any sample weighs on (batch,), counted from the first
+    (0: none beyond it), as a dense design's non-zero columns say: a
+    sample weighs on ``low`` (1 - frac > 0 but at the last node) and on
+    ``low + 1`` where frac > 0.
 
     Examples
     --------
-    >>> touched(hats(np.array([[0.0, 1.0]]), 4)).tolist()
-    [[True, False, False]]
+    >>> last_touched(hats(np.array([[0.0, 1.0], [0.5, 0.0], [0.0, 0.0]]), 4)).tolist()
+    [1, 1, 0]
     """
-    weights = _scatter(h, (1.0 - h.frac != 0).astype(float)) + _scatter(h, (h.frac != 0).astype(float), 1)
-    return weights[:, 1:] > 0
+    return np.max(h.low + (h.frac != 0), axis=1, initial=0)
 
 
 def _scatter(h: Hats, values: np.ndarray, above: int = 0) -> np.ndarray:

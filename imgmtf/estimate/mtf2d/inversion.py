@@ -245,10 +245,11 @@ class EllipticalProblem:
         weighted = hats.dense(h, weight).reshape(count, aspects, *h.low.shape[1:], -1)
         goal = targets * self.weight[:, :, None]
         unknowns = h.size - 1
-        gram = hats.gram(h, weight)
+        bands = hats.gram_bands(h, weight)
+        gram = hats.tridiagonal(*bands)
         # the inverses (by their bands: half the time of dense ones) times the right-hand sides: a third of the
         # time of solving for them, and as exact here (the normal matrices' condition is a few thousand)
-        inverse = solve_pentadiagonal(*self._bands(h, weight),
+        inverse = solve_pentadiagonal(*self._bands(h, weight, bands),
                                       np.broadcast_to(np.eye(unknowns), (weight.shape[0], unknowns, unknowns)))
         projected = np.swapaxes(weighted, 2, 3) @ goal[:, None]                     # b = (W D)^T g
         solution = inverse.reshape(count, aspects, unknowns, unknowns) @ projected
@@ -278,9 +279,8 @@ class EllipticalProblem:
         each = np.swapaxes(targets, 1, 2).reshape(count * draws, -1)
         solution = np.concatenate([np.zeros((count * draws, 1)), self._solved(h, self._each(draws), each)],
                                   axis=1)
-        touched = hats.touched(h)                                                    # draws x (nodes - 1)
-        last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
-        reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
+        # the nodes up to the last the data touch (the first, log 1 = 0, always)
+        reach = np.arange(size)[None, :] <= hats.last_touched(h)[:, None]
         aspects = np.array([math.exp(a) for a in log_aspects.ravel().tolist()])
         return EllipticalModel(nodes.reshape(-1, size), np.where(reach, solution, np.nan), aspects)
 
@@ -309,11 +309,13 @@ class EllipticalProblem:
         time of dense ones)."""
         return solve_pentadiagonal(*self._bands(h, weight), hats.transposed(h, weight * (targets * weight)))
 
-    def _bands(self, h: hats.Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _bands(self, h: hats.Hats, weight: np.ndarray,
+               gram: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The normal matrices of stacked designs (:func:`_solve`'s: the
         Gram matrix, the smoothing and a ridge of 1e-10) by their three
-        bands (the matrix pentadiagonal)."""
-        diagonal, beside = hats.gram_bands(h, weight)
+        bands (the matrix pentadiagonal); ``gram``: the Gram matrix's
+        (:func:`.hats.gram_bands`), when made already."""
+        diagonal, beside = hats.gram_bands(h, weight) if gram is None else gram
         p0, p1, p2 = _penalty_bands(h.size)
         return diagonal + p0 + 1e-10, beside + p1, np.broadcast_to(p2, (diagonal.shape[0], p2.size))
 
