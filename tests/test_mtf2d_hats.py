@@ -19,8 +19,10 @@ def test_the_sparse_designs_algebra_is_the_dense_designs():
     assert np.array_equal(hats.dense(h), design)
     weight, values, solution = rng.uniform(0.5, 2.0, x.shape[1]), rng.normal(size=x.shape), rng.normal(size=(3, 8))
     weighted = design * weight[None, :, None]
+    assert np.array_equal(hats.dense(h, np.broadcast_to(weight, x.shape)), weighted)        # W D at once
     assert np.allclose(hats.gram(h, weight), np.transpose(weighted, (0, 2, 1)) @ weighted, rtol=1e-13, atol=1e-13)
     diagonal, beside = hats.gram_bands(h, weight)
+    assert np.array_equal(hats.tridiagonal(diagonal, beside), hats.gram(h, weight))
     assert np.array_equal(diagonal, np.diagonal(hats.gram(h, weight), axis1=1, axis2=2))
     assert np.array_equal(beside, np.diagonal(hats.gram(h, weight), offset=1, axis1=1, axis2=2))
     assert np.allclose(hats.transposed(h, values), np.einsum("bsn,bs->bn", design, values), rtol=1e-13, atol=1e-13)
