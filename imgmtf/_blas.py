@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import functools
 import sys
+from contextlib import nullcontext
+
+_for_good = False       # this process's BLAS is on one thread for its life (a worker process)
 
 
 def one_blas_thread():
@@ -26,6 +29,8 @@ def one_blas_thread():
     ...     float(np.linalg.det(np.eye(3)))
     1.0
     """
+    if _for_good:
+        return nullcontext()
     return _controller("scipy.linalg" in sys.modules).limit(limits=1, user_api="blas")
 
 
@@ -35,3 +40,12 @@ def _controller(scipy_loaded: bool):
     states that matter: before and after SciPy brings its own BLAS."""
     from threadpoolctl import ThreadpoolController
     return ThreadpoolController()
+
+
+def one_thread_for_good() -> None:
+    """Say that this process's BLAS runs on one thread for the rest of its
+    life (a worker process, :func:`imgmtf.parallel.limit_threads`):
+    :func:`one_blas_thread` then does nothing, rather than look for the
+    libraries (20-30 ms, on each worker's first task) and set them."""
+    global _for_good
+    _for_good = True

@@ -479,24 +479,33 @@ def _init_worker(parent_pid: int, modules: tuple[str, ...] = ()) -> None:
                      name="imgmtf-parent-watchdog").start()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    limit_threads()
+    # a worker whose environment asked for one thread from its start (forked from a fork server started
+    # so, or spawned from such a parent) has its libraries loaded on one thread: threadpoolctl's search
+    # of the loaded libraries (about 10 ms) would find nothing to change
+    limit_threads(loaded_on_one=all(os.environ.get(name) == "1" for name in THREAD_VARIABLES))
     for name in modules:
         importlib.import_module(name)
 
 
-def limit_threads() -> None:
+def limit_threads(loaded_on_one: bool = False) -> None:
     """One thread for every numerical library of this process: the loaded
     ones now (threadpoolctl, OpenCV), those loaded later through the
-    environment they read when they load."""
+    environment they read when they load; for good (the estimators' own
+    :func:`imgmtf._blas.one_blas_thread` then does nothing).
+    ``loaded_on_one``: the loaded libraries read an environment asking for
+    one thread when they loaded (threadpoolctl need not look for them)."""
+    from ._blas import one_thread_for_good
     for name in THREAD_VARIABLES:
         os.environ[name] = "1"
-    try:
-        from threadpoolctl import threadpool_limits
-        threadpool_limits(limits=1)
-    except ImportError:          # an optional speed-up: without it the environment still applies
-        pass
+    if not loaded_on_one:
+        try:
+            from threadpoolctl import threadpool_limits
+            threadpool_limits(limits=1)
+        except ImportError:          # an optional speed-up: without it the environment still applies
+            pass
     if "cv2" in sys.modules:
         sys.modules["cv2"].setNumThreads(1)
+    one_thread_for_good()
 
 
 def _watch_parent(parent_pid: int, first_ppid: int) -> None:

@@ -58,3 +58,18 @@ def test_robust_noise_is_the_mad_of_horizontal_differences_exactly():
     # integer pixels: their differences taken as floats, never wrapped (int16 32000 - -32000 overflows)
     wide = np.clip(np.round(rng.normal(0, 20000, (20, 21))), -32768, 32767)
     assert robust_noise(wide.astype(np.int16)) == robust_noise(wide) > 10000
+
+
+@pytest.mark.parametrize("shape", [(48, 34), (3, 9), (2, 5)])
+def test_a_chip_with_every_pixel_valid_is_weighted_and_bounded_as_its_mask_would_be(shape):
+    # the smoothed mask and the interior kept by shape are what the masked path makes of an all-True mask
+    import cv2
+
+    from imgmtf.estimate import detection
+    valid = np.ones(shape, bool)
+    weight = cv2.GaussianBlur(valid.astype(np.float32), (17, 17), 2.0, borderType=cv2.BORDER_CONSTANT)
+    assert np.array_equal(detection._full_weight(shape, 2.0), weight + np.float32(1e-12))
+    eroded = cv2.erode(valid.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                       borderValue=0).astype(bool)
+    assert np.array_equal(detection._interior(valid), eroded)
+    assert not detection._interior(valid).flags.writeable

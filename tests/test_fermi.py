@@ -75,3 +75,22 @@ def test_edges_fitted_together_are_each_fitted_as_alone_to_the_bit():
         for a, t in zip(alone, together, strict=True):
             for name in ("params", "rms", "ok", "pinned"):
                 assert np.array_equal(getattr(a, name), getattr(t, name), equal_nan=name in ("params", "rms"))
+
+
+def test_a_fit_of_rows_read_for_it_locates_the_edge_as_the_edge_locates_itself():
+    # the rows edge_rows reads carry their image rows through fit_fermi_many, and
+    # locate_edge takes them from the fit (not reading them again): the same line, bit for bit
+    from imgmtf.estimate.geometry import edge_rows, locate_edge
+    rows_n, slope = 30, np.tan(np.radians(6.0))
+    seed_x = 15.0 + slope * np.arange(rows_n)
+    x = np.tile(np.arange(30.0), (rows_n, 1))
+    image = fermi(x, np.column_stack([np.full(rows_n, -800.0), seed_x + 0.3, np.full(rows_n, 0.8),
+                                      np.full(rows_n, 900.0)]))
+    image += np.random.default_rng(2).normal(0, 2.0, image.shape)
+    image[4, :] = np.nan                                  # a row left out: the rows are not all the image's
+    usable, rows = edge_rows(image, seed_x)
+    (fit,) = fit_fermi_many([rows])
+    assert np.array_equal(fit.rows, usable) and not usable.all()
+    alone, fitted = locate_edge(image, seed_x), locate_edge(image, seed_x, fit=fit)
+    assert (alone.slope, alone.intercept) == (fitted.slope, fitted.intercept)
+    assert np.array_equal(alone.rows, fitted.rows) and np.array_equal(alone.kept, fitted.kept)

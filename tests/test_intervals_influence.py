@@ -87,3 +87,32 @@ def test_one_pass_through_the_resampling_serves_the_figures_and_a_read_width_ali
                                                     estimate.shape_profile.span))
     shared, separate = intervals(estimate), intervals(apart)
     assert shared == separate and shared.mtf_nyquist.width > 0
+
+
+@pytest.mark.parametrize("target", ["edge", "bar"])
+def test_the_figures_gradients_combined_on_the_grid_are_those_of_the_frequencies(target):
+    """Each figure's gradient, |F(f)| / |F(0)| scaled to the MTF, taken as a
+    real combination of the transform's rows before the passes backwards,
+    is the one made of every frequency's complex gradient dF(f) / dv
+    (each frequency's real and imaginary rows through the adjoints)."""
+    from imgmtf.estimate.edge import EdgeKind
+    from imgmtf.estimate.intervals.influence import _figure_combination, _sample_gradients, _transform_kernel
+    from imgmtf.estimate.pipeline import run
+    from imgmtf.estimate.pulse import PulseKind
+    from imgmtf.estimate.settings import make_settings
+    shape = im.Target("edge", 6.0) if target == "edge" else im.Target("pulse", 6.0, width_px=1.5)
+    chip = im.render(im.Sensor(), shape, 60, noise_std_dn=2.0, seed=4)
+    kind = EdgeKind() if target == "edge" else PulseKind(1.5)
+    estimate = run(kind, chip.image, make_settings(intervals="none")).estimate
+    freqs = np.array([0.0, 0.5, estimate.spectrum.mtf50_cy_px])
+    kernel = _transform_kernel(estimate.lsf.x_px, freqs)
+    transform, mtf_at = kernel @ estimate.lsf.combined, estimate.spectrum.mtf(freqs[1:])
+    figures, _ = _sample_gradients(estimate, kernel, _figure_combination(transform, mtf_at), None)
+    rows, _ = _sample_gradients(estimate, kernel, np.eye(2 * freqs.size - 1), None)
+    n_f, f0 = freqs.size, transform[0].real
+    for j in (1, 2):
+        fj, gradient = transform[j], rows[j] + 1j * rows[n_f - 1 + j]
+        ratio = abs(fj) / abs(f0)
+        expected = np.real(np.conj(fj) * gradient) / (abs(fj) * abs(f0)) - ratio * rows[0] / f0
+        expected *= mtf_at[j - 1] / ratio
+        np.testing.assert_allclose(figures[j - 1], expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())

@@ -149,3 +149,24 @@ def test_asking_a_textured_chip_for_points_loads_no_optimizer():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["None", "False"]
+
+
+def test_the_cheap_look_for_points_never_misses_a_used_one():
+    # points_seen skips find_sources' judging where no peak passes its cheap checks (faint, off the
+    # chip, blended): then none may be used, on textured edges and on chips of a few points alike
+    from imgmtf.estimate.mtf2d.sources import _may_hold_points, find_sources, pixel_gaussian, points_seen
+    rng = np.random.default_rng(3)
+    n = np.arange(-3, 4.0)
+    chips = [im.render(SENSOR, im.Target("edge", 6.0, 200.0, 1200.0), 40, noise_std_dn=2.0, seed=k).image
+             + rng.normal(0, 40, (40, 40)) for k in range(4)]
+    for _ in range(12):
+        chip = rng.normal(100.0, 2.0, (36, 44))
+        for _ in range(rng.integers(0, 4)):
+            y, x = rng.integers(0, 30), rng.integers(0, 38)
+            chip[y:y + 7, x:x + 7] += pixel_gaussian((rng.uniform(30, 900), 0.2, -0.3, 0.7, 0.6, 0.0), n)
+        chips.append(chip)
+    may = [_may_hold_points(chip, 10.0, 4) for chip in chips]
+    used = [bool(find_sources(chip, min_snr=10.0).used) for chip in chips]
+    assert all(m for m, u in zip(may, used) if u)
+    assert any(used) and not all(may)           # both kinds of chip are here
+    assert all(points_seen(chip) is None for chip, u in zip(chips, used) if not u)

@@ -258,9 +258,9 @@ def test_a_candidate_that_breaks_the_estimator_is_rejected_as_internal(monkeypat
         calls.append(args)
         if len(calls) == 1:
             raise ZeroDivisionError("float division by zero")
-        return real(*args, **keywords)
-    real = pipeline.transform
-    monkeypatch.setattr(pipeline, "transform", breaks_once)
+        return (yield from real(*args, **keywords))
+    real = pipeline.transform_steps
+    monkeypatch.setattr(pipeline, "transform_steps", breaks_once)
     records = scan_scene(str(SCENE), ScanSettings(intervals=im.Intervals("none")))
     internal = [r for r in records if r.reason == "internal"]
     assert len(internal) == 1 and "ZeroDivisionError: float division by zero" in internal[0].error

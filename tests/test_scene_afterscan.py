@@ -41,12 +41,13 @@ def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_tar
     kinds = []
 
     def in_turn(function, items, workers, **options):     # the pool's tasks, run here in turn
-        kinds.extend((workers, kind) for kind, _ in items)
+        kinds.extend((workers, kind, item[1].get("target_id") if kind == "fit" else None) for kind, item in items)
         return map(function, items)
     monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
-    # on workers: the measurements travel without their MTF function, the fits the same
+    # on workers: the measurements travel without their MTF function, the fits the same; the targets'
+    # fits are sent the last-ranked (the noisiest, the longest to fit) first
     there = sections_and_fits(records, summaries, "auto", workers=2)
-    assert kinds == [(2, "fit"), (2, "sections"), (2, "fit"), (2, "fit")]
+    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fit", 2), (2, "fit", 1)]
     assert (rows(there[0]), rows(there[1])) == (rows(sections), rows(fits))
     assert sections_and_fits(records, summaries, None, workers=2)[1] == []
     with pytest.raises(ParameterError, match="workers"):

@@ -3,10 +3,13 @@ import numpy as np
 
 
 def test_detection_on_workers_finds_the_segments_one_process_finds(tmp_path):
-    """Tiles searched on two workers give the same segments, in the same
-    order, as in this process: the tiles' pieces are joined in tile order."""
+    """Tiles searched on two workers (the first of them here while the
+    workers start) give the same segments, in the same order, as in this
+    process: the tiles' pieces are joined in tile order."""
     import imgmtf as im
     from imgmtf.io import raster_info
+    from imgmtf.parallel import prestart_workers
+    from imgmtf.preloads import SCAN_TASK_MODULES
     from imgmtf.scene.detect import detect_segments, tile_windows
     from imgmtf.scene.settings import ScanSettings
     from imgmtf.sensor.scenes import QuadrantTarget, render_quadrants, texture
@@ -17,6 +20,7 @@ def test_detection_on_workers_finds_the_segments_one_process_finds(tmp_path):
     settings = ScanSettings(tile_px=256)
     assert len(tile_windows(raster_info(str(path)), settings.tile_px)) == 9
     here = detect_segments(str(path), settings)
+    prestart_workers(2, SCAN_TASK_MODULES)      # as a scan does: its workers then start beside the first tiles
     there = detect_segments(str(path), settings, workers=2)
     assert len(here[0]) > 4
     np.testing.assert_array_equal(here[0], there[0])

@@ -110,3 +110,36 @@ def test_noise_limited_frequency_closed_form():
     # masked frequencies (NaN) are skipped, not taken for noise
     masked = noise_limited_frequency(lambda f: np.where((f > 0.5) & (f < 0.7), np.nan, mtf(f)), edge_noise)
     assert masked == got
+
+
+def test_many_spectra_are_each_the_same_to_the_bit_as_alone():
+    """Profiles of one step and length share an FFT (in blocks of a few
+    rows); each row is the profile's transform alone."""
+    from imgmtf.estimate.spectrum import _rows_at_once, spectrum, spectrum_many
+    rng = np.random.default_rng(6)
+    requests = [(rng.normal(size=rng.integers(50, 400)), 0.05) for _ in range(_rows_at_once(20000) + 3)]
+    requests += [(rng.normal(size=300), 0.1), (rng.normal(size=600), 2.0)]     # a coarser step; longer than padded
+    together = spectrum_many(requests)
+    for (profile, step), (f, modulus) in zip(requests, together):
+        alone_f, alone_modulus = spectrum(profile, step)
+        np.testing.assert_array_equal(f, alone_f)
+        np.testing.assert_array_equal(modulus, alone_modulus)
+
+
+def test_many_restorations_are_each_the_same_to_the_bit_as_alone():
+    """LSFs restored together (their transforms as rows of one FFT per
+    length) are each the one restored alone; a profile that cannot be
+    restored gets its exception in its place."""
+    from imgmtf.estimate.spectrum import RestoreRequest, restore_lsf_many
+    rng = np.random.default_rng(7)
+    x = np.arange(-150, 151) * 0.05
+    requests = [RestoreRequest(np.exp(-(x / (0.4 + 0.1 * k)) ** 2) * (np.abs(x) < 3 + k % 3), x,
+                               lambda f: np.sinc(0.1 * f), 0.8 + 0.3 * k) for k in range(20)]
+    requests.append(RestoreRequest(np.zeros(x.size), x, lambda f: np.ones_like(f)))
+    requests.append(RestoreRequest(rng.normal(size=x.size), x, lambda f: np.sinc(f), out_step=0.02))
+    together = restore_lsf_many(requests)
+    assert isinstance(together[-2], IndexError)
+    for request, (x_out, lsf) in zip(requests[:-2] + requests[-1:], together[:-2] + together[-1:]):
+        (x_alone, lsf_alone), = restore_lsf_many([request])
+        np.testing.assert_array_equal(x_out, x_alone)
+        np.testing.assert_array_equal(lsf, lsf_alone)

@@ -26,10 +26,18 @@ def _shifted_powers(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndar
     grid weights, the bootstrap's weightings), whose shifted copies leave
     the cache, and moments whose copies would fill more than
     ``SHIFTED_ELEMENTS``, are correlated power by power instead."""
+    if moments.ndim > 2 or moments.size * offsets.size > SHIFTED_ELEMENTS:
+        return _shifted_powers_by_power(moments, offsets, binomials)
+    return _shifted_powers_folded(moments, offsets, binomials)
+
+
+def _shifted_powers_folded(moments: np.ndarray, offsets: np.ndarray, binomials: np.ndarray) -> np.ndarray:
+    """:func:`_shifted_powers` by one product of the folded kernel with the
+    moments shifted by every tap (a stack of moments, each its own
+    product: for the few rows of an adjoint, whose shifted copies stay
+    small)."""
     n, size = moments.shape[-2], moments.shape[-1]
     taps = offsets.size
-    if moments.ndim > 2 or moments.size * taps > SHIFTED_ELEMENTS:
-        return _shifted_powers_by_power(moments, offsets, binomials)
     kernel = _folded_kernel(binomials.tobytes(), n, offsets.tobytes())
     half = taps // 2
     padded = np.zeros((*moments.shape[:-1], size + 2 * half))

@@ -35,12 +35,18 @@ block-boundaries  the block compression check of a chip's row locations
 line-checks   the checks of a target's line through its rows
               (:func:`.gate.line_checks_many`; payload: the chip's
               arguments of :func:`.gate.line_checks`).
+restore-lsf   the LSF restored from a windowed profile
+              (:func:`.spectrum.restore_lsf_many`; payload: a
+              :class:`.spectrum.RestoreRequest`).
 saturation    the saturation checks of a chip's sides and peak
               (:func:`.saturation.saturation_checks_many`; payload: the
               chip's keywords of :func:`.saturation.saturation_checks`).
 settled-sides the settling check of a chip's sides
               (:func:`.settling.settled_sides_many`; payload: the chip's
               :class:`.evidence.Evidence`).
+spectrum      the windowed profile's zero-padded transform
+              (:func:`.spectrum.spectrum_many`; payload: the profile's
+              support and its step, px).
 side-checks   the uniformity checks of a chip's sides
               (:func:`.sides.side_checks_many`; payload: the chip's
               arguments of :func:`.sides.side_checks`).
@@ -57,6 +63,7 @@ from .gate import line_checks_many
 from .saturation import saturation_checks_many
 from .settling import settled_sides_many
 from .sides import side_checks_many
+from .spectrum import restore_lsf_many, spectrum_many
 from .stacked_resampling import resample_many
 
 T = TypeVar("T")
@@ -83,10 +90,12 @@ ANSWERS: dict[str, Callable[[list], list]] = {
     "blur-widths": group_widths_many,
     "block-boundaries": block_boundaries_many,
     "resample": resample_many,
+    "restore-lsf": restore_lsf_many,
     "line-checks": line_checks_many,
     "saturation": saturation_checks_many,
     "settled-sides": settled_sides_many,
     "side-checks": side_checks_many,
+    "spectrum": spectrum_many,
 }
 
 Steps = Generator[Ask, Any, T]

@@ -13,6 +13,7 @@ is also the tilt of the line from the column axis.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -112,18 +113,43 @@ def _gradients(image: np.ndarray, valid: np.ndarray, sigma: float) -> tuple[np.n
 
     def blur(values):
         return cv2.GaussianBlur(values, size, sigma, borderType=cv2.BORDER_CONSTANT)
-    smoothed = blur(image.astype(np.float32)) / (blur(valid.astype(np.float32)) + np.float32(1e-12))
+    weight = _full_weight(valid.shape, sigma) if valid.all() else blur(valid.astype(np.float32)) + np.float32(1e-12)
+    smoothed = blur(image.astype(np.float32)) / weight
     dx = cv2.Sobel(smoothed, cv2.CV_32F, 1, 0, ksize=3, borderType=cv2.BORDER_REFLECT)
     dy = cv2.Sobel(smoothed, cv2.CV_32F, 0, 1, ksize=3, borderType=cv2.BORDER_REFLECT)
     return dx, dy
+
+
+@functools.lru_cache(maxsize=64)
+def _full_weight(shape: tuple[int, int], sigma: float) -> np.ndarray:
+    """:func:`_gradients`' smoothed mask where every pixel is valid (plus
+    its 1e-12): the same for every chip of a shape (a scan's many chips
+    are of a few; read only)."""
+    radius = int(GAUSSIAN_TRUNCATE * sigma + 0.5)
+    weight = cv2.GaussianBlur(np.ones(shape, np.float32), (2 * radius + 1, 2 * radius + 1), sigma,
+                              borderType=cv2.BORDER_CONSTANT) + np.float32(1e-12)
+    weight.flags.writeable = False
+    return weight
 
 
 def _interior(valid: np.ndarray) -> np.ndarray:
     """The pixels whose 3 x 3 neighbourhood lies wholly in ``valid`` and in
     the image: only they may be edges (their gradients see no left-out
     pixel)."""
+    if valid.all():
+        return _full_interior(valid.shape)
     return cv2.erode(valid.astype(np.uint8), np.ones((3, 3), np.uint8),
                      borderType=cv2.BORDER_CONSTANT, borderValue=0).astype(bool)
+
+
+@functools.lru_cache(maxsize=64)
+def _full_interior(shape: tuple[int, int]) -> np.ndarray:
+    """:func:`_interior` where every pixel is valid: all but the border
+    (read only)."""
+    inside = np.zeros(shape, bool)
+    inside[1:-1, 1:-1] = True
+    inside.flags.writeable = False
+    return inside
 
 
 def _canny(dx: np.ndarray, dy: np.ndarray, low: float, high: float, inside: np.ndarray) -> np.ndarray:
@@ -164,9 +190,10 @@ def _strongest_lines(edges, max_lines, min_distance_px=5, min_angle_deg=8.0, on_
                                        math.radians(_THETA_STEP_DEG))
         if found is None:
             break
-        # (OpenCV returns single-precision angles: put them back on the grid)
-        candidates = [Line(_THETA_STEP_DEG * round(math.degrees(theta) / _THETA_STEP_DEG), float(rho), int(votes))
-                      for votes, rho, theta in found.reshape(-1, 3)]
+        # (OpenCV returns single-precision angles: put them back on the grid; made
+        # one by one up to the first one kept, usually the first)
+        candidates = (Line(_THETA_STEP_DEG * round(math.degrees(theta) / _THETA_STEP_DEG), float(rho), int(votes))
+                      for votes, rho, theta in found.reshape(-1, 3).tolist())
         line = next((c for c in candidates if not any(_near(c, taken, min_distance_px, min_angle_deg)
                                                       for taken in lines)), None)
         if line is None:
@@ -270,7 +297,7 @@ def line_distance(shape: tuple[int, int], line: Line) -> np.ndarray:
     """Signed distance (px) of every pixel centre of an image of ``shape``
     from ``line``."""
     t = math.radians(line.theta_deg)
-    y, x = np.indices(shape)
+    y, x = np.arange(shape[0])[:, None], np.arange(shape[1])[None, :]
     return x * math.cos(t) + y * math.sin(t) - line.rho_px
 
 

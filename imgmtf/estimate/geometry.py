@@ -79,9 +79,12 @@ def locate_edge(image: np.ndarray, seed_x: np.ndarray, half_window: int = EDGE_F
     other chips' by :func:`.fermi.fit_fermi_many`).
     """
     rows = np.arange(image.shape[0])
-    usable, fitted = edge_rows(image, seed_x, half_window)
-    if fit is None:
-        fit = fit_fermi(fitted.x, fitted.y, fitted.weight, fitted.b0)
+    if fit is not None and fit.rows is not None:
+        usable = fit.rows           # the rows were read for the fit already
+    else:
+        usable, fitted = edge_rows(image, seed_x, half_window)
+        if fit is None:
+            fit = fit_fermi(fitted.x, fitted.y, fitted.weight, fitted.b0)
     # a Fermi step a with width c under noise s locates its edge to about
     # s sqrt(30 c) / |a| (the location's Cramer-Rao bound on a 1-px grid)
     a, c = np.abs(fit.params[fit.ok, 0]), np.abs(fit.params[fit.ok, 2])
@@ -105,7 +108,8 @@ def edge_rows(image: np.ndarray, seed_x: np.ndarray,
     usable = inside.sum(axis=1) >= half_window + 4
     if usable.sum() < 5:
         raise TargetNotFoundError("the edge does not cross enough rows of the image")
-    return usable, FermiRows(cols[usable].astype(float), values[usable], inside[usable].astype(float), seed_x[usable])
+    return usable, FermiRows(cols[usable].astype(float), values[usable], inside[usable].astype(float), seed_x[usable],
+                             usable)
 
 
 def fit_line(y: np.ndarray, x: np.ndarray, transposed: bool = False,

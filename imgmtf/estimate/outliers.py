@@ -40,10 +40,24 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
     finite = np.isfinite(data)
     if finite.sum() < 9:
         return np.zeros(data.shape, bool)
+    # the noise's margin alone first: a pixel not beyond it is beyond no larger
+    # one, and on most chips none is (the contrast's percentiles then spared)
+    extremes = _extremes(data, finite)
+    if OUTLIER_NOISE * noise > 0 and not _beyond(data, finite, extremes, OUTLIER_NOISE * noise).any():
+        return np.zeros(data.shape, bool)
     low, high = percentile(data[finite], [1.0, 99.0])
     margin = max(OUTLIER_NOISE * noise, OUTLIER_CONTRAST * (high - low))
     if not margin > 0:
         return np.zeros(data.shape, bool)
+    outlier = _beyond(data, finite, extremes, margin)
+    # isolated: no outlying neighbour (a cluster is a feature, the gate's to judge)
+    clustered = cv2.dilate(outlier.view(np.uint8), _ring(1), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    return outlier & ~clustered.astype(bool)
+
+
+def _extremes(data: np.ndarray, finite: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The largest and the smallest of the other pixels of each pixel's
+    5 x 5 block (-inf and inf where none), and the block's range."""
     block = _ring(2)
     # the largest and smallest of the other pixels of each block (grey
     # dilation and erosion; beyond the border and at NaN, nothing)
@@ -55,12 +69,18 @@ def isolated_outliers(data: np.ndarray, noise: float) -> np.ndarray:
     # its block by less than the bar's height (the block holds pixels along
     # the bar), a hot pixel on a level stands far out of its block's noise
     spread = np.where(np.isfinite(above - below), above - below, 0.0)
+    return above, below, spread
+
+
+def _beyond(data: np.ndarray, finite: np.ndarray, extremes: tuple[np.ndarray, np.ndarray, np.ndarray],
+            margin: float) -> np.ndarray:
+    """The pixels of ``data`` above all the other pixels of their block, or
+    below all of them (``extremes``), by more than ``margin`` (DN) and the
+    block's own range."""
+    above, below, spread = extremes
     with np.errstate(invalid="ignore"):
         beyond = np.maximum(margin, spread)
-        outlier = finite & ((data > above + beyond) | (data < below - beyond))
-    # isolated: no outlying neighbour (a cluster is a feature, the gate's to judge)
-    clustered = cv2.dilate(outlier.view(np.uint8), _ring(1), borderType=cv2.BORDER_CONSTANT, borderValue=0)
-    return outlier & ~clustered.astype(bool)
+        return finite & ((data > above + beyond) | (data < below - beyond))
 
 
 def _ring(reach: int) -> np.ndarray:

@@ -24,7 +24,7 @@ supplies only what differs:
 8. :func:`.window.blend_tails` -> ``TailedLSF``: the kind's LSF-like profile (an
    ESF's central difference, a pulse response above its background) kept as
    measured in the window, each side's tail model (a / x^2) beyond it;
-9. :func:`.transform.transform` -> ``Spectrum``: the transform divided by the transfer
+9. :func:`.transform.transform_steps` -> ``Spectrum``: the transform divided by the transfer
    between the system's LSF and that profile (the kind's and the resampling
    method's); its figures;
 10. :func:`.judge.judge` -> checks, warnings: the quality gate (:mod:`.gate`) and the
@@ -57,7 +57,7 @@ from .settings import Settings
 from .sharpening import mtf_peak
 from .spectrum import mtf_area
 from .state import Chip, Located, Noise, Profile, Samples
-from .transform import transform
+from .transform import transform_steps
 from .window import blend_tails, choose_window, measure_noise
 
 
@@ -224,7 +224,7 @@ def run_steps(kind: TargetKind, image: ArrayLike, settings: Settings, *, prefit:
         window = choose_window(kind, samples, shape, noise, settings, chip.quantum_dn)
         profile = yield from widen_profile_steps(read, samples, shape, window, settings, kind.name)
         lsf = blend_tails(kind, samples, profile, shape, window)
-        spectrum = transform(kind, samples, profile, shape, noise, window, lsf, settings)
+        spectrum = yield from transform_steps(kind, samples, profile, shape, noise, window, lsf, settings)
         checks, warnings = yield from judge_steps(kind, chip, located, samples, shape, noise, window, spectrum,
                                                   settings)
     except ImgmtfError as exc:

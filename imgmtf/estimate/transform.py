@@ -10,15 +10,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..metrics import fwhm
+from .asks import Ask, Steps, alone
 from .kind import Shape, TargetKind
 from .settings import Settings
 from .spectrum import (
     MIN_TRANSFER,
     NYQUIST,
-    corrected_mtf,
+    RestoreRequest,
     mtf50,
     noise_limited_frequency,
-    restore_lsf,
+    supported,
+    tabulated_mtf,
     white_noise_mtf_sd,
 )
 from .state import Noise, Profile, Samples, Spectrum, TailedLSF, Window
@@ -70,14 +72,25 @@ def transform(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape
     >>> spectrum.mtf_nyquist == e.spectrum.mtf_nyquist
     True
     """
+    return alone(transform_steps(kind, samples, profile, shape, noise, window, lsf, settings))
+
+
+def transform_steps(kind: TargetKind, samples: Samples, profile: Profile, shape: Shape, noise: Noise,
+                    window: Window, lsf: TailedLSF, settings: Settings) -> Steps[Spectrum]:
+    """:func:`transform` as a generator of asks (:mod:`.asks`): the
+    profile's zero-padded FFT (``spectrum``) and the LSF's restoration
+    (``restore-lsf``) are made among other chips' (:func:`.spectrum.spectrum_many`,
+    :func:`.spectrum.restore_lsf_many`)."""
     divisor = kind.divisor(lsf.step_px, profile.resampled.transfer if settings.correct else None, shape)
-    mtf = corrected_mtf(lsf.combined, lsf.step_px, divisor)
+    freqs, modulus = yield Ask("spectrum", (supported(lsf.combined), lsf.step_px))
+    mtf = tabulated_mtf(freqs, modulus, divisor)
     density = samples.distance_px.size / (2.0 * samples.half_range_px)
     white = white_noise_mtf_sd(noise.snr, 2.0 * window.core_px + window.taper_px, density,
                                kind.noise_gain(shape, noise.contrast_dn))
     noise_sd = functools.partial(_corrected_noise_sd, white=white, divisor=divisor)
     noise_limit = noise_limited_frequency(mtf, noise_sd)
-    lsf_x, restored = restore_lsf(lsf.combined, lsf.x_px, divisor, noise_limit, min_divisor=kind.restore_min_divisor)
+    lsf_x, restored = yield Ask("restore-lsf", RestoreRequest(lsf.combined, lsf.x_px, divisor, noise_limit,
+                                                             min_divisor=kind.restore_min_divisor))
     return Spectrum(divisor, mtf, noise_sd, noise_limit, lsf_x, restored, float(mtf(np.array([NYQUIST]))[0]),
                     mtf50(mtf), fwhm(lsf_x, restored))
 

@@ -77,16 +77,22 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
     fits, scenes = fit_tasks(records, stages, workers=chosen, scheduler=scheduler) if stages else ([], 0)
     here = chosen == 1 and scheduler is None
     # the scene's fit first (the longest), then the sections (short tasks; here, all at once), then the
-    # targets' fits
-    tasks = [(FIT, t) for t in fits[:scenes]] + \
-        [(SECTIONS, t) for t in ([groups] if here else section_tasks(groups)) if t] + [(FIT, t) for t in fits[scenes:]]
+    # targets' fits, the last-numbered first: targets are numbered by their best rank (the narrowest
+    # interval, then the highest SNR), and the last are the noisiest, often misfit, whose fits try more
+    # stages (0.4-1.6 s against 0.02 s on the 4096 px bench scene): started last, one of them ran alone
+    order = [*range(scenes), *range(len(fits) - 1, scenes - 1, -1)]
+    tasks = [(FIT, fits[k]) for k in order[:scenes]] + \
+        [(SECTIONS, t) for t in ([groups] if here else section_tasks(groups)) if t] + \
+        [(FIT, fits[k]) for k in order[scenes:]]
     if here:
         results = [_stage_task(task) for task in tasks]
     else:
         results = list(run_tasks(_stage_task, tasks, workers=chosen, scheduler=scheduler, progress=progress,
                                  description="sections and fits"))
     sections = [row for (kind, _), rows in zip(tasks, results) if kind == SECTIONS for row in rows]
-    fitted = [rows for (kind, _), rows in zip(tasks, results) if kind == FIT]
+    fitted: list[list[Record]] = [[] for _ in fits]
+    for k, rows in zip(order, (rows for (kind, _), rows in zip(tasks, results) if kind == FIT)):
+        fitted[k] = rows
     return sections, fitted_rows(fitted, scenes)
 
 

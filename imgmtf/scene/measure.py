@@ -32,7 +32,7 @@ from ..estimate.geometry import direction_label
 from ..inputs import MIN_SIZE_PX
 from ..io import RasterInfo, raster_info
 from ..kinds import get_kind
-from ..parallel import auto_workers, prestart_workers, run_tasks
+from ..parallel import auto_workers, preloaded, prestart_workers, run_tasks
 from ..preloads import SCAN_TASK_MODULES
 from ..records import CANDIDATE_SCOPE, Record, utc_now
 from .candidates import Context, Plan, measure_batch
@@ -143,8 +143,10 @@ def scan_scene(path: str, settings: ScanSettings | None = None, *, workers: int 
                                 f"at least {MIN_SIZE_PX} x {MIN_SIZE_PX}, so no target can be measured in it")
     detecting = (auto_workers(len(tile_windows(info, settings.tile_px)), AUTO_TILES_PER_WORKER) if workers is None
                  else workers)
-    if scheduler is None and detecting > 1:
-        prestart_workers(detecting, SCAN_TASK_MODULES)    # once, not by each of the two pools' workers
+    if scheduler is None and detecting > 1 and not preloaded(SCAN_TASK_MODULES):
+        # once, not by each of the two pools' workers; a fork server running them already (the
+        # command's) is left to import them while detection searches its first tiles here
+        prestart_workers(detecting, SCAN_TASK_MODULES)
     from .segments import (
         BAR_MAX_SEPARATION_PX,
         SampledSegments,

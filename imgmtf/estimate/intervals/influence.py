@@ -119,33 +119,23 @@ def influence_intervals(estimate: Estimate, *, confidence: float = 0.95) -> Figu
     freqs = np.array([0.0, NYQUIST] + ([f50] if math.isfinite(f50) else []))
     read = estimate.shape_profile.resampled
     reading = estimate.width if estimate.width is not None and read.adjoint is not None else None
-    transform, gradient, spectrum_pull = _transform_gradients(estimate, freqs, reading)
+    kernel = _transform_kernel(estimate.lsf.x_px, freqs)
+    transform = kernel @ estimate.lsf.combined
+    mtf_at = estimate.spectrum.mtf(freqs[1:])
+    grads, spectrum_pull = _sample_gradients(estimate, kernel, _figure_combination(transform, mtf_at), reading)
     residual = _residuals(estimate)
     rows = estimate.samples.rows
-    width_pull = None
+    fixed_width = None
     if reading is not None and spectrum_pull is not None:
-        width_pull = _width_pull(reading, spectrum_pull, residual, rows, confidence)
-    # each figure is |F(f)| / |F(0)| divided by the corrections: its gradient scaled alike
-    mtf, f0 = spectrum.mtf, transform[0].real
-    grads, fixed_width = [], None
-    for j in range(1, freqs.size):
-        fj, f = transform[j], freqs[j]
-        ratio = abs(fj) / abs(f0)
-        mtf_at = float(mtf(np.array([f]))[0])
-        scale = mtf_at / ratio if ratio else 0.0
-        grad = (np.real(np.conj(fj) * gradient[j]) / (abs(fj) * abs(f0)) - ratio * gradient[0].real / f0) * scale
-        if width_pull is not None:
-            width_change, log_slope = width_pull
-            if j == 1:
-                fixed_width = grad
-            # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
-            grad = grad - mtf_at * float(log_slope(f)) * width_change
-        grads.append(grad)
-    if fixed_width is not None:
-        grads.append(fixed_width)
-    sds, n_rows = influence_sds(np.stack(grads) * residual, rows)
+        width_change, log_slope = _width_pull(reading, spectrum_pull, residual, rows, confidence)
+        fixed_width = grads[0].copy()
+        # MTF = |F| / |F0| / |divisor(f; W)|: W's pull moves it by -MTF d ln|divisor| / dW
+        for j in range(freqs.size - 1):
+            grads[j] -= mtf_at[j] * float(log_slope(freqs[j + 1])) * width_change
+        grads = np.concatenate([grads, fixed_width[None, :]])
+    sds, n_rows = influence_sds(grads * residual, rows)
     width_share = None
-    if width_pull is not None:
+    if fixed_width is not None:
         fixed_sd, sds = sds[-1], sds[:-1]
         width_share = 1.0 - (fixed_sd / sds[0]) ** 2 if sds[0] > 0 else 0.0
     window, lsf = estimate.window, estimate.lsf
@@ -156,7 +146,7 @@ def influence_intervals(estimate: Estimate, *, confidence: float = 0.95) -> Figu
     fifty = Interval.none()
     if freqs.size > 2:
         h = 1e-3
-        slope = float(mtf(np.array([f50 + h]))[0] - mtf(np.array([f50 - h]))[0]) / (2 * h)
+        slope = float(spectrum.mtf(np.array([f50 + h]))[0] - spectrum.mtf(np.array([f50 - h]))[0]) / (2 * h)
         sd50 = float(sds[1]) / abs(slope) if slope else math.inf
         systematic = f50 * (SYSTEMATIC_MTF50 + TAIL_MODEL_UNCERTAINTY * abs(tail_share)
                             + (SYSTEMATIC_DEQUANTISED_MTF50 if dequantised else 0.0)
@@ -170,23 +160,59 @@ def influence_intervals(estimate: Estimate, *, confidence: float = 0.95) -> Figu
     return FigureIntervals(nyquist, fifty, warnings)
 
 
-def _transform_gradients(estimate: Estimate, freqs: np.ndarray,
-                         reading: WidthReading | None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """The transform F(f) of the windowed profile at ``freqs`` (the first
-    0), its gradient dF(f) / dv over the samples, and where a width was
-    read, dR(f) / dv of its spectrum (:meth:`WidthReading.sample_pull`).
-    One pass backwards through the resampling serves all of them where the
-    width was read off the same resampling; F(0)'s imaginary part, nil,
-    takes none."""
+def _transform_kernel(x: np.ndarray, freqs: np.ndarray) -> np.ndarray:
+    """The transform's row at each of ``freqs`` (cy/px) over the profile's
+    uniform positions ``x`` (px): F(f) = kernel @ profile."""
+    return np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * float(x[1] - x[0])
+
+
+def _stacked(z: np.ndarray) -> np.ndarray:
+    """Complex rows, one per frequency (the first 0, whose imaginary part
+    is nil), as real ones: every real part, then the imaginary parts of
+    the frequencies after the first."""
+    return np.concatenate([z.real, z.imag[1:]])
+
+
+def _figure_combination(transform: np.ndarray, mtf_at: np.ndarray) -> np.ndarray:
+    """The (figures, 2 n_f - 1) real map from the transform's stacked
+    gradients (:func:`_stacked`; the transform F at n_f frequencies, the
+    first 0) to the figures' gradients: a figure, |F(f)| / |F(0)| divided
+    by the corrections (``mtf_at`` its value at each frequency after the
+    first), changes by (Re(conj F dF) / (|F| |F0|) - |F| / |F0| dF0 / F0)
+    times its ratio to |F| / |F0|."""
+    n_f = transform.size
+    f0 = transform[0].real
+    combination = np.zeros((n_f - 1, 2 * n_f - 1))
+    for j in range(1, n_f):
+        fj = transform[j]
+        ratio = abs(fj) / abs(f0)
+        scale = mtf_at[j - 1] / ratio if ratio else 0.0
+        norm = abs(fj) * abs(f0)
+        combination[j - 1, j] = fj.real / norm * scale
+        combination[j - 1, n_f - 1 + j] = fj.imag / norm * scale
+        combination[j - 1, 0] = -ratio / f0 * scale
+    return combination
+
+
+def _sample_gradients(estimate: Estimate, kernel: np.ndarray, combination: np.ndarray,
+                      reading: WidthReading | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The gradients over the samples of the real combinations
+    ``combination`` (rows; :func:`_figure_combination`, or the identity
+    for every frequency's) of the transform's stacked rows ``kernel``
+    (:func:`_transform_kernel`), and where a width was read, dR(f) / dv of
+    its spectrum (:meth:`WidthReading.sample_pull`).
+
+    The transform is linear in the samples, so the combinations are taken
+    of the kernel's rows on the profile's grid, and one pass backwards
+    through the resampling carries one row per combination, not two per
+    frequency; the width's rows share it where the width was read off the
+    same resampling."""
     lsf, profile = estimate.lsf, estimate.profile
     resampled, span = profile.resampled, profile.span
     x, window, tail_shape = lsf.x_px, lsf.weights, lsf.tail_shape
-    step = float(x[1] - x[0])
-    kernel = np.exp(-2j * np.pi * freqs[:, None] * x[None, :]) * step                 # (n_f, n_x)
-    transform = kernel @ lsf.combined
-    weighted = (kernel * window)[:, lsf.measured_at]
-    on_grid = lsf.adjoint(np.concatenate([weighted.real, weighted.imag[1:]]))
-    full = np.zeros((on_grid.shape[0], resampled.grid.size))
+    n_out = combination.shape[0]
+    on_grid = lsf.adjoint(combination @ _stacked((kernel * window)[:, lsf.measured_at]))
+    full = np.zeros((n_out, resampled.grid.size))
     full[:, span[0]: span[1]] = on_grid
     if resampled.adjoint is None:
         raise ParameterError("linearised intervals need the resampling's adjoint, which a stack of weightings "
@@ -196,25 +222,28 @@ def _transform_gradients(estimate: Estimate, freqs: np.ndarray,
     if reading is not None and shared:
         full = np.concatenate([full, reading.grid_weights(resampled.grid.size, read.span)])
     through = resampled.adjoint(full)
-    n_f = freqs.size
-    gradient = through[:n_f].astype(complex)
-    gradient[1:] += 1j * through[n_f: 2 * n_f - 1]
+    gradient = through[:n_out]
     spectrum_pull = None
     if reading is not None and shared:
-        spectrum_pull = reading.background_pull(through[2 * n_f - 1:])
+        spectrum_pull = reading.background_pull(through[n_out:])
     elif reading is not None and read.resampled.adjoint is not None:
         spectrum_pull = reading.sample_pull(read.resampled.adjoint, read.resampled.grid.size, read.span)
     # through each side's tail amplitude (its least-squares operator), and
     # for a bar through the background under the window
+    # (each side's pull spread over every sample, nil off the side: whole rows
+    # added cost a tenth of a scatter into a side's columns)
     left = x < estimate.centre_px
     for i, side in enumerate(lsf.sides):
         in_side = left if i == 0 else ~left
-        per_amplitude = kernel @ ((1.0 - window) * tail_shape * in_side)
-        idx = np.nonzero(side.mask)[0]
-        gradient[:, idx] += per_amplitude[:, None] * (lsf.to_amplitude[i] @ side.operator)[None, :]
+        per_amplitude = combination @ _stacked(kernel @ ((1.0 - window) * tail_shape * in_side))
+        pull = np.zeros(gradient.shape[1])
+        pull[side.mask] = lsf.to_amplitude[i] @ side.operator
+        gradient += per_amplitude[:, None] * pull
         if estimate.subtracts_background:
-            gradient[:, idx] -= 0.5 * (kernel @ window)[:, None] * side.operator[0][None, :]
-    return transform, gradient, spectrum_pull
+            pull = np.zeros(gradient.shape[1])
+            pull[side.mask] = side.operator[0]
+            gradient -= 0.5 * (combination @ _stacked(kernel @ window))[:, None] * pull
+    return gradient, spectrum_pull
 
 
 def _residuals(estimate: Estimate) -> np.ndarray:

@@ -37,6 +37,8 @@ MIN_SIGMA_PX = 0.15
 MAX_BORDER_FRACTION = 0.2
 #: a neighbour blends a target when its smoothed peak is at least this share of the target's
 BLEND_FRACTION = 0.1
+#: the smallest peak SNR of a point target that tells a chip refused as a line holds points instead
+POINTS_SEEN_SNR = 10.0
 
 
 @dataclass(frozen=True)
@@ -203,6 +205,56 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     data = np.asarray(image, float)
     if data.ndim != 2:
         raise ParameterError(f"a chip must be 2-D, got shape {data.shape}")
+    peaks = _peaks(image, data, polarity)
+    polarity, signal, smoothed, noise = peaks.polarity, peaks.signal, peaks.smoothed, peaks.noise
+    iy, ix = peaks.iy, peaks.ix
+    radius = int(stamp_radius_px)
+    separation = 2 * radius + 2 if min_separation_px is None else float(min_separation_px)
+    sources, stamps, phases = [], [], []
+    padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
+    peaks_xy = np.column_stack([ix, iy])
+    faint = signal[iy, ix] < min_snr * noise
+    for k, (y, x) in enumerate(zip(iy, ix)):
+        source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
+                                      radius, peaks.nearest(k, faint),
+                                      separation, noise, min_snr, saturation, polarity)
+        sources.append(source)
+        if stamp is not None:
+            stamps.append(stamp)
+            phases.append(phase)
+    size = 2 * radius + 1
+    return FoundSources(tuple(sources), np.array(stamps).reshape(-1, size, size),
+                        np.array(phases, float).reshape(-1, 2), polarity, noise, radius)
+
+
+@dataclass(frozen=True, eq=False)
+class _Peaks:
+    """A chip's candidate targets before they are judged: its signal (the
+    residual from its background, turned to ``polarity``), that signal
+    smoothed, the chip's noise (DN) and the peaks (rows ``iy``, columns
+    ``ix``), strongest first."""
+
+    polarity: str
+    signal: np.ndarray
+    smoothed: np.ndarray
+    noise: float
+    iy: np.ndarray
+    ix: np.ndarray
+    heights: np.ndarray             # the smoothed signal at the peaks
+
+    def nearest(self, k: int, faint: np.ndarray) -> float:
+        """The distance (px) from peak ``k`` to the nearest other peak that
+        could blend with it: one not ``faint`` and of some weight beside it."""
+        distance = np.hypot(self.ix - self.ix[k], self.iy - self.iy[k])
+        distance[k] = np.inf
+        # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture is not)
+        distance[faint | (self.heights < BLEND_FRACTION * self.heights[k])] = np.inf
+        return float(distance.min())
+
+
+def _peaks(image: np.ndarray, data: np.ndarray, polarity: str) -> _Peaks:
+    """The peaks of ``data`` (``image`` as floats) that may be targets, of
+    ``polarity`` ("auto": the one whose extreme departs further)."""
     residual = data - background(data)
     if polarity == "auto":
         polarity = "bright" if residual.max() >= -residual.min() else "dark"
@@ -219,33 +271,14 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     iy, ix = iy[order], ix[order]
     # one target, one peak: a tie (a target half-way between pixels) or a shoulder within 2.5 px of a
     # stronger peak is that peak's
+    # (on Python's integers: NumPy's scalars cost ten times as much in a loop)
+    xs, ys = ix.tolist(), iy.tolist()
     keep: list[int] = []
-    for k in range(len(ix)):
-        if all((ix[k] - ix[i]) ** 2 + (iy[k] - iy[i]) ** 2 > 6.25 for i in keep):
+    for k, (x, y) in enumerate(zip(xs, ys)):
+        if all((x - xs[i]) ** 2 + (y - ys[i]) ** 2 > 6.25 for i in keep):
             keep.append(k)
     iy, ix = iy[keep], ix[keep]
-    radius = int(stamp_radius_px)
-    separation = 2 * radius + 2 if min_separation_px is None else float(min_separation_px)
-    sources, stamps, phases = [], [], []
-    padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
-    peaks_xy = np.column_stack([ix, iy])
-    heights = smoothed[iy, ix]
-    faint = signal[iy, ix] < min_snr * noise
-    for k, (y, x) in enumerate(zip(iy, ix)):
-        distance = np.hypot(ix - x, iy - y)
-        distance[k] = np.inf
-        # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture is not)
-        distance[faint | (heights < BLEND_FRACTION * heights[k])] = np.inf
-        source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
-                                      radius, float(distance.min()),
-                                      separation, noise, min_snr, saturation, polarity)
-        sources.append(source)
-        if stamp is not None:
-            stamps.append(stamp)
-            phases.append(phase)
-    size = 2 * radius + 1
-    return FoundSources(tuple(sources), np.array(stamps).reshape(-1, size, size),
-                        np.array(phases, float).reshape(-1, 2), polarity, noise, radius)
+    return _Peaks(polarity, signal, smoothed, noise, iy, ix, smoothed[iy, ix])
 
 
 def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separation, noise, min_snr, saturation,
@@ -396,6 +429,25 @@ def fit_pixel_gaussian(stamp: np.ndarray):
     return tuple(float(v) for v in fit.x)
 
 
+def _may_hold_points(data: np.ndarray, min_snr: float, radius: int) -> bool:
+    """Whether any of the peaks :func:`find_sources` finds on ``data``
+    (floats; ``min_snr``, a stamp of ``radius`` and the default separation)
+    passes its cheap checks, each as :func:`_judge` makes it: not faint,
+    its stamp on the chip, no other target within the separation.  A peak
+    that fails one is refused whatever else it is, so where none passes
+    none is used, and the fits of a textured chip's many peaks are spared."""
+    peaks = _peaks(data, data, "auto")
+    iy, ix = peaks.iy, peaks.ix
+    rows, cols = data.shape
+    signal = peaks.signal[iy, ix]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        snr = signal / peaks.noise if peaks.noise > 0 else np.full(signal.shape, np.inf)
+    on_chip = (ix - radius >= 0) & (iy - radius >= 0) & (ix + radius < cols) & (iy + radius < rows)
+    faint = signal < min_snr * peaks.noise          # (find_sources' own test of a neighbour's weight)
+    separation = 2 * radius + 2
+    return any(peaks.nearest(int(k), faint) >= separation for k in np.flatnonzero(~(snr < min_snr) & on_chip))
+
+
 def points_seen(image: np.ndarray) -> str | None:
     """What a chip refused as an edge or a bar shows if it holds point
     targets instead: "16 compact bright point targets (median peak SNR 95)",
@@ -424,7 +476,9 @@ def points_seen(image: np.ndarray) -> str | None:
     data = np.asarray(image, float)
     if data.ndim != 2 or min(data.shape) < 9:
         return None
-    found = find_sources(data, min_snr=10.0)
+    if not _may_hold_points(data, POINTS_SEEN_SNR, 4):
+        return None
+    found = find_sources(data, min_snr=POINTS_SEEN_SNR)
     used = found.used
     lines = found.refusal_counts().get("extended", 0)
     if not used or lines >= len(used):
