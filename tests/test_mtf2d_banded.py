@@ -5,7 +5,7 @@ import numpy as np
 
 from imgmtf.estimate.mtf2d import hats
 from imgmtf.estimate.mtf2d.banded import solve_pentadiagonal
-from imgmtf.estimate.mtf2d.inversion import BANDED_FROM, EllipticalProblem, _one, prepared
+from imgmtf.estimate.mtf2d.inversion import EllipticalProblem, _one, _penalty, prepared
 
 
 def dense(diagonal, first, second):
@@ -40,10 +40,11 @@ def test_the_inversions_normal_matrices_solved_by_bands_as_dense():
     theta = np.radians([16.8, -73.2])
     m = np.array([np.sinc(f * abs(np.cos(t))) * np.sinc(f * abs(np.sin(t))) * np.exp(-1.5 * f) for t in theta])
     problem = EllipticalProblem(*_one(prepared(np.degrees(theta), f, m, 0.01 * f[None] / 0.5)))
-    _, h = problem._stacked(np.linspace(-0.4, 0.4, BANDED_FROM + 2)[None])
-    weight = problem._each(BANDED_FROM + 2)
-    assert np.array_equal(dense(*problem._bands(h, weight)), problem._normal(h, weight))
+    _, h = problem._stacked(np.linspace(-0.4, 0.4, 50)[None])
+    weight = problem._each(50)
+    normal = hats.gram(h, weight) + _penalty(1, h.size) + 1e-10 * np.eye(h.size - 1)
+    assert np.array_equal(dense(*problem._bands(h, weight)), normal)
     targets = problem.log_r + np.random.default_rng(8).normal(0, 0.01, (h.low.shape[0], problem.log_r.shape[1]))
     rhs = hats.transposed(h, weight * (targets * weight))
-    assert np.allclose(problem._solved(h, weight, targets, BANDED_FROM),
-                       np.linalg.solve(problem._normal(h, weight), rhs[:, :, None])[:, :, 0], rtol=1e-10, atol=1e-12)
+    assert np.allclose(problem._solved(h, weight, targets), np.linalg.solve(normal, rhs[:, :, None])[:, :, 0],
+                       rtol=1e-10, atol=1e-12)

@@ -1,10 +1,9 @@
 """Sparse linear-interpolation designs (imgmtf.estimate.mtf2d.hats): the
-dense design's algebra, and the draws' vertices and the curves' node
-search, batched, each exactly what one at a time gives."""
+dense design's algebra, and the draws' vertices, batched, each exactly
+what one at a time gives."""
 import numpy as np
 
 from imgmtf.estimate.mtf2d import hats
-from imgmtf.estimate.mtf2d.curves import _search_rows
 from imgmtf.estimate.mtf2d.inversion import _hat, _vertex, _vertices
 
 
@@ -20,15 +19,18 @@ def test_the_sparse_designs_algebra_is_the_dense_designs():
     assert np.array_equal(hats.dense(h), design)
     weight, values, solution = rng.uniform(0.5, 2.0, x.shape[1]), rng.normal(size=x.shape), rng.normal(size=(3, 8))
     weighted = design * weight[None, :, None]
+    assert np.array_equal(hats.dense(h, np.broadcast_to(weight, x.shape)), weighted)        # W D at once
     assert np.allclose(hats.gram(h, weight), np.transpose(weighted, (0, 2, 1)) @ weighted, rtol=1e-13, atol=1e-13)
     diagonal, beside = hats.gram_bands(h, weight)
+    assert np.array_equal(hats.tridiagonal(diagonal, beside), hats.gram(h, weight))
     assert np.array_equal(diagonal, np.diagonal(hats.gram(h, weight), axis1=1, axis2=2))
     assert np.array_equal(beside, np.diagonal(hats.gram(h, weight), offset=1, axis1=1, axis2=2))
     assert np.allclose(hats.transposed(h, values), np.einsum("bsn,bs->bn", design, values), rtol=1e-13, atol=1e-13)
     assert np.allclose(hats.predicted(h, solution), np.einsum("bsn,bn->bs", design, solution), rtol=1e-13,
                        atol=1e-13)
-    assert np.array_equal(hats.touched(h), np.abs(design).sum(axis=1) > 0)
-    assert not hats.touched(h)[:, -3:].any()                  # nothing reaches past 0.5 cy/px
+    touched = np.abs(design).sum(axis=1) > 0                   # the unknowns (the nodes after the first)
+    assert np.array_equal(hats.last_touched(h), [np.flatnonzero(row).max(initial=-1) + 1 for row in touched])
+    assert hats.last_touched(h).max() < nodes.size - 3          # nothing reaches past 0.5 cy/px
 
 
 def test_the_draws_vertices_are_each_draws_own():
@@ -42,17 +44,3 @@ def test_the_draws_vertices_are_each_draws_own():
     together = _vertices(trials[None], costs[None])[0]
     assert np.array_equal(together, [_vertex(trials, costs[:, k]) for k in range(costs.shape[1])])
 
-
-def test_the_node_search_is_numpys():
-    """Uniform rows (a model's linspace, the guess then exact), uneven
-    rows (several steps), points on nodes, outside and NaN: the index of
-    the last node at or below each point, as comparing with every node."""
-    rng = np.random.default_rng(6)
-    uniform = np.linspace(0.0, rng.uniform(0.5, 1.2, 4), 33, axis=-1)
-    uneven = np.sort(rng.uniform(0, 1, (4, 33)), axis=1)
-    for nodes in (uniform, uneven):
-        x = np.concatenate([rng.uniform(-0.2, 1.3, (4, 50)), nodes, np.full((4, 1), np.nan)], axis=1)
-        expected = np.sum(x[:, :, None] >= nodes[:, None, :], axis=2) - 1
-        found = _search_rows(x, nodes, np.arange(4)[:, None])
-        finite = np.isfinite(x)
-        assert np.array_equal(found[finite], expected[finite])

@@ -156,7 +156,7 @@ def test_sections_it_cannot_invert_are_refused():
 def test_the_draws_elliptical_models_solved_together_are_each_ones_own():
     """The redrawn sections' elliptical models, every draw's normal
     equations solved in one call (by bands), are those solved draw by
-    draw (dense: nodes, reach and log g to 1e-12), and so are the misfits
+    draw (nodes, reach and log g to 1e-12), and so are the misfits
     of many aspects, of many targets at once and of each alone."""
     from imgmtf.estimate.mtf2d.inversion import EllipticalProblem, _one, prepared
     f = np.linspace(0, 1, 101)

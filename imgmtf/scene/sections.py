@@ -190,7 +190,20 @@ def _group_rows(curves: list[Record], result, track: float) -> list[Record]:
     if isinstance(result, ParameterError):
         return []
     shown = ("separable", "elliptical", *((BRACKET,) if result.assumption == BRACKET else ()))
-    return [_row(curves, result, assumption, k, track) for assumption in shown for k in (0, 1)]
+    shared = _shared_figures(curves)
+    return [_row(curves, result, assumption, k, track, shared) for assumption in shown for k in (0, 1)]
+
+
+def _shared_figures(records: list[Record]) -> dict[str, Any]:
+    """What every row of a target takes from its combined rows (the same
+    for each assumption and axis: made once, not by each of its 4-6
+    rows)."""
+    snrs = [float(r.figures["snr_min"]) for r in records if r.figures.get("snr_min") is not None]
+    return {"normals_deg": [r.figures["normal_angle_deg"] for r in records],   # the image's, as the combined rows'
+            "n_edges": int(sum(r.figures.get("n_edges") or 0 for r in records)),
+            "edge_ids": [i for r in records for i in (r.figures.get("edge_ids") or [])],
+            "rows_used": int(sum(r.figures.get("rows_used") or 0 for r in records)),
+            "snr_min": finite(min(snrs, default=math.nan))}
 
 
 def sensor_frame(normal_deg: float, track_deg: float) -> float:
@@ -221,27 +234,23 @@ def _sd(records: list[Record], frequencies: np.ndarray) -> np.ndarray | None:
     return sd_from_nyquist(sds, frequencies)
 
 
-def _row(records: list[Record], result, assumption: str, axis: int, track: float) -> Record:
+def _row(records: list[Record], result, assumption: str, axis: int, track: float, shared: dict[str, Any]) -> Record:
     first = records[0]
     section = result.alternatives[assumption][axis]
     gsd = first.figures.get("gsd_m")
     normal = sensor_frame(track - 90.0 * axis, 0.0)       # across lies at the azimuth, along 90 deg before
-    ids = [i for r in records for i in (r.figures.get("edge_ids") or [])]
-    snrs = [float(r.figures["snr_min"]) for r in records if r.figures.get("snr_min") is not None]
     figures: dict[str, Any] = {
         "summary": SECTIONS, "direction": section.direction, "assumption": assumption,
         "chosen_assumption": result.assumption, "assumption_because": result.because,
         "assumption_tests": {k: finite(v) for k, v in result.tests.items()},
         "aspect": finite(result.aspect) if assumption == "elliptical" else None,
         "normal_angle_deg": round(normal, 3),
-        "normals_deg": [r.figures["normal_angle_deg"] for r in records],   # the image's, as the combined rows'
-        "n_edges": int(sum(r.figures.get("n_edges") or 0 for r in records)), "edge_ids": ids,
+        "normals_deg": list(shared["normals_deg"]), "n_edges": shared["n_edges"], "edge_ids": list(shared["edge_ids"]),
         "mtf_nyquist": finite(section.mtf_nyquist), "mtf_nyquist_ci": [finite(v) for v in section.mtf_nyquist_ci],
         "mtf50_cy_px": finite(section.mtf50_cy_px), "mtf50_ci_cy_px": [finite(v) for v in section.mtf50_ci_cy_px],
         "fwhm_px": finite(section.fwhm_px),
-        "rows_used": int(sum(r.figures.get("rows_used") or 0 for r in records)),
-        "snr_min": finite(min(snrs, default=math.nan)), "gsd_m": gsd,
-        "frequencies_cy_px": [float(f) for f in section.frequencies_cy_px],
+        "rows_used": shared["rows_used"], "snr_min": shared["snr_min"], "gsd_m": gsd,
+        "frequencies_cy_px": np.asarray(section.frequencies_cy_px, float).tolist(),
         "mtf": finite_values(section.mtf),
         "warnings": [f"across/along from {len(records)} orientations: {result.because}"]
                     if assumption == result.assumption else [],

@@ -31,11 +31,17 @@ class Hats:
         1 - frac).
     size : int
         Nodes, the first fixed (not an unknown).
+    flat : numpy.ndarray of int
+        (batch x samples,): ``low`` as an index into the batch's rows of
+        nodes laid end to end (their sums by node are one
+        :func:`numpy.bincount`; made once here, not by each sum: making it
+        was five sixths of a sum's time).
     """
 
     low: np.ndarray
     frac: np.ndarray
     size: int
+    flat: np.ndarray
 
 
 def hats(position: np.ndarray, size: int) -> Hats:
@@ -51,24 +57,31 @@ def hats(position: np.ndarray, size: int) -> Hats:
     """
     position = np.clip(position, 0, size - 1)
     low = np.minimum(np.floor(position).astype(int), size - 2)
-    return Hats(low, position - low, size)
+    return Hats(low, position - low, size, (low + size * np.arange(low.shape[0])[:, None]).ravel())
 
 
-def dense(h: Hats) -> np.ndarray:
+def dense(h: Hats, weight: np.ndarray | None = None) -> np.ndarray:
     """The design (batch, samples, size - 1), the first node dropped: for
-    products with many right-hand sides at once (BLAS does those best).
+    products with many right-hand sides at once (BLAS does those best);
+    with ``weight`` (batch, samples), each sample's row times its weight
+    (W D, the same numbers as the product, without a pass over the zeros).
 
     Examples
     --------
     >>> dense(hats(np.array([[0.25, 1.5]]), 3)).tolist()
     [[[0.25, 0.0], [0.5, 0.5]]]
+    >>> dense(hats(np.array([[0.25, 1.5]]), 3), np.array([[2.0, 4.0]])).tolist()
+    [[[0.5, 0.0], [2.0, 2.0]]]
     """
     batch, samples = h.low.shape
     out = np.zeros((batch, samples, h.size))
+    lower, upper = 1.0 - h.frac, h.frac
+    if weight is not None:
+        lower, upper = lower * weight, upper * weight
     # by flat indices into the rows of nodes: a third of the time of indexing by (batch, sample, node)
     flat, at = out.reshape(-1, h.size), np.arange(batch * samples)
-    flat[at, h.low.ravel()] = (1.0 - h.frac).ravel()
-    flat[at, h.low.ravel() + 1] = h.frac.ravel()
+    flat[at, h.low.ravel()] = lower.ravel()
+    flat[at, h.low.ravel() + 1] = upper.ravel()
     return out[:, :, 1:]
 
 
@@ -83,14 +96,26 @@ def gram(h: Hats, weight: np.ndarray) -> np.ndarray:
     >>> bool(np.allclose(gram(h, np.ones(2))[0], dense(h)[0].T @ dense(h)[0]))
     True
     """
-    diagonal, beside = _gram_bands(h, weight)
+    return tridiagonal(*gram_bands(h, weight))
+
+
+def tridiagonal(diagonal: np.ndarray, beside: np.ndarray) -> np.ndarray:
+    """The symmetric matrices (batch, n, n) of bands ``diagonal`` (batch,
+    n) and ``beside`` (batch, n - 1): :func:`gram` of its
+    :func:`gram_bands`, when those are wanted too.
+
+    Examples
+    --------
+    >>> tridiagonal(np.array([[2.0, 3.0]]), np.array([[1.0]])).tolist()
+    [[[2.0, 1.0], [1.0, 3.0]]]
+    """
     batch, nodes = diagonal.shape
     out = np.zeros((batch, nodes, nodes))
     k = np.arange(nodes)
     out[:, k, k] = diagonal
     out[:, k[:-1], k[1:]] = beside
     out[:, k[1:], k[:-1]] = beside
-    return out[:, 1:, 1:]
+    return out
 
 
 def gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -111,8 +136,8 @@ def gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _gram_bands(h: Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The Gram matrix's bands with the first node: (batch, size), (batch, size - 1)."""
     lower, upper = weight * (1.0 - h.frac), weight * h.frac
-    diagonal = _scatter(h.low, lower * lower, h.size) + _scatter(h.low + 1, upper * upper, h.size)
-    return diagonal, _scatter(h.low, lower * upper, h.size)[:, :-1]
+    diagonal = _scatter(h, lower * lower) + _scatter(h, upper * upper, 1)
+    return diagonal, _scatter(h, lower * upper)[:, :-1]
 
 
 def transposed(h: Hats, values: np.ndarray) -> np.ndarray:
@@ -125,7 +150,7 @@ def transposed(h: Hats, values: np.ndarray) -> np.ndarray:
     >>> transposed(h, np.array([[2.0, 4.0]])).tolist()
     [[2.5, 2.0]]
     """
-    return (_scatter(h.low, (1.0 - h.frac) * values, h.size) + _scatter(h.low + 1, h.frac * values, h.size))[:, 1:]
+    return (_scatter(h, (1.0 - h.frac) * values) + _scatter(h, h.frac * values, 1))[:, 1:]
 
 
 def predicted(h: Hats, solution: np.ndarray) -> np.ndarray:
@@ -142,23 +167,23 @@ def predicted(h: Hats, solution: np.ndarray) -> np.ndarray:
                                                                                                   axis=1)
 
 
-def touched(h: Hats) -> np.ndarray:
-    """Whether any sample weighs on each unknown node (batch, size - 1),
-    as a dense design's non-zero columns say.
+def last_touched(h: Hats) -> np.ndarray:
+    """The last node any sample weighs on (batch,), counted from the first
+    (0: none beyond it), as a dense design's non-zero columns say: a
+    sample weighs on ``low`` (1 - frac > 0 but at the last node) and on
+    ``low + 1`` where frac > 0.
 
     Examples
     --------
-    >>> touched(hats(np.array([[0.0, 1.0]]), 4)).tolist()
-    [[True, False, False]]
+    >>> last_touched(hats(np.array([[0.0, 1.0], [0.5, 0.0], [0.0, 0.0]]), 4)).tolist()
+    [1, 1, 0]
     """
-    weights = _scatter(h.low, (1.0 - h.frac != 0).astype(float), h.size) + \
-        _scatter(h.low + 1, (h.frac != 0).astype(float), h.size)
-    return weights[:, 1:] > 0
+    return np.max(h.low + (h.frac != 0), axis=1, initial=0)
 
 
-def _scatter(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
-    """Sums of ``values`` (batch, samples) by node ``index``: (batch, size)."""
-    batch = index.shape[0]
-    flat = (index + size * np.arange(batch)[:, None]).ravel()
-    return np.bincount(flat, weights=np.broadcast_to(values, index.shape).ravel(),
-                       minlength=batch * size).reshape(batch, size)
+def _scatter(h: Hats, values: np.ndarray, above: int = 0) -> np.ndarray:
+    """Sums of ``values`` (batch, samples) by node ``low + above`` (0 or
+    1): (batch, size)."""
+    batch = h.low.shape[0]
+    return np.bincount(h.flat + above if above else h.flat, weights=np.broadcast_to(values, h.low.shape).ravel(),
+                       minlength=batch * h.size).reshape(batch, h.size)

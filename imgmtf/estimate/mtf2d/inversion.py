@@ -45,9 +45,6 @@ ASPECT_BOUNDS = (0.25, 4.0)  # the elliptical remainder's along/across width rat
 # a least-squares misfit below this fraction of its data's sum of squares is summed sample by sample (the
 # normal equations' difference would lose its digits)
 CANCELLATION = 1e-6
-# from this many systems on, solved by their bands: fewer are solved faster as dense matrices (the banded
-# loop's steps cost the same for one system as for a hundred; a hundred dense ones are megabytes)
-BANDED_FROM = 48
 
 
 @dataclass(frozen=True)
@@ -241,17 +238,19 @@ class EllipticalProblem:
         weight = self._each(aspects)
         if targets.ndim == 2:
             each = np.broadcast_to(targets[:, None], (count, aspects, targets.shape[1])).reshape(weight.shape)
-            misfit = weight * (hats.predicted(h, self._solved(h, weight, each, aspects)) - each)
+            misfit = weight * (hats.predicted(h, self._solved(h, weight, each)) - each)
             # summed in order (a padded sample adds an exact 0): the same sum whatever the targets batched with
             return np.cumsum(misfit ** 2, axis=1)[:, -1].reshape(count, aspects)
         # many right-hand sides per aspect: one dense product each (BLAS), the normal matrices still sparse
-        weighted = (hats.dense(h) * weight[:, :, None]).reshape(count, aspects, *h.low.shape[1:], -1)
+        weighted = hats.dense(h, weight).reshape(count, aspects, *h.low.shape[1:], -1)
         goal = targets * self.weight[:, :, None]
         unknowns = h.size - 1
-        gram = hats.gram(h, weight)
-        # the inverses (one small factorisation each) times the right-hand sides: a third of the time of
-        # solving for them, and as exact here (the normal matrices' condition is a few thousand)
-        inverse = np.linalg.inv(gram + _penalty(1, h.size) + 1e-10 * np.eye(unknowns))
+        bands = hats.gram_bands(h, weight)
+        gram = hats.tridiagonal(*bands)
+        # the inverses (by their bands: half the time of dense ones) times the right-hand sides: a third of the
+        # time of solving for them, and as exact here (the normal matrices' condition is a few thousand)
+        inverse = solve_pentadiagonal(*self._bands(h, weight, bands),
+                                      np.broadcast_to(np.eye(unknowns), (weight.shape[0], unknowns, unknowns)))
         projected = np.swapaxes(weighted, 2, 3) @ goal[:, None]                     # b = (W D)^T g
         solution = inverse.reshape(count, aspects, unknowns, unknowns) @ projected
         # |W D x - g|^2 = g.g - 2 b.x + x.(D^T W^2 D) x: products of the unknowns, not of the samples (those
@@ -278,11 +277,10 @@ class EllipticalProblem:
         nodes, h = self._stacked(log_aspects)
         size = nodes.shape[-1]
         each = np.swapaxes(targets, 1, 2).reshape(count * draws, -1)
-        solution = np.concatenate([np.zeros((count * draws, 1)), self._solved(h, self._each(draws), each, draws)],
+        solution = np.concatenate([np.zeros((count * draws, 1)), self._solved(h, self._each(draws), each)],
                                   axis=1)
-        touched = hats.touched(h)                                                    # draws x (nodes - 1)
-        last = np.where(touched.any(axis=1), size - 2 - np.argmax(touched[:, ::-1], axis=1), -1)
-        reach = np.arange(size)[None, :] < np.where(last >= 0, last + 2, 1)[:, None]
+        # the nodes up to the last the data touch (the first, log 1 = 0, always)
+        reach = np.arange(size)[None, :] <= hats.last_touched(h)[:, None]
         aspects = np.array([math.exp(a) for a in log_aspects.ravel().tolist()])
         return EllipticalModel(nodes.reshape(-1, size), np.where(reach, solution, np.nan), aspects)
 
@@ -302,24 +300,22 @@ class EllipticalProblem:
         step = nodes[..., 1] - nodes[..., 0]
         return nodes, hats.hats((w / step[..., None]).reshape(-1, w.shape[2]), nodes.shape[-1])
 
-    def _normal(self, h: hats.Hats, weight: np.ndarray) -> np.ndarray:
-        """:func:`_solve`'s normal matrices of stacked designs (sparse)."""
-        return hats.gram(h, weight) + _penalty(1, h.size) + 1e-10 * np.eye(h.size - 1)
-
-    def _solved(self, h: hats.Hats, weight: np.ndarray, targets: np.ndarray, per_target: int) -> np.ndarray:
+    def _solved(self, h: hats.Hats, weight: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """:func:`_solve`'s node values (but the first, 0) for stacked
         designs, weights and one target each (batch x samples): batch x
-        (nodes - 1).  A target's ``per_target`` systems are solved by their
-        bands (:mod:`.banded`) when they are many, else as dense matrices:
-        the same arithmetic however many targets share the call."""
-        rhs = hats.transposed(h, weight * (targets * weight))
-        if per_target < BANDED_FROM:
-            return np.linalg.solve(self._normal(h, weight), rhs[:, :, None])[:, :, 0]
-        return solve_pentadiagonal(*self._bands(h, weight), rhs)
+        (nodes - 1), solved by their bands (:mod:`.banded`): the same
+        arithmetic however many targets share the call (and for the many
+        systems of a batch of targets' aspects and draws a third of the
+        time of dense ones)."""
+        return solve_pentadiagonal(*self._bands(h, weight), hats.transposed(h, weight * (targets * weight)))
 
-    def _bands(self, h: hats.Hats, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`_normal`'s three bands (the matrix pentadiagonal)."""
-        diagonal, beside = hats.gram_bands(h, weight)
+    def _bands(self, h: hats.Hats, weight: np.ndarray,
+               gram: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The normal matrices of stacked designs (:func:`_solve`'s: the
+        Gram matrix, the smoothing and a ridge of 1e-10) by their three
+        bands (the matrix pentadiagonal); ``gram``: the Gram matrix's
+        (:func:`.hats.gram_bands`), when made already."""
+        diagonal, beside = hats.gram_bands(h, weight) if gram is None else gram
         p0, p1, p2 = _penalty_bands(h.size)
         return diagonal + p0 + 1e-10, beside + p1, np.broadcast_to(p2, (diagonal.shape[0], p2.size))
 
