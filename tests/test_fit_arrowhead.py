@@ -130,3 +130,25 @@ def test_residuals_not_finite_at_the_start_end_the_solve_at_once():
     with pytest.raises(NoConvergence, match="not finite"):
         solve_arrowhead(broken, jacobian, z0, 2, counts, lower, upper)
     assert len(calls) == 1
+
+
+def test_stopped_as_scipys_trust_region_the_solve_ends_near_the_optimum():
+    """With ``ftol`` (a target's few edges) the solve stops after a step
+    that lowered the cost by less than ftol of it: within that of its
+    tight optimum, in no more residual evaluations than to its own tight
+    end, and with the Jacobian at the point it returns."""
+    residuals, jacobian, z0, counts, lower, upper = edges_problem()
+    calls = []
+
+    def counted(z):
+        calls.append(1)
+        return residuals(z)
+    z_tight, _ = solve_arrowhead(counted, jacobian, z0, 2, counts, lower, upper)
+    tight = len(calls)
+    calls.clear()
+    z, final = solve_arrowhead(counted, jacobian, z0, 2, counts, lower, upper, ftol=1e-9)
+    assert len(calls) <= tight
+    assert np.array_equal(final.toarray(), jacobian(z).toarray())
+    cost, best = 0.5 * np.sum(residuals(z) ** 2), 0.5 * np.sum(residuals(z_tight) ** 2)
+    assert best <= cost * (1 + 1e-12) and cost <= best * (1 + 1e-9)
+    np.testing.assert_allclose(z, z_tight, rtol=1e-4, atol=1e-4)

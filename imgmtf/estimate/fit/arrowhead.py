@@ -196,7 +196,8 @@ class NoConvergence(Exception):
 
 def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Callable[[np.ndarray], object],
                     z: np.ndarray, n_free: int, counts: list[int], lower: np.ndarray, upper: np.ndarray,
-                    max_evaluations: int = 200, tolerance: float = 1e-12, layout: np.ndarray | None = None):
+                    max_evaluations: int = 200, tolerance: float = 1e-12, layout: np.ndarray | None = None,
+                    ftol: float | None = None):
     """Bounded nonlinear least squares over an arrowhead Jacobian by
     Levenberg-Marquardt steps solved exactly (:func:`damped_step`), the
     damping scaled by the columns' largest squared norms so far
@@ -210,7 +211,11 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
     that led there.
 
     ``layout`` is the compressed-row Jacobian's column indices, when known
-    (:func:`split_columns`).
+    (:func:`split_columns`).  With ``ftol`` it also stops, as SciPy's
+    ``least_squares`` does, after an accepted step that lowered half the
+    sum of squares by less than ``ftol`` times it (the Jacobian then
+    evaluated at the new point): a few edges' fits, whose last steps at
+    the 1e-12 criterion were mostly rejected at rounding level.
 
     Returns
     -------
@@ -265,5 +270,8 @@ def solve_arrowhead(residuals: Callable[[np.ndarray], np.ndarray], jacobian: Cal
             growth *= 2.0
             if damping > MAX_DAMPING:                     # no step lowers the cost: nowhere to go
                 raise NoConvergence("no step lowers the cost")
+        settled = ftol is not None and actual <= ftol * cost
         z, r, cost = trial, r_trial, cost_trial
         jac = jacobian(z)
+        if settled:
+            return z, jac

@@ -48,6 +48,9 @@ DETERMINED_PX = 0.2
 #: (bench's scan chart) cost the same either way at 8 edges (0.169 s dense,
 #: 0.163 s sparse), dense 10 % less at 4-6, sparse 15-35 % less at 12-16
 DENSE_EDGES = 8
+#: a few edges' fits solved by ours: a target's (4+ half-edges, <= 4 stage parameters); with more parameters
+#: (Baotou's target 1) or fewer edges (one chip) the optimum reached followed the solver's path
+OWN_SOLVER_FREE, OWN_SOLVER_EDGES = 4, 4
 
 
 def stage_names(names, start: Sensor | None) -> list[str]:
@@ -491,12 +494,18 @@ class Model:
         return len(self.data) > DENSE_EDGES
 
     def solve(self, z: np.ndarray, max_iterations: int = 200):
-        """Bounded least squares from ``z`` with :meth:`jacobian`: a few
-        edges' by SciPy's trust-region reflective ``least_squares`` (the
-        columns scaled by their norms, the steps exact by its SVD), many
-        edges' (a sparse Jacobian) by Levenberg-Marquardt steps solved
-        exactly over the arrowhead normal matrix
-        (:func:`.arrowhead.solve_arrowhead`).  Returns the solution and
+        """Bounded least squares from ``z`` with :meth:`jacobian`, by
+        Levenberg-Marquardt steps solved exactly over the arrowhead normal
+        matrix (:func:`.arrowhead.solve_arrowhead`): many edges' (a sparse
+        Jacobian) to its own tight end, a few edges' of at most
+        :data:`OWN_SOLVER_FREE` stage parameters and at least
+        :data:`OWN_SOLVER_EDGES` edges (a target's optics and detector)
+        stopped where an accepted step lowers the cost by less
+        than 1e-9 of it, as SciPy's trust region did (its overhead was a
+        quarter of a target's solve).  Other few edges' fits, and those
+        it cannot finish, go to SciPy's
+        trust-region reflective ``least_squares`` (the columns scaled by
+        their norms), which refuses as before.  Returns the solution and
         its Jacobian.
 
         Raises
@@ -506,13 +515,16 @@ class Model:
         """
         lower, upper = self.bounds()
         z = np.clip(z, lower, upper)
-        if max_iterations > 0 and self.sparse:
+        ours = self.sparse or (self.n_free <= OWN_SOLVER_FREE and len(self.data) >= OWN_SOLVER_EDGES)
+        if max_iterations > 0 and ours:
             try:
                 return solve_arrowhead(self.residuals, self.jacobian, z, self.n_free, self.counts, lower, upper,
-                                       max_iterations, layout=self._jacobian_layout()[0])
+                                       max_iterations, layout=self._jacobian_layout()[0] if self.sparse else None,
+                                       ftol=None if self.sparse else 1e-9)
             except NoConvergence:
                 pass
-        elif max_iterations > 0:
+        if max_iterations > 0 and not self.sparse:
+            # a few edges' fit not ours, or one ours could not finish: SciPy's, which refuses as before
             from scipy.optimize import least_squares
             result = least_squares(self.residuals, z, jac=self.jacobian, bounds=(lower, upper), method="trf",
                                    x_scale="jac", ftol=1e-9, xtol=1e-10, gtol=1e-10, max_nfev=max_iterations)
