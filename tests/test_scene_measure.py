@@ -216,10 +216,15 @@ def test_a_scan_detecting_on_workers_has_their_fork_server_load_its_tasks_module
     monkeypatch.setattr(parallel, "available_cores", lambda: 2)
     monkeypatch.setattr(measure, "prestart_workers", lambda *a: started.append(a))
     monkeypatch.setattr(measure, "detect_segments", lambda *a, **k: (np.zeros((0, 4)), np.zeros(0)))
+    # (whether an earlier test of this process left a fork server running with them is set here)
+    monkeypatch.setattr(measure, "preloaded", lambda modules: False)
     settings = ScanSettings(tile_px=256)            # 15 tiles: two workers
     assert scan_scene(str(path), settings, workers=1) == [] and started == []
     assert scan_scene(str(path), settings, workers=None) == []
     assert started == [(2, SCAN_TASK_MODULES)]
+    # a fork server already running with the scan's modules (the command's) is not started again
+    monkeypatch.setattr(measure, "preloaded", lambda modules: set(modules) == set(SCAN_TASK_MODULES))
+    assert scan_scene(str(path), settings, workers=None) == [] and started == [(2, SCAN_TASK_MODULES)]
     assert all(importlib.util.find_spec(name) is not None for name in SCAN_TASK_MODULES)
 
 
