@@ -108,26 +108,31 @@ def _gradients(image: np.ndarray, valid: np.ndarray, sigma: float) -> tuple[np.n
     by a Gaussian that ignores the pixels outside ``valid`` and beyond the
     edges (the smoothed image divided by the smoothed mask: they neither
     pull it down nor cut a false edge into it)."""
-    radius = int(GAUSSIAN_TRUNCATE * sigma + 0.5)
-    size = (2 * radius + 1, 2 * radius + 1)
-
-    def blur(values):
-        return cv2.GaussianBlur(values, size, sigma, borderType=cv2.BORDER_CONSTANT)
-    weight = _full_weight(valid.shape, sigma) if valid.all() else blur(valid.astype(np.float32)) + np.float32(1e-12)
-    smoothed = blur(image.astype(np.float32)) / weight
+    weight = _full_weight(valid.shape, sigma) if valid.all() else _mask_weight(valid.astype(np.float32), sigma)
+    smoothed = _blur(image.astype(np.float32), sigma) / weight
     dx = cv2.Sobel(smoothed, cv2.CV_32F, 1, 0, ksize=3, borderType=cv2.BORDER_REFLECT)
     dy = cv2.Sobel(smoothed, cv2.CV_32F, 0, 1, ksize=3, borderType=cv2.BORDER_REFLECT)
     return dx, dy
 
 
+def _blur(values: np.ndarray, sigma: float) -> np.ndarray:
+    """``values`` smoothed by a Gaussian truncated at ``GAUSSIAN_TRUNCATE``
+    sigma, nothing beyond the image."""
+    radius = int(GAUSSIAN_TRUNCATE * sigma + 0.5)
+    return cv2.GaussianBlur(values, (2 * radius + 1, 2 * radius + 1), sigma, borderType=cv2.BORDER_CONSTANT)
+
+
+def _mask_weight(valid: np.ndarray, sigma: float) -> np.ndarray:
+    """:func:`_gradients`' divisor: the smoothed mask (plus 1e-12, where
+    no valid pixel reaches)."""
+    return _blur(valid, sigma) + np.float32(1e-12)
+
+
 @functools.lru_cache(maxsize=64)
 def _full_weight(shape: tuple[int, int], sigma: float) -> np.ndarray:
-    """:func:`_gradients`' smoothed mask where every pixel is valid (plus
-    its 1e-12): the same for every chip of a shape (a scan's many chips
-    are of a few; read only)."""
-    radius = int(GAUSSIAN_TRUNCATE * sigma + 0.5)
-    weight = cv2.GaussianBlur(np.ones(shape, np.float32), (2 * radius + 1, 2 * radius + 1), sigma,
-                              borderType=cv2.BORDER_CONSTANT) + np.float32(1e-12)
+    """:func:`_mask_weight` where every pixel is valid: the same for every
+    chip of a shape (a scan's many chips are of a few; read only)."""
+    weight = _mask_weight(np.ones(shape, np.float32), sigma)
     weight.flags.writeable = False
     return weight
 
