@@ -292,8 +292,8 @@ def _rows_at_once(length: int) -> int:
 
 def spectrum_many(requests: list[tuple[np.ndarray, float]]) -> list[tuple[np.ndarray, np.ndarray]]:
     """:func:`spectrum` of many profiles (``requests``: each a profile and
-    its step, px), those of one transform length and step as the rows of
-    one FFT: NumPy's FFT makes its plan on every call, which for a single
+    its step, px), those of one transform length as the rows of one FFT
+    (:func:`_fft_rows`): NumPy's FFT makes its plan on every call, which for a single
     zero-padded profile costs about as much as the transform.  Each row's
     result is the same, to the bit, as the profile's transformed alone.
 
@@ -304,23 +304,14 @@ def spectrum_many(requests: list[tuple[np.ndarray, float]]) -> list[tuple[np.nda
     >>> bool(np.array_equal(m, spectrum(lsf, 0.05)[1])), f.size
     (True, 10001)
     """
-    out: list = [None] * len(requests)
-    groups: dict[tuple[int, float], list[int]] = {}
-    for k, (lsf, step) in enumerate(requests):
-        n = _transform_length(lsf.size, step)
-        groups.setdefault((n, step), []).append(k)
-    for (n, step), members in groups.items():
-        freqs = np.fft.rfftfreq(n, d=step)
-        at_once = _rows_at_once(n)
-        for start in range(0, len(members), at_once):
-            part = members[start: start + at_once]
-            rows = np.zeros((len(part), n))
-            for row, k in zip(rows, part):
-                row[: requests[k][0].size] = requests[k][0]
-            moduli = np.abs(np.fft.rfft(rows, axis=-1)) * step
-            for k, modulus in zip(part, moduli):
-                out[k] = (freqs, modulus)
-    return out
+    return _fft_rows([_spectrum_steps(lsf, step) for lsf, step in requests])
+
+
+def _spectrum_steps(lsf: np.ndarray, step: float) -> Generator[tuple, np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """:func:`spectrum` as a generator of its transform (as :func:`_fft_rows` runs them)."""
+    n = _transform_length(lsf.size, step)
+    transformed = yield np.fft.rfft, lsf, n
+    return np.fft.rfftfreq(n, d=step), np.abs(transformed) * step
 
 
 @dataclass(frozen=True, eq=False)
