@@ -184,10 +184,23 @@ def _step(s, p):
     """A Fermi step and its Jacobian in (amplitude, centre, scale, base);
     ``s`` (groups, samples), ``p`` (groups, 4)."""
     a, b, c, d = (p[:, k, None] for k in range(4))
-    u = np.clip((s - b) / c, -50.0, 50.0)
-    f = 1.0 / (1.0 + np.exp(-u))
+    u = (s - b) / c
+    np.maximum(u, -50.0, out=u)
+    np.minimum(u, 50.0, out=u)
+    jac = np.empty(s.shape + (4,))
+    # f = 1 / (1 + exp(-u)), made in the Jacobian's first column (the same operations, fewer arrays)
+    f = jac[..., 0]
+    np.negative(u, out=f)
+    np.exp(f, out=f)
+    f += 1.0
+    np.divide(1.0, f, out=f)
     slope = f * (1.0 - f)
-    return d + a * f, np.stack([f, -a * slope / c, -a * slope * u / c, np.ones_like(f)], axis=-1)
+    slope *= -a                     # -a f (1 - f), as -a * slope
+    np.divide(slope, c, out=jac[..., 1])
+    slope *= u
+    np.divide(slope, c, out=jac[..., 2])
+    jac[..., 3] = 1.0
+    return d + a * f, jac
 
 
 def _bar(s, p):
@@ -224,7 +237,8 @@ def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] 
     groups = s.shape[0]
     p = np.array(start, float)
     fit, jac = model(s, p)
-    cost = np.einsum("gn,gn->g", w * (v - fit), v - fit)
+    resid = v - fit
+    cost = np.einsum("gn,gn->g", w * resid, resid)
     damping = np.full(groups, 1e-3)
     active = np.ones(groups, bool)
     failed = np.zeros(groups, bool)
@@ -236,7 +250,7 @@ def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] 
         # are few: fewer, larger operations cost less than selecting them)
         weighted = np.swapaxes(jac * w[..., None], 1, 2)
         normal = weighted @ jac
-        gradient = (weighted @ (v - fit)[..., None])[..., 0]
+        gradient = (weighted @ resid[..., None])[..., 0]
         diagonal = np.maximum(np.einsum("gii->gi", normal), 1e-12)
         damped = np.where(active[:, None, None], normal + damping[:, None, None] * (diagonal[:, :, None] * identity),
                           identity)
@@ -249,18 +263,23 @@ def _fit(model, s, v, w, start, iterations=60) -> list[tuple[np.ndarray, float] 
         damping[zero] *= 4.0
         tried = active & ~zero
         trial_fit, trial_jac = model(s, np.where(tried[:, None], trial, p))
-        trial_cost = np.einsum("gn,gn->g", w * (v - trial_fit), v - trial_fit)
+        trial_resid = v - trial_fit
+        trial_cost = np.einsum("gn,gn->g", w * trial_resid, trial_resid)
         better = tried & np.isfinite(trial_cost) & (trial_cost < cost)
-        p = np.where(better[:, None], trial, p)
-        fit = np.where(better[:, None], trial_fit, fit)
-        jac = np.where(better[:, None, None], trial_jac, jac)
-        cost = np.where(better, trial_cost, cost)
+        if better.all():        # the selections below, made whole (the common first steps)
+            p, resid, jac, cost = trial, trial_resid, trial_jac, trial_cost
+        elif better.any():
+            p = np.where(better[:, None], trial, p)
+            resid = np.where(better[:, None], trial_resid, resid)
+            jac = np.where(better[:, None, None], trial_jac, jac)
+            cost = np.where(better, trial_cost, cost)
         lost = tried & ~better
         damping = np.where(better, damping / 3.0, np.where(lost, damping * 4.0, damping))
         converged = np.abs(step[:, 2]) < 1e-7 * np.maximum(np.abs(trial[:, 2]), 1e-9)
         active &= ~(better & converged) & ~(lost & (damping > 1e10))
-    weighted = jac * w[..., None]
-    covariance, regular = _solve_each(np.einsum("gni,gnj->gij", weighted, jac), np.tile(np.eye(4)[2], (groups, 1)))
+    # the normal equations at the solution (as each step makes them) give the scale's variance
+    weighted = np.swapaxes(jac * w[..., None], 1, 2)
+    covariance, regular = _solve_each(weighted @ jac, np.tile(np.eye(4)[2], (groups, 1)))
     variance = covariance[:, 2] * cost / np.maximum(w.sum(axis=1) - 4, 1)
     return [(p[k], max(float(variance[k]), 0.0)) if regular[k] and not failed[k] and np.isfinite(p[k]).all()
             and math.isfinite(variance[k]) else None for k in range(groups)]
