@@ -44,3 +44,20 @@ def test_least_squares_per_group_match_numpy_and_a_dependent_column_gets_zero():
     # a group's answer alone is its answer among others, to the bit
     one, one_resid = least_squares(Groups([sizes[2]]), [c[42:] for c in columns], y[42:])
     assert (one[0] == coef[2]).all() and (one_resid == resid[42:]).all()
+
+
+def test_least_squares_on_the_padded_grid_gives_the_bincounts_floats():
+    from imgmtf.estimate.ragged import Grid, _least_squares_by_counts
+    rng = np.random.default_rng(5)
+    for sizes in ([40], [25, 0, 60, 3], [7, 90, 88]):
+        groups = Groups(sizes)
+        assert Grid.of(groups) is not None
+        x = rng.uniform(2.0, 20.0, groups.ids.size)
+        columns = [np.ones_like(x), x ** -1.0, x - 10.0, rng.normal(size=x.size)]
+        y = 3.0 + 50.0 / x + rng.normal(0, 0.3, x.size)
+        grid = Grid.of(groups)
+        assert grid.sum(grid.scatter(y))[: groups.count].tobytes() == groups.sum(y).tobytes()
+        coef, resid = least_squares(groups, columns, y)
+        slow_coef, slow_resid = _least_squares_by_counts(groups, columns, y)
+        assert coef.tobytes() == slow_coef.tobytes() and resid.tobytes() == slow_resid.tobytes()
+    assert Grid.of(Groups([1000, 1, 1, 1])) is None        # padding would swamp the samples
