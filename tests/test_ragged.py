@@ -61,3 +61,14 @@ def test_least_squares_on_the_padded_grid_gives_the_bincounts_floats():
         slow_coef, slow_resid = _least_squares_by_counts(groups, columns, y)
         assert coef.tobytes() == slow_coef.tobytes() and resid.tobytes() == slow_resid.tobytes()
     assert Grid.of(Groups([1000, 1, 1, 1])) is None        # padding would swamp the samples
+
+
+def test_few_large_groups_medians_by_partition_are_the_sorts():
+    rng = np.random.default_rng(6)
+    sizes = [300, 0, 301, 1000]
+    values = rng.normal(size=sum(sizes)).round(2)            # ties among the middle values
+    groups = Groups(sizes)
+    parts = np.split(values, np.cumsum(sizes)[:-1])
+    medians = groups.median(values)
+    assert np.isnan(medians[1])
+    assert [medians[k] for k in (0, 2, 3)] == [np.median(parts[k]) for k in (0, 2, 3)]
