@@ -26,10 +26,14 @@ class SideFit:
     sd: float
 
 
-def tail_integral(s, v, side: int, start: float, half_range: float, kind) -> tuple[float, float]:
+def tail_integral(s, v, side: int, start: float, half_range: float, kind,
+                  fit: SideFit | None = None) -> tuple[float, float]:
     """Area (DN px) of one side's fitted LSF-like tail a / s^2 from ``start``
-    to the data's reach, a (1 / start - 1 / reach), and its standard error."""
-    fit = fit_side(s, v, (np.sign(s) == side) & (np.abs(s) >= start), kind.tail_power)
+    to the data's reach, a (1 / start - 1 / reach), and its standard error.
+    ``fit``: the side's fit from ``start`` on where already made
+    (:func:`reach_and_fit`)."""
+    if fit is None:
+        fit = fit_side(s, v, (np.sign(s) == side) & (np.abs(s) >= start), kind.tail_power)
     if not np.isfinite(fit.coef).all() or not math.isfinite(fit.sd):
         return 0.0, math.inf
     to_amplitude = kind.lsf_tail_amplitudes()[0 if side < 0 else 1]
@@ -56,7 +60,7 @@ def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> Side
     if x.size < 3:
         return SideFit(np.array([np.nan, 0.0]), np.zeros((2, x.size)), mask, math.nan)
     u = x ** -float(power)
-    mean_u = float(np.mean(u))
+    mean_u = float(np.add.reduce(u)) / x.size          # np.mean's sum and division, without its wrappers
     centred = u - mean_u
     spread = float(centred @ centred)
     operator = np.empty((2, x.size))
@@ -85,26 +89,36 @@ def model_reach(s: np.ndarray, v: np.ndarray, side: int, start: float, power: in
     measured; at low SNR the test has little power and the core stays at
     ``start``.  ``floor`` (DN) is a part of each bin's error that does not
     average down (rounding shared by neighbouring samples)."""
-    reach = np.abs(s[np.sign(s) == side])
-    values = v[np.sign(s) == side]
+    return reach_and_fit(s, v, side, start, power, step, floor)[0]
+
+
+def reach_and_fit(s: np.ndarray, v: np.ndarray, side: int, start: float, power: int, step: float,
+                  floor: float = 0.0) -> tuple[float, SideFit | None]:
+    """:func:`model_reach`, and the side's fit from there on where it was
+    made (the same samples in the same order as :func:`fit_side` of all
+    the samples selects: the same floats), else None."""
+    on_side = np.sign(s) == side
+    reach = np.abs(s[on_side])
+    values = v[on_side]
     if reach.size < 4 * MIN_TAIL_SAMPLES:
-        return start
+        return start, None
     far = float(reach.max())
     x0 = start
     while x0 <= 0.5 * far:
-        fit = fit_side(reach, values, reach >= x0, power)
-        near = (reach >= x0) & (reach < x0 + MODEL_CHECK_PX)
-        if not math.isfinite(fit.sd) or fit.sd == 0 or near.sum() < MIN_TAIL_SAMPLES:
-            return x0
+        beyond = reach >= x0
+        fit = fit_side(reach, values, beyond, power)
+        near = beyond & (reach < x0 + MODEL_CHECK_PX)
+        if not math.isfinite(fit.sd) or fit.sd == 0 or np.count_nonzero(near) < MIN_TAIL_SAMPLES:
+            return x0, fit
         u = reach[near] ** -float(power)
         resid = values[near] - (fit.coef[0] + fit.coef[1] * u)
         bins = np.floor((reach[near] - x0) / MODEL_BIN_PX).astype(int)
         counts = np.bincount(bins)
         full = counts >= 3
         means = np.bincount(bins, weights=resid)[full] / counts[full]
-        chi2 = float(np.sum(means ** 2 / (fit.sd ** 2 / counts[full] + floor ** 2)))
-        dof = int(full.sum())
+        chi2 = float(np.add.reduce(means ** 2 / (fit.sd ** 2 / counts[full] + floor ** 2)))
+        dof = int(np.count_nonzero(full))
         if dof == 0 or chi2 <= dof + 3.0 * math.sqrt(2.0 * dof):
-            return x0
+            return x0, fit
         x0 += step
-    return x0
+    return x0, None

@@ -19,7 +19,7 @@ from .kind import Shape, TargetKind
 from .settings import Settings
 from .spectrum import flat_top_window
 from .state import Noise, Profile, Samples, TailedLSF, Window
-from .tails import fit_side, model_reach, tail_integral
+from .tails import fit_side, reach_and_fit, tail_integral
 
 TAPER_FACTOR = 1.0                # the window's raised-cosine taper, in units of its flat half-width
 TAIL_FIT_MAX_START = 0.6          # the tail fit starts at most this far out, as a fraction of the range
@@ -125,10 +125,13 @@ def choose_window(kind: TargetKind, samples: Samples, shape: Shape, noise: Noise
         # a noise-free quantised profile rounds neighbouring samples alike:
         # its residuals do not average down below the rounding's own q / sqrt(12)
         floor = quantum_dn / math.sqrt(12.0) if noise.noise_dn < 0.5 * quantum_dn else 0.0
-        core = max(core, max(model_reach(offsets, samples.values_dn, side, core, kind.tail_power, CORE_STEP_PX,
-                                         floor) for side in (-1, 1)))
-        tails = [tail_integral(offsets, samples.values_dn, side, core, samples.half_range_px, kind)
-                 for side in (-1, 1)]
+        reached = [reach_and_fit(offsets, samples.values_dn, side, core, kind.tail_power, CORE_STEP_PX, floor)
+                   for side in (-1, 1)]
+        core = max(core, max(reach for reach, _ in reached))
+        # a side whose tail model took over at the core has its fit from there made already
+        tails = [tail_integral(offsets, samples.values_dn, side, core, samples.half_range_px, kind,
+                               fit if reach == core else None)
+                 for side, (reach, fit) in zip((-1, 1), reached)]
         share = sum(abs(area) for area, _ in tails) / noise.contrast_dn
         share_sd = math.hypot(*(sd for _, sd in tails)) / noise.contrast_dn
         if share > LONG_TAIL_SHARE and share > 3.0 * share_sd:
