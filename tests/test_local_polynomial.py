@@ -58,3 +58,13 @@ def test_the_adjoint_is_the_transpose_of_the_fits_linear_map(monkeypatch, weight
     np.testing.assert_allclose(fitted.adjoint(h), expected.T, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(fitted.adjoint(h[0]), expected[:, 0], rtol=1e-9, atol=1e-12)
     assert fitted.adjoint(h)[:, -1].tolist() == [0.0, 0.0, 0.0]
+
+
+def test_the_features_powers_are_numpys_vander_to_the_bit():
+    from imgmtf.estimate.local_polynomial import _features
+    rng = np.random.default_rng(7)
+    u, v = rng.uniform(-1.0, 1.0, 257), rng.normal(size=257)
+    for order in range(5):
+        powers = np.vander(u, 2 * order + 1, increasing=True).T
+        expected = np.concatenate([powers, powers[: order + 1] * v])
+        assert _features(u, v, order).tobytes() == expected.tobytes()

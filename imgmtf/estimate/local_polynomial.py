@@ -182,9 +182,16 @@ def _windows(distance: np.ndarray, values: np.ndarray, step: float, half_range: 
 
 
 def _features(u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
-    """Each sample's u^0..u^(2 order), then v u^0..v u^order."""
-    powers = np.vander(u, 2 * order + 1, increasing=True).T
-    return np.concatenate([powers, powers[: order + 1] * v])
+    """Each sample's u^0..u^(2 order), then v u^0..v u^order: rows of one
+    array, each power the one before times u, as :func:`numpy.vander`
+    accumulates them (the same floats, without its strided accumulation and
+    a transposed copy)."""
+    features = np.empty((3 * order + 2, u.size))
+    features[0] = 1.0
+    for k in range(1, 2 * order + 1):
+        np.multiply(features[k - 1], u, out=features[k])
+    np.multiply(features[: order + 1], v, out=features[2 * order + 1:])
+    return features
 
 
 def _valid_windows(m: np.ndarray, occupied: np.ndarray, half_bins: int, order: int, unit, inner: np.ndarray
@@ -213,6 +220,7 @@ def _fit_side_by_side(members: list[tuple[_Windows, bool]], order: int, step: fl
     bins = np.concatenate([win.bins + start for win, start in zip(wins, starts)])
     u, v = np.concatenate([win.u for win in wins]), np.concatenate([win.v for win in wins])
     features = _features(u, v, order)
+    u0 = np.ascontiguousarray(features[: order + 1].T)        # (n_kept, order + 1): u^0..u^order
     weighted = any(w for _, w in members)
     if weighted:        # the unweighted's ones change nothing
         features = features * np.concatenate([win.w for win in wins])
@@ -239,7 +247,6 @@ def _fit_side_by_side(members: list[tuple[_Windows, bool]], order: int, step: fl
     if valid.any():
         coef[valid] = _inverse_first_rows(m[:, valid], order + 1).T
     level = np.where(valid, np.einsum("kj,kj->k", coef, rhs), np.nan)
-    u0 = np.vander(u, order + 1, increasing=True)                 # (n_kept, order + 1)
     own = np.einsum("ij,ij->i", coef[bins], u0)
     width = (2 * half_bins + 1) * step
     transfer = _local_polynomial_transfer(order, width)

@@ -67,10 +67,11 @@ def _bin_sums(bins: np.ndarray, n_bins: int, features: np.ndarray) -> np.ndarray
     lead = features.shape[:-1]
     flat = features.reshape(-1, features.shape[-1])
     if flat.shape[0] <= 16:
-        # one count over every feature's bins side by side: each bin gathers
-        # its samples in their order, as a count of its feature alone does
-        where = (bins[None, :] + n_bins * np.arange(flat.shape[0])[:, None]).ravel()
-        sums = np.bincount(where, weights=flat.ravel(), minlength=flat.shape[0] * n_bins).reshape(-1, n_bins)
+        # a count of each feature alone: each bin gathers its samples in their order (cheaper than one
+        # count over every feature's bins side by side, whose indices cost as much as the counting)
+        sums = np.empty((flat.shape[0], n_bins))
+        for row, feature in zip(sums, flat):
+            row[:] = np.bincount(bins, weights=feature, minlength=n_bins)
     else:
         from scipy import sparse  # only for stacks of weights (the bootstrap)
         # one 1 per sample, in its bin's column: built as the compressed rows it is (a row pointer
