@@ -152,12 +152,13 @@ def _group_inputs(ev: Evidence, groups: list[np.ndarray]):
     indices, samples (s, v, w: padded to the longest with zero weights),
     each one's start and whether the model is a bar's; None for none."""
     reach = max(ev.plateau_px, MIN_REACH_PX)
+    offsets = ev.distance_px - ev.centre_px
+    near = np.abs(offsets) <= reach        # (each sample's offset the same whichever group reads it)
     selected = []
     for g, in_group in enumerate(groups):
-        s = ev.distance_px[in_group] - ev.centre_px
-        near = np.abs(s) <= reach
-        if np.count_nonzero(near) >= MIN_GROUP_SAMPLES:
-            selected.append((g, s[near], ev.values[in_group][near]))
+        take = in_group & near
+        if np.count_nonzero(take) >= MIN_GROUP_SAMPLES:
+            selected.append((g, offsets[take], ev.values[take]))
     if not selected:
         return None
     # the groups side by side, padded to the longest with zero weights
