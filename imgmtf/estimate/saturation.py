@@ -180,11 +180,11 @@ def _held_plateaus(asks: Sequence[tuple]) -> list[Check | None]:
     # (a generator's last-digit wobble near the plateau aside)
     band = np.floor(sv / HELD_BAND_PX).astype(int)
     slots = Groups(sides.extreme(band.astype(float), True).astype(np.intp) + 1)
-    slot = slots.starts[sides.ids] + band
+    slot = sides.spread(slots.starts) + band
     counts = np.bincount(slot, minlength=slots.ids.size)
     at = np.bincount(slot, weights=(v == sides.spread(extreme)).astype(float), minlength=slots.ids.size)
     share = at / np.maximum(counts, 1)
-    local = np.arange(slots.ids.size) - slots.starts[slots.ids]
+    local = np.arange(slots.ids.size) - slots.spread(slots.starts)
     failing = np.where((counts > 0) & (share < HELD_PLATEAU), local, -1)
     first = slots.extreme(failing.astype(float), True).astype(np.intp) + 1      # the bands from here out all hold it
     held = slots.sum(np.where(local >= slots.spread(first), counts, 0).astype(float))

@@ -222,7 +222,7 @@ def _departures(sides: Groups, reach: np.ndarray, resid: np.ndarray, nearest: np
     band = ((reach - sides.spread(nearest)) / BAND_PX).astype(int)       # (non-negative: truncation is the floor)
     # each side's bands in a run of slots of its own
     slots = Groups(np.where(sides.sizes > 0, np.nan_to_num(sides.extreme(band.astype(float), True)) + 1, 0))
-    slot = slots.starts[sides.ids] + band
+    slot = sides.spread(slots.starts) + band
     counts = np.bincount(slot, minlength=slots.ids.size)
     sums = np.bincount(slot, weights=resid, minlength=slots.ids.size)
     full = counts >= MIN_BAND_SAMPLES

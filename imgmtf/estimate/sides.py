@@ -92,7 +92,7 @@ def side_checks_many(calls: Sequence[tuple[Any, ...]]) -> list[list[Check]]:
     scatter = fits.sum(centred * centred) / n
     bands = np.floor(ss).astype(int)
     slots = Groups(np.where(fits.sizes > 0, np.nan_to_num(fits.extreme(bands.astype(float), True)) + 1, 0))
-    slot = slots.starts[fits.ids] + bands
+    slot = fits.spread(slots.starts) + bands
     counts = np.bincount(slot, minlength=slots.ids.size)
     sums = np.bincount(slot, weights=resid, minlength=slots.ids.size)
     full = counts >= MIN_BAND_SAMPLES
