@@ -188,7 +188,7 @@ def _step(s, p):
     u = (s - b) / c
     np.maximum(u, -50.0, out=u)
     np.minimum(u, 50.0, out=u)
-    jac = np.empty(s.shape + (4,))
+    jac = np.empty((*s.shape, 4))
     # f = 1 / (1 + exp(-u)), made in the Jacobian's first column (the same operations, fewer arrays)
     f = jac[..., 0]
     np.negative(u, out=f)

@@ -17,7 +17,6 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-
 PARTITIONED_GROUP_SAMPLES = 256    # groups this large on average: a median is a partition per group
 
 
