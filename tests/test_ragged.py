@@ -49,7 +49,7 @@ def test_least_squares_per_group_match_numpy_and_a_dependent_column_gets_zero():
 def test_least_squares_on_the_padded_grid_gives_the_bincounts_floats():
     from imgmtf.estimate.ragged import Grid, _least_squares_by_counts
     rng = np.random.default_rng(5)
-    for sizes in ([40], [25, 0, 60, 3], [7, 90, 88]):
+    for sizes in ([40], [25, 0, 60, 3], [7, 90, 88], list(range(20, 60))):     # the last filled by indexing
         groups = Groups(sizes)
         assert Grid.of(groups) is not None
         x = rng.uniform(2.0, 20.0, groups.ids.size)

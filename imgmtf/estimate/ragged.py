@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 PARTITIONED_GROUP_SAMPLES = 256    # groups this large on average: a median is a partition per group
+LOOPED_SCATTER_GROUPS = 32          # up to this many groups, a Grid is filled group by group
 
 
 class Groups:
@@ -149,7 +150,8 @@ class Grid:
     def __init__(self, groups: Groups):
         self.count = groups.count
         self.shape = (int(groups.sizes.max()), max(groups.count, 2))
-        self.runs = list(zip(range(groups.count), groups.starts.tolist(), groups.sizes.tolist()))
+        self.runs = (list(zip(range(groups.count), groups.starts.tolist(), groups.sizes.tolist()))
+                     if groups.count <= LOOPED_SCATTER_GROUPS else [])
         self.at = (np.arange(groups.ids.size) - groups.starts[groups.ids]) * self.shape[1] + groups.ids
 
     @classmethod
@@ -165,7 +167,10 @@ class Grid:
     def scatter(self, values: np.ndarray) -> np.ndarray:
         """``values`` (one a sample) in their groups' columns, 0 beyond."""
         out = np.zeros(self.shape)
-        for g, start, size in self.runs:
+        if self.count > LOOPED_SCATTER_GROUPS:       # many groups: one indexed assignment
+            out.ravel()[self.at] = values
+            return out
+        for g, start, size in self.runs:            # few: a strided copy each (faster than indexing)
             out[:size, g] = values[start: start + size]
         return out
 
