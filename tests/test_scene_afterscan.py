@@ -52,3 +52,24 @@ def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_tar
     assert sections_and_fits(records, summaries, None, workers=2)[1] == []
     with pytest.raises(ParameterError, match="workers"):
         sections_and_fits(records, summaries, "auto", workers=0)
+
+
+def test_on_workers_the_fits_name_their_half_edges_in_one_shared_block_freed_even_when_interrupted(
+        two_targets, monkeypatch):
+    from multiprocessing import shared_memory
+
+    from imgmtf.scene.afterscan import Shared
+    records, summaries = two_targets
+    names = []
+
+    def interrupted(function, items, workers, **options):
+        fits = [item for kind, item in items if kind == "fit"]
+        names.extend({item[0].name for item in fits if isinstance(item[0], Shared)})
+        assert [len(item[3]) for item in fits] == [8, 4, 4]     # the scene's eight half-edges, each target's four
+        raise KeyboardInterrupt
+    monkeypatch.setattr(imgmtf.parallel, "run_tasks", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sections_and_fits(records, summaries, "auto", workers=2)
+    assert len(names) == 1
+    with pytest.raises(FileNotFoundError):
+        shared_memory.SharedMemory(name=names[0])
