@@ -170,3 +170,35 @@ def test_the_cheap_look_for_points_never_misses_a_used_one():
     assert all(m for m, u in zip(may, used) if u)
     assert any(used) and not all(may)           # both kinds of chip are here
     assert all(points_seen(chip) is None for chip, u in zip(chips, used) if not u)
+
+
+def test_each_peaks_nearest_blending_neighbour_whatever_the_blocks(monkeypatch):
+    # the distance to the nearest neighbour that could blend (not faint, at least a tenth of the peak's
+    # height), found a block of peaks at a time: the same as peak by peak, whatever the block
+    from imgmtf.estimate.mtf2d import sources
+    rng = np.random.default_rng(5)
+    n = np.arange(-3, 4.0)
+    chip = rng.normal(100.0, 2.0, (60, 60))
+    for y, x, flux in [(5, 5, 900.0), (5, 12, 60.0), (30, 30, 400.0), (33, 35, 30.0), (50, 8, 900.0)]:
+        chip[y:y + 7, x:x + 7] += pixel_gaussian_stamp(flux, n)
+    peaks = sources._peaks(chip, chip, "bright")
+    assert len(peaks.ix) >= 5
+    seen = []
+    for min_snr in (10.0, 200.0):                  # neighbours of some weight, then all faint
+        faint = peaks.faint(min_snr)
+        expected = [min((np.hypot(peaks.ix[j] - peaks.ix[k], peaks.iy[j] - peaks.iy[k])
+                         for j in range(len(peaks.ix))
+                         if j != k and not faint[j] and peaks.heights[j] >= 0.1 * peaks.heights[k]), default=np.inf)
+                    for k in range(len(peaks.ix))]
+        whole = peaks.nearest(faint)
+        with monkeypatch.context() as patch:
+            patch.setattr(sources, "NEAREST_BLOCK", 2)
+            assert np.array_equal(whole, expected) and np.array_equal(peaks.nearest(faint), expected)
+            assert np.array_equal(peaks.nearest(faint, np.array([3, 0])), [expected[3], expected[0]])
+        seen += expected
+    assert np.isinf(seen).any() and np.isfinite(seen).any()
+
+
+def pixel_gaussian_stamp(flux, n):
+    from imgmtf.estimate.mtf2d.sources import pixel_gaussian
+    return pixel_gaussian((flux, 0.2, -0.3, 0.7, 0.6, 0.0), n)

@@ -39,6 +39,8 @@ MAX_BORDER_FRACTION = 0.2
 BLEND_FRACTION = 0.1
 #: the smallest peak SNR of a point target that tells a chip refused as a line holds points instead
 POINTS_SEEN_SNR = 10.0
+# peaks whose nearest neighbours are found at once (a block against every peak: 256 x peaks floats)
+NEAREST_BLOCK = 256
 
 
 @dataclass(frozen=True)
@@ -213,11 +215,11 @@ def find_sources(image: np.ndarray, *, polarity: str = "auto", stamp_radius_px: 
     sources, stamps, phases = [], [], []
     padded = np.pad(smoothed, radius, constant_values=np.nan)      # off the chip is no border
     peaks_xy = np.column_stack([ix, iy])
-    faint = signal[iy, ix] < min_snr * noise
+    snr, nearest = peaks.snr(), peaks.nearest(peaks.faint(min_snr))
     for k, (y, x) in enumerate(zip(iy, ix)):
         source, stamp, phase = _judge(data, signal, smoothed, padded, (int(x), int(y)), np.delete(peaks_xy, k, 0),
-                                      radius, peaks.nearest(k, faint),
-                                      separation, noise, min_snr, saturation, polarity)
+                                      radius, float(snr[k]), float(nearest[k]), separation, min_snr, saturation,
+                                      polarity)
         sources.append(source)
         if stamp is not None:
             stamps.append(stamp)
@@ -242,14 +244,34 @@ class _Peaks:
     ix: np.ndarray
     heights: np.ndarray             # the smoothed signal at the peaks
 
-    def nearest(self, k: int, faint: np.ndarray) -> float:
-        """The distance (px) from peak ``k`` to the nearest other peak that
-        could blend with it: one not ``faint`` and of some weight beside it."""
-        distance = np.hypot(self.ix - self.ix[k], self.iy - self.iy[k])
-        distance[k] = np.inf
-        # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture is not)
-        distance[faint | (self.heights < BLEND_FRACTION * self.heights[k])] = np.inf
-        return float(distance.min())
+    def snr(self) -> np.ndarray:
+        """Each peak's signal over the chip's noise (infinite where the
+        noise is 0)."""
+        signal = self.signal[self.iy, self.ix]
+        if self.noise > 0:
+            return signal / self.noise
+        return np.full(signal.shape, np.inf)
+
+    def faint(self, min_snr: float) -> np.ndarray:
+        """Which peaks are too faint to blend with another (under
+        ``min_snr`` times the noise)."""
+        return self.signal[self.iy, self.ix] < min_snr * self.noise
+
+    def nearest(self, faint: np.ndarray, among: np.ndarray | None = None) -> np.ndarray:
+        """The distance (px) from each peak (of the indices ``among``; all
+        by default) to the nearest other peak that could blend with it: one
+        not ``faint`` and of some weight beside it (infinite: none)."""
+        among = np.arange(len(self.iy)) if among is None else np.asarray(among, int)
+        nearest = np.empty(len(among))
+        for start in range(0, len(among), NEAREST_BLOCK):       # a block of peaks against all: memory bounded
+            k = among[start: start + NEAREST_BLOCK]
+            distance = np.hypot(self.ix - self.ix[k, None], self.iy - self.iy[k, None])
+            distance[np.arange(len(k)), k] = np.inf
+            # a neighbour blends only if it is a target of some weight beside this one (a faint bump of texture
+            # is not)
+            distance[faint | (self.heights < BLEND_FRACTION * self.heights[k, None])] = np.inf
+            nearest[start: start + NEAREST_BLOCK] = distance.min(axis=1, initial=np.inf)
+        return nearest
 
 
 def _peaks(image: np.ndarray, data: np.ndarray, polarity: str) -> _Peaks:
@@ -281,13 +303,13 @@ def _peaks(image: np.ndarray, data: np.ndarray, polarity: str) -> _Peaks:
     return _Peaks(polarity, signal, smoothed, noise, iy, ix, smoothed[iy, ix])
 
 
-def _judge(data, signal, smoothed, padded, at, others, radius, nearest, separation, noise, min_snr, saturation,
+def _judge(data, signal, smoothed, padded, at, others, radius, snr, nearest, separation, min_snr, saturation,
            polarity):
-    """One target's verdict, and its stamp and phase when used."""
+    """One target's verdict, and its stamp and phase when used (its peak's
+    ``snr`` and ``nearest`` blending neighbour, px, as :class:`_Peaks`
+    gives them)."""
     x, y = at
     rows, cols = data.shape
-    peak = float(signal[y, x])
-    snr = peak / noise if noise > 0 else math.inf
 
     def refused(reason, message):
         return Source(float(x), float(y), snr, reason, message), None, None
@@ -439,13 +461,9 @@ def _may_hold_points(data: np.ndarray, min_snr: float, radius: int) -> bool:
     peaks = _peaks(data, data, "auto")
     iy, ix = peaks.iy, peaks.ix
     rows, cols = data.shape
-    signal = peaks.signal[iy, ix]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        snr = signal / peaks.noise if peaks.noise > 0 else np.full(signal.shape, np.inf)
     on_chip = (ix - radius >= 0) & (iy - radius >= 0) & (ix + radius < cols) & (iy + radius < rows)
-    faint = signal < min_snr * peaks.noise          # (find_sources' own test of a neighbour's weight)
-    separation = 2 * radius + 2
-    return any(peaks.nearest(int(k), faint) >= separation for k in np.flatnonzero(~(snr < min_snr) & on_chip))
+    candidates = np.flatnonzero(~(peaks.snr() < min_snr) & on_chip)
+    return bool((peaks.nearest(peaks.faint(min_snr), candidates) >= 2 * radius + 2).any())
 
 
 def points_seen(image: np.ndarray) -> str | None:
