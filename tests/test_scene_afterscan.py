@@ -41,14 +41,37 @@ def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_tar
     kinds = []
 
     def in_turn(function, items, workers, **options):     # the pool's tasks, run here in turn
-        kinds.extend((workers, kind, item[1].get("target_id") if kind == "fit" else None) for kind, item in items)
+        kinds.extend((workers, kind, item[1].get("target_id") if kind == "fit" else
+                      [each[1]["target_id"] for each in item] if kind == "fits" else None) for kind, item in items)
         return map(function, items)
     monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
     # on workers: the measurements travel without their MTF function, the fits the same; the targets'
-    # fits are sent the last-ranked (the noisiest, the longest to fit) first
+    # fits are sent the last-ranked (the noisiest, the longest to fit) first, a few to a task
     there = sections_and_fits(records, summaries, "auto", workers=2)
-    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fit", 2), (2, "fit", 1)]
+    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fits", [2, 1])]
     assert (rows(there[0]), rows(there[1])) == (rows(sections), rows(fits))
     assert sections_and_fits(records, summaries, None, workers=2)[1] == []
     with pytest.raises(ParameterError, match="workers"):
         sections_and_fits(records, summaries, "auto", workers=0)
+
+
+def test_on_workers_the_fits_name_their_half_edges_in_one_shared_block_freed_even_when_interrupted(
+        two_targets, monkeypatch):
+    from multiprocessing import shared_memory
+
+    from imgmtf.scene.afterscan import Shared
+    records, summaries = two_targets
+    names = []
+
+    def interrupted(function, items, workers, **options):
+        fits = [item for kind, item in items if kind == "fit"] + \
+            [each for kind, item in items if kind == "fits" for each in item]
+        names.extend({item[0].name for item in fits if isinstance(item[0], Shared)})
+        assert [len(item[3]) for item in fits] == [8, 4, 4]     # the scene's eight half-edges, each target's four
+        raise KeyboardInterrupt
+    monkeypatch.setattr(imgmtf.parallel, "run_tasks", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sections_and_fits(records, summaries, "auto", workers=2)
+    assert len(names) == 1
+    with pytest.raises(FileNotFoundError):
+        shared_memory.SharedMemory(name=names[0])

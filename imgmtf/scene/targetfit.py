@@ -44,6 +44,8 @@ from ..safe_json import finite_values
 #: on a synthetic chip, the exponential wings, lag and halo real L0R needs
 DEFAULT_STAGES = "auto"
 _DIRECTIONS = {"across": "across-track", "along": "along-track"}
+#: the figures of a half-edge's record that a fit's rows read: all a record sent to a worker keeps
+FIT_FIGURES = ("rows_used", "snr", "gsd_m", "frequencies_cy_px")
 
 
 def fit_targets(records: Sequence[Record], *, stages: str | list[str] = DEFAULT_STAGES, workers: int = 1,
@@ -137,8 +139,9 @@ def fit_tasks(records: list[Record], stages: str | list[str], *, workers: int = 
         missing = [r for r in accepted if r.measurement is None]
         known.update(zip(map(id, missing), _measured(missing)))
     # tasks sent to workers carry each measurement once, beside its record (which then travels without
-    # its own: a dense chart's 1936 half-edges were 0.2 GB twice, for its scene's task and its targets')
-    shipped = {id(r): r if here or r.measurement is None else r.with_(measurement=None) for r in accepted}
+    # its own: a dense chart's 1936 half-edges were 0.2 GB twice, for its scene's task and its targets'),
+    # and with only the figures a fit's rows read (its checks and curves were half of its pickle)
+    shipped = {id(r): r if here else replace(r, measurement=None, figures=_fit_figures(r)) for r in accepted}
 
     def task(members: list[Record], site: dict) -> tuple:
         return [shipped[id(r)] for r in members], site, stages, [known[id(r)] for r in members]
@@ -185,15 +188,22 @@ def roi_mask(shape: tuple[int, int], origin: tuple[int, int], polygon: ArrayLike
     return inside
 
 
+def _fit_figures(record: Record) -> dict:
+    """The figures of a half-edge's record that its fit's rows read
+    (:func:`_direction_row`)."""
+    return {k: record.figures[k] for k in FIT_FIGURES if k in record.figures}
+
+
 def _from_scan(record: Record, shipped: bool = False) -> Any:
     """The scan's own measurement of a half-edge, its normal turned into
     the sensor's frame; None when the record has none.  ``shipped`` (to a
-    worker): without its MTF function, which the fit does not use (more
-    than half of a pickled measurement: the transform it interpolates)."""
+    worker): without its MTF function (more than half of a pickled
+    measurement: the transform it interpolates) or its checks (half of
+    what remains, pickled in band), which the fit does not use."""
     if record.measurement is None:
         return None
     result = record.measurement
-    dropped = {"mtf_function": None} if shipped else {}
+    dropped = {"mtf_function": None, "checks": ()} if shipped else {}
     return replace(result, normal_angle_deg=_turned(result.normal_angle_deg, track_of(record) or 0.0), **dropped)
 
 
