@@ -8,6 +8,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..lines import sinc
 from .base import FitSpec, Stage, param, register
 
 
@@ -41,7 +42,9 @@ class Detector(Stage):
     width_y_m: float = param(1.0, "m", FitSpec(axis="y", upper_px=3.0, pair="width_x_m", rank=6))
 
     def transfer(self, fx: ArrayLike, fy: ArrayLike, gsd_m: float) -> np.ndarray:
-        return np.sinc(np.asarray(fx, float) * self.width_x_m) * np.sinc(np.asarray(fy, float) * self.width_y_m)
+        out = sinc(np.asarray(fx, float) * self.width_x_m)
+        out = out * sinc(np.asarray(fy, float) * self.width_y_m)          # (broadcast: not in place)
+        return out
 
     def support_radius_m(self, gsd_m: float) -> float:
         return math.hypot(self.width_x_m, self.width_y_m) / 2.0
