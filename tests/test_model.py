@@ -148,3 +148,24 @@ def test_absurd_blur_is_refused_before_allocating():
     for call in (huge.psf, huge.fwhm_m, lambda: huge.line_response(6.0)):
         with pytest.raises(ParameterError, match="check the stage parameters"):
             call()
+
+
+@pytest.mark.parametrize("angle", [0.0, 90.0, 20.0])
+def test_the_fwhms_spectrum_is_the_transfer_but_for_the_sign_of_a_zero(angle):
+    """Sensor.normal_lsf takes each stage's transfer only where those before
+    it leave the product non-zero: the same numbers as normal_transfer (a
+    one-sided, complex stage and a stage after the optics' underflow
+    included), so the same LSF and FWHM as from the full transfer."""
+    from imgmtf.sensor.lines import line_grid, line_spread
+    f = np.linspace(0.0, 200.0, 16385)
+    for sensor in (im.Sensor(1.0, [st.GaussianOptics(0.42, 0.45), st.Detector(1.05, 0.97)]),
+                   im.Sensor(0.5, [st.GaussianOptics(0.3, 0.3), st.Lag(0.4, 0.2), st.Detector(0.5, 0.5)]),
+                   im.Sensor(1.0, [st.Detector(1.0, 1.0), st.Diffraction(), st.GaussianOptics(0.3, 0.3)])):
+        spectrum = sensor._normal_spectrum(f, angle, sensor.gsd_m)
+        transfer = sensor.normal_transfer(f, angle)
+        assert spectrum.dtype == transfer.dtype and np.array_equal(spectrum, transfer)
+        x, lsf = sensor.normal_lsf(angle)
+        half = 4 * sensor.support_radius_m() / sensor.gsd_m
+        grid = line_grid(sensor, angle, sensor.gsd_m, reach_px=half, step_px=1 / 400)
+        full = grid.lsf_remainder(sensor.normal_transfer(grid.frequencies_cy_px, angle))
+        assert np.array_equal(lsf, line_spread(grid.start_px, grid.step_px, full, grid.reference, x))
