@@ -150,3 +150,21 @@ def test_optics_transfer_underflows_to_exact_zero():
     f = np.linspace(0.0, 40.0, 4001)
     assert np.array_equal(optics.transfer(f, f / 3, 1.0),
                           np.exp(-2.0 * np.pi**2 * (0.4**2 * f**2 + 0.5**2 * (f / 3) ** 2)))
+
+
+def test_a_fits_floats_pass_the_checks_they_would_pass():
+    """The checked copy's quick path for a float in (0, MAX_PARAMETER]
+    keeps every refusal: a field's own bound, zero where it must be
+    positive, the largest parameter."""
+    from imgmtf.sensor.stages.base import MAX_PARAMETER
+    halo = st.Halo()
+    assert halo._replaced({"fraction": 0.25}).fraction == 0.25
+    with pytest.raises(ParameterError, match="halo fraction must be at most 1"):
+        halo._replaced({"fraction": 1.5})
+    with pytest.raises(ParameterError, match="diffraction f_number must be > 0"):
+        st.Diffraction()._replaced({"f_number": 0.0})
+    optics = st.GaussianOptics()
+    assert optics._replaced({"sigma_x_m": MAX_PARAMETER}).sigma_x_m == MAX_PARAMETER
+    for bad, message in ((MAX_PARAMETER * 1.5, "must be at most"), (-0.1, ">= 0"), (math.nan, "finite")):
+        with pytest.raises(ParameterError, match=message):
+            optics._replaced({"sigma_x_m": bad})

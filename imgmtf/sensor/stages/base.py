@@ -192,6 +192,12 @@ class Stage:
 
 def _checked(stage: Stage, f, value) -> float:
     """A parameter's ``value`` checked (a ParameterError naming it) and as a float."""
+    # a fit's every evaluation: a float in (0, MAX_PARAMETER] and its field's bound, which every check passes as
+    # it is (check_number's float() of a float is itself)
+    if type(value) is float and 0.0 < value <= MAX_PARAMETER:
+        high = f.metadata.get("high")
+        if high is None or value <= high:
+            return value
     number = check_number(f"{stage.name} {f.name}", value, positive=f.metadata.get("positive", False),
                           allow_inf=f.metadata.get("allow_inf", False), signed=f.metadata.get("signed", False),
                           high=f.metadata.get("high"))
