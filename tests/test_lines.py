@@ -232,20 +232,3 @@ def test_underflowing_exp_is_exp_bit_for_bit():
     x = np.concatenate([-np.linspace(700.0, 760.0, 6001), [0.0, -0.5, -np.inf, np.nan, 3.0]])
     assert np.array_equal(underflowing_exp(x), np.exp(x), equal_nan=True)
     assert underflowing_exp(-2.0) == np.exp(-2.0) and np.ndim(underflowing_exp(-2.0)) == 0
-
-
-def test_sinc_is_numpys_bit_for_bit():
-    """Ours writes in place and gives all ones for arguments whose sines
-    round to themselves (an axis a normal at 0 or 90 deg does not lean on):
-    NumPy's numbers, shapes and scalars, NaN included."""
-    from imgmtf.sensor.lines import SINC_ONE_BELOW, sinc
-    rng = np.random.default_rng(3)
-    tiny = SINC_ONE_BELOW / np.pi
-    cases = [rng.normal(0.0, 8.0, 3001), np.linspace(-40.0, 40.0, 8001), np.zeros(7),
-             np.linspace(0.0, 200.0, 4001) * math.cos(math.radians(90.0)), rng.uniform(-tiny, tiny, 500),
-             np.array([0.0, 1e-300, -2.5, 3.0, np.nan, 0.999 * tiny, 1.001 * tiny]), np.zeros((2, 3))]
-    for t in cases:
-        ours, theirs = sinc(t), np.sinc(t)
-        assert ours.shape == theirs.shape and np.array_equal(ours, theirs, equal_nan=True)
-    for scalar in (0.0, 0.5, 1e-30, np.float64(2.25)):
-        assert sinc(scalar) == np.sinc(scalar) and np.ndim(sinc(scalar)) == 0

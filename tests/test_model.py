@@ -157,11 +157,14 @@ def test_the_fwhms_spectrum_is_the_transfer_but_for_the_sign_of_a_zero(angle):
     one-sided, complex stage and a stage after the optics' underflow
     included), so the same LSF and FWHM as from the full transfer."""
     from imgmtf.sensor.lines import line_grid, line_spread
+    from imgmtf.sensor.stages.base import nonzero_transfer
     f = np.linspace(0.0, 200.0, 16385)
     for sensor in (im.Sensor(1.0, [st.GaussianOptics(0.42, 0.45), st.Detector(1.05, 0.97)]),
                    im.Sensor(0.5, [st.GaussianOptics(0.3, 0.3), st.Lag(0.4, 0.2), st.Detector(0.5, 0.5)]),
                    im.Sensor(1.0, [st.Detector(1.0, 1.0), st.Diffraction(), st.GaussianOptics(0.3, 0.3)])):
-        spectrum = sensor._normal_spectrum(f, angle, sensor.gsd_m)
+        a = math.radians(angle)
+        spectrum = nonzero_transfer(sensor.stages, f / sensor.gsd_m * math.cos(a), f / sensor.gsd_m * math.sin(a),
+                                    sensor.gsd_m)
         transfer = sensor.normal_transfer(f, angle)
         assert spectrum.dtype == transfer.dtype and np.array_equal(spectrum, transfer)
         x, lsf = sensor.normal_lsf(angle)

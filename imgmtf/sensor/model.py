@@ -39,6 +39,7 @@ from ..inputs import check_number
 from ..metrics import first_crossing, fwhm
 from .lines import LineResponse, line_grid, line_spread
 from .stages import STAGES, Detector, Electronics, GaussianOptics, Motion, Stage, stage_from_dict
+from .stages.base import nonzero_transfer
 from .toml_text import sensor_toml_lines, write_toml_lines
 
 DIRECTIONS = ("across", "along")
@@ -163,38 +164,6 @@ class Sensor:
         a = math.radians(check_angle(angle_deg))
         f = np.asarray(f_cy_px, float) / gsd
         return self.transfer(f * math.cos(a), f * math.sin(a))
-
-    def _normal_spectrum(self, f_cy_px: np.ndarray, angle_deg: float, gsd_m: float) -> np.ndarray:
-        """:meth:`normal_transfer` at the 1-D frequencies ``f_cy_px`` for an
-        inverse FFT: each stage's transfer computed only where those before
-        it leave the product non-zero, 0 elsewhere.  The same numbers but
-        for the sign of a zero (0 x T of a finite T), which the transform's
-        sums and a modulus do not see; a FWHM's fine grid (16385
-        frequencies to 200 cy/px) lies beyond a Gaussian optics' underflow
-        at over nine tenths of them, where the detector's sines were half
-        the transfer's time.
-
-        Examples
-        --------
-        >>> f = np.linspace(0.0, 200.0, 16385)
-        >>> bool(np.array_equal(Sensor()._normal_spectrum(f, 30.0, 1.0), Sensor().normal_transfer(f, 30.0)))
-        True
-        """
-        a = math.radians(check_angle(angle_deg))
-        f = np.asarray(f_cy_px, float) / gsd_m
-        fx, fy = f * math.cos(a), f * math.sin(a)
-        out = np.ones(f.shape)
-        kept: np.ndarray | None = None            # where the product so far is not zero; None: everywhere
-        for stage in self.stages:
-            if kept is None:
-                out = out * stage.transfer(fx, fy, self.gsd_m)
-            else:
-                part = out[kept] * stage.transfer(fx[kept], fy[kept], self.gsd_m)
-                out = np.zeros(f.shape, part.dtype)
-                out[kept] = part
-            nonzero = out != 0                    # (NaN kept: it stays NaN, as it would)
-            kept = None if nonzero.all() else np.flatnonzero(nonzero)
-        return out
 
     def mtf(self, f_cy_px: ArrayLike, direction: str = "across") -> np.ndarray:
         """MTF across track (x) or along track (y) at ``f_cy_px`` cycles/pixel.
@@ -339,7 +308,9 @@ class Sensor:
         half = 4 * self.support_radius_m() / gsd
         # the line response's LSF (its ESF unused: half the inverse FFTs of :meth:`line_response`)
         grid = line_grid(self, angle_deg, gsd, reach_px=half, step_px=1.0 / samples_per_px)
-        remainder = grid.lsf_remainder(self._normal_spectrum(grid.frequencies_cy_px, angle_deg, gsd))
+        # the transfer where it is not zero only: most of the fine grid's frequencies lie beyond the optics' underflow
+        a, f = math.radians(check_angle(angle_deg)), grid.frequencies_cy_px / gsd
+        remainder = grid.lsf_remainder(nonzero_transfer(self.stages, f * math.cos(a), f * math.sin(a), self.gsd_m))
         n = 2 * int(math.ceil(half * samples_per_px)) + 1
         x = (np.arange(n) - n // 2) / samples_per_px
         return x, line_spread(grid.start_px, grid.step_px, remainder, grid.reference, x)
