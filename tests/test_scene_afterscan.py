@@ -46,11 +46,16 @@ def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_tar
         return map(function, items)
     monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
     # on workers: the measurements travel without their MTF function, the fits the same; the targets'
-    # fits are sent the last-ranked (the noisiest, the longest to fit) first, a few to a task
+    # fits are sent the last-ranked (the noisiest, the longest to fit) first; a few only, one to a task
     there = sections_and_fits(records, summaries, "auto", workers=2)
-    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fits", [2, 1])]
+    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fits", [2]), (2, "fits", [1])]
     assert (rows(there[0]), rows(there[1])) == (rows(sections), rows(fits))
     assert sections_and_fits(records, summaries, None, workers=2)[1] == []
+    # many, a few to a task (fits_per_task's own examples: 4 of 484 on 2 workers, 1 of 20)
+    monkeypatch.setattr(imgmtf.scene.afterscan, "fits_per_task", lambda targets, workers: 2)
+    kinds.clear()
+    assert rows(sections_and_fits(records, summaries, "auto", workers=2)[1]) == rows(fits)
+    assert kinds[2:] == [(2, "fits", [2, 1])]
     with pytest.raises(ParameterError, match="workers"):
         sections_and_fits(records, summaries, "auto", workers=0)
 

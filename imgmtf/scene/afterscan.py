@@ -26,8 +26,8 @@ from typing import Any
 from ..records import Record
 
 SECTIONS, FIT, FITS = "sections", "fit", "fits"
-#: targets' fits per task
-TARGETS_PER_TASK = 4
+#: targets' fits per task at most; and the tasks each worker gets at least before fits are grouped
+TARGETS_PER_TASK, TASKS_PER_WORKER = 4, 8
 
 
 def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], stages: str | list[str] | None, *,
@@ -91,11 +91,12 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
     # interval, then the highest SNR), and the last are the noisiest, often misfit, whose fits try more
     # stages (0.4-1.6 s against 0.02 s on the 4096 px bench scene): started last, one of them ran alone
     order = [*range(scenes), *range(len(fits) - 1, scenes - 1, -1)]
-    # a few targets' fits to a task: each is short (30 ms on the dense chart) beside a task's round trip
+    # many targets' fits a few to a task: each is short (30 ms on the dense chart) beside a task's round trip
     targets = [fits[k] for k in order[scenes:]]
+    per_task = fits_per_task(len(targets), chosen)
     tasks = [(FIT, fits[k]) for k in order[:scenes]] + \
         [(SECTIONS, t) for t in ([groups] if here else section_tasks(groups)) if t] + \
-        [(FITS, targets[k:k + TARGETS_PER_TASK]) for k in range(0, len(targets), TARGETS_PER_TASK)]
+        [(FITS, targets[k:k + per_task]) for k in range(0, len(targets), per_task)]
     if here:
         results = [_stage_task(task) for task in tasks]
     else:
@@ -116,6 +117,21 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
     for k, rows in zip(order, (rows for kind, rows in done if kind == FIT)):
         fitted[k] = rows
     return sections, fitted_rows(fitted, scenes)
+
+
+def fits_per_task(targets: int, workers: int) -> int:
+    """How many of ``targets`` fits go in one task on ``workers``: up to
+    ``TARGETS_PER_TASK``, but one each until every worker would get
+    ``TASKS_PER_WORKER`` tasks.  A scene's few fits are uneven (the noisiest
+    targets' 0.4-1.6 s against 0.02 s on the 4096 px bench scene, and sent
+    first): four of them in one task left the other worker idle.
+
+    Examples
+    --------
+    >>> fits_per_task(484, 2), fits_per_task(40, 2), fits_per_task(20, 2)
+    (4, 2, 1)
+    """
+    return max(1, min(TARGETS_PER_TASK, targets // (TASKS_PER_WORKER * max(workers, 1))))
 
 
 def fit_workers(records: Sequence[Record], workers: int | None) -> int:
