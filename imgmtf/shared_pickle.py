@@ -106,6 +106,8 @@ def load(name: str) -> Any:
     if name in _loaded:
         return _loaded[name]
     from multiprocessing import parent_process, shared_memory
+    if _loaded and parent_process() is not None:
+        gc.unfreeze()           # the block loaded before (frozen below) goes back to the collector with it
     _loaded.clear()
     memory = shared_memory.SharedMemory(name=name)
     try:
