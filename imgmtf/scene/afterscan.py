@@ -170,9 +170,14 @@ def _shipped_once(tasks: list[tuple]) -> tuple[Any, list[tuple]]:
     shared = SharedPickle(halves)
 
     def light(item: tuple) -> tuple:
+        """A fit's task with its half-edges named by their indices in the block."""
         return Shared(shared.name), item[1], item[2], [index[id(r)] for r in item[0]]
-    return shared, [(kind, light(item) if kind == FIT else [light(each) for each in item] if kind == FITS else item)
-                    for kind, item in tasks]
+
+    def lightened(kind: str, item):
+        if kind == FIT:
+            return light(item)
+        return [light(each) for each in item] if kind == FITS else item       # (sections: as they are)
+    return shared, [(kind, lightened(kind, item)) for kind, item in tasks]
 
 
 @dataclass(frozen=True)
