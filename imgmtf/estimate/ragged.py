@@ -209,14 +209,7 @@ def _least_squares(grid: Grid, columns: Sequence[np.ndarray], target: np.ndarray
         basis.append(q)
         rhs.append(grid.sum(np.multiply(q, residual, out=work)))
         residual -= np.multiply(q, rhs[j], out=work)
-    coef = np.zeros((grid.shape[1], m))
-    for j in range(m - 1, -1, -1):
-        value = rhs[j]
-        for k in range(j + 1, m):
-            value = value - r[j][k] * coef[:, k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            coef[:, j] = np.where(r[j][j] > 0, value / np.where(r[j][j] > 0, r[j][j], 1.0), 0.0)
-    return coef[: grid.count], grid.gather(residual)
+    return _back_substituted(r, rhs, grid.shape[1])[: grid.count], grid.gather(residual)
 
 
 def least_squares(groups: Groups, columns: Sequence[np.ndarray], target: np.ndarray
@@ -271,11 +264,20 @@ def _least_squares_by_counts(groups: Groups, columns: Sequence[np.ndarray], targ
         basis.append(q)
         rhs.append(groups.sum(q * residual))
         residual = residual - q * groups.spread(rhs[j])
-    coef = np.zeros((groups.count, m))
+    return _back_substituted(r, rhs, groups.count), residual
+
+
+def _back_substituted(r: list, rhs: list, count: int) -> np.ndarray:
+    """Each of ``count`` groups' coefficients (groups, columns) from the
+    triangular factor ``r`` (``r[i][j]`` one value a group) and the
+    projections ``rhs``: a column with no independent part (``r[j][j]``
+    0) gets 0."""
+    m = len(rhs)
+    coef = np.zeros((count, m))
     for j in range(m - 1, -1, -1):
         value = rhs[j]
         for k in range(j + 1, m):
             value = value - r[j][k] * coef[:, k]
         with np.errstate(divide="ignore", invalid="ignore"):
             coef[:, j] = np.where(r[j][j] > 0, value / np.where(r[j][j] > 0, r[j][j], 1.0), 0.0)
-    return coef, residual
+    return coef
