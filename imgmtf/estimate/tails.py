@@ -79,24 +79,21 @@ def fit_side(s: np.ndarray, v: np.ndarray, mask: np.ndarray, power: int) -> Side
     return SideFit(coef, operator, mask, float(math.sqrt(resid @ resid / dof)))
 
 
-def model_reach(s: np.ndarray, v: np.ndarray, side: int, start: float, power: int, step: float,
-                floor: float = 0.0) -> float:
-    """Where a side's tail model takes over: the smallest distance from
-    ``start`` on (in ``step`` px steps, at most half the side's range) from
-    which level + A / |s|^p, fitted out to the end of the data, explains the
-    next few pixels to within their noise.  Before it the LSF still carries
-    structure of its own (a shoulder, a halo) that the window must keep as
-    measured; at low SNR the test has little power and the core stays at
-    ``start``.  ``floor`` (DN) is a part of each bin's error that does not
-    average down (rounding shared by neighbouring samples)."""
-    return reach_and_fit(s, v, side, start, power, step, floor)[0]
-
-
 def reach_and_fit(s: np.ndarray, v: np.ndarray, side: int, start: float, power: int, step: float,
                   floor: float = 0.0) -> tuple[float, SideFit | None]:
-    """:func:`model_reach`, and the side's fit from there on where it was
-    made (the same samples in the same order as :func:`fit_side` of all
-    the samples selects: the same floats), else None."""
+    """Where a side's tail model takes over, and the side's fit from there
+    on where it was made (else None).
+
+    The reach is the smallest distance from ``start`` on (in ``step`` px
+    steps, at most half the side's range) from which level + A / |s|^p,
+    fitted out to the end of the data, explains the next few pixels to
+    within their noise.  Before it the LSF still carries structure of its
+    own (a shoulder, a halo) that the window must keep as measured; at low
+    SNR the test has little power and the core stays at ``start``.
+    ``floor`` (DN) is a part of each bin's error that does not average down
+    (rounding shared by neighbouring samples).  The fit is made of the same
+    samples in the same order as :func:`fit_side` of all the samples
+    selects from the reach on: the same floats."""
     on_side = np.sign(s) == side
     reach = np.abs(s[on_side])
     values = v[on_side]
