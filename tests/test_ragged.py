@@ -47,7 +47,7 @@ def test_least_squares_per_group_match_numpy_and_a_dependent_column_gets_zero():
 
 
 def test_least_squares_on_the_padded_grid_gives_the_bincounts_floats():
-    from imgmtf.estimate.ragged import Grid, _least_squares_by_counts
+    from imgmtf.estimate.ragged import Grid, _EndToEnd, _least_squares
     rng = np.random.default_rng(5)
     for sizes in ([40], [25, 0, 60, 3], [7, 90, 88], list(range(20, 60))):     # the last filled by indexing
         groups = Groups(sizes)
@@ -58,7 +58,7 @@ def test_least_squares_on_the_padded_grid_gives_the_bincounts_floats():
         grid = Grid.of(groups)
         assert grid.sum(grid.scatter(y))[: groups.count].tobytes() == groups.sum(y).tobytes()
         coef, resid = least_squares(groups, columns, y)
-        slow_coef, slow_resid = _least_squares_by_counts(groups, columns, y)
+        slow_coef, slow_resid = _least_squares(_EndToEnd(groups), columns, y)
         assert coef.tobytes() == slow_coef.tobytes() and resid.tobytes() == slow_resid.tobytes()
     assert Grid.of(Groups([1000, 1, 1, 1])) is None        # padding would swamp the samples
 

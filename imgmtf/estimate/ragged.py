@@ -182,34 +182,67 @@ class Grid:
         """Each column's sum, in order from 0 (padding columns included)."""
         return np.add.reduce(grid, axis=0, initial=0.0)
 
+    def spread(self, per_column: np.ndarray) -> np.ndarray:
+        """A value per column, as it broadcasts down its column."""
+        return per_column
 
-def _least_squares(grid: Grid, columns: Sequence[np.ndarray], target: np.ndarray
+    @property
+    def columns(self) -> int:
+        """Values a group per sum (padding columns included)."""
+        return self.shape[1]
+
+
+class _EndToEnd:
+    """The samples end to end, as :class:`Grid` lays them out: each
+    group's sum a bincount, a group's value spread by a repeat (for groups
+    too unequal to pad)."""
+
+    def __init__(self, groups: Groups):
+        self.count = self.columns = groups.count
+        self.shape = groups.ids.shape
+        self.sum, self.spread = groups.sum, groups.spread
+
+    def scatter(self, values: np.ndarray) -> np.ndarray:
+        return np.array(values, float)           # (a copy: the fit works on it in place)
+
+    def gather(self, samples: np.ndarray) -> np.ndarray:
+        return samples
+
+
+def _least_squares(layout: Grid | _EndToEnd, columns: Sequence[np.ndarray], target: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`least_squares` on a :class:`Grid`: the same operations on the
-    same values in the same order (each group's floats the same), with a
-    scatter of each input and a gather of the residual in place of a
-    bincount and a spread at every step."""
+    """:func:`least_squares` on the samples as ``layout`` holds them: the
+    same operations on the same values in the same order whichever it is
+    (each group's floats the same)."""
     m = len(columns)
     basis: list[np.ndarray] = []
-    r = [[np.zeros(grid.shape[1]) for _ in range(m)] for _ in range(m)]
+    # r[i][j]: the triangular factor, one value a group
+    r = [[np.zeros(layout.columns) for _ in range(m)] for _ in range(m)]
     rhs = []
-    residual = grid.scatter(np.asarray(target, float))
-    work = np.empty(grid.shape)       # each product made in place (the arrays are large: no new one a step)
+    residual = layout.scatter(np.asarray(target, float))
+    work = np.empty(layout.shape)       # each product made in place (the arrays are large: no new one a step)
     for j, column in enumerate(columns):
-        q = grid.scatter(np.asarray(column, float))
-        original = np.sqrt(grid.sum(np.multiply(q, q, out=work)))
+        q = layout.scatter(np.asarray(column, float))
+        original = np.sqrt(layout.sum(np.multiply(q, q, out=work)))
         for i, earlier in enumerate(basis):
-            r[i][j] = grid.sum(np.multiply(earlier, q, out=work))
-            q -= np.multiply(earlier, r[i][j], out=work)
-        norm = np.sqrt(grid.sum(np.multiply(q, q, out=work)))
+            r[i][j] = layout.sum(np.multiply(earlier, q, out=work))
+            q -= np.multiply(earlier, layout.spread(r[i][j]), out=work)
+        norm = np.sqrt(layout.sum(np.multiply(q, q, out=work)))
         independent = norm > 1e-13 * original
         r[j][j] = np.where(independent, norm, 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            q *= np.where(independent, 1.0 / norm, 0.0)
+            q *= layout.spread(np.where(independent, 1.0 / norm, 0.0))
         basis.append(q)
-        rhs.append(grid.sum(np.multiply(q, residual, out=work)))
-        residual -= np.multiply(q, rhs[j], out=work)
-    return _back_substituted(r, rhs, grid.shape[1])[: grid.count], grid.gather(residual)
+        rhs.append(layout.sum(np.multiply(q, residual, out=work)))
+        residual -= np.multiply(q, layout.spread(rhs[j]), out=work)
+    coef = np.zeros((layout.columns, m))
+    for j in range(m - 1, -1, -1):
+        value = rhs[j]
+        for k in range(j + 1, m):
+            value = value - r[j][k] * coef[:, k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            coef[:, j] = np.where(r[j][j] > 0, value / np.where(r[j][j] > 0, r[j][j], 1.0), 0.0)
+    return coef[: layout.count], layout.gather(residual)
 
 
 def least_squares(groups: Groups, columns: Sequence[np.ndarray], target: np.ndarray
@@ -234,50 +267,4 @@ def least_squares(groups: Groups, columns: Sequence[np.ndarray], target: np.ndar
     >>> np.round(coef, 12).tolist(), bool(np.abs(resid).max() < 1e-12)
     ([[1.0, 2.0], [1.0, 2.0]], True)
     """
-    grid = Grid.of(groups)
-    if grid is not None:
-        return _least_squares(grid, columns, target)
-    return _least_squares_by_counts(groups, columns, target)
-
-
-def _least_squares_by_counts(groups: Groups, columns: Sequence[np.ndarray], target: np.ndarray
-                             ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`least_squares` on the samples end to end, each sum a bincount
-    (for groups too unequal to pad)."""
-    m = len(columns)
-    basis: list[np.ndarray] = []
-    # r[i][j]: the triangular factor, one value a group
-    r = [[np.zeros(groups.count) for _ in range(m)] for _ in range(m)]
-    rhs = []
-    residual = np.array(target, float)
-    for j, column in enumerate(columns):
-        q = np.array(column, float)
-        original = np.sqrt(groups.sum(q * q))
-        for i, earlier in enumerate(basis):
-            r[i][j] = groups.sum(earlier * q)
-            q = q - earlier * groups.spread(r[i][j])
-        norm = np.sqrt(groups.sum(q * q))
-        independent = norm > 1e-13 * original
-        r[j][j] = np.where(independent, norm, 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            q = q * groups.spread(np.where(independent, 1.0 / norm, 0.0))
-        basis.append(q)
-        rhs.append(groups.sum(q * residual))
-        residual = residual - q * groups.spread(rhs[j])
-    return _back_substituted(r, rhs, groups.count), residual
-
-
-def _back_substituted(r: list, rhs: list, count: int) -> np.ndarray:
-    """Each of ``count`` groups' coefficients (groups, columns) from the
-    triangular factor ``r`` (``r[i][j]`` one value a group) and the
-    projections ``rhs``: a column with no independent part (``r[j][j]``
-    0) gets 0."""
-    m = len(rhs)
-    coef = np.zeros((count, m))
-    for j in range(m - 1, -1, -1):
-        value = rhs[j]
-        for k in range(j + 1, m):
-            value = value - r[j][k] * coef[:, k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            coef[:, j] = np.where(r[j][j] > 0, value / np.where(r[j][j] > 0, r[j][j], 1.0), 0.0)
-    return coef
+    return _least_squares(Grid.of(groups) or _EndToEnd(groups), columns, target)
