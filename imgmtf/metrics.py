@@ -51,5 +51,4 @@ def first_crossing(x: np.ndarray, y: np.ndarray, level: float):
     i = i[..., 0]
     with np.errstate(invalid="ignore", divide="ignore"):
         crossing = x[i - 1] + (y0 - level) / (y0 - y1) * (x[i] - x[i - 1])
-    crossing = np.where(found, crossing, np.nan)
-    return float(crossing) if y.ndim == 1 else crossing
+    return np.where(found, crossing, np.nan)

@@ -204,9 +204,9 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
         mtf50[rows] = first_crossing(first, mtf(sensor, np.broadcast_to(first, (count, first.size)), rows), 0.5)
     again = np.flatnonzero(np.isnan(mtf50))
     for start in range(0, again.size, chunk):
-        rows = again[start: start + chunk]
-        f = np.broadcast_to(MTF50_GRID_CY_PX, (rows.size, MTF50_GRID_CY_PX.size))
-        mtf50[rows] = first_crossing(MTF50_GRID_CY_PX, mtf(sensor, f, rows), 0.5)
+        picked = again[start: start + chunk]
+        f = np.broadcast_to(MTF50_GRID_CY_PX, (picked.size, MTF50_GRID_CY_PX.size))
+        mtf50[picked] = first_crossing(MTF50_GRID_CY_PX, mtf(sensor, f, picked), 0.5)
     return bands, mtf50
 
 
