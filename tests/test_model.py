@@ -172,28 +172,3 @@ def test_the_fwhms_spectrum_is_the_transfer_but_for_the_sign_of_a_zero(angle):
         grid = line_grid(sensor, angle, sensor.gsd_m, reach_px=half, step_px=1 / 400)
         full = grid.lsf_remainder(sensor.normal_transfer(grid.frequencies_cy_px, angle))
         assert np.array_equal(lsf, line_spread(grid.start_px, grid.step_px, full, grid.reference, x))
-
-
-@pytest.mark.parametrize("core_widths", [4.0, 0.1])
-def test_the_fwhm_read_on_the_lsfs_core_is_the_whole_lsfs(monkeypatch, core_widths):
-    """Sensor.fwhm_m reads the LSF on its core when the rest is provably
-    lower than its peak: the FWHM of the whole LSF (Sensor.lsf), bit for
-    bit (a one-sided stage, a Cauchy reference, a flat-topped rect); a core
-    too narrow to hold the half maximum (0.1 reference widths: 1 px) falls
-    back to the whole LSF."""
-    from imgmtf.metrics import fwhm
-    from imgmtf.sensor import model
-    sensors = (im.Sensor(1.0, [st.GaussianOptics(0.42, 0.45), st.Detector(1.05, 0.97)]),
-               im.Sensor(0.5, [st.GaussianOptics(0.3, 0.3), st.Lag(0.4, 0.2), st.Detector(0.5, 0.5)]),
-               im.Sensor(1.0, [st.Detector(1.0, 1.0), st.Diffraction(), st.GaussianOptics(0.3, 0.3)]),
-               im.Sensor(1.0, [st.GaussianOptics(0.05, 0.05), st.Detector(3.0, 2.5)]))
-    whole = [fwhm(*s.lsf(d)) for s in sensors for d in ("across", "along")]
-    calls = []
-    monkeypatch.setattr(model, "FWHM_CORE_WIDTHS", core_widths)
-    whole_lsf = im.Sensor.lsf
-    monkeypatch.setattr(im.Sensor, "lsf", lambda self, direction="across": calls.append(self) or whole_lsf(self,
-                                                                                                           direction))
-    assert [s.fwhm_m(d) for s in sensors for d in ("across", "along")] == whole
-    # the core alone at 4 widths; at a 1 px core, the whole LSF for the half-maxima beyond it (the 3 px
-    # rect's, the lagged sensor's of 0.5 m pixels)
-    assert calls == ([] if core_widths == 4.0 else [sensors[1]] * 2 + [sensors[3]] * 2)

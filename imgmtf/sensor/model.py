@@ -50,9 +50,6 @@ GSD_RANGE_M = (1e-12, 1e15)
 PAPER_STAGES = ("optics", "detector", "motion", "electronics")
 #: largest 2-D grid (cells) a sensor may ask for (its 1-D lines: :data:`.lines.MAX_LINE_SAMPLES`)
 MAX_GRID_CELLS = 1 << 24
-#: the half-width of the LSF's core a FWHM is read on first, in widths of its line response's reference
-#: (for a Gaussian reference, its standard deviation: a Gaussian's half maximum lies at 1.18, a rect's at 1.73)
-FWHM_CORE_WIDTHS = 4.0
 
 # keyword of the generic sensor -> (stage, parameter); a stage whose
 # parameters are all 0 is left out (cut-off 0 meant no electronics filter)
@@ -307,20 +304,16 @@ class Sensor:
         lsf : numpy.ndarray
             The LSF there, 1/px.
         """
-        grid, remainder, n = self._normal_lsf_remainder(angle_deg, self._gsd(gsd_m), samples_per_px)
-        x = (np.arange(n) - n // 2) / samples_per_px
-        return x, line_spread(grid.start_px, grid.step_px, remainder, grid.reference, x)
-
-    def _normal_lsf_remainder(self, angle_deg: float, gsd: float, samples_per_px: int):
-        """:meth:`normal_lsf`'s fine grid, its LSF remainder there and the
-        count of the positions it returns."""
+        gsd = self._gsd(gsd_m)
         half = 4 * self.support_radius_m() / gsd
         # the line response's LSF (its ESF unused: half the inverse FFTs of :meth:`line_response`)
         grid = line_grid(self, angle_deg, gsd, reach_px=half, step_px=1.0 / samples_per_px)
         # the transfer where it is not zero only: most of the fine grid's frequencies lie beyond the optics' underflow
         a, f = math.radians(check_angle(angle_deg)), grid.frequencies_cy_px / gsd
         remainder = grid.lsf_remainder(nonzero_transfer(self.stages, f * math.cos(a), f * math.sin(a), self.gsd_m))
-        return grid, remainder, 2 * int(math.ceil(half * samples_per_px)) + 1
+        n = 2 * int(math.ceil(half * samples_per_px)) + 1
+        x = (np.arange(n) - n // 2) / samples_per_px
+        return x, line_spread(grid.start_px, grid.step_px, remainder, grid.reference, x)
 
     def lsf(self, direction: str = "across") -> tuple[np.ndarray, np.ndarray]:
         """Line spread function across or along track: ``(x_m, lsf)``,
@@ -344,11 +337,6 @@ class Sensor:
     def fwhm_m(self, direction: str = "across") -> float:
         """FWHM of the line spread function across or along track (metres).
 
-        ``metrics.fwhm(*self.lsf(direction))``, bit for bit, read on the
-        LSF's core (:data:`FWHM_CORE_WIDTHS` widths of its reference, at
-        least 1 px) when the rest of it is provably below the core's peak
-        and the core holds both half-maximum crossings.
-
         Parameters
         ----------
         direction : {"across", "along"}, optional
@@ -359,24 +347,6 @@ class Sensor:
         float
             The FWHM, m on the ground.
         """
-        samples_per_px = 400                      # as :meth:`lsf` samples it
-        grid, remainder, n = self._normal_lsf_remainder(direction_angle(direction), self.gsd_m, samples_per_px)
-        centre = n // 2
-        reach = int(math.ceil(max(FWHM_CORE_WIDTHS * grid.reference[1], 1.0) * samples_per_px))
-        if reach < centre:
-            # the LSF's core alone, as :meth:`lsf` gives it (each position's value its own), when the rest is
-            # provably lower than its peak: the remainder's samples there (between which it is linear) plus the
-            # reference, falling with distance, from the first position outside on
-            x = (np.arange(centre - reach, centre + reach + 1) - centre) / samples_per_px
-            y = line_spread(grid.start_px, grid.step_px, remainder, grid.reference, x)
-            first, last = (int((x[k] - grid.start_px) / grid.step_px) for k in (0, -1))
-            outside = np.abs(np.concatenate([remainder[:first + 3], remainder[last - 2:]])).max(initial=0.0)
-            beyond = np.array([-(reach + 1), reach + 1]) / samples_per_px
-            outside += line_spread(0.0, 1.0, np.zeros(1), grid.reference, beyond).max()
-            width = fwhm(x * self.gsd_m, y / self.gsd_m)
-            # (its crossings of the half maximum, when found, the first from the peak: the LSF's own)
-            if outside < (1.0 - 1e-9) * y.max() and math.isfinite(width):
-                return width
         return fwhm(*self.lsf(direction))
 
     def psf(self, oversampling: int = 20, tolerance: float = 1e-7,
