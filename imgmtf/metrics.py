@@ -35,6 +35,14 @@ def first_crossing(x: np.ndarray, y: np.ndarray, level: float):
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     below = y < level
+    if y.ndim == 1:
+        # one curve (a report reads thousands): the same arithmetic on its two samples, without the
+        # stacked path's gathers
+        k = int(np.argmax(below))
+        if k == 0:                           # never below, or below from the start
+            return float("nan")
+        y0, y1 = y[k - 1], y[k]
+        return float(x[k - 1] + (y0 - level) / (y0 - y1) * (x[k] - x[k - 1]))
     i = np.argmax(below, axis=-1)
     found = below.any(axis=-1) & (i > 0)
     i = np.clip(i, 1, x.size - 1)[..., None]
@@ -43,5 +51,4 @@ def first_crossing(x: np.ndarray, y: np.ndarray, level: float):
     i = i[..., 0]
     with np.errstate(invalid="ignore", divide="ignore"):
         crossing = x[i - 1] + (y0 - level) / (y0 - y1) * (x[i] - x[i - 1])
-    crossing = np.where(found, crossing, np.nan)
-    return float(crossing) if y.ndim == 1 else crossing
+    return np.where(found, crossing, np.nan)

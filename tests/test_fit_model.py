@@ -61,6 +61,36 @@ def test_edge_model_mtfs_are_each_edges_own(edges):
         assert own[0] == value and abs(own[2] - own[1] - 2 * NormalDist().inv_cdf(0.95) * se) < 1e-15
 
 
+@pytest.mark.parametrize("first", [101, 766])
+def test_mtf50s_read_on_the_grids_first_part_are_the_whole_grids(edges, monkeypatch, first):
+    """The report's MTF50s (edges' and directions', with their intervals)
+    and Nyquist bands, read on the MTF50 grid's first frequencies and on
+    the whole grid where a curve has not crossed 0.5 there (to 0.05 cy/px:
+    none has, every curve made again; to 0.3825 cy/px: the lower bounds), are the whole
+    grid's first crossings and the band at 0.5 cy/px, bit for bit."""
+    from imgmtf.estimate.fit import report
+    from imgmtf.metrics import first_crossing
+    data = [edge_data(e, k, None) for k, e in enumerate(edges)]
+    model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    u = model.initial_vector()[: model.n_free]
+    covariance = np.diag(np.linspace(1e-4, 4e-4, model.n_free)) + 5e-5
+    sensors = fit_bands.band_sensors(model, u)
+    f = np.linspace(0.0, 2.0, 4001)
+    whole = [[first_crossing(f, c, 0.5) for c in fit_bands.model_mtf_band(model, u, covariance, f, a, 1.0, 0.9,
+                                                                          sensors)] for a in (0.0, 90.0)]
+    nyquist = [fit_bands.model_mtf_band(model, u, covariance, np.array(0.5), a, 1.0, 0.9, sensors) for a in (0.0, 90.0)]
+    edge_bands, edge_mtf50 = report.edge_model_mtfs(model, u, covariance, sensors, 0.9, chunk=3)
+    monkeypatch.setattr(fit_bands, "MTF50_FIRST", first)
+    monkeypatch.setattr(report, "MTF50_FIRST", first)
+    crossed = [bool(v <= f[first - 1]) for row in whole for v in row]
+    assert not any(crossed) if first == 101 else any(crossed) and not all(crossed)
+    for a, own, at_nyquist in zip((0.0, 90.0), whole, nyquist):
+        band, mtf50, (low, high) = fit_bands.model_nyquist_mtf50_bands(model, u, covariance, a, 1.0, 0.9, sensors)
+        assert [mtf50, low, high] == own and [float(v) for v in band] == [float(v) for v in at_nyquist]
+    bands, mtf50 = report.edge_model_mtfs(model, u, covariance, sensors, 0.9, chunk=3)
+    assert np.array_equal(bands, edge_bands) and np.array_equal(mtf50, edge_mtf50)
+
+
 def test_edges_grouped_by_angle_fit_as_each_edge_alone(edges, monkeypatch):
     """Edges whose responses are interpolated in angle (:mod:`.angles`,
     here groups of two) give the residuals, Jacobian and optimum of each

@@ -94,6 +94,26 @@ def test_first_crossing():
     assert np.isnan(first_crossing(f, np.ones(11), 0.5))
 
 
+def test_one_curves_first_crossing_is_its_rows_in_a_stack():
+    """A single curve's crossing (read off its two samples) is the one the
+    stacked path gives its row, bit for bit: crossings inside, at the last
+    sample, never (NaN), below from the start (NaN), a sample exactly at
+    the level (not below) and a NaN sample (never below)."""
+    import math
+    rng = np.random.default_rng(3)
+    x = np.sort(rng.random(12)) * 3.0
+    curves = np.vstack([np.cumsum(-rng.random((40, 12)), axis=1) + rng.random((40, 1)) * 6.0,
+                        np.linspace(1.0, 0.2, 12), np.ones(12), np.full(12, 0.1),
+                        np.r_[1.0, 0.5, 0.4, np.zeros(9)], np.r_[1.0, np.nan, 0.3, np.zeros(9)]])
+    stacked = first_crossing(x, curves, 0.5)
+    assert np.isnan(stacked).sum() >= 3 and np.isfinite(stacked).sum() >= 30
+    for row, expected in zip(curves, stacked):
+        got = first_crossing(x, row, 0.5)
+        assert type(got) is float and (got == expected or (math.isnan(got) and math.isnan(expected)))
+    # at the level is not below: the crossing is that sample; a NaN before the first sample below spoils it
+    assert first_crossing(x, curves[-2], 0.5) == x[1] and math.isnan(first_crossing(x, curves[-1], 0.5))
+
+
 def test_noise_limited_frequency_closed_form():
     from scipy.optimize import brentq
 

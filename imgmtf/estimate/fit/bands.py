@@ -41,22 +41,89 @@ def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.nd
     """The model's MTF at ``f`` along ``angle_deg`` and its delta-method
     band; ``sensors`` (:func:`band_sensors` of ``model`` and ``u``) when
     several angles are asked for."""
+    value, gradients = _mtf_and_gradients(model, u, f, angle_deg, gsd, sensors)
+    return _band(value, gradients, covariance, confidence)
+
+
+def _mtf_and_gradients(model: Model, u: np.ndarray, f: np.ndarray, angle_deg: float, gsd: float,
+                       sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None):
+    """The model's MTF at ``f`` along ``angle_deg`` and its derivatives in
+    the free coordinates (by forward steps; stacked on a last axis, None
+    without a free coordinate)."""
     sensor, steps = band_sensors(model, u) if sensors is None else sensors
     n = model.n_free
     value, *stepped = normal_mtfs([sensor] + [shifted for _, shifted in steps[:n]], f, angle_deg, gsd)
     if n == 0:
+        return value, None
+    return value, np.stack([(mtf - value) / h for (h, _), mtf in zip(steps, stepped)], axis=-1)
+
+
+def _band(value: np.ndarray, gradients: np.ndarray | None, covariance: np.ndarray, confidence: float):
+    """An MTF ``value``, its delta-method band's lower and upper bounds
+    (clipped to [0, 1]) from its ``gradients`` and their ``covariance``."""
+    if gradients is None:
         return value, value, value
-    grads = [(mtf - value) / h for (h, _), mtf in zip(steps, stepped)]
-    g = np.stack(grads, axis=-1)
-    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g), 0.0))
+    n = gradients.shape[-1]
+    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", gradients, covariance[:n, :n], gradients), 0.0))
     z = NormalDist().inv_cdf(0.5 + confidence / 2)
     return value, np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
 
 
-def model_mtf50_band(model, u, covariance, angle_deg, gsd, confidence, sensors=None):
-    f = np.linspace(0.0, 2.0, 4001)
-    value, low, high = model_mtf_band(model, u, covariance, f, angle_deg, gsd, confidence, sensors)
-    return first_crossing(f, value, 0.5), (first_crossing(f, low, 0.5), first_crossing(f, high, 0.5))
+#: the frequencies (cy/px) a model's MTF50 is read on: 4001 to 2 cy/px
+MTF50_GRID_CY_PX = np.linspace(0.0, 2.0, 4001)
+#: Nyquist's place on that grid (0.5 cy/px exactly)
+NYQUIST_INDEX = 1000
+#: how many of its frequencies are tried first: to Nyquist, below which a sampled
+#: system's MTF50 usually lies (its MTF at Nyquist under a half); the others only
+#: when a curve has not crossed 0.5 there
+MTF50_FIRST = NYQUIST_INDEX + 1
+
+
+def model_nyquist_mtf50_bands(model: Model, u: np.ndarray, covariance: np.ndarray, angle_deg: float, gsd: float,
+                              confidence: float, sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None = None):
+    """The model's MTF at Nyquist along ``angle_deg`` with its band, and its
+    MTF50 (cy/px) with its interval: where its MTF and the band's bounds
+    first fall to 0.5 on :data:`MTF50_GRID_CY_PX`; the numbers of
+    :func:`model_mtf_band` at 0.5 cy/px and of
+    :func:`imgmtf.metrics.first_crossing` of its curves on the whole grid,
+    bit for bit, in a quarter of the transfers.  The curves are made on the
+    grid's first :data:`MTF50_FIRST` frequencies, and on all of it only
+    when one has not crossed 0.5 there (each frequency's value is its own,
+    and a first crossing among the first frequencies is the whole curve's).
+
+    Returns
+    -------
+    nyquist : tuple of float
+        The MTF at 0.5 cy/px, its band's lower and upper bounds.
+    mtf50 : float
+        The MTF50, cy/px (NaN where the MTF stays above 0.5 to 2 cy/px).
+    interval : tuple of float
+        Where the band's lower and upper bounds fall to 0.5, cy/px.
+
+    Examples
+    --------
+    >>> import imgmtf as im
+    >>> from imgmtf.estimate.fit.data import edge_data
+    >>> from imgmtf.estimate.fit.model import Model, initial_stages
+    >>> edges = [im.measure_edge(im.render(im.Sensor(), im.Target("edge", a), 60).image) for a in (5.0, 84.0)]
+    >>> model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0),
+    ...               [edge_data(e, k, None) for k, e in enumerate(edges)])
+    >>> u = model.initial_vector()[: model.n_free]
+    >>> (value, low, high), mtf50, (below, above) = model_nyquist_mtf50_bands(
+    ...     model, u, np.eye(model.n_free) * 1e-4, 0.0, 1.0, 0.95)
+    >>> bool(low < value < high), bool(below < mtf50 < above)
+    (True, True)
+    """
+    for size in (MTF50_FIRST, MTF50_GRID_CY_PX.size):
+        f = MTF50_GRID_CY_PX[:size]
+        value, gradients = _mtf_and_gradients(model, u, f, angle_deg, gsd, sensors)
+        mtf50, low, high = (first_crossing(f, curve, 0.5) for curve in _band(value, gradients, covariance, confidence))
+        if not math.isnan(mtf50 + low + high):
+            break
+    # one frequency's band formed alone (a batched quadratic form may sum in another order)
+    nyquist = _band(value[NYQUIST_INDEX], None if gradients is None else gradients[NYQUIST_INDEX], covariance,
+                    confidence)
+    return nyquist, mtf50, (low, high)
 
 
 def normal_mtfs(sensors: Sequence[Sensor], f_cy_px: ArrayLike, angle_deg: float, gsd_m: float) -> list[np.ndarray]:

@@ -11,7 +11,7 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
-from .bands import band_sensors, model_mtf50_band, model_mtf_band, sensor_transfers
+from .bands import MTF50_FIRST, MTF50_GRID_CY_PX, band_sensors, model_nyquist_mtf50_bands, sensor_transfers
 from .choice import other_stages
 from .model import Model
 from .responses import StackedResponses
@@ -102,8 +102,8 @@ def fit_report(model: Model, z: np.ndarray, covariance: np.ndarray, notes: dict,
     directions = {}
     for direction in DIRECTIONS:
         angle = direction_angle(direction)
-        value, low, high = model_mtf_band(model, u, covariance, np.array(0.5), angle, model.gsd, confidence, stepped)
-        mtf50, mtf50_ci = model_mtf50_band(model, u, covariance, angle, model.gsd, confidence, stepped)
+        (value, low, high), mtf50, mtf50_ci = model_nyquist_mtf50_bands(model, u, covariance, angle, model.gsd,
+                                                                         confidence, stepped)
         directions[direction] = {"mtf_nyquist": float(value), "mtf_nyquist_ci": [float(low), float(high)],
                                  "mtf50_cy_px": mtf50, "mtf50_cy_px_ci": list(mtf50_ci),
                                  "constrained": direction in seen}
@@ -177,7 +177,7 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
     sin = np.array([math.sin(a) for a in radians])
     gsd = np.array([sensor._gsd(d.gsd_m) for d in model.data])
 
-    def mtf(s: Sensor, f: np.ndarray, rows: slice) -> np.ndarray:
+    def mtf(s: Sensor, f: np.ndarray, rows: slice | np.ndarray) -> np.ndarray:
         f = f / (gsd[rows, None] if f.ndim > 1 else gsd[rows])
         return np.abs(s.transfer(f * (cos[rows, None] if f.ndim > 1 else cos[rows]),
                                  f * (sin[rows, None] if f.ndim > 1 else sin[rows])))
@@ -194,12 +194,19 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
         se = np.sqrt(np.maximum([np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g) for g in grads], 0.0))
         z = NormalDist().inv_cdf(0.5 + confidence / 2)
         bands[1], bands[2] = np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
-    f = np.linspace(0.0, 2.0, 4001)
+    # as model_nyquist_mtf50_bands reads them: on the grid's first frequencies, then on all of it for an edge
+    # whose MTF has not crossed 0.5 there
+    first = MTF50_GRID_CY_PX[:MTF50_FIRST]
     mtf50 = np.empty(gsd.size)
     for start in range(0, gsd.size, chunk):
         rows = slice(start, start + chunk)
         count = gsd[rows].size
-        mtf50[rows] = first_crossing(f, mtf(sensor, np.broadcast_to(f, (count, f.size)), rows), 0.5)
+        mtf50[rows] = first_crossing(first, mtf(sensor, np.broadcast_to(first, (count, first.size)), rows), 0.5)
+    again = np.flatnonzero(np.isnan(mtf50))
+    for start in range(0, again.size, chunk):
+        picked = again[start: start + chunk]
+        f = np.broadcast_to(MTF50_GRID_CY_PX, (picked.size, MTF50_GRID_CY_PX.size))
+        mtf50[picked] = first_crossing(MTF50_GRID_CY_PX, mtf(sensor, f, picked), 0.5)
     return bands, mtf50
 
 
