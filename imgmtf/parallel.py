@@ -24,7 +24,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
@@ -120,7 +120,11 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     function : callable
         What to run on each item (picklable: a module's function).
     items : iterable
-        The tasks' arguments, one each.
+        The tasks' arguments, one each.  A sequence (list, tuple) is taken
+        whole; any other iterable (a generator) is taken lazily, on local
+        workers a few items ahead of those running, so that the work of
+        making later items overlaps the workers' on earlier ones (its
+        progress bar then has no total).
     workers : int, optional
         Local worker processes (1, the default: run here, no processes), at
         most :data:`MAX_WORKERS`.
@@ -151,13 +155,15 @@ def run_tasks(function: Callable, items: Iterable, *, workers: int = 1, schedule
     >>> list(run_tasks(abs, [-2, 1, -3], workers=2))
     [2, 1, 3]
     """
-    items = list(items)
+    if isinstance(items, Sequence):
+        items = list(items)
     check_workers(workers)
+    total = len(items) if isinstance(items, list) else None
     if progress is None:
-        progress = len(items) > 1 and _stderr_is_terminal()
+        progress = (total is None or total > 1) and _stderr_is_terminal()
     completed = _completed(function, items, workers, scheduler, on_error)
     if progress:
-        completed = _with_progress(completed, len(items), description)
+        completed = _with_progress(completed, total, description)
     try:
         if ordered:
             reorder = InputOrder()
@@ -341,7 +347,7 @@ class InputOrder:
         return [self._waiting.pop(i) for i in sorted(self._waiting)]
 
 
-def _with_progress(completed, total: int, description: str):
+def _with_progress(completed, total: int | None, description: str):
     from tqdm import tqdm
     with tqdm(total=total, desc=description, unit="task", leave=False) as bar:
         try:
@@ -359,9 +365,10 @@ def _completed(function, items, workers, scheduler, on_error):
     milliseconds, and this process need not import them."""
     if scheduler is not None:
         from .dask_tasks import dask_completed
-        yield from dask_completed(function, items, workers, scheduler, on_error,
+        yield from dask_completed(function, list(items), workers, scheduler, on_error,
                                   local=scheduler == LOCAL_CLUSTER, timeout_s=SCHEDULER_TIMEOUT_S)
-    elif workers == 1 or not items or (len(items) == 1 and not (_preloaded and _fork_server_running())):
+    elif workers == 1 or (isinstance(items, list) and (
+            not items or (len(items) == 1 and not (_preloaded and _fork_server_running())))):
         _take_prestarted(0)
         for index, item in enumerate(items):
             yield index, _call(function, item, on_error)
@@ -382,36 +389,39 @@ def _pool_completed(function, items, workers, on_error):
     """(index, result) pairs from a pool of ``workers`` processes.  Only
     ``IN_FLIGHT_PER_WORKER`` tasks per worker are submitted at a time, so
     that each wait (and a stop's cancelling) looks at a few futures however
-    long the batch."""
+    long the batch; and items are taken from ``items`` only as they are
+    submitted (a generator's work on the next ones overlaps the workers')."""
     from concurrent.futures.process import BrokenProcessPool
-    pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)))
+    pool = _take_prestarted(workers) or _new_pool(min(workers, len(items)) if isinstance(items, list) else workers)
     queue = iter(enumerate(items))
-    in_flight: dict = {}
+    in_flight: dict = {}        # future: (index, item)
     finished = False
     try:
         while True:
             failed = []         # tasks the pool refused: it broke (a worker died)
+            # taken before the signals are held back: a lazy iterable's work on them may be long
+            taken = list(itertools.islice(queue, IN_FLIGHT_PER_WORKER * workers - len(in_flight)))
             with signals_deferred():
-                for index, item in itertools.islice(queue, IN_FLIGHT_PER_WORKER * workers - len(in_flight)):
+                for index, item in taken:
                     try:
-                        in_flight[pool.submit(function, item)] = index
+                        in_flight[pool.submit(function, item)] = index, item
                     except BrokenProcessPool as exc:
-                        failed.append((index, exc))
-            for index, broken in failed:
-                yield index, _died(items[index], broken, on_error)
+                        failed.append((index, item, exc))
+            for index, item, broken in failed:
+                yield index, _died(item, broken, on_error)
             if not in_flight:
                 break
             done, _ = _wait_between_signals(set(in_flight))
             for future in done:
-                index = in_flight.pop(future)
+                index, item = in_flight.pop(future)
                 try:
                     result = future.result()
                 except BrokenProcessPool as exc:
-                    result = _died(items[index], exc, on_error)
+                    result = _died(item, exc, on_error)
                 except Exception as exc:
                     if on_error is None:
                         raise
-                    result = on_error(items[index], exc)
+                    result = on_error(item, exc)
                 yield index, result
         finished = True
     finally:

@@ -20,6 +20,25 @@ def test_processes_keep_input_order():
     assert list(run_tasks(math.sqrt, [16, 9, 4, 1, 0], workers=2)) == [4, 3, 2, 1, 0]
 
 
+def test_a_generators_items_are_taken_as_they_are_submitted():
+    # a sequence is taken whole; a generator a few items ahead of the workers (the pool's first
+    # submissions, IN_FLIGHT_PER_WORKER a worker), and a failed task's error names its own item
+    from imgmtf.parallel import IN_FLIGHT_PER_WORKER
+    taken = []
+
+    def items():
+        for x in [16, 9, -1, 4, 1, 0, 25, 36]:
+            taken.append(x)
+            yield x
+    results = run_tasks(math.sqrt, items(), workers=2, ordered=False, on_error=lambda item, exc: f"{item}?")
+    first = next(results)
+    assert taken == [16, 9, -1, 4][:IN_FLIGHT_PER_WORKER * 2] and first in {(0, 4), (1, 3), (2, "-1?"), (3, 2)}
+    assert sorted([first, *results]) == [(0, 4), (1, 3), (2, "-1?"), (3, 2), (4, 1), (5, 0), (6, 5), (7, 6)]
+    taken.clear()
+    here = run_tasks(math.sqrt, items(), workers=1)
+    assert (next(here), taken) == (4, [16])
+
+
 def test_a_worker_that_dies_fails_its_tasks_and_the_rest_still_report():
     # os._exit kills the worker running it: the pool breaks, and every task,
     # those running and those not yet submitted, gets one result each

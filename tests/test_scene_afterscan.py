@@ -5,6 +5,7 @@ import pytest
 
 import imgmtf as im
 import imgmtf.parallel
+import imgmtf.scene.targetfit
 from imgmtf.errors import ParameterError
 from imgmtf.scene.afterscan import sections_and_fits
 from imgmtf.scene.combine import summarise_scan
@@ -33,29 +34,37 @@ def rows(records):
     return [(r.status, r.site, r.figures) for r in records]
 
 
-def test_the_rows_are_each_stages_own_in_order_with_the_scenes_fit_first(two_targets, monkeypatch):
+def test_the_rows_are_each_stages_own_in_order_with_the_sections_first(two_targets, monkeypatch):
     records, summaries = two_targets
     sections, fits = section_rows(summaries), fit_targets(records)
     assert [r.site.get("target_id") for r in fits[::2]] == [1, 2, None]
     assert rows(sections_and_fits(records, summaries, "auto")[0]) == rows(sections)
     kinds = []
 
-    def in_turn(function, items, workers, **options):     # the pool's tasks, run here in turn
-        kinds.extend((workers, kind, item[1].get("target_id") if kind == "fit" else
-                      [each[1]["target_id"] for each in item] if kind == "fits" else None) for kind, item in items)
-        return map(function, items)
+    def in_turn(function, items, workers, **options):     # the pool's tasks, taken one by one and run here
+        assert not isinstance(items, list)                 # (taken lazily)
+        for kind, item in items:
+            kinds.append((workers, kind, item[1].get("target_id") if kind == "fit" else
+                          [each[1]["target_id"] for each in item] if kind == "fits" else None))
+            yield function((kind, item))
     monkeypatch.setattr(imgmtf.parallel, "run_tasks", in_turn)
-    # on workers: the measurements travel without their MTF function, the fits the same; the targets'
-    # fits are sent the last-ranked (the noisiest, the longest to fit) first; a few only, one to a task
+    made = imgmtf.scene.targetfit.fit_tasks
+    monkeypatch.setattr(imgmtf.scene.targetfit, "fit_tasks",
+                        lambda *a, **k: kinds.append("fit tasks made") or made(*a, **k))
+    # on workers: the sections first, each target's (and the scene's) a task of its own: the pool takes
+    # them all at once; the fits' tasks made only then; the measurements travel without their MTF
+    # function, the fits the same; the targets' fits are sent the last-ranked (the noisiest, the
+    # longest to fit) first; a few only, one to a task
     there = sections_and_fits(records, summaries, "auto", workers=2)
-    assert kinds == [(2, "fit", None), (2, "sections", None), (2, "fits", [2]), (2, "fits", [1])]
+    assert kinds == [(2, "sections", None)] * 3 + ["fit tasks made", (2, "fit", None), (2, "fits", [2]),
+                                                   (2, "fits", [1])]
     assert (rows(there[0]), rows(there[1])) == (rows(sections), rows(fits))
     assert sections_and_fits(records, summaries, None, workers=2)[1] == []
     # many, a few to a task (fits_per_task's own examples: 4 of 484 on 2 workers, 1 of 20)
     monkeypatch.setattr(imgmtf.scene.afterscan, "fits_per_task", lambda targets, workers: 2)
     kinds.clear()
     assert rows(sections_and_fits(records, summaries, "auto", workers=2)[1]) == rows(fits)
-    assert kinds[2:] == [(2, "fits", [2, 1])]
+    assert kinds[5:] == [(2, "fits", [2, 1])]
     with pytest.raises(ParameterError, match="workers"):
         sections_and_fits(records, summaries, "auto", workers=0)
 
@@ -69,6 +78,7 @@ def test_on_workers_the_fits_name_their_half_edges_in_one_shared_block_freed_eve
     names = []
 
     def interrupted(function, items, workers, **options):
+        items = list(items)
         fits = [item for kind, item in items if kind == "fit"] + \
             [each for kind, item in items if kind == "fits" for each in item]
         names.extend({item[0].name for item in fits if isinstance(item[0], Shared)})

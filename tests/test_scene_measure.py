@@ -228,6 +228,27 @@ def test_a_scan_detecting_on_workers_has_their_fork_server_load_its_tasks_module
     assert all(importlib.util.find_spec(name) is not None for name in SCAN_TASK_MODULES)
 
 
+def test_segments_found_here_that_promise_a_pool_start_its_fork_server_before_the_rois_are_planned(monkeypatch):
+    import imgmtf.parallel as parallel
+    import imgmtf.scene.measure as measure
+    started = []
+    monkeypatch.setattr(parallel, "available_cores", lambda: 2)
+    monkeypatch.setattr(parallel, "can_preload", lambda: True)
+    monkeypatch.setattr(measure, "prestart_workers", lambda *a: started.append(a))
+    monkeypatch.setattr(measure, "preloaded", lambda modules: False)
+    enough = 2 * measure.AUTO_PLANS_PER_WORKER
+    # (segments, workers, detecting, scheduler): workers chosen, the tiles searched here, a pool's worth
+    for args in [(enough - 1, None, 1, None), (enough, 2, 2, None), (enough, None, 2, None),
+                 (enough, None, 1, "local")]:
+        measure._prestart_for_candidates(*args)
+    assert started == []
+    measure._prestart_for_candidates(enough, None, 1, None)
+    assert started == [(2, SCAN_TASK_MODULES)]
+    monkeypatch.setattr(measure, "preloaded", lambda modules: True)          # (the command's, running)
+    measure._prestart_for_candidates(enough, None, 1, None)
+    assert len(started) == 1
+
+
 def test_the_scan_module_loads_without_scipy_so_the_workers_fork_server_starts_first():
     # the segment graph's SciPy is imported by scan_scene once the workers' fork server has started,
     # so that the two imports overlap rather than follow each other

@@ -6,10 +6,13 @@ Neither needs the other: both follow the scan's records and their
 summaries.  Run one after the other, each stage waited for its last task
 (a barrier), and the scene's fit is one task as long as all its targets'
 (11 s of a dense chart's 21 s on two workers): while it ran alone the
-other worker waited.  Here the scene's fit goes first, then the
-sections' tasks and the targets' fits, on the same workers, and each
-task's rows are put back in their place: the rows are those the two
-stages give apart, in the same order.
+other worker waited.  Here the sections' tasks go first, then the
+scene's fit and the targets' fits, on the same workers, and each task's
+rows are put back in their place: the rows are those the two stages give
+apart, in the same order.  The fits' tasks are made (and their
+half-edges packed, below) only once the sections' are in the workers'
+hands (:func:`imgmtf.parallel.run_tasks` takes its tasks lazily): the
+parent's 0.4 s on a dense chart had kept both workers waiting.
 
 On local workers the fits' half-edges are pickled once into shared memory
 (:mod:`imgmtf.shared_pickle`), each worker loads them once, and a fit's
@@ -73,7 +76,7 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
     >>> sections, fits = sections_and_fits(records, summarise_scan(records), "auto", workers=2)  # doctest: +SKIP
     """
     from ..errors import ParameterError
-    from ..parallel import can_preload, check_workers, run_tasks
+    from ..parallel import IN_FLIGHT_PER_WORKER, can_preload, check_workers, run_tasks, signals_deferred
     from .sections import section_groups, section_tasks, sections_workers
     from .targetfit import fit_tasks, fitted_rows
     groups = section_groups(summaries)
@@ -84,31 +87,52 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
         raise ParameterError("records must be a scan's Records (imgmtf.scan_scene)")
     fitting = fit_workers(records, workers) if stages else 1
     chosen = max(sections_workers(len(groups), workers), fitting)
-    fits, scenes = fit_tasks(records, stages, workers=chosen, scheduler=scheduler) if stages else ([], 0)
     here = chosen == 1 and scheduler is None
-    # the scene's fit first (the longest), then the sections (short tasks; here, all at once), then the
-    # targets' fits, the last-numbered first: targets are numbered by their best rank (the narrowest
-    # interval, then the highest SNR), and the last are the noisiest, often misfit, whose fits try more
-    # stages (0.4-1.6 s against 0.02 s on the 4096 px bench scene): started last, one of them ran alone
-    order = [*range(scenes), *range(len(fits) - 1, scenes - 1, -1)]
-    # many targets' fits a few to a task: each is short (30 ms on the dense chart) beside a task's round trip
-    targets = [fits[k] for k in order[scenes:]]
-    per_task = fits_per_task(len(targets), chosen)
-    tasks = [(FIT, fits[k]) for k in order[:scenes]] + \
-        [(SECTIONS, t) for t in ([groups] if here else section_tasks(groups)) if t] + \
-        [(FITS, targets[k:k + per_task]) for k in range(0, len(targets), per_task)]
-    if here:
-        results = [_stage_task(task) for task in tasks]
-    else:
-        shared = None
-        try:
-            if scheduler is None and can_preload():
-                shared, tasks = _shipped_once(tasks)
-            results = list(run_tasks(_stage_task, tasks, workers=chosen, scheduler=scheduler, progress=progress,
-                                     description="sections and fits"))
-        finally:
-            if shared is not None:
-                shared.close()
+    # with fits to make ready, the sections go in as many tasks as the pool takes at once, so that the
+    # workers have them all in hand while this process makes the fits' tasks (0.4 s on a dense chart)
+    pieces = [groups] if here else _chunks(groups, IN_FLIGHT_PER_WORKER * chosen) if stages else section_tasks(groups)
+    sectioned = [(SECTIONS, t) for t in pieces if t]
+    planned: list[tuple[list, int, list[int]]] = []       # the fits' tasks, their scene's count and order
+    shared: list = []           # the shared block of the fits' half-edges, once made
+
+    def staged():
+        """The sections' tasks, then the fits' (made only once the sections' are handed out: on
+        workers, the fits' tasks and their shared block are made while the workers section)."""
+        yield from sectioned
+        fits, scenes = fit_tasks(records, stages, workers=chosen, scheduler=scheduler) if stages else ([], 0)
+        # the scene's fit first (the longest), then the targets' fits, the last-numbered first:
+        # targets are numbered by their best rank (the narrowest interval, then the highest SNR), and
+        # the last are the noisiest, often misfit, whose fits try more stages (0.4-1.6 s against
+        # 0.02 s on the 4096 px bench scene): started last, one of them ran alone
+        order = [*range(scenes), *range(len(fits) - 1, scenes - 1, -1)]
+        planned.append((fits, scenes, order))
+        # many targets' fits a few to a task: each is short (30 ms on the dense chart) beside a task's round trip
+        targets = [fits[k] for k in order[scenes:]]
+        per_task = fits_per_task(len(targets), chosen)
+        fit_work = [(FIT, fits[k]) for k in order[:scenes]] + \
+            [(FITS, targets[k:k + per_task]) for k in range(0, len(targets), per_task)]
+        if not here and scheduler is None and can_preload() and fit_work:
+            with signals_deferred():       # the block made and owned at once (closed below)
+                block, fit_work = _shipped_once(fit_work)
+                shared.append(block)
+        yield from fit_work
+
+    tasks: list[tuple] = []             # the tasks as they were handed out, in order
+
+    def handed():
+        for task in staged():
+            tasks.append(task)
+            yield task
+    try:
+        if here:
+            results = [_stage_task(task) for task in handed()]
+        else:
+            results = list(run_tasks(_stage_task, handed(), workers=chosen, scheduler=scheduler,
+                                     progress=progress, description="sections and fits"))
+    finally:
+        for block in shared:
+            block.close()
+    fits, scenes, order = planned[0]
     done: list[tuple[str, list]] = []
     for (kind, _), rows in zip(tasks, results):
         done.extend([(FIT, each) for each in rows] if kind == FITS else [(kind, rows)])
@@ -117,6 +141,19 @@ def sections_and_fits(records: Sequence[Record], summaries: Sequence[Record], st
     for k, rows in zip(order, (rows for kind, rows in done if kind == FIT)):
         fitted[k] = rows
     return sections, fitted_rows(fitted, scenes)
+
+
+def _chunks(groups: list, tasks: int) -> list[list]:
+    """``groups`` cut into at most ``tasks`` runs of about equal length, in
+    order (their sections' rows, joined, are those of all the groups).
+
+    Examples
+    --------
+    >>> _chunks([1, 2, 3, 4, 5], 2), _chunks([1], 4)
+    ([[1, 2, 3], [4, 5]], [[1]])
+    """
+    size = max(1, -(-len(groups) // max(tasks, 1)))
+    return [groups[k: k + size] for k in range(0, len(groups), size)]
 
 
 def fits_per_task(targets: int, workers: int) -> int:
