@@ -2,6 +2,7 @@
 renderer (inverse FFT of an analytic 1-D transfer function)."""
 import math
 import os
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,26 @@ import imgmtf as im
 SHARED_DATA_VARIABLE = "IMGMTF_SHARED_DATA"
 SHARED_DATA = Path(os.environ.get(SHARED_DATA_VARIABLE) or Path(__file__).resolve().parents[2] / "shared" / "data")
 REAL_SCENES = SHARED_DATA / "real-scenes"
+
+
+def ctrl_c_as_at_a_terminal() -> None:
+    """``preexec_fn`` for a command a test interrupts with SIGINT: the
+    command starts with Ctrl-C's default action, as typed at a terminal.
+    A process inherits an ignored SIGINT (a shell ignores it in a job it
+    starts in the background without job control, as scripts and agents
+    run the suite), and Python then leaves it ignored: the command would
+    run to its end whatever the test sends."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.fixture
+def ctrl_c_raises():
+    """Ctrl-C raises KeyboardInterrupt in this process during the test,
+    even when the suite was started with SIGINT ignored (see
+    :func:`ctrl_c_as_at_a_terminal`)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
 def real_scene(name: str, provenance: str = "") -> Path:

@@ -221,7 +221,8 @@ def test_the_readme_tells_how_to_install_and_test_and_ci_runs_that():
                     "pip install '.[test]' && pytest"):
         assert command in first_screen
     ci = (ROOT / ".ci" / "run").read_text()
-    assert '".[$extras]"' in ci and "run_suite .venv-ci test" in ci and "\n    pytest" in ci
+    assert '".[$extras]"' in ci and "make_env .venv-ci test" in ci and "\n    pytest" in ci
+    assert "\nrun_tests .venv-ci\n" in ci and "\nrun_tests .venv-ci-lowest\n" in ci     # both environments tested
 
 
 def update_console_outputs(document: str) -> None:

@@ -13,7 +13,7 @@ import pytest
 
 from imgmtf.io import write_geotiff
 
-from conftest import exact_edge_chip, gaussian_pixel_transfer
+from conftest import ctrl_c_as_at_a_terminal, exact_edge_chip, gaussian_pixel_transfer
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 
@@ -33,7 +33,8 @@ def chips(tmp_path_factory):
 def start_measure(chips, csv_path, workers=2):
     return subprocess.Popen([sys.executable, "-m", "imgmtf.cli", "measure", str(chips), "--workers",
                              str(workers), "--csv", str(csv_path), "--format", "json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=ctrl_c_as_at_a_terminal)
 
 
 def csv_rows(path):

@@ -129,7 +129,7 @@ def test_workers_forked_from_a_fork_server_start_with_its_modules_and_one_thread
         "[(True, False, '1'), (False, False, '1')] 7 False False"
 
 
-def test_a_signal_inside_a_deferred_block_is_handled_after_it():
+def test_a_signal_inside_a_deferred_block_is_handled_after_it(ctrl_c_raises):
     steps = []
     with pytest.raises(KeyboardInterrupt):
         with signals_deferred():

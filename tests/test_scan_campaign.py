@@ -20,6 +20,8 @@ from imgmtf.sensor.series import SyntheticCampaign
 from imgmtf.sensor.stages import Detector, GaussianOptics
 from imgmtf.synthetic import write_campaign
 
+from conftest import ctrl_c_as_at_a_terminal
+
 
 @pytest.fixture(scope="module")
 def campaign(tmp_path_factory):
@@ -129,7 +131,8 @@ def test_fit_rows_are_printed_and_written_beside_the_combined_ones(tmp_path):
 def start_scan(paths, store, *more):
     return subprocess.Popen([sys.executable, "-m", "imgmtf.cli", "scan", *map(str, paths), "--campaign", str(store),
                              "--format", "json", "--no-progress", *more],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=ctrl_c_as_at_a_terminal)
 
 
 def test_two_scans_writing_one_store_at_once_lose_no_row(campaign, tmp_path):
