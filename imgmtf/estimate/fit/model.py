@@ -195,6 +195,7 @@ class Model:
         self._solution: tuple = ((None, [], None), (None, None, None))
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
+        self._sensor_gsd: float | None = None
 
     # -- which parameters are free ------------------------------------------------
     def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
@@ -288,7 +289,11 @@ class Model:
             if made not in self._stages_made:
                 self._stages_made[made] = stage.with_fit_coordinates(own, self.gsd)
             stages.append(self._stages_made[made])
-        return Sensor(self.gsd, stages)
+        if self._sensor_gsd is None:           # the first sensor checked; the next ones of the same GSD and stages
+            sensor = Sensor(self.gsd, stages)
+            self._sensor_gsd = sensor.gsd_m
+            return sensor
+        return Sensor._of_checked(self._sensor_gsd, tuple(stages))
 
     def responses(self, u: np.ndarray) -> list[LineResponse]:
         """Each edge's line response for stage coordinates ``u``; the last
