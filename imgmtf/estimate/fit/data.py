@@ -142,7 +142,14 @@ def bin_profile(x: np.ndarray, y: np.ndarray, width_px: float = FIT_BIN_PX) -> P
     ([3, 1], [0.2, 1.5], [2.0, 7.0], [0.006667, 0.0])
     """
     order = np.argsort(x, kind="stable")
-    x, y = np.asarray(x, float)[order], np.asarray(y, float)[order]
+    return sorted_bins(np.asarray(x, float)[order], np.asarray(y, float)[order], width_px)
+
+
+def sorted_bins(x: np.ndarray, y: np.ndarray, width_px: float = FIT_BIN_PX) -> ProfileBins:
+    """:func:`bin_profile` of float samples ``x`` (px) already in ascending
+    order, ``y`` (DN) in theirs: the same bins, without sorting them again
+    (a stable sort of sorted distances keeps every sample in its place;
+    :func:`edge_data` sorts its samples before it bins them)."""
     if not x.size:
         return ProfileBins(np.zeros(0, np.intp), x, y, x.copy())
     keys = np.floor(x / width_px)
@@ -230,7 +237,7 @@ def edge_data(item: np.ndarray | EdgeImage | MeasuredEdge | EdgeResult, k: int, 
     noise = max(profile_noise(x, y), floor)           # of one sample, from the samples themselves
     gsd = result.gsd_m if result.gsd_m else (gsd_m or 1.0)
     normal = float(result.normal_angle_deg)
-    return EdgeData(source, x, y, bin_profile(x, y), normal, float(gsd), bool(result.gsd_m),
+    return EdgeData(source, x, y, sorted_bins(x, y), normal, float(gsd), bool(result.gsd_m),
                     noise, levels, result, profile_angle_deg(result) != normal)
 
 
