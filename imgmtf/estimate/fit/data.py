@@ -15,7 +15,9 @@ from numpy.typing import DTypeLike
 from ...errors import ImgmtfError, ParameterError
 
 if TYPE_CHECKING:
+    from ...sensor.lines import HermitePlacement, LineResponse
     from ..edge import EdgeResult
+    from .responses import StackedResponses
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +76,7 @@ class MeasuredEdge:
 
 
 #: the fit's bins along the normal, px.  The model of a bin is the mean of
-#: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`.model.bin_esf`);
+#: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`bin_esf`);
 #: it leaves out the third and fourth moments' terms, at most f''' w^3 / 48
 #: and f'''' w^4 / 384 for bins w wide.  Measured on noise-free slanted-edge
 #: samples (5 deg, 100 and 300 rows; tests/test_fit_bins.py), for a step of
@@ -263,3 +265,15 @@ def profile_noise(x: np.ndarray, y: np.ndarray) -> float:
     misfit = y[1:-1] - (w * y[:-2] + (1 - w) * y[2:])
     scale = np.sqrt(1 + w**2 + (1 - w) ** 2)
     return float(1.4826 * np.median(np.abs(misfit / scale)))
+
+
+def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
+            placement: HermitePlacement | None = None) -> np.ndarray:
+    """The mean of the edge response over each bin's samples, for an edge
+    at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
+    third and higher moments' terms (see :data:`FIT_BIN_PX`).
+    Several edges' bins in turn take their :class:`.responses.StackedResponses`
+    and each bin's edge's ``x0``; ``placement``, when given, is the bins'
+    distances placed on the response's grid with the curvature's weights."""
+    value, curvature = response.esf_with_curvature(bins.x - x0, placement)
+    return value + 0.5 * bins.m2 * curvature

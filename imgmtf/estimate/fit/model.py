@@ -29,13 +29,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...errors import ImgmtfError, ParameterError
-from ...sensor.lines import HermitePlacement, LineResponse
+from ...sensor.lines import LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
 from .arrowhead import NoConvergence, solve_arrowhead
 from .choice import AUTO, AUTO_CANDIDATES
-from .data import EdgeData, ProfileBins
+from .data import EdgeData, ProfileBins, bin_esf
 from .responses import EdgeResponses, StackedResponses, edges_responses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
@@ -585,18 +585,6 @@ class Model:
             if not np.isfinite(width) or width > max(DETERMINED_RELATIVE * length, DETERMINED_PX):
                 out[i] = width if np.isfinite(width) else math.inf
         return out
-
-
-def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
-            placement: HermitePlacement | None = None) -> np.ndarray:
-    """The mean of the edge response over each bin's samples, for an edge
-    at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
-    third and higher moments' terms (see :data:`.data.FIT_BIN_PX`).
-    Several edges' bins in turn take their :class:`.responses.StackedResponses`
-    and each bin's edge's ``x0``; ``placement``, when given, is the bins'
-    distances placed on the response's grid with the curvature's weights."""
-    value, curvature = response.esf_with_curvature(bins.x - x0, placement)
-    return value + 0.5 * bins.m2 * curvature
 
 
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
