@@ -118,17 +118,6 @@ class Sensor:
         object.__setattr__(self, "gsd_m", gsd)
         object.__setattr__(self, "stages", stages)
 
-    @classmethod
-    def _of_checked(cls, gsd_m: float, stages: tuple[Stage, ...]) -> Sensor:
-        """The sensor of a GSD and stages the constructor has checked
-        already (the ``gsd_m`` of a sensor it made, a non-empty tuple of
-        :class:`Stage`): what a fit makes at its every evaluation, without
-        checking them again."""
-        sensor = object.__new__(cls)
-        object.__setattr__(sensor, "gsd_m", gsd_m)
-        object.__setattr__(sensor, "stages", stages)
-        return sensor
-
     # -- transfer functions -------------------------------------------------
     def transfer(self, fx: ArrayLike, fy: ArrayLike) -> np.ndarray:
         """System transfer function at (``fx``, ``fy``) cycles per metre:

@@ -293,7 +293,7 @@ class Model:
             sensor = Sensor(self.gsd, stages)
             self._sensor_gsd = sensor.gsd_m
             return sensor
-        return Sensor._of_checked(self._sensor_gsd, tuple(stages))
+        return checked_sensor(self._sensor_gsd, tuple(stages))
 
     def responses(self, u: np.ndarray) -> list[LineResponse]:
         """Each edge's line response for stage coordinates ``u``; the last
@@ -589,3 +589,12 @@ class Model:
 
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
+
+
+def checked_sensor(gsd_m: float, stages: tuple[Stage, ...]) -> Sensor:
+    """The sensor of a GSD and stages the constructor has checked (a sensor's ``gsd_m``, Stage objects),
+    made without checking them again: what a fit makes at its every evaluation."""
+    sensor = object.__new__(Sensor)
+    object.__setattr__(sensor, "gsd_m", gsd_m)
+    object.__setattr__(sensor, "stages", stages)
+    return sensor
