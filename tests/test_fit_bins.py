@@ -11,7 +11,7 @@ from scipy.special import chdtrc
 
 import imgmtf as im
 from imgmtf.estimate.fit import fit_edges
-from imgmtf.estimate.fit.data import FIT_BIN_PX, EdgeData, bin_profile, edge_data
+from imgmtf.estimate.fit.data import FIT_BIN_PX, EdgeData, bin_profile, edge_data, sorted_bins
 from imgmtf.estimate.fit.model import Model, bin_esf, initial_stages
 from imgmtf.estimate.fit.report import misfit_test, residual_means
 from imgmtf.sensor import stages as st
@@ -49,6 +49,16 @@ def test_bins_hold_their_samples_count_mean_and_variance():
     np.testing.assert_allclose(bins.y, [v.mean() for v, _ in expected], rtol=1e-13)
     np.testing.assert_allclose(bins.m2, [d.var() for _, d in expected], rtol=0, atol=1e-15)
     assert bin_profile(np.zeros(0), np.zeros(0)).x.size == 0
+
+
+def test_sorted_samples_bin_as_sorted_again():
+    """sorted_bins (edge_data's samples, sorted before) gives bin_profile's
+    bins bit for bit, tied distances' values kept in their order."""
+    rng = np.random.default_rng(2)
+    x = np.sort(np.concatenate([rng.uniform(-5, 5, 400), np.full(5, 0.5), [-0.25, 0.25]]), kind="stable")
+    y = rng.normal(500, 40, x.size)
+    for mine, theirs in zip(dataclasses.astuple(sorted_bins(x, y, 0.25)), dataclasses.astuple(bin_profile(x, y, 0.25))):
+        assert mine.tobytes() == theirs.tobytes()
 
 
 @pytest.mark.parametrize("name", SENSORS)

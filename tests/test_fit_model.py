@@ -159,3 +159,19 @@ def test_a_targets_solve_reaches_scipys_optimum(edges):
     errors = np.sqrt(np.diag(covariance))
     n = model.n_free                         # SciPy's own end with the model's settings: 4e-5 of them
     assert np.all(np.abs(z[:n] - best[:n]) < 3e-4 * errors)
+
+
+def test_the_models_sensors_after_the_first_are_the_constructors(edges):
+    """Model.sensor makes the sensors after its first without the
+    constructor's checks: each equals the one the constructor makes of the
+    same stages (a GSD of the same float), and a moved parameter moves it."""
+    data = [edge_data(e, 0, None) for e in edges[:1]]
+    model = Model(1.0, initial_stages(["optics", "detector"], None, 1.0), data)
+    u = model.initial_vector()[: model.n_free]
+    first, again = model.sensor(u), model.sensor(u)
+    fresh = im.Sensor(1.0, list(again.stages))
+    assert again == first == fresh and type(again.gsd_m) is float and again.stages is not first.stages
+    assert again.mtf_nyquist() == fresh.mtf_nyquist()
+    moved = u.copy()
+    moved[0] *= 1.1
+    assert model.sensor(moved) != first and model.sensor(moved).stages[1] is first.stages[1]

@@ -373,8 +373,8 @@ class HermitePlacement:
         right = k + 1
         # np.take gathers along the last axis faster than fancy indexing; the sum is accumulated in
         # place, in the same order (((w0 v0 + w1 s0) + w2 v1) + w3 s1): the same numbers, fewer temporaries
-        near = (np.take(values, k, axis=-1), np.take(slopes, k, axis=-1),
-                np.take(values, right, axis=-1), np.take(slopes, right, axis=-1))
+        near = (values.take(k, axis=-1), slopes.take(k, axis=-1),
+                values.take(right, axis=-1), slopes.take(right, axis=-1))
         outputs = []
         term: np.ndarray | None = None
         for weights in self.weights[: 2 if curvature else 1]:

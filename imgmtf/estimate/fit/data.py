@@ -15,7 +15,9 @@ from numpy.typing import DTypeLike
 from ...errors import ImgmtfError, ParameterError
 
 if TYPE_CHECKING:
+    from ...sensor.lines import HermitePlacement, LineResponse
     from ..edge import EdgeResult
+    from .responses import StackedResponses
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +76,7 @@ class MeasuredEdge:
 
 
 #: the fit's bins along the normal, px.  The model of a bin is the mean of
-#: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`.model.bin_esf`);
+#: the ESF over its samples, f(x̄) + f''(x̄) m2 / 2 (:func:`bin_esf`);
 #: it leaves out the third and fourth moments' terms, at most f''' w^3 / 48
 #: and f'''' w^4 / 384 for bins w wide.  Measured on noise-free slanted-edge
 #: samples (5 deg, 100 and 300 rows; tests/test_fit_bins.py), for a step of
@@ -142,7 +144,14 @@ def bin_profile(x: np.ndarray, y: np.ndarray, width_px: float = FIT_BIN_PX) -> P
     ([3, 1], [0.2, 1.5], [2.0, 7.0], [0.006667, 0.0])
     """
     order = np.argsort(x, kind="stable")
-    x, y = np.asarray(x, float)[order], np.asarray(y, float)[order]
+    return sorted_bins(np.asarray(x, float)[order], np.asarray(y, float)[order], width_px)
+
+
+def sorted_bins(x: np.ndarray, y: np.ndarray, width_px: float = FIT_BIN_PX) -> ProfileBins:
+    """:func:`bin_profile` of float samples ``x`` (px) already in ascending
+    order, ``y`` (DN) in theirs: the same bins, without sorting them again
+    (a stable sort of sorted distances keeps every sample in its place;
+    :func:`edge_data` sorts its samples before it bins them)."""
     if not x.size:
         return ProfileBins(np.zeros(0, np.intp), x, y, x.copy())
     keys = np.floor(x / width_px)
@@ -230,7 +239,7 @@ def edge_data(item: np.ndarray | EdgeImage | MeasuredEdge | EdgeResult, k: int, 
     noise = max(profile_noise(x, y), floor)           # of one sample, from the samples themselves
     gsd = result.gsd_m if result.gsd_m else (gsd_m or 1.0)
     normal = float(result.normal_angle_deg)
-    return EdgeData(source, x, y, bin_profile(x, y), normal, float(gsd), bool(result.gsd_m),
+    return EdgeData(source, x, y, sorted_bins(x, y), normal, float(gsd), bool(result.gsd_m),
                     noise, levels, result, profile_angle_deg(result) != normal)
 
 
@@ -256,3 +265,15 @@ def profile_noise(x: np.ndarray, y: np.ndarray) -> float:
     misfit = y[1:-1] - (w * y[:-2] + (1 - w) * y[2:])
     scale = np.sqrt(1 + w**2 + (1 - w) ** 2)
     return float(1.4826 * np.median(np.abs(misfit / scale)))
+
+
+def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
+            placement: HermitePlacement | None = None) -> np.ndarray:
+    """The mean of the edge response over each bin's samples, for an edge
+    at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
+    third and higher moments' terms (see :data:`FIT_BIN_PX`).
+    Several edges' bins in turn take their :class:`.responses.StackedResponses`
+    and each bin's edge's ``x0``; ``placement``, when given, is the bins'
+    distances placed on the response's grid with the curvature's weights."""
+    value, curvature = response.esf_with_curvature(bins.x - x0, placement)
+    return value + 0.5 * bins.m2 * curvature

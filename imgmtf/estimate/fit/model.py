@@ -29,13 +29,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...errors import ImgmtfError, ParameterError
-from ...sensor.lines import HermitePlacement, LineResponse
+from ...sensor.lines import LineResponse
 from ...sensor.model import PAPER_STAGES, Sensor
 from ...sensor.stages import STAGES, Stage
 from .angles import grid_layout, grouped_edges, laid_out_changes
 from .arrowhead import NoConvergence, solve_arrowhead
 from .choice import AUTO, AUTO_CANDIDATES
-from .data import EdgeData, ProfileBins
+from .data import EdgeData, ProfileBins, bin_esf
 from .responses import EdgeResponses, StackedResponses, edges_responses, esf_changes, shared_transfers
 
 #: a free parameter is undetermined when its 1-SE range of blur length is
@@ -195,6 +195,7 @@ class Model:
         self._solution: tuple = ((None, [], None), (None, None, None))
         self._last_samples: tuple = (None, [])
         self._stages_made: dict[tuple, Stage] = {}
+        self._sensor_gsd: float | None = None
 
     # -- which parameters are free ------------------------------------------------
     def screen_axes(self, held: set[str]) -> dict[str, tuple[str, str]]:
@@ -288,7 +289,11 @@ class Model:
             if made not in self._stages_made:
                 self._stages_made[made] = stage.with_fit_coordinates(own, self.gsd)
             stages.append(self._stages_made[made])
-        return Sensor(self.gsd, stages)
+        if self._sensor_gsd is None:           # the first sensor checked; the next ones of the same GSD and stages
+            sensor = Sensor(self.gsd, stages)
+            self._sensor_gsd = sensor.gsd_m
+            return sensor
+        return checked_sensor(self._sensor_gsd, tuple(stages))
 
     def responses(self, u: np.ndarray) -> list[LineResponse]:
         """Each edge's line response for stage coordinates ``u``; the last
@@ -582,17 +587,14 @@ class Model:
         return out
 
 
-def bin_esf(response: LineResponse | StackedResponses, bins: ProfileBins, x0: float | np.ndarray,
-            placement: HermitePlacement | None = None) -> np.ndarray:
-    """The mean of the edge response over each bin's samples, for an edge
-    at ``x0`` px: ESF(x̄ - x0) + ESF''(x̄ - x0) m2 / 2, exact but for the
-    third and higher moments' terms (see :data:`.data.FIT_BIN_PX`).
-    Several edges' bins in turn take their :class:`.responses.StackedResponses`
-    and each bin's edge's ``x0``; ``placement``, when given, is the bins'
-    distances placed on the response's grid with the curvature's weights."""
-    value, curvature = response.esf_with_curvature(bins.x - x0, placement)
-    return value + 0.5 * bins.m2 * curvature
-
-
 def stage_coordinates(stage: Stage, gsd: float) -> dict[str, float]:
     return {f"{stage.name}.{k}": v for k, v in stage.fit_coordinates(gsd).items()}
+
+
+def checked_sensor(gsd_m: float, stages: tuple[Stage, ...]) -> Sensor:
+    """The sensor of a GSD and stages the constructor has checked (a sensor's ``gsd_m``, Stage objects),
+    made without checking them again: what a fit makes at its every evaluation."""
+    sensor = object.__new__(Sensor)
+    object.__setattr__(sensor, "gsd_m", gsd_m)
+    object.__setattr__(sensor, "stages", stages)
+    return sensor

@@ -13,6 +13,8 @@ from .base import FitSpec, Stage, param, register
 #: below this |pi t| every sine rounds to its argument (glibc returns it for |x| < 2^-26), so sinc(t)
 #: is 1 exactly: an axis's frequencies along a normal at 0 or 90 deg (0, or f cos 90 deg ~ 6e-17 f)
 SINC_ONE_BELOW = 2.0 ** -27
+#: what np.sinc puts for a zero argument (looked up once: a fit's every detector transfer asked np.finfo)
+_EPS = float(np.finfo(float).eps)
 
 
 def sinc(t: ArrayLike) -> np.ndarray:
@@ -30,10 +32,10 @@ def sinc(t: ArrayLike) -> np.ndarray:
     >>> sinc(np.full(3, 1e-17)).tolist()
     [1.0, 1.0, 1.0]
     """
-    y = np.multiply(t, np.pi, out=np.empty(np.shape(t)), dtype=float)
+    y = np.multiply(t, np.pi, out=np.empty(t.shape if isinstance(t, np.ndarray) else np.shape(t)), dtype=float)
     if y.size and np.abs(y).max() < SINC_ONE_BELOW:           # (NaN compares False: computed)
         return np.ones(y.shape)[()]
-    y[y == 0] = np.finfo(float).eps           # as np.sinc: sin(eps) / eps, 1
+    y[y == 0] = _EPS                          # as np.sinc: sin(eps) / eps, 1
     out = np.sin(y)
     out /= y
     return out[()] if out.ndim == 0 else out
