@@ -42,7 +42,7 @@ def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.nd
     band; ``sensors`` (:func:`band_sensors` of ``model`` and ``u``) when
     several angles are asked for."""
     value, gradients = _mtf_and_gradients(model, u, f, angle_deg, gsd, sensors)
-    return _band(value, gradients, covariance, confidence)
+    return delta_band(value, gradients, covariance, confidence)
 
 
 def _mtf_and_gradients(model: Model, u: np.ndarray, f: np.ndarray, angle_deg: float, gsd: float,
@@ -58,13 +58,21 @@ def _mtf_and_gradients(model: Model, u: np.ndarray, f: np.ndarray, angle_deg: fl
     return value, np.stack([(mtf - value) / h for (h, _), mtf in zip(steps, stepped)], axis=-1)
 
 
-def _band(value: np.ndarray, gradients: np.ndarray | None, covariance: np.ndarray, confidence: float):
+def delta_band(value: np.ndarray, gradients: np.ndarray | None, covariance: np.ndarray, confidence: float, *,
+               each_alone: bool = False):
     """An MTF ``value``, its delta-method band's lower and upper bounds
-    (clipped to [0, 1]) from its ``gradients`` and their ``covariance``."""
+    (clipped to [0, 1]) from its ``gradients`` (on a last axis; None
+    without a free coordinate) and their ``covariance``; ``each_alone``:
+    each value's quadratic form made by itself, as for one value (a
+    batched einsum may sum in another order: an edge's band the same bit
+    for bit whatever the edges beside it)."""
     if gradients is None:
         return value, value, value
     n = gradients.shape[-1]
-    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", gradients, covariance[:n, :n], gradients), 0.0))
+    c = covariance[:n, :n]
+    forms = [np.einsum("...i,ij,...j->...", g, c, g) for g in gradients] if each_alone else \
+        np.einsum("...i,ij,...j->...", gradients, c, gradients)
+    se = np.sqrt(np.maximum(forms, 0.0))
     z = NormalDist().inv_cdf(0.5 + confidence / 2)
     return value, np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
 
@@ -117,11 +125,12 @@ def model_nyquist_mtf50_bands(model: Model, u: np.ndarray, covariance: np.ndarra
     for size in (MTF50_FIRST, MTF50_GRID_CY_PX.size):
         f = MTF50_GRID_CY_PX[:size]
         value, gradients = _mtf_and_gradients(model, u, f, angle_deg, gsd, sensors)
-        mtf50, low, high = (first_crossing(f, curve, 0.5) for curve in _band(value, gradients, covariance, confidence))
+        curves = delta_band(value, gradients, covariance, confidence)
+        mtf50, low, high = (first_crossing(f, curve, 0.5) for curve in curves)
         if not math.isnan(mtf50 + low + high):
             break
     # one frequency's band formed alone (a batched quadratic form may sum in another order)
-    nyquist = _band(value[NYQUIST_INDEX], None if gradients is None else gradients[NYQUIST_INDEX], covariance,
+    nyquist = delta_band(value[NYQUIST_INDEX], None if gradients is None else gradients[NYQUIST_INDEX], covariance,
                     confidence)
     return nyquist, mtf50, (low, high)
 

@@ -3,7 +3,6 @@ each edge's misfit test, the MTF across and along track."""
 from __future__ import annotations
 
 import math
-from statistics import NormalDist
 
 import numpy as np
 
@@ -11,7 +10,14 @@ from ...metrics import first_crossing
 from ...sensor.model import DIRECTIONS, Sensor, check_angle, direction_angle
 from ...sensor.stages import Stage
 from ..geometry import direction_label
-from .bands import MTF50_FIRST, MTF50_GRID_CY_PX, band_sensors, model_nyquist_mtf50_bands, sensor_transfers
+from .bands import (
+    MTF50_FIRST,
+    MTF50_GRID_CY_PX,
+    band_sensors,
+    delta_band,
+    model_nyquist_mtf50_bands,
+    sensor_transfers,
+)
 from .choice import other_stages
 from .model import Model
 from .responses import StackedResponses
@@ -187,13 +193,8 @@ def edge_model_mtfs(model: Model, u: np.ndarray, covariance: np.ndarray,
     # the stepped sensors' unstepped stages computed once (as mtf() gives them, bit for bit)
     value, *stepped = (np.abs(t) for t in sensor_transfers([sensor] + [s for _, s in steps[:n]],
                                                              nyquist * cos, nyquist * sin))
-    bands = np.stack([value, value, value])
-    if n:
-        grads = np.stack([(mtf - value) / h for (h, _), mtf in zip(steps, stepped)], axis=-1)
-        # one edge's quadratic form at a time: batched, einsum may sum in another order
-        se = np.sqrt(np.maximum([np.einsum("...i,ij,...j->...", g, covariance[:n, :n], g) for g in grads], 0.0))
-        z = NormalDist().inv_cdf(0.5 + confidence / 2)
-        bands[1], bands[2] = np.clip(value - z * se, 0.0, 1.0), np.clip(value + z * se, 0.0, 1.0)
+    grads = np.stack([(mtf - value) / h for (h, _), mtf in zip(steps, stepped)], axis=-1) if n else None
+    bands = np.stack(delta_band(value, grads, covariance, confidence, each_alone=True))
     # as model_nyquist_mtf50_bands reads them: on the grid's first frequencies, then on all of it for an edge
     # whose MTF has not crossed 0.5 there
     first = MTF50_GRID_CY_PX[:MTF50_FIRST]
