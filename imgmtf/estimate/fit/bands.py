@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from statistics import NormalDist
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -14,11 +14,20 @@ from numpy.typing import ArrayLike
 from ...metrics import first_crossing
 from ...sensor.model import Sensor, check_angle
 
-if TYPE_CHECKING:
-    from .model import Model
+
+class FittedModel(Protocol):
+    """What a band differentiates: a fit's free coordinates (how many, their
+    bounds) and the sensor at them (:class:`.model.Model`, the bars' model)."""
+
+    @property
+    def n_free(self) -> int: ...
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def sensor(self, u: np.ndarray) -> Sensor: ...
 
 
-def band_sensors(model: Model, u: np.ndarray) -> tuple[Sensor, list[tuple[float, Sensor]]]:
+def band_sensors(model: FittedModel, u: np.ndarray) -> tuple[Sensor, list[tuple[float, Sensor]]]:
     """The sensor at ``u`` and, for each free parameter, its step and the
     sensor with it stepped: what :func:`model_mtf_band` differentiates,
     the same at every angle (made once for a scene's thousands of edges,
@@ -36,7 +45,7 @@ def band_sensors(model: Model, u: np.ndarray) -> tuple[Sensor, list[tuple[float,
     return model.sensor(u), steps
 
 
-def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
+def model_mtf_band(model: FittedModel, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
               gsd: float, confidence: float, sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None = None):
     """The model's MTF at ``f`` along ``angle_deg`` and its delta-method
     band; ``sensors`` (:func:`band_sensors` of ``model`` and ``u``) when
@@ -45,7 +54,7 @@ def model_mtf_band(model: Model, u: np.ndarray, covariance: np.ndarray, f: np.nd
     return delta_band(value, gradients, covariance, confidence)
 
 
-def _mtf_and_gradients(model: Model, u: np.ndarray, f: np.ndarray, angle_deg: float, gsd: float,
+def _mtf_and_gradients(model: FittedModel, u: np.ndarray, f: np.ndarray, angle_deg: float, gsd: float,
                        sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None):
     """The model's MTF at ``f`` along ``angle_deg`` and its derivatives in
     the free coordinates (by forward steps; stacked on a last axis, None
@@ -87,7 +96,7 @@ NYQUIST_INDEX = 1000
 MTF50_FIRST = NYQUIST_INDEX + 1
 
 
-def model_nyquist_mtf50_bands(model: Model, u: np.ndarray, covariance: np.ndarray, angle_deg: float, gsd: float,
+def model_nyquist_mtf50_bands(model: FittedModel, u: np.ndarray, covariance: np.ndarray, angle_deg: float, gsd: float,
                               confidence: float, sensors: tuple[Sensor, list[tuple[float, Sensor]]] | None = None):
     """The model's MTF at Nyquist along ``angle_deg`` with its band, and its
     MTF50 (cy/px) with its interval: where its MTF and the band's bounds

@@ -33,7 +33,6 @@ import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from statistics import NormalDist
 from typing import Any
 
 import numpy as np
@@ -44,6 +43,7 @@ from ...metrics import first_crossing
 from ...sensor.model import Sensor
 from ..intervals import Interval
 from ..spectrum import NYQUIST
+from .bands import band_sensors, model_mtf_band
 from .data import ProfileBins, bin_profile, profile_noise
 from .model import hold_keys, initial_stages, stage_names
 from .results import FittedParameter
@@ -454,13 +454,18 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
     covariance = np.linalg.pinv(jacobian.T @ jacobian) * max(reduced, 1.0)
     u, cov = z[: model.n_free], covariance[: model.n_free, : model.n_free]
     sensor = model.sensor(u)
-    quantile = NormalDist().inv_cdf(0.5 + confidence / 2)
+    # the stepped sensors made once for every profile's angle and the curve's
+    sensors = band_sensors(model, u)
+
+    def band(f: np.ndarray, angle_deg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return model_mtf_band(model, u, cov, f, angle_deg, model.gsd, confidence, sensors)
+
     nyquist, nyquist_ci, mtf50, mtf50_ci = [], [], [], []
     for p in model.profiles:
-        value, low, high = _mtf_band(model, u, cov, np.array([NYQUIST]), p.normal_angle_deg, quantile)
+        value, low, high = band(np.array([NYQUIST]), p.normal_angle_deg)
         nyquist.append(float(value[0]))
         nyquist_ci.append(Interval(float(low[0]), float(high[0])))
-        value, low, high = _mtf_band(model, u, cov, MTF50_GRID_CY_PX, p.normal_angle_deg, quantile)
+        value, low, high = band(MTF50_GRID_CY_PX, p.normal_angle_deg)
         mtf50.append(float(first_crossing(MTF50_GRID_CY_PX, value, 0.5)))
         mtf50_ci.append(Interval(float(first_crossing(MTF50_GRID_CY_PX, low, 0.5)),
                                  float(first_crossing(MTF50_GRID_CY_PX, high, 0.5))))
@@ -471,27 +476,7 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
     return BarFit(sensor, ",".join(names), _parameters(model, z, covariance), float(reduced),
                   tuple(p.source for p in model.profiles), tuple(p.normal_angle_deg for p in model.profiles),
                   tuple(nyquist), tuple(nyquist_ci), tuple(mtf50), tuple(mtf50_ci), confidence, tuple(warnings),
-                  lambda f, angle_deg: _mtf_band(model, u, cov, f, angle_deg, quantile))
-
-
-def _mtf_band(model: _BarModel, u: np.ndarray, covariance: np.ndarray, f: np.ndarray, angle_deg: float,
-              quantile: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The model's MTF along ``angle_deg`` at ``f`` (cy/px) and its
-    delta-method band (clipped to [0, 1])."""
-    value = np.abs(model.sensor(u).normal_transfer(f, angle_deg, model.gsd))
-    if model.n_free == 0:
-        return value, value, value
-    _, upper = model.bounds()
-    gradients = []
-    for k in range(model.n_free):
-        h = 1e-4 * max(u[k], 0.05 * upper[k] ** 0.5)
-        h = -h if u[k] + h > upper[k] else h
-        shifted = u.copy()
-        shifted[k] += h
-        gradients.append((np.abs(model.sensor(shifted).normal_transfer(f, angle_deg, model.gsd)) - value) / h)
-    g = np.stack(gradients, axis=-1)
-    se = np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", g, covariance, g), 0.0))
-    return value, np.clip(value - quantile * se, 0.0, 1.0), np.clip(value + quantile * se, 0.0, 1.0)
+                  band)
 
 
 def _parameters(model: _BarModel, z: np.ndarray, covariance: np.ndarray) -> tuple[FittedParameter, ...]:
