@@ -170,8 +170,8 @@ def test_only_the_fork_server_skips_its_teardown(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == "[1, 2]", out.stderr
     assert time.perf_counter() - t < 4
-    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit as quick; "
-            "print(quick._in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
+    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit, imgmtf._fork_server as server; "
+            "print(server.in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 3 and out.stdout.split() == ["False", "handled"], out.stderr
 
