@@ -1,5 +1,5 @@
 """Whether this import runs in the workers' fork server as it preloads its modules: for the
-modules meant for the server alone (:mod:`imgmtf._server_exit`)."""
+modules meant for the server alone (:mod:`imgmtf._server_exit`, :mod:`imgmtf._server_numpy`)."""
 from __future__ import annotations
 
 import sys
