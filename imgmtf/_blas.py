@@ -11,16 +11,21 @@ caller's own process, and gives the threads back after it.
 from __future__ import annotations
 
 import functools
+import importlib
 import sys
 from contextlib import nullcontext
 
 _for_good = False       # this process's BLAS is on one thread for its life (a worker process)
 
 
-def one_blas_thread():
+def one_blas_thread(load: str | None = None):
     """A context manager: BLAS on one thread inside it, as before after it
     (NumPy's BLAS, and SciPy's where SciPy's linear algebra is loaded: load
-    it before entering).
+    it before entering, or name a module that loads it as ``load``).  In a
+    process on one thread for good (:func:`one_thread_for_good`) ``load`` is
+    not imported: whatever loads a library later finds the environment
+    asking for one thread, and a worker that never needs the module (a
+    sensor fit's SciPy solver is its fallback) does not pay its import.
 
     Examples
     --------
@@ -31,6 +36,8 @@ def one_blas_thread():
     """
     if _for_good:
         return nullcontext()
+    if load is not None:
+        importlib.import_module(load)
     return _controller("scipy.linalg" in sys.modules).limit(limits=1, user_api="blas")
 
 

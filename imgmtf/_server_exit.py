@@ -8,22 +8,8 @@ from __future__ import annotations
 
 import atexit
 import os
-import sys
-from types import FrameType
 
+from ._fork_server import in_fork_server
 
-def _in_fork_server() -> bool:
-    """Whether this import runs inside the fork server's preloading."""
-    server = sys.modules.get("multiprocessing.forkserver")
-    if server is None:
-        return False
-    frame: FrameType | None = sys._getframe()
-    while frame is not None:
-        if frame.f_code is server.main.__code__:
-            return True
-        frame = frame.f_back
-    return False
-
-
-if _in_fork_server():
+if in_fork_server():
     atexit.register(os._exit, 0)

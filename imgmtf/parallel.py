@@ -48,6 +48,9 @@ IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, o
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
 # as it starts (5-10 ms each); and the server's own quick exit
 WORKER_MODULES = ("threadpoolctl", "imgmtf._server_exit")
+# what the fork server imports before any other module: NumPy's unused submodules deferred (SciPy's
+# first import would load them)
+SERVER_PRELUDE = ("imgmtf._server_numpy",)
 # what numerical libraries read, at load time, for their thread count
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
@@ -294,7 +297,7 @@ def _start_fork_server(modules: Iterable[str]) -> None:
     ``modules``, its environment asking for one thread of each numerical
     library; the call does not wait for the imports."""
     from multiprocessing import forkserver
-    forkserver.set_forkserver_preload([*modules, *WORKER_MODULES])
+    forkserver.set_forkserver_preload([*SERVER_PRELUDE, *modules, *WORKER_MODULES])
     _preloaded.update([*modules, *WORKER_MODULES])
     saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
     os.environ.update(dict.fromkeys(THREAD_VARIABLES, "1"))

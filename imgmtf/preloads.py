@@ -33,11 +33,12 @@ CLI_MODULES = ("imgmtf.cli",) if main_run_again() else ()
 # a scan's own tasks: the tiles' detection, the candidates' measurement
 SCAN_TASK_MODULES = ("imgmtf.scene.detect", "imgmtf.scene.candidates", "imgmtf.estimate.edge",
                      "imgmtf.estimate.pulse", *NUMPY_LAZY)
-# what a scan's workers run besides, the targets' sections and the 2-D MTF (fits below: SciPy's optimizer,
-# 0.35 s alone, only when targets are fitted)
+# what a scan's workers run besides, the targets' sections and the 2-D MTF (fits below: SciPy's special
+# functions, only when targets are fitted)
 SCANNING_MODULES = (*SCAN_TASK_MODULES, "imgmtf.scene.targetfit", "imgmtf.scene.sections", "imgmtf.estimate.mtf2d",
                     *CLI_MODULES)
-FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.optimize", "scipy.special")
+# (not SciPy's optimizer, 0.15-0.2 s more, the solver's fallback: a worker loads it if it falls back)
+FITTING_MODULES = ("imgmtf.estimate.fit", "scipy.special")
 # with several scenes each worker runs whole scans, the segment graph included
 WHOLE_SCAN_MODULES = ("imgmtf.scene.series", "imgmtf.scene.measure", "imgmtf.scene.combine")
 # a batch of files measured (imgmtf measure): the estimators and the files' reading and records

@@ -150,7 +150,30 @@ def test_the_fork_server_preloads_what_every_worker_set_up_imports(monkeypatch):
     monkeypatch.setattr(forkserver, "set_forkserver_preload", preloaded.extend)
     monkeypatch.setattr(forkserver, "ensure_running", lambda: None)
     parallel._start_fork_server(("imgmtf.batch",))
-    assert preloaded == ["imgmtf.batch", *parallel.WORKER_MODULES] and "threadpoolctl" in preloaded
+    assert preloaded == [*parallel.SERVER_PRELUDE, "imgmtf.batch", *parallel.WORKER_MODULES]
+    assert "threadpoolctl" in preloaded
+
+
+def test_the_fork_server_defers_numpys_unused_submodules():
+    """In workers forked from the server, NumPy's f2py and testing are registered but not loaded (SciPy's
+    first import would load them, 0.2-0.25 s), and load on first use; a process that merely imports the
+    module keeps them as NumPy has them."""
+    import subprocess
+    import sys
+    if "forkserver" not in __import__("multiprocessing").get_all_start_methods():
+        pytest.skip("no fork server on this platform")
+    probe = ("(type(__import__('sys').modules['numpy.f2py']).__name__, "
+             "'scipy.special' in __import__('sys').modules, "
+             "__import__('numpy').testing.assert_allclose.__name__)")
+    code = ("from imgmtf.parallel import prestart_workers, run_tasks\n"
+            "if __name__ == '__main__':\n"
+            "    prestart_workers(2, ['scipy.special'])\n"
+            f"    print(list(run_tasks(eval, [{probe!r}], workers=2)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "[('_LazyModule', True, 'assert_allclose')]", out.stderr
+    code = "import sys, imgmtf._server_numpy, numpy; print('numpy.f2py' in sys.modules, hasattr(numpy, 'f2py'))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.split() == ["False", "True"], out.stderr
 
 
 def test_only_the_fork_server_skips_its_teardown(tmp_path):
@@ -170,8 +193,8 @@ def test_only_the_fork_server_skips_its_teardown(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == "[1, 2]", out.stderr
     assert time.perf_counter() - t < 4
-    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit as quick; "
-            "print(quick._in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
+    code = ("import atexit, sys, multiprocessing.forkserver, imgmtf._server_exit, imgmtf._fork_server as server; "
+            "print(server.in_fork_server()); atexit.register(print, 'handled'); sys.exit(3)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 3 and out.stdout.split() == ["False", "handled"], out.stderr
 

@@ -200,7 +200,7 @@ def _prestart(scenes, recursive: bool, kind: str, fit_stages: str, workers: int 
     """Start the workers' fork server (parallel.prestart_workers) as the scan starts, before this process
     loads anything numerical, so that its imports overlap this process's own: for the workers asked for,
     or chosen for several scenes; for one scene's fits, workers chosen automatically, one per core: they
-    go to workers forked from a server that imports SciPy's optimizer (0.35-0.6 s) on another core while
+    go to workers forked from a server that imports SciPy's special functions (0.2-0.4 s) on another core while
     this process detects and measures (scene.afterscan.fit_workers).  Workers chosen automatically for one
     scene's tiles and candidates wait for them to be counted.  The scenes are listed again where their
     errors are reported, after the options' (the list is not checked here)."""

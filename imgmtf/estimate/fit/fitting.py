@@ -2,7 +2,6 @@
 stages freed or held by the likelihood ratio."""
 from __future__ import annotations
 
-import importlib
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -110,8 +109,7 @@ def fit_edges(edges: Sequence[np.ndarray | EdgeImage | EdgeResult], *,
     if not data:
         raise ParameterError("no edges to fit")
     gsd = gsd_m if gsd_m is not None else next((d.gsd_m for d in data if d.gsd_known), 1.0)
-    importlib.import_module("scipy.optimize")      # (its BLAS loaded before the next line limits it)
-    with one_blas_thread():
+    with one_blas_thread(load="scipy.optimize"):     # (the solver's fallback: its BLAS limited too)
         if not auto:
             return run_fit(new_model(gsd, initial_stages(names, start, gsd), data, start), hold, confidence)
         fits, failed, stopped = [], [], False
