@@ -453,9 +453,9 @@ def fit_bars(profiles: Sequence[BarProfile], *, stages: str | Sequence[str] | No
     jacobian = solved.jac
     covariance = np.linalg.pinv(jacobian.T @ jacobian) * max(reduced, 1.0)
     u, cov = z[: model.n_free], covariance[: model.n_free, : model.n_free]
-    sensor = model.sensor(u)
-    # the stepped sensors made once for every profile's angle and the curve's
+    # the fitted sensor and its stepped copies, made once for every profile's angle and the curve's
     sensors = band_sensors(model, u)
+    sensor = sensors[0]
 
     def band(f: np.ndarray, angle_deg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return model_mtf_band(model, u, cov, f, angle_deg, model.gsd, confidence, sensors)
