@@ -431,7 +431,7 @@ def _pool_completed(function, items, workers, on_error):
         if finished:
             pool.shutdown()
         else:
-            _stop(pool, in_flight)
+            _stop(pool)
 
 
 def _died(item, exc: BrokenProcessPool, on_error):
@@ -457,12 +457,14 @@ def _wait_between_signals(waiting: set) -> tuple[set, set]:
             return done, waiting
 
 
-def _stop(pool: ProcessPoolExecutor, futures) -> None:
-    """Cancel what has not started and terminate the workers now (not after
-    their current task), then reap them."""
-    for future in futures:
-        future.cancel()
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Terminate the workers now (not after their current task), reap them,
+    and end the pool's wait for their results; the tasks not started are
+    cancelled by the pool's own shutdown (a future cancelled here instead
+    could be failed by the pool again, and its manager thread would stop on
+    the error, with a traceback, in Python before 3.12)."""
     processes = list((getattr(pool, "_processes", None) or {}).values())
+    results = getattr(pool, "_result_queue", None)
     for process in processes:
         if process.is_alive():
             process.terminate()
@@ -472,6 +474,12 @@ def _stop(pool: ProcessPoolExecutor, futures) -> None:
         if process.is_alive():
             process.kill()
             process.join(timeout=1)
+    # a worker terminated while it sent a result (a large one takes a while through the pipe) leaves
+    # part of a message there, and the pool's manager thread waits for the rest for ever; the
+    # interpreter's exit joins that thread, so the command would never end.  With the workers gone,
+    # this process's end for writing is the pipe's last: closing it ends that wait with an EOF.
+    if results is not None and not any(process.is_alive() for process in processes):
+        results._writer.close()
 
 
 def _fresh_processes():

@@ -4,6 +4,7 @@ import json
 import math
 import os
 import signal
+import sys
 from pathlib import Path
 
 import pytest
@@ -215,3 +216,42 @@ def test_a_lone_task_goes_to_the_prestarted_fork_server(tmp_path):
     for asked, away in (("prestart", "True"), ("none", "False")):
         out = subprocess.run([sys.executable, "-c", code, asked], capture_output=True, text=True, env=env, timeout=60)
         assert out.returncode == 0 and out.stdout.split() == [away], out.stderr
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_a_worker_stopped_while_it_sends_its_result_does_not_hold_up_the_exit(tmp_path):
+    """A worker terminated part-way through sending its result (a large one takes a while through the
+    pipe) leaves part of a message in the pool's result pipe: an interrupted run still ends at once and
+    without a traceback (the pool's manager thread waited for the rest of the message for ever, and the
+    interpreter's exit for that thread)."""
+    import subprocess
+    import time
+    (tmp_path / "half_sent.py").write_text(
+        "import os, struct, sys, time\n"
+        "def send_half(marker):\n"
+        "    results = sys._getframe(1).f_locals['result_queue']   # the worker loop's, that calls the task\n"
+        "    os.write(results._writer.fileno(), struct.pack('!i', 1 << 20) + bytes(16))   # 16 of 1 MiB\n"
+        "    open(marker, 'w').close()\n"
+        "    time.sleep(60)\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    markers = [tmp_path / f"sent{i}" for i in range(6)]      # two running, the rest waiting (cancelled)
+    code = ("import sys, half_sent; from imgmtf.parallel import run_tasks, terminate_raises\n"
+            "try:\n"
+            "    with terminate_raises():\n"
+            "        list(run_tasks(half_sent.send_half, sys.argv[1:], workers=2))\n"
+            "except KeyboardInterrupt:\n"
+            "    sys.exit(143)\n")
+    process = subprocess.Popen([sys.executable, "-c", code, *map(str, markers)], env=env, text=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        end = time.monotonic() + 60
+        while not all(m.exists() for m in markers[:2]) and time.monotonic() < end and process.poll() is None:
+            time.sleep(0.05)
+        assert all(m.exists() for m in markers[:2]), process.communicate()[1]
+        process.send_signal(signal.SIGTERM)
+        _, stderr = process.communicate(timeout=20)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    assert process.returncode == 143 and "Traceback" not in stderr and "Exception" not in stderr, stderr
