@@ -45,6 +45,7 @@ MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
+STUCK_S = 2.0                # how long a dead worker may go unseen by its pool before it is broken here
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
 # as it starts (5-10 ms each); and the server's own quick exit
 WORKER_MODULES = ("threadpoolctl", "imgmtf._server_exit")
@@ -414,7 +415,7 @@ def _pool_completed(function, items, workers, on_error):
                 yield index, _died(item, broken, on_error)
             if not in_flight:
                 break
-            done, _ = _wait_between_signals(set(in_flight))
+            done, _ = _wait_between_signals(set(in_flight), pool)
             for future in done:
                 index, item = in_flight.pop(future)
                 try:
@@ -443,18 +444,41 @@ def _died(item, exc: BrokenProcessPool, on_error):
                                        "or out of memory"))
 
 
-def _wait_between_signals(waiting: set) -> tuple[set, set]:
-    """``wait(waiting, return_when=FIRST_COMPLETED)``, with Ctrl-C and
+def _wait_between_signals(waiting: set, pool: ProcessPoolExecutor) -> tuple[set, set]:
+    """``wait(waiting, return_when=FIRST_COMPLETED)`` on ``pool``'s futures
+    (a pool a worker's death left stuck is broken), with Ctrl-C and
     SIGTERM handled only between waits: an exception raised inside
     concurrent.futures' wait can leave a future's lock taken, and the
     pool's manager thread then blocks on it for ever, so the interpreter
     hangs at exit.  Short waits keep the signal's handling prompt."""
     from concurrent.futures import FIRST_COMPLETED, wait
+    dead_since = None
     while True:
         with signals_deferred():
             done, waiting = wait(waiting, timeout=SIGNAL_POLL_S, return_when=FIRST_COMPLETED)
         if done:
             return done, waiting
+        dead_since = _broken_if_stuck(pool, dead_since)
+
+
+def _broken_if_stuck(pool: ProcessPoolExecutor, dead_since: float | None) -> float | None:
+    """Break ``pool`` if one of its workers has been dead for
+    :data:`STUCK_S` and the pool has not seen it.  A worker that died
+    part-way through sending its result (killed by the system, out of
+    memory) leaves part of a message in the results' pipe: the pool's
+    manager thread waits for the rest of it, never sees the death, and
+    nothing would end.  Its other workers are then stopped and that wait
+    ended: the pool breaks, and its tasks fail as a dead worker's do.
+    Returns when a dead worker was first seen (None: none is)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    if getattr(pool, "_broken", False) or all(process.exitcode is None for process in processes):
+        return None
+    now = time.monotonic()
+    if dead_since is None:
+        return now
+    if now - dead_since >= STUCK_S:
+        _end_workers(processes, getattr(pool, "_result_queue", None))
+    return dead_since
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
@@ -465,19 +489,26 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     the error, with a traceback, in Python before 3.12)."""
     processes = list((getattr(pool, "_processes", None) or {}).values())
     results = getattr(pool, "_result_queue", None)
+    pool.shutdown(wait=False, cancel_futures=True)
+    _end_workers(processes, results)
+
+
+def _end_workers(processes: list, results) -> None:
+    """Terminate ``processes`` (a pool's workers), reap them, then end the
+    pool's wait on its ``results`` queue.  A worker that died while it sent
+    a result (terminated here: a large one takes a while through the pipe)
+    leaves part of a message there, and the pool's manager thread waits for
+    the rest for ever; the interpreter's exit joins that thread, so the
+    command would never end.  With the workers gone, this process's end for
+    writing is the pipe's last: closing it ends that wait with an EOF."""
     for process in processes:
         if process.is_alive():
             process.terminate()
-    pool.shutdown(wait=False, cancel_futures=True)
     for process in processes:
         process.join(timeout=2)
         if process.is_alive():
             process.kill()
             process.join(timeout=1)
-    # a worker terminated while it sent a result (a large one takes a while through the pipe) leaves
-    # part of a message there, and the pool's manager thread waits for the rest for ever; the
-    # interpreter's exit joins that thread, so the command would never end.  With the workers gone,
-    # this process's end for writing is the pipe's last: closing it ends that wait with an EOF.
     if results is not None and not any(process.is_alive() for process in processes):
         results._writer.close()
 

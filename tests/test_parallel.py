@@ -255,3 +255,29 @@ def test_a_worker_stopped_while_it_sends_its_result_does_not_hold_up_the_exit(tm
             process.kill()
             process.communicate()
     assert process.returncode == 143 and "Traceback" not in stderr and "Exception" not in stderr, stderr
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_a_worker_that_dies_while_it_sends_its_result_breaks_the_pool_rather_than_hang_it(tmp_path):
+    """A worker killed part-way through sending its result (by the system: out of memory) leaves part of a
+    message in the pool's result pipe, and the pool never sees the death; the run still ends, every task
+    with a result, the dead worker's a failure."""
+    import subprocess
+    (tmp_path / "dies_sending.py").write_text(
+        "import os, struct, sys\n"
+        "def send_half_and_die(x):\n"
+        "    if x == 0:\n"
+        "        results = sys._getframe(1).f_locals['result_queue']   # the worker loop's, that calls the task\n"
+        "        os.write(results._writer.fileno(), struct.pack('!i', 1 << 20) + bytes(16))   # 16 of 1 MiB\n"
+        "        os._exit(9)\n"
+        "    return x\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    code = ("import json, dies_sending; from imgmtf import parallel; from imgmtf.parallel import run_tasks\n"
+            "parallel.STUCK_S = 0.3     # the test's wait, not the user's\n"
+            "rows = run_tasks(dies_sending.send_half_and_die, [0, 1, 2, 3, 4], workers=2,\n"
+            "                 on_error=lambda item, exc: 'died' if 'worker process died' in str(exc) else exc)\n"
+            "print(json.dumps(list(rows)))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 0 and "Traceback" not in out.stderr, out.stderr
+    rows = json.loads(out.stdout)
+    assert len(rows) == 5 and rows[0] == "died" and all(r in ("died", i) for i, r in enumerate(rows))
