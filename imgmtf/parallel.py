@@ -45,6 +45,7 @@ MAX_WORKERS = 64
 WATCHDOG_PERIOD_S = 0.5
 SIGNAL_POLL_S = 0.1          # how long a signal can wait for a pool's wait to end
 IN_FLIGHT_PER_WORKER = 2      # tasks submitted ahead per worker: one running, one queued
+MANAGER_END_S = 5.0          # how long an interrupt waits for a stopped pool's manager thread to end
 STUCK_S = 2.0                # how long a dead worker may go unseen by its pool before it is broken here
 # what every worker's set-up imports (limit_threads): loaded once by a fork server, not by each worker
 # as it starts (5-10 ms each); and the server's own quick exit
@@ -486,11 +487,17 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     and end the pool's wait for their results; the tasks not started are
     cancelled by the pool's own shutdown (a future cancelled here instead
     could be failed by the pool again, and its manager thread would stop on
-    the error, with a traceback, in Python before 3.12)."""
+    the error, with a traceback, in Python before 3.12).  The pool's
+    manager thread is given a moment to end: the interpreter's exit wakes it
+    without its lock, and in Python before 3.12 a thread still closing its
+    pipes then fails the exit with a traceback (``Bad file descriptor``)."""
     processes = list((getattr(pool, "_processes", None) or {}).values())
     results = getattr(pool, "_result_queue", None)
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
     _end_workers(processes, results)
+    if manager is not None:
+        manager.join(timeout=MANAGER_END_S)
 
 
 def _end_workers(processes: list, results) -> None:

@@ -240,6 +240,9 @@ def test_a_worker_stopped_while_it_sends_its_result_does_not_hold_up_the_exit(tm
             "    with terminate_raises():\n"
             "        list(run_tasks(half_sent.send_half, sys.argv[1:], workers=2))\n"
             "except KeyboardInterrupt:\n"
+            "    from concurrent.futures.process import _ExecutorManagerThread\n"
+            "    import threading\n"
+            "    print(sum(isinstance(t, _ExecutorManagerThread) for t in threading.enumerate()))\n"
             "    sys.exit(143)\n")
     process = subprocess.Popen([sys.executable, "-c", code, *map(str, markers)], env=env, text=True,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -249,12 +252,14 @@ def test_a_worker_stopped_while_it_sends_its_result_does_not_hold_up_the_exit(tm
             time.sleep(0.05)
         assert all(m.exists() for m in markers[:2]), process.communicate()[1]
         process.send_signal(signal.SIGTERM)
-        _, stderr = process.communicate(timeout=20)
+        stdout, stderr = process.communicate(timeout=20)
     finally:
         if process.poll() is None:
             process.kill()
             process.communicate()
     assert process.returncode == 143 and "Traceback" not in stderr and "Exception" not in stderr, stderr
+    # the pool's manager thread has ended before the exit, which would otherwise race it (a traceback)
+    assert stdout.split() == ["0"]
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
